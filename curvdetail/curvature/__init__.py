@@ -1,0 +1,20 @@
+"""The paper's mathematics: operators, curvature detail, reconstruction, minimal surfaces.
+
+numpy/scipy only. Every function takes ``(V, F)`` arrays and validates them at its boundary.
+"""
+
+from ._validate import boundary_edges, boundary_vertices, check_mesh
+from .cotan_laplacian import cotan_laplacian
+from .curvature_detail import curvature_detail
+from .errors import ConstraintError, MeshError
+from .mean_curvature_normal import mean_curvature_normal
+from .minimal_surface import minimal_surface
+from .mixed_voronoi_area import mixed_voronoi_area
+from .reconstruct import Reconstructor, reconstruct
+from .sparse_solver import SolverError, available_backends
+
+__all__ = [
+    "ConstraintError", "MeshError", "Reconstructor", "SolverError", "available_backends",
+    "boundary_edges", "boundary_vertices", "check_mesh", "cotan_laplacian", "curvature_detail",
+    "mean_curvature_normal", "minimal_surface", "mixed_voronoi_area", "reconstruct",
+]

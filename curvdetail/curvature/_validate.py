@@ -1,0 +1,222 @@
+"""Input checks shared by the public functions of :mod:`curvdetail.curvature`.
+
+They run at the boundary of each public function, before any sparse algebra, and raise
+:class:`MeshError` / :class:`ConstraintError` with messages that name the problem, the count
+and the first offending indices.
+"""
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+
+from .errors import ConstraintError, MeshError, first_indices
+
+# A triangle whose area is below this fraction of the squared bbox diagonal is degenerate:
+# its cotangents overflow. 1e-14 leaves room for meshes of ~1e12 well-shaped triangles.
+ZERO_AREA_RELATIVE = 1e-14
+
+
+def as_vertices(V, name="V"):
+    """Return ``V`` as a C-contiguous (n, 3) float64 array or raise MeshError."""
+    try:
+        arr = np.asarray(V)
+    except Exception as exc:  # ragged lists and the like
+        raise MeshError(f"{name} could not be read as an array ({exc}); pass an (n, 3) float array.") from None
+    if arr.dtype == object or not (np.issubdtype(arr.dtype, np.floating) or np.issubdtype(arr.dtype, np.integer)):
+        raise MeshError(f"{name} has dtype {arr.dtype}; pass an (n, 3) array of real numbers.")
+    if arr.ndim != 2 or arr.shape[1] != 3:
+        raise MeshError(f"{name} has shape {arr.shape}; vertex positions must be an (n, 3) array.")
+    if arr.shape[0] == 0:
+        raise MeshError(f"{name} is empty (0 vertices); pass a mesh with at least one triangle.")
+    arr = np.ascontiguousarray(arr, dtype=np.float64)
+    bad = np.flatnonzero(~np.isfinite(arr).all(axis=1))
+    if bad.size:
+        raise MeshError(
+            f"{name}: {bad.size} vertices have NaN or infinite coordinates (first: {first_indices(bad)}); "
+            "remove or repair them before computing curvature."
+        )
+    return arr
+
+
+def as_faces(F, n_vertices, name="F"):
+    """Return ``F`` as a C-contiguous (m, 3) int64 array with indices in range, or raise."""
+    try:
+        arr = np.asarray(F)
+    except Exception as exc:
+        raise MeshError(f"{name} could not be read as an array ({exc}); pass an (m, 3) int array.") from None
+    if arr.ndim != 2 or arr.shape[1] != 3:
+        raise MeshError(f"{name} has shape {arr.shape}; triangles must be an (m, 3) integer array.")
+    if arr.shape[0] == 0:
+        raise MeshError(f"{name} is empty (0 triangles); pass a mesh with at least one triangle.")
+    if np.issubdtype(arr.dtype, np.floating):
+        if not np.all(np.isfinite(arr)) or np.any(arr != np.round(arr)):
+            raise MeshError(f"{name} has non-integer entries; triangle indices must be integers.")
+    elif not np.issubdtype(arr.dtype, np.integer):
+        raise MeshError(f"{name} has dtype {arr.dtype}; triangle indices must be integers.")
+    arr = np.ascontiguousarray(arr, dtype=np.int64)
+    bad = np.flatnonzero(((arr < 0) | (arr >= n_vertices)).any(axis=1))
+    if bad.size:
+        raise MeshError(
+            f"{name}: {bad.size} triangles have vertex indices outside [0, {n_vertices}) "
+            f"(first: {first_indices(bad)}); indices are 0-based into V."
+        )
+    rep = np.flatnonzero((arr[:, 0] == arr[:, 1]) | (arr[:, 1] == arr[:, 2]) | (arr[:, 0] == arr[:, 2]))
+    if rep.size:
+        raise MeshError(
+            f"{name}: {rep.size} triangles repeat a vertex index (first: {first_indices(rep)}); "
+            "remove them, e.g. with pymeshlab's meshing_remove_null_faces."
+        )
+    return arr
+
+
+def face_double_areas(V, F):
+    """|(v1 - v0) x (v2 - v0)| per triangle, shape (m,)."""
+    e1 = V[F[:, 1]] - V[F[:, 0]]
+    e2 = V[F[:, 2]] - V[F[:, 0]]
+    return np.linalg.norm(np.cross(e1, e2), axis=1)
+
+
+def bbox_diagonal(V):
+    return float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
+
+
+def check_mesh(V, F, *, check_manifold=True, check_unreferenced=True):
+    """Validate a triangle mesh and return ``(V, F)`` as float64 / int64 arrays.
+
+    Checks, in order: shapes and dtypes, emptiness, NaN/inf, index range, repeated indices in
+    a face, zero-area faces, non-manifold edges (an edge in more than two triangles) and
+    unreferenced vertices.
+    """
+    V = as_vertices(V)
+    F = as_faces(F, V.shape[0])
+    diag = bbox_diagonal(V)
+    dbl = face_double_areas(V, F)
+    zero = np.flatnonzero(dbl <= 2.0 * ZERO_AREA_RELATIVE * max(diag, np.finfo(float).tiny) ** 2)
+    if zero.size:
+        raise MeshError(
+            f"{zero.size} triangles have zero area (first: {first_indices(zero)}); remove them, e.g. "
+            "with pymeshlab's meshing_remove_null_faces, before computing curvature."
+        )
+    if check_manifold:
+        bad = non_manifold_edges(F)
+        if bad.shape[0]:
+            pairs = ", ".join(f"({a}, {b})" for a, b in bad[:3])
+            raise MeshError(
+                f"{bad.shape[0]} edges are shared by more than two triangles (first: {pairs}); "
+                "the mesh is not manifold. Repair it, e.g. with pymeshlab's "
+                "meshing_repair_non_manifold_edges."
+            )
+    if check_unreferenced:
+        used = np.zeros(V.shape[0], dtype=bool)
+        used[F.ravel()] = True
+        unused = np.flatnonzero(~used)
+        if unused.size:
+            raise MeshError(
+                f"{unused.size} vertices are not used by any triangle (first: {first_indices(unused)}); "
+                "remove them, e.g. with pymeshlab's meshing_remove_unreferenced_vertices."
+            )
+    return V, F
+
+
+def undirected_edges(F):
+    """All half-edges as sorted pairs, shape (3m, 2), in face order (edge k of face f at 3f+k,
+    edge k joins corners k+1 and k+2, i.e. it is opposite corner k)."""
+    E = np.stack([F[:, [1, 2]], F[:, [2, 0]], F[:, [0, 1]]], axis=1).reshape(-1, 2)
+    return np.sort(E, axis=1)
+
+
+def _edge_keys(F):
+    E = undirected_edges(F)
+    n = int(F.max()) + 1
+    return E[:, 0] * n + E[:, 1], E
+
+
+def non_manifold_edges(F):
+    """Undirected edges used by more than two triangles, shape (k, 2)."""
+    keys, E = _edge_keys(F)
+    uniq, first, counts = np.unique(keys, return_index=True, return_counts=True)
+    return E[first[counts > 2]]
+
+
+def boundary_edges(F):
+    """Undirected edges used by exactly one triangle, shape (k, 2), oriented as in their face."""
+    D = np.stack([F[:, [1, 2]], F[:, [2, 0]], F[:, [0, 1]]], axis=1).reshape(-1, 2)
+    keys, _ = _edge_keys(F)
+    uniq, first, counts = np.unique(keys, return_index=True, return_counts=True)
+    return D[first[counts == 1]]
+
+
+def boundary_vertices(F):
+    """Sorted indices of the vertices on a boundary edge."""
+    return np.unique(boundary_edges(F))
+
+
+def as_index_set(indices, n, name):
+    """Return ``indices`` as a duplicate-free int64 array in [0, n), in the order given (a
+    boolean mask gives its true positions in increasing order), or raise ConstraintError."""
+    try:
+        arr = np.asarray(indices)
+    except Exception as exc:
+        raise ConstraintError(f"{name} could not be read as an index array ({exc}).") from None
+    if arr.dtype == bool:
+        if arr.shape != (n,):
+            raise ConstraintError(f"{name} is a boolean mask of shape {arr.shape}; it must have shape ({n},).")
+        return np.flatnonzero(arr)
+    arr = arr.reshape(-1)
+    if arr.size and not np.issubdtype(arr.dtype, np.integer):
+        if np.issubdtype(arr.dtype, np.floating) and np.all(np.isfinite(arr)) and np.all(arr == np.round(arr)):
+            arr = arr.astype(np.int64)
+        else:
+            raise ConstraintError(f"{name} has dtype {arr.dtype}; pass integer vertex indices.")
+    arr = arr.astype(np.int64)
+    out = np.flatnonzero((arr < 0) | (arr >= n))
+    if out.size:
+        raise ConstraintError(
+            f"{name}: {out.size} indices are outside [0, {n}) (first: {first_indices(arr[out])}); "
+            "indices are 0-based into V."
+        )
+    uniq, counts = np.unique(arr, return_counts=True)
+    if uniq.size != arr.size:
+        raise ConstraintError(
+            f"{name}: {arr.size - uniq.size} indices are repeated (first: {first_indices(uniq[counts > 1])}); "
+            "list each vertex once."
+        )
+    return arr
+
+
+def as_values(values, count, name):
+    """Return ``values`` as a (count, 3) float64 array of finite numbers or raise ConstraintError."""
+    try:
+        arr = np.asarray(values, dtype=np.float64)
+    except Exception as exc:
+        raise ConstraintError(f"{name} could not be read as a float array ({exc}).") from None
+    if arr.shape != (count, 3):
+        raise ConstraintError(f"{name} has shape {arr.shape}; expected ({count}, 3), one row per vertex.")
+    bad = np.flatnonzero(~np.isfinite(arr).all(axis=1))
+    if bad.size:
+        raise ConstraintError(f"{name}: {bad.size} rows are NaN or infinite (first: {first_indices(bad)}).")
+    return np.ascontiguousarray(arr)
+
+
+def vertex_components(F, n):
+    """Connected-component label per vertex, shape (n,), and the number of components."""
+    rows = np.concatenate([F[:, 0], F[:, 1], F[:, 2]])
+    cols = np.concatenate([F[:, 1], F[:, 2], F[:, 0]])
+    A = sp.coo_matrix((np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(n, n)).tocsr()
+    count, labels = connected_components(A, directed=False)
+    return labels, count
+
+
+def check_every_component_fixed(F, n, fixed):
+    """Raise ConstraintError if a connected component has no fixed vertex (the system is singular)."""
+    labels, count = vertex_components(F, n)
+    has = np.zeros(count, dtype=bool)
+    has[labels[fixed]] = True
+    missing = np.flatnonzero(~has)
+    if missing.size:
+        example = [int(np.flatnonzero(labels == c)[0]) for c in missing[:3]]
+        raise ConstraintError(
+            f"{missing.size} of {count} connected components have no fixed vertex (e.g. the pieces "
+            f"containing vertex {', '.join(map(str, example))}); their position is undetermined. "
+            "Fix at least one vertex in every piece, or split the mesh."
+        )

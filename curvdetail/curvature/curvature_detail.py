@@ -1,0 +1,33 @@
+"""Curvature detail ``D = L V`` (the paper's ``K_i A_i``)."""
+
+from ._validate import check_mesh
+from .cotan_laplacian import _cotan_laplacian_unchecked
+
+
+def curvature_detail(V, F):
+    """Curvature detail ``D_i = K_i A_i = (L V)_i``, the gradient of the surface area at ``V``.
+
+    Extensive: it scales with the vertex's area, so it must never be interpolated across meshes
+    of different density (transfer ``K`` and multiply by the new area instead).
+
+    Parameters
+    ----------
+    V : (n, 3) float array   vertex positions
+    F : (m, 3) int array     triangles
+
+    Returns
+    -------
+    D : (n, 3) float array   equal to ``cotan_laplacian(V, F) @ V``
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from curvdetail.curvature.testing import grid
+    >>> V, F = grid(5, 5)                        # a flat square
+    >>> D = curvature_detail(V, F)
+    >>> inner = (V[:, :2] > 0).all(1) & (V[:, :2] < 1).all(1)
+    >>> bool(np.abs(D[inner]).max() < 1e-12)     # a plane has no interior detail
+    True
+    """
+    V, F = check_mesh(V, F)
+    return _cotan_laplacian_unchecked(V, F) @ V

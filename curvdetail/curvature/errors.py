@@ -1,0 +1,21 @@
+"""Exceptions raised for malformed input.
+
+Every class derives from ``ValueError`` so that ``except ValueError`` keeps working for callers
+who do not care about the details; the message always says what is wrong, how much, where (the
+first offending indices) and what to do about it.
+"""
+
+
+class MeshError(ValueError):
+    """A mesh ``(V, F)`` is malformed: shapes, dtypes, non-finite values, bad indices,
+    degenerate or non-manifold elements, unreferenced vertices, wrong topology."""
+
+
+class ConstraintError(ValueError):
+    """A set of constrained (fixed) vertices or their values is malformed or insufficient."""
+
+
+def first_indices(indices, count=3):
+    """Format the first few offending indices for an error message: ``'17, 402, 9311'``."""
+    indices = [int(i) for i in list(indices)[:count]]
+    return ", ".join(str(i) for i in indices)

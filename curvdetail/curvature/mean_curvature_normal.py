@@ -1,0 +1,39 @@
+"""Mean curvature normal per vertex (Meyer et al. 2002)."""
+
+from ._validate import check_mesh
+from .cotan_laplacian import _cotan_laplacian_unchecked
+from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
+
+
+def mean_curvature_normal(V, F):
+    """Mean curvature normal and mixed Voronoi area per vertex.
+
+    Parameters
+    ----------
+    V : (n, 3) float array   vertex positions
+    F : (m, 3) int array     triangles
+
+    Returns
+    -------
+    K : (n, 3) float array   ``K_i = (L V)_i / A_i = 2 H_i n_i``; on a sphere of radius R it points
+                             away from the centre with ``|K| = 2 / R``. Intensive: it does not
+                             depend on the mesh density. On boundary vertices it carries the
+                             boundary's geodesic-curvature term as well (one-sided cotangents).
+    A : (n,) float array     mixed Voronoi areas; ``A.sum()`` is the surface area
+
+    Raises
+    ------
+    MeshError   if V or F is malformed or a triangle has zero area (names the first ones)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from curvdetail.curvature.testing import icosphere
+    >>> K, A = mean_curvature_normal(*icosphere(radius=2.0, subdivisions=4))
+    >>> bool(np.allclose(np.linalg.norm(K, axis=1), 1.0, atol=2e-2))
+    True
+    """
+    V, F = check_mesh(V, F)
+    L = _cotan_laplacian_unchecked(V, F)
+    A = _mixed_voronoi_area_unchecked(V, F)
+    return (L @ V) / A[:, None], A

@@ -1,0 +1,133 @@
+"""Mesh file input/output through pymeshlab: every format MeshLab reads and writes.
+
+Writes are atomic (a temporary file in the same folder, then a rename), so a failed or
+interrupted write never leaves a half-written file, and an existing file is never replaced
+unless ``overwrite=True``.
+"""
+
+import os
+import tempfile
+
+import numpy as np
+
+from .curvature._validate import as_faces, as_vertices
+from .curvature.errors import MeshError
+
+
+class MeshFileError(MeshError):
+    """A mesh file cannot be read or written (unknown format, unreadable, no triangles)."""
+
+
+def _meshset():
+    import pymeshlab
+
+    return pymeshlab.MeshSet()
+
+
+def read_mesh(path):
+    """Read a triangle mesh from any format pymeshlab reads (OBJ, OFF, PLY, STL, ...).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+
+    Returns
+    -------
+    V : (n, 3) float64 array   vertex positions, in file order
+    F : (m, 3) int64 array     triangles (polygons are triangulated by the loader)
+
+    Raises
+    ------
+    FileNotFoundError   the file does not exist
+    MeshFileError       the format is unknown, the file is unreadable or holds no triangles
+
+    Examples
+    --------
+    >>> from curvdetail import read_mesh
+    >>> from curvdetail.data import example_path
+    >>> V, F = read_mesh(example_path())
+    >>> V.shape[1], F.shape[1]
+    (3, 3)
+    """
+    path = os.fspath(path)
+    if not os.path.isfile(path):
+        raise FileNotFoundError(f"mesh file not found: {path}")
+    ms = _meshset()
+    try:
+        ms.load_new_mesh(path)
+    except Exception as exc:
+        raise MeshFileError(f"could not read {path!r}: {exc}. Use a format MeshLab reads "
+                            "(.obj, .off, .ply, .stl, ...).") from None
+    mesh = ms.current_mesh()
+    V = np.ascontiguousarray(mesh.vertex_matrix(), dtype=np.float64)
+    F = np.ascontiguousarray(mesh.face_matrix(), dtype=np.int64)
+    if F.shape[0] == 0:
+        raise MeshFileError(f"{path!r} holds {V.shape[0]} vertices but no triangles; a surface mesh "
+                            "is needed.")
+    return V, F
+
+
+def write_mesh(path, V, F, *, quality=None, overwrite=False):
+    """Write a triangle mesh atomically in the format given by the file extension.
+
+    Parameters
+    ----------
+    path : str or os.PathLike   destination; its extension picks the format (.ply, .obj, .off, .stl, ...)
+    V : (n, 3) float array      vertex positions
+    F : (m, 3) int array        triangles
+    quality : (n,) float array or None   per-vertex quality (saved where the format holds it,
+                                          e.g. PLY; MeshLab colours meshes by it)
+    overwrite : bool            replace an existing file; by default an existing file is refused
+
+    Raises
+    ------
+    FileExistsError   ``path`` exists and ``overwrite`` is False
+    MeshError         malformed ``V``, ``F`` or ``quality``
+    MeshFileError     the format is unknown or the folder is not writable
+    """
+    import pymeshlab
+
+    path = os.fspath(path)
+    if os.path.exists(path) and not overwrite:
+        raise FileExistsError(f"{path} exists; pass overwrite=True (or --overwrite) to replace it.")
+    V = as_vertices(V)
+    F = as_faces(F, V.shape[0])
+    kwargs = {}
+    if quality is not None:
+        q = np.asarray(quality, dtype=np.float64).reshape(-1)
+        if q.shape[0] != V.shape[0]:
+            raise MeshError(f"quality has {q.shape[0]} values for {V.shape[0]} vertices; pass one per vertex.")
+        kwargs["v_scalar_array"] = q
+    mesh = pymeshlab.Mesh(vertex_matrix=V, face_matrix=F.astype(np.int32), **kwargs)
+    save_mesh(path, mesh, overwrite=overwrite)
+
+
+def save_mesh(path, mesh, *, overwrite=False, **save_options):
+    """Atomically save a ``pymeshlab.Mesh`` (with its quality, colours and custom attributes where
+    the format holds them). Used by :func:`write_mesh`, the filters and the CLI."""
+    path = os.fspath(path)
+    if os.path.exists(path) and not overwrite:
+        raise FileExistsError(f"{path} exists; pass overwrite=True (or --overwrite) to replace it.")
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise MeshFileError(f"cannot write {path!r}: folder {folder!r} does not exist.")
+    ext = os.path.splitext(path)[1].lower()
+    if not ext:
+        raise MeshFileError(f"cannot write {path!r}: no file extension to choose the format from "
+                            "(use .ply, .obj, .off, .stl, ...).")
+    ms = _meshset()
+    ms.add_mesh(mesh)
+    fd, tmp = tempfile.mkstemp(prefix=".curvdetail-", suffix=ext, dir=folder)
+    os.close(fd)
+    try:
+        options = dict(save_options)
+        if ext == ".ply" and mesh.has_vertex_scalar():
+            options.setdefault("save_vertex_quality", True)
+        try:
+            ms.save_current_mesh(tmp, **options)
+        except Exception as exc:
+            raise MeshFileError(f"could not write {path!r}: {exc}") from None
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)

@@ -1,0 +1,61 @@
+"""Shared fixtures: analytic meshes with known answers and the bundled real meshes."""
+
+import os
+
+import numpy as np
+import pytest
+
+from curvdetail import read_mesh
+from curvdetail.curvature.testing import cylinder, disk, grid, icosphere
+
+DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
+
+#: Real disk-topology patches shipped in tests/data (source and terms in tests/data/README.md).
+DISK_PATCHES = ("mannequin_nose.obj", "mannequin_ear.obj", "terrainA_1k.obj")
+
+
+def data_path(name):
+    return os.path.join(DATA, name)
+
+
+@pytest.fixture(scope="session")
+def load_mesh():
+    """``load_mesh(name) -> (V, F)`` for a file in tests/data (cached; returns copies)."""
+    cache = {}
+
+    def load(name):
+        if name not in cache:
+            cache[name] = read_mesh(data_path(name))
+        V, F = cache[name]
+        return V.copy(), F.copy()
+
+    return load
+
+
+@pytest.fixture
+def sphere():
+    """Icosphere of radius 2 (2562 vertices)."""
+    return icosphere(radius=2.0, subdivisions=4)
+
+
+@pytest.fixture
+def plane_grid():
+    """Flat 21 x 21 grid on the unit square."""
+    return grid(21, 21)
+
+
+@pytest.fixture
+def open_cylinder():
+    """Open cylinder, radius 0.5, height 2, 48 around x 21 along."""
+    return cylinder(radius=0.5, height=2.0, n_around=48, n_along=21)
+
+
+@pytest.fixture
+def flat_disk():
+    """Flat unit disk of 20 rings (1261 vertices)."""
+    return disk(n_rings=20)
+
+
+@pytest.fixture
+def rng():
+    return np.random.default_rng(20061210)
