@@ -114,8 +114,9 @@ def _minimal_command(parser):
     add_input_output_arguments(parser, "mesh file with a boundary",
                                "minimal surface; quality = distance moved")
     parser.add_argument("--max-iterations", type=int, default=200, help="Pinkall-Polthier steps at most")
-    parser.add_argument("--tol", type=float, default=1e-6,
-                        help="stop when the largest step is below TOL x bbox diagonal")
+    parser.add_argument("--tol", type=float, default=1e-4,
+                        help="stop when no vertex moves more than TOL x bbox diagonal normal to the "
+                             "surface in a step (tangential sliding is not counted; default 1e-4)")
     parser.add_argument("--backend", default="auto", help="sparse solver: auto, pardiso, cholmod, splu")
     add_output_arguments(parser)
 

@@ -38,7 +38,7 @@ def cotan_laplacian(V, F):
     >>> L = cotan_laplacian(V, F)
     >>> np.allclose(L.sum(axis=1), 0)
     True
-    >>> L[1, 2]   # edge opposite the right angle: -cot(90 deg) / 2
+    >>> float(L[1, 2])   # edge opposite the right angle: -cot(90 deg) / 2
     0.0
     """
     V, F = check_mesh(V, F)

@@ -10,16 +10,43 @@ from .sparse_solver import factorize
 
 
 class MinimalSurfaceResult(np.ndarray):
-    """(n, 3) positions with ``iterations``, ``converged`` and ``last_step`` (relative) attached."""
+    """(n, 3) positions with ``iterations``, ``converged``, ``last_step`` (the last step's largest
+    normal displacement) and ``last_full_step`` (its largest displacement, tangential sliding
+    included), both relative to the bbox diagonal, attached."""
 
 
-def minimal_surface(V, F, fixed, *, max_iterations=200, tol=1e-6, backend="auto", callback=None):
+#: Default stopping tolerance of :func:`minimal_surface`: the shape moves by less than 1e-4 of the
+#: bbox diagonal in a step. The cotangent minimal surface itself is only second-order accurate
+#: (the 64 x 33 catenoid is off by 2e-4 of its diagonal), so iterating further buys nothing.
+DEFAULT_TOL = 1e-4
+
+
+def _vertex_normals(X, F):
+    """Area-weighted unit vertex normals, shape (n, 3)."""
+    fn = np.cross(X[F[:, 1]] - X[F[:, 0]], X[F[:, 2]] - X[F[:, 0]])
+    n = X.shape[0]
+    N = np.column_stack([np.bincount(F.ravel(), weights=np.repeat(fn[:, k], 3), minlength=n)
+                         for k in range(3)])
+    length = np.linalg.norm(N, axis=1, keepdims=True)
+    return N / np.where(length > 0, length, 1.0)
+
+
+def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, backend="auto", callback=None):
     """Minimal surface with the ``fixed`` vertices kept: the paper's validity check, ``D = 0``.
 
     Each step solves the free rows ``L_ff X_f = -L_fc X_c`` with the cotangent weights of the
     current surface (a cotangent-harmonic step; Pinkall & Polthier 1993), then recomputes the
-    weights. It stops when the largest vertex displacement of a step is below
-    ``tol * bbox_diagonal`` or after ``max_iterations`` steps.
+    weights. It stops when the shape has settled: when the largest displacement of a step
+    *normal to the surface* (projected on the area-weighted vertex normals of the new surface) is
+    below ``tol * bbox_diagonal``, or after ``max_iterations`` steps.
+
+    Why the normal part: after the first few steps the shape is found, but on irregular meshes
+    the vertices keep sliding *within* the surface, because sliding lowers the discrete area by
+    degrading triangles; Pinkall-Polthier's iteration never stops doing that. On the mannequin
+    nose (640 vertices) the full step is still 2e-4 of the diagonal after 200 steps and 1.6e-4
+    after 400, nearly all of it tangential, while the normal part is below 1e-4 from step ~40
+    on. On a symmetric grid (the catenoid) a tangential drift of ~2.4e-7 per step goes on forever
+    while the normal step falls to 1e-11. The full step is reported as ``last_full_step``.
 
     Parameters
     ----------
@@ -27,14 +54,16 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=1e-6, backend="auto"
     F : (m, 3) int array        triangles
     fixed : (k,) int array or (n,) bool mask   vertices that keep their positions, e.g. the boundary
     max_iterations : int        at least 1
-    tol : float                 relative step size at which to stop, > 0
+    tol : float                 stop when no vertex moves more than ``tol * bbox_diagonal`` across
+                                the surface in a step (default 1e-4, :data:`DEFAULT_TOL`), > 0
     backend : str               sparse solver backend
     callback : callable or None called as ``callback(iteration, relative_step)`` after each step
+                                (``relative_step``: the normal step that ``tol`` is compared with)
 
     Returns
     -------
     X : (n, 3) float array (a :class:`MinimalSurfaceResult` with ``.iterations``,
-        ``.converged`` and ``.last_step``)
+        ``.converged``, ``.last_step`` and ``.last_full_step``)
 
     Raises
     ------
@@ -65,7 +94,9 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=1e-6, backend="auto"
     free = np.setdiff1d(np.arange(n), fixed)
     diag = bbox_diagonal(V)
     X = V.copy()
-    step, it, converged = np.inf, 0, free.size == 0
+    converged = free.size == 0
+    step = full_step = 0.0 if converged else np.inf
+    it = 0
     while not converged and it < int(max_iterations):
         L = _cotan_laplacian_unchecked(X, F)
         Lf = L[free]
@@ -80,12 +111,14 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=1e-6, backend="auto"
                 f"{first_indices(collapsed)}); the fixed vertices span no minimal surface of this "
                 "topology (e.g. two circles too far apart for a catenoid)."
             )
-        step = float(np.abs(X_new - X).max()) / diag
+        move = X_new - X
+        full_step = float(np.abs(move).max()) / diag
+        step = float(np.abs(np.einsum("ij,ij->i", move, _vertex_normals(X_new, F))).max()) / diag
         X = X_new
         it += 1
         converged = step < tol
         if callback is not None:
             callback(it, step)
     out = X.view(MinimalSurfaceResult)
-    out.iterations, out.converged, out.last_step = it, bool(converged), step
+    out.iterations, out.converged, out.last_step, out.last_full_step = it, bool(converged), step, full_step
     return out

@@ -18,7 +18,13 @@ class Reconstructor:
     geometry ``V_ref`` (positive semi-definite convention, see :func:`cotan_laplacian`).
 
     ``rows="all"`` sums over every vertex (the paper): normal equations
-    ``(L_:f^T L_:f) X_f = L_:f^T (D - L_:c X_c)``, formed as ``(L L)_ff`` since ``L`` is symmetric.
+    ``(L_:f^T L_:f) X_f = L_:f^T (D - L_:c X_c)``, formed as ``L_f: L_f:^T`` since ``L`` is
+    symmetric, followed by ``refinement_steps`` (default 1) steps of corrected semi-normal
+    refinement: the correction solves the same factored system with ``L_:f^T (D - L X)``, the
+    least-squares residual. Without it the normal equations lose accuracy with the square of the
+    condition number (camelhead, 11k vertices: 1.5e-9 of the bbox diagonal on its own round trip);
+    with it the error is ~1e-14, as for the square system. The step costs one extra
+    back-substitution and two sparse products.
     ``rows="free"`` sums over the free vertices only: the square system
     ``L_ff X_f = D_f - L_fc X_c``. Both are symmetric positive definite when every connected
     component holds a fixed vertex, and both reproduce ``V_ref`` exactly from its own detail.
@@ -36,6 +42,7 @@ class Reconstructor:
     fixed : (k,) int array       the constrained vertices, in the order given (a mask: increasing)
     free : (n - k,) int array    the solved-for vertices, increasing
     backend : str                the solver backend in use
+    refinement_steps : int       refinement steps of ``rows="all"`` solves (class default 1)
 
     Examples
     --------
@@ -47,6 +54,10 @@ class Reconstructor:
     >>> bool(abs(X - V).max() < 1e-12)
     True
     """
+
+    #: corrected semi-normal refinement steps after a ``rows="all"`` solve (each costs one
+    #: back-substitution); 0 gives the plain normal-equation solution
+    refinement_steps = 1
 
     def __init__(self, V_ref, F, fixed, *, rows="all", backend="auto"):
         V_ref, F = check_mesh(V_ref, F)
@@ -64,13 +75,15 @@ class Reconstructor:
         self.free = np.flatnonzero(is_free)
         L = _cotan_laplacian_unchecked(V_ref, F)
         self._L = L
-        Lc = L.tocsc()[:, self.fixed]
+        L_f = L[self.free]                                       # (f, n) rows of the free vertices
+        self._L_c = L.tocsc()[:, self.fixed].tocsr()             # (n, k) columns of the fixed ones
         if rows == "all":
-            self._L_c = Lc.tocsr()                               # (n, k)
-            system = (L @ L)[self.free][:, self.free]
+            # L is symmetric, so L_:f = L_f:^T and the normal matrix L_:f^T L_:f is L_f: L_f:^T
+            self._L_f = L_f                                      # (f, n)
+            system = L_f @ L_f.T
         else:
-            self._L_fc = Lc.tocsr()[self.free]                   # (f, k)
-            system = L[self.free][:, self.free]
+            self._L_fc = self._L_c[self.free]                    # (f, k)
+            system = L_f[:, self.free]
         self._factor = factorize(system, symmetric=True, backend=backend) if self.free.size else None
         self.backend = self._factor.backend if self._factor is not None else "none"
 
@@ -86,6 +99,10 @@ class Reconstructor:
         Returns
         -------
         X : (n, 3) float array   with ``X[self.fixed] == fixed_positions`` exactly
+
+        Raises
+        ------
+        ConstraintError   ``detail`` or ``fixed_positions`` has the wrong shape or non-finite rows
         """
         D = as_values(detail, self.n, "detail")
         Xc = as_values(fixed_positions, self.fixed.size, "fixed_positions")
@@ -93,11 +110,16 @@ class Reconstructor:
         X[self.fixed] = Xc
         if self._factor is None:
             return X
-        if self.rows == "all":
-            rhs = (self._L @ (D - self._L_c @ Xc))[self.free]
-        else:
-            rhs = D[self.free] - self._L_fc @ Xc
-        X[self.free] = self._factor.solve(rhs)
+        if self.rows == "free":
+            X[self.free] = self._factor.solve(D[self.free] - self._L_fc @ Xc)
+            return X
+        # Normal equations L_:f^T L_:f X_f = L_:f^T r with r = D - L_:c X_c, then corrected
+        # semi-normal refinement: the correction is computed from the least-squares residual
+        # D - L X itself (not from the normal-equation residual, which carries the squared
+        # condition number), which brings the error from ~cond(L_:f)^2 eps to ~cond(L_:f) eps.
+        X[self.free] = self._factor.solve(self._L_f @ (D - self._L_c @ Xc))
+        for _ in range(self.refinement_steps):
+            X[self.free] += self._factor.solve(self._L_f @ (D - self._L @ X))
         return X
 
 

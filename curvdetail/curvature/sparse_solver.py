@@ -6,7 +6,7 @@ Backends, chosen automatically in this order where installed:
 ``"cholmod"``  SuiteSparse CHOLMOD through ``scikit-sparse`` (symmetric positive definite only).
 ``"splu"``     SciPy's SuperLU with ``MMD_AT_PLUS_A`` ordering and symmetric mode (everywhere).
 
-``"auto"`` takes SuperLU for systems under ``SMALL_SYSTEM`` unknowns. The choice can be overridden per call (``backend="splu"``) or for the whole process with the
+``"auto"`` takes SuperLU for systems under ``SMALL_SYSTEM`` unknowns (see there). The choice can be overridden per call (``backend="splu"``) or for the whole process with the
 environment variable ``CURVDETAIL_SOLVER``. All backends agree to ~1e-12 relative on the
 systems used here.
 """
@@ -55,9 +55,13 @@ def available_backends():
     return found
 
 
-#: Below this many unknowns ``"auto"`` picks SuperLU: PARDISO's fixed start-up cost (~0.1 s a
-#: factorization here) outweighs its speed on small systems.
-SMALL_SYSTEM = 20000
+#: Below this many unknowns ``"auto"`` picks SuperLU. Measured on 2 cores (factor + one solve of
+#: 3 right-hand sides, grid Laplacians): the free-row system ``L_ff`` at 4.9k / 10k / 20k / 40k
+#: unknowns takes 0.017 / 0.043 / 0.117 / 0.289 s with SuperLU and 0.036 / 0.051 / 0.105 /
+#: 0.225 s with PARDISO; the ``L^T L`` system 0.045 / 0.120 / 0.322 / 0.826 s and 0.038 / 0.075 /
+#: 0.168 / 0.344 s. Below ~5k both take a few milliseconds. (PARDISO's former ~0.2 s fixed cost
+#: per factorization was pypardiso's library look-up, now done once per process.)
+SMALL_SYSTEM = 5000
 
 
 def resolve_backend(backend="auto", *, symmetric=True, size=None):
@@ -80,6 +84,27 @@ def resolve_backend(backend="auto", *, symmetric=True, size=None):
     if backend == "cholmod" and not symmetric:
         raise SolverError("CHOLMOD factors symmetric positive definite matrices only; use 'pardiso' or 'splu'.")
     return backend
+
+
+_MKL_RT = None   # path of the MKL runtime found by the first PARDISO solver in this process
+
+
+def _new_pardiso_solver(mtype):
+    """A fresh ``pypardiso.PyPardisoSolver``. Its constructor looks the MKL runtime up with
+    ``ctypes.util.find_library`` (a subprocess, ~0.2 s, on every call); the path found the first
+    time is handed to later constructors through pypardiso's ``PYPARDISO_MKL_RT`` setting."""
+    global _MKL_RT
+    import pypardiso
+
+    if _MKL_RT is None or os.environ.get("PYPARDISO_MKL_RT"):
+        solver = pypardiso.PyPardisoSolver(mtype=mtype)
+        _MKL_RT = getattr(solver.libmkl, "_name", None) or _MKL_RT
+        return solver
+    os.environ["PYPARDISO_MKL_RT"] = _MKL_RT
+    try:
+        return pypardiso.PyPardisoSolver(mtype=mtype)
+    finally:
+        os.environ.pop("PYPARDISO_MKL_RT", None)
 
 
 class Factorization:
@@ -108,9 +133,7 @@ class Factorization:
 
     # -- backends ---------------------------------------------------------------------------
     def _factor_pardiso(self, A):
-        import pypardiso
-
-        solver = pypardiso.PyPardisoSolver(mtype=2 if self.symmetric else 11)
+        solver = _new_pardiso_solver(mtype=2 if self.symmetric else 11)
         iparm = solver.iparm
         iparm[0] = 1    # use the values below instead of all defaults
         iparm[1] = 2    # METIS nested-dissection ordering
