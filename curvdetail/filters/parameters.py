@@ -1,0 +1,203 @@
+"""Typed filter parameters, as pymeshlab's: declaration, checking and parsing from text.
+
+A :class:`Parameter` has a ``name``, a ``type`` (one of :data:`TYPES`), a ``default``, a
+``description`` and, where they apply, ``choices`` (for ``str``) and ``min`` / ``max`` (for
+``int``, ``float`` and ``PercentageValue``).
+
+Types, as pymeshlab names them:
+
+``bool``, ``int``, ``float``, ``str``
+    plain values; a ``str`` with ``choices`` is an enumeration (pymeshlab's RichEnum).
+``PercentageValue``
+    a length given either as a percentage of the bounding-box diagonal
+    (``pymeshlab.PercentageValue(1.0)``, ``"1%"`` on the command line) or as an absolute value
+    (``pymeshlab.PureValue(0.01)``, a plain number, ``"0.01"``). The filter receives a
+    :class:`BBoxLength` and calls ``.resolve(diagonal)``.
+``mesh``
+    a layer id of the MeshSet (pymeshlab shows these as ``int``); the default ``None`` means the
+    current mesh.
+"""
+
+import math
+import numbers
+from dataclasses import dataclass
+
+from .errors import FilterParameterError
+
+#: The parameter types a filter may declare.
+TYPES = ("bool", "int", "float", "str", "PercentageValue", "mesh")
+
+
+@dataclass(frozen=True)
+class BBoxLength:
+    """A length given as a percentage of a bounding-box diagonal or as an absolute value."""
+
+    value: float
+    percent: bool
+
+    def resolve(self, diagonal):
+        """The absolute length for a mesh whose bounding-box diagonal is ``diagonal``."""
+        return self.value / 100.0 * float(diagonal) if self.percent else self.value
+
+    def __str__(self):
+        return f"{self.value:g}%" if self.percent else repr(self.value)
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """One typed filter parameter (see the module docstring for the types).
+
+    Examples
+    --------
+    >>> p = Parameter("rows", "str", "all", "residual rows in E_Q", choices=("all", "free"))
+    >>> p.check("free")
+    'free'
+    """
+
+    name: str
+    type: str
+    default: object
+    description: str
+    choices: tuple = None
+    min: float = None
+    max: float = None
+
+    def __post_init__(self):
+        if self.type not in TYPES:
+            raise TypeError(f"parameter {self.name!r}: type {self.type!r} is not one of {TYPES}.")
+        if not self.description or not self.description.strip():
+            raise TypeError(f"parameter {self.name!r} needs a description.")
+        if self.choices is not None:
+            object.__setattr__(self, "choices", tuple(self.choices))
+        if self.default is not None or self.type != "mesh":
+            object.__setattr__(self, "default", self.check(self.default))
+
+    # -- checking Python values -----------------------------------------------------------------
+
+    def _fail(self, value, expected):
+        return FilterParameterError(
+            f"parameter {self.name!r} expects {expected}; got {value!r} ({type(value).__name__})."
+        )
+
+    def check(self, value):
+        """Return ``value`` converted to this parameter's type, or raise FilterParameterError
+        naming the parameter and the expected type (and the choices or range)."""
+        t = self.type
+        if t == "bool":
+            if isinstance(value, bool) or type(value).__name__ == "bool_":
+                return bool(value)
+            raise self._fail(value, "a bool (True or False)")
+        if t in ("int", "mesh"):
+            if value is None and t == "mesh":
+                return None
+            if isinstance(value, numbers.Integral) and not isinstance(value, bool) \
+                    and type(value).__name__ != "bool_":
+                return self._range(int(value))
+            raise self._fail(value, "an int" if t == "int" else "a layer id (int) of the MeshSet")
+        if t == "float":
+            if isinstance(value, numbers.Real) and not isinstance(value, bool) \
+                    and type(value).__name__ != "bool_":
+                return self._range(self._finite(float(value)))
+            raise self._fail(value, "a float")
+        if t == "str":
+            if not isinstance(value, str):
+                raise self._fail(value, "a str" + (f" (one of {', '.join(self.choices)})"
+                                                   if self.choices else ""))
+            if self.choices is not None:
+                for c in self.choices:
+                    if value.lower() == c.lower():
+                        return c
+                raise FilterParameterError(
+                    f"parameter {self.name!r} is {value!r}; it must be one of {', '.join(self.choices)}."
+                )
+            return value
+        # PercentageValue
+        if isinstance(value, BBoxLength):
+            length = value
+        elif type(value).__name__ == "PercentageValue":
+            length = BBoxLength(float(value.value()), True)
+        elif type(value).__name__ == "PureValue":
+            length = BBoxLength(float(value.value()), False)
+        elif isinstance(value, numbers.Real) and not isinstance(value, bool):
+            length = BBoxLength(float(value), False)
+        else:
+            raise self._fail(value, "a PercentageValue: pymeshlab.PercentageValue(percent of the "
+                             "bbox diagonal), pymeshlab.PureValue(absolute) or a number (absolute)")
+        self._finite(length.value)
+        self._range(length.value)
+        return length
+
+    def _finite(self, x):
+        if not math.isfinite(x):
+            raise FilterParameterError(f"parameter {self.name!r} is {x}; it must be a finite number.")
+        return x
+
+    def _range(self, x):
+        if self.min is not None and x < self.min:
+            raise FilterParameterError(f"parameter {self.name!r} is {x}; it must be at least {self.min}.")
+        if self.max is not None and x > self.max:
+            raise FilterParameterError(f"parameter {self.name!r} is {x}; it must be at most {self.max}.")
+        return x
+
+    # -- parsing text (command line, .mlx) ------------------------------------------------------
+
+    def parse(self, text):
+        """Convert ``text`` (from the command line or an .mlx ``value``) and check it.
+
+        ``bool``: true/false/1/0/yes/no; ``PercentageValue``: ``"1.5%"`` (percent of the bbox
+        diagonal) or ``"0.01"`` (absolute); ``mesh``: a layer id; ``str`` with choices: the
+        choice, case-insensitive, or its 0-based index (how MeshLab writes a RichEnum).
+        """
+        s = str(text).strip()
+        t = self.type
+        try:
+            if t == "bool":
+                low = s.lower()
+                if low in ("true", "1", "yes", "on"):
+                    return True
+                if low in ("false", "0", "no", "off"):
+                    return False
+                raise ValueError
+            if t in ("int", "mesh"):
+                return self.check(int(s))
+            if t == "float":
+                return self.check(float(s))
+            if t == "str":
+                if self.choices is not None and s.isdigit() and s not in self.choices \
+                        and int(s) < len(self.choices):
+                    return self.choices[int(s)]
+                return self.check(s)
+            if s.endswith("%"):
+                return self.check(BBoxLength(float(s[:-1]), True))
+            return self.check(BBoxLength(float(s), False))
+        except FilterParameterError:
+            raise
+        except ValueError:
+            expected = {"bool": "true or false", "int": "an integer", "mesh": "a layer id (integer)",
+                        "float": "a number",
+                        "PercentageValue": "a number (absolute) or a percentage of the bbox "
+                                           "diagonal such as 1%"}[t]
+            raise FilterParameterError(f"parameter {self.name!r} expects {expected}; got {s!r}.") from None
+
+    def format(self, value):
+        """``value`` as text that :meth:`parse` reads back exactly."""
+        if value is None:
+            return ""
+        if self.type == "bool":
+            return "true" if value else "false"
+        if self.type == "float":
+            return repr(float(value))
+        return str(value)
+
+    @property
+    def type_label(self):
+        """The type as pymeshlab prints it (a layer id is an ``int``)."""
+        return "int" if self.type == "mesh" else self.type
+
+    def default_label(self):
+        """The default as pymeshlab prints it (``'all'``, ``1%``, ``True``, ``current``)."""
+        if self.type == "mesh" and self.default is None:
+            return "current mesh"
+        if self.type == "str":
+            return repr(self.default)
+        return str(self.default)

@@ -1,0 +1,149 @@
+"""The filter registry: every filter is declared once, next to its code, with :func:`filter`.
+
+A filter is a function ``f(ms, *, p1, p2, ...) -> dict`` that reads a ``pymeshlab.MeshSet``,
+calls the package's numeric code and writes custom attributes, vertex quality or a new layer.
+Its declaration gives everything a user needs to call it without reading the code::
+
+    from .parameters import Parameter
+    from .registry import filter
+
+    @filter(name="apply_curvature_reconstruction",
+            category="Curvature detail",
+            description="Rebuild the current mesh from ... (Zhejiang Univ. Sci. A 2006, Sec. 3).",
+            parameters=[Parameter("rows", "str", "all", "residual rows in E_Q",
+                                  choices=("all", "free"))])
+    def apply_curvature_reconstruction(ms, *, rows):
+        ...
+        return {"max_displacement": ...}
+
+and the module is imported by ``curvdetail/filters/__init__.py`` so that registration happens.
+Users call it through :func:`curvdetail.filters.apply`, which checks and completes the
+parameters first.
+"""
+
+import difflib
+import inspect
+from dataclasses import dataclass
+
+from .errors import UnknownFilterError
+
+#: Name prefixes (pymeshlab's verb families); a filter name starts with one of them.
+FAMILIES = ("compute_", "meshing_", "apply_", "generate_", "transfer_", "get_")
+
+#: The reference cited in descriptions.
+PAPER = ("Curvature detail representation of triangular surfaces, Zhejiang Univ. Sci. A 7(7):1210 "
+         "(2006), doi 10.1631/jzus.2006.A1210")
+
+_REGISTRY = {}
+
+
+@dataclass(frozen=True)
+class FilterSpec:
+    """A registered filter: ``name``, ``category``, ``description``, ``parameters`` (a tuple of
+    :class:`~curvdetail.filters.parameters.Parameter`) and the ``function`` that runs it."""
+
+    name: str
+    category: str
+    description: str
+    parameters: tuple
+    function: object
+
+    def parameter(self, name):
+        """The :class:`Parameter` called ``name`` (KeyError if there is none)."""
+        for p in self.parameters:
+            if p.name == name:
+                return p
+        raise KeyError(name)
+
+    @property
+    def parameter_names(self):
+        return tuple(p.name for p in self.parameters)
+
+    def defaults(self):
+        """``{name: default}`` for every parameter."""
+        return {p.name: p.default for p in self.parameters}
+
+
+def filter(*, name, category, description, parameters=()):  # noqa: A001 (pymeshlab's word)
+    """Declare and register a filter (decorator).
+
+    Parameters
+    ----------
+    name : str          snake_case, starting with a verb family (:data:`FAMILIES`)
+    category : str      MeshLab menu-style category, e.g. ``"Curvature detail"``
+    description : str   one paragraph, with the paper reference where it applies
+    parameters : list of Parameter   in the order they are listed; each must match a keyword-only
+                        argument of the decorated function, and vice versa
+
+    The decorated function keeps working as a plain function; the spec is attached as
+    ``function.spec``.
+    """
+    def register(function):
+        if not name.startswith(FAMILIES) or name != name.lower() or " " in name:
+            raise TypeError(f"filter name {name!r} must be snake_case and start with one of {FAMILIES}.")
+        if name in _REGISTRY:
+            raise TypeError(f"filter {name!r} is registered twice.")
+        if not description or not description.strip() or not category:
+            raise TypeError(f"filter {name!r} needs a category and a description.")
+        params = tuple(parameters)
+        names = [p.name for p in params]
+        if len(set(names)) != len(names):
+            raise TypeError(f"filter {name!r} declares a parameter twice: {names}.")
+        sig = inspect.signature(function)
+        kw = [p.name for p in sig.parameters.values() if p.kind is inspect.Parameter.KEYWORD_ONLY]
+        if sorted(kw) != sorted(names):
+            raise TypeError(f"filter {name!r}: declared parameters {names} do not match the "
+                            f"function's keyword-only arguments {kw}.")
+        spec = FilterSpec(name, category, " ".join(description.split()), params, function)
+        _REGISTRY[name] = spec
+        function.spec = spec
+        return function
+
+    return register
+
+
+def list_filters():
+    """Every registered filter's :class:`FilterSpec`, sorted by name.
+
+    Examples
+    --------
+    >>> from curvdetail.filters import list_filters
+    >>> "compute_curvature_detail" in [f.name for f in list_filters()]
+    True
+    """
+    return [_REGISTRY[k] for k in sorted(_REGISTRY)]
+
+
+def close_matches(word, candidates):
+    """Up to three candidates that look like ``word`` (difflib), for error messages."""
+    return difflib.get_close_matches(word, list(candidates), n=3, cutoff=0.5)
+
+
+def get_filter(name):
+    """The :class:`FilterSpec` called ``name``, or UnknownFilterError listing the close matches."""
+    try:
+        return _REGISTRY[name]
+    except (KeyError, TypeError):
+        pass
+    matches = close_matches(str(name), _REGISTRY)
+    hint = (f"did you mean {', '.join(matches)}?" if matches
+            else "see curvdetail.filters.print_filter_list() or `curvdetail list`.")
+    raise UnknownFilterError(f"unknown filter {name!r}; {hint}")
+
+
+def print_filter_list():
+    """Print the filter names, as ``pymeshlab.print_filter_list()`` does."""
+    print("curvdetail.filters - list of filter names:")
+    for spec in list_filters():
+        print(f"\t{spec.name}")
+
+
+def print_filter_parameter_list(name):
+    """Print a filter's parameters as ``name : type = default``, as
+    ``pymeshlab.print_filter_parameter_list(name)`` does."""
+    spec = get_filter(name)
+    print(f"{spec.name} filter - list of parameter names:")
+    if not spec.parameters:
+        print("\tNone.")
+    for p in spec.parameters:
+        print(f"\t{p.name} : {p.type_label} = {p.default_label()}")
