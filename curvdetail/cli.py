@@ -148,6 +148,93 @@ def _minimal_command(parser):
 
 # --- list / apply / run (filter-suite issue) ------------------------------------------------
 
+@command("list", help="list the filters (curvdetail.filters) with their parameters")
+def _list_command(parser):
+    parser.add_argument("filter", metavar="FILTER", nargs="?", help="show this filter only")
+
+    def run(args):
+        from .filters import get_filter, list_filters
+        from .filters.registry import describe_filter
+
+        specs = [get_filter(args.filter)] if args.filter else list_filters()
+        print("\n\n".join(describe_filter(spec) for spec in specs))
+        return 0
+
+    return run
+
+
+def _filter_params(spec, pairs):
+    """``--param NAME=VALUE`` strings -> typed values (unknown names are left to apply())."""
+    params = {}
+    for pair in pairs:
+        name, sep, value = pair.partition("=")
+        name = name.strip()
+        if not sep or not name:
+            raise ValueError(f"--param {pair!r} is not NAME=VALUE (e.g. --param rows=free).")
+        if name in params:
+            raise ValueError(f"--param {name} is given twice.")
+        try:
+            params[name] = spec.parameter(name).parse(value)
+        except KeyError:
+            params[name] = value
+    return params
+
+
+def _run_on_file(args, work):
+    """Check OUTPUT, load INPUT into a MeshSet, ``work(ms)``, print its figures as JSON, save
+    the current mesh (quality and curvature attributes kept in PLY)."""
+    import json
+
+    from .filters.files import check_output_path, load_meshset, save_current_mesh
+
+    check_output_path(args.output, args.overwrite)
+    ms = load_meshset(args.input)
+    figures = work(ms)
+    save_current_mesh(ms, args.output, overwrite=args.overwrite)
+    print(json.dumps(figures, indent=2, default=str))
+    return 0
+
+
+@command("apply", help="apply one filter to a mesh file and write the current mesh")
+def _apply_command(parser):
+    parser.add_argument("filter", metavar="FILTER", help="filter name (see `curvdetail list`)")
+    parser.add_argument("input", metavar="INPUT", help="mesh file (any format MeshLab reads)")
+    parser.add_argument("output", metavar="OUTPUT",
+                        help="the current mesh afterwards (.ply keeps quality and attributes)")
+    parser.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                        help="a filter parameter (repeatable); lengths as 0.01 or 1%% of the bbox diagonal")
+    add_output_arguments(parser)
+
+    def run(args):
+        from .filters import apply, get_filter
+
+        spec = get_filter(args.filter)
+        params = _filter_params(spec, args.param)
+        return _run_on_file(args, lambda ms: apply(ms, spec.name, **params))
+
+    return run
+
+
+@command("run", help="run a MeshLab filter script (.mlx; ours and pymeshlab's) on a mesh file")
+def _run_command(parser):
+    parser.add_argument("script", metavar="SCRIPT", help="MeshLab filter script (.mlx)")
+    parser.add_argument("input", metavar="INPUT", help="mesh file (any format MeshLab reads)")
+    parser.add_argument("output", metavar="OUTPUT",
+                        help="the current mesh after the script (.ply keeps quality and attributes)")
+    add_output_arguments(parser)
+
+    def run(args):
+        import os
+
+        from .filters import run_script
+
+        if not os.path.isfile(args.script):
+            raise FileNotFoundError(f"filter script not found: {args.script}")
+        return _run_on_file(args, lambda ms: run_script(ms, args.script))
+
+    return run
+
+
 # --- edit (editing issue) -------------------------------------------------------------------
 
 

@@ -21,6 +21,7 @@ import importlib.util
 
 from .dispatch import apply
 from .errors import FilterError, FilterParameterError, ScriptError, UnknownFilterError
+from .mlx import run_script, save_script
 from .parameters import BBoxLength, Parameter
 from .registry import (FilterSpec, filter, get_filter, list_filters, print_filter_list,
                        print_filter_parameter_list)
@@ -45,5 +46,5 @@ del _module
 __all__ = [
     "BBoxLength", "FilterError", "FilterParameterError", "FilterSpec", "Parameter", "ScriptError",
     "UnknownFilterError", "apply", "filter", "get_filter", "list_filters", "print_filter_list",
-    "print_filter_parameter_list",
+    "print_filter_parameter_list", "run_script", "save_script",
 ]

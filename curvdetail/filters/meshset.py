@@ -21,6 +21,10 @@ from .errors import FilterError
 
 _scratch_ids = itertools.count()
 
+#: ``{name: "point" | "scalar"}`` for every custom attribute a filter stored with
+#: :func:`set_vertex_attribute` or :func:`add_layer`; saving to PLY keeps these.
+WRITTEN_ATTRIBUTES = {}
+
 
 def layer_id(ms, mesh_id=None, role="mesh"):
     """Return a valid layer id: ``mesh_id`` if the MeshSet has it, the current mesh if None.
@@ -131,6 +135,7 @@ def set_vertex_attribute(ms, mesh_id, name, values):
     arr = np.asarray(values, dtype=np.float64)
     kind = "point" if arr.ndim == 2 else "scalar"
     arr = _as_columns(mesh, arr, 3 if kind == "point" else 1, f"attribute {name!r}")
+    WRITTEN_ATTRIBUTES[name] = kind
     if vertex_attribute(ms, mesh_id, name, kind) is None:
         if kind == "point":
             mesh.add_vertex_custom_point_attribute(np.ascontiguousarray(arr), name)
@@ -177,6 +182,7 @@ def add_layer(ms, V, F, label, *, quality=None, attributes=None):
                           face_matrix=np.ascontiguousarray(F, dtype=np.int32), **kwargs)
     for name, values in (attributes or {}).items():
         arr = np.ascontiguousarray(values, dtype=np.float64)
+        WRITTEN_ATTRIBUTES[name] = "point" if arr.ndim == 2 else "scalar"
         if arr.ndim == 2:
             mesh.add_vertex_custom_point_attribute(arr, name)
         else:

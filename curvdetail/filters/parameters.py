@@ -40,7 +40,7 @@ class BBoxLength:
         return self.value / 100.0 * float(diagonal) if self.percent else self.value
 
     def __str__(self):
-        return f"{self.value:g}%" if self.percent else repr(self.value)
+        return f"{self.value!r}%" if self.percent else repr(self.value)
 
 
 @dataclass(frozen=True)

@@ -147,3 +147,25 @@ def print_filter_parameter_list(name):
         print("\tNone.")
     for p in spec.parameters:
         print(f"\t{p.name} : {p.type_label} = {p.default_label()}")
+
+
+def describe_filter(spec, width=96):
+    """A filter as text for ``curvdetail list``: name, category, description, and each
+    parameter with its type, default, choices or range and description."""
+    import textwrap
+
+    lines = [f"{spec.name}  [{spec.category}]"]
+    lines += textwrap.wrap(spec.description, width, initial_indent="    ", subsequent_indent="    ")
+    for p in spec.parameters:
+        extra = []
+        if p.choices:
+            extra.append(" | ".join(p.choices))
+        if p.min is not None:
+            extra.append(f">= {p.min}")
+        if p.max is not None:
+            extra.append(f"<= {p.max}")
+        suffix = f"  ({', '.join(extra)})" if extra else ""
+        lines.append(f"    {p.name} : {p.type_label} = {p.default_label()}{suffix}")
+        lines += textwrap.wrap(p.description, width, initial_indent="        ",
+                               subsequent_indent="        ")
+    return "\n".join(lines)

@@ -1,0 +1,88 @@
+"""Load a mesh file into a MeshSet and save its current mesh with the filters' results.
+
+Saving keeps what the format can hold: in PLY (binary, doubles) the vertex quality and every
+custom per-vertex attribute the filters wrote (``curvature_normal``, ``curvature_detail``,
+``curvature_area``, ...; pymeshlab's PLY exporter options ``__ca_vp__<name>`` /
+``__ca_vs__<name>``); OBJ, OFF and STL hold the geometry only. The file is written from the
+MeshSet itself (pymeshlab crashes when a mesh with custom attributes is copied into another
+MeshSet and exported), to a temporary file in the same folder and renamed, so a failed save
+leaves nothing behind; an existing file is replaced only with ``overwrite=True``.
+"""
+
+import os
+import tempfile
+
+from ..io import MeshFileError
+from .meshset import WRITTEN_ATTRIBUTES, vertex_attribute
+
+
+def load_meshset(path):
+    """A new ``pymeshlab.MeshSet`` with the mesh file ``path`` loaded as layer 0.
+
+    Raises FileNotFoundError if the file does not exist, MeshFileError if pymeshlab cannot
+    read it."""
+    import pymeshlab
+
+    path = os.fspath(path)
+    if not os.path.isfile(path):
+        raise FileNotFoundError(f"mesh file not found: {path}")
+    ms = pymeshlab.MeshSet()
+    try:
+        ms.load_new_mesh(path)
+    except pymeshlab.PyMeshLabException as exc:
+        raise MeshFileError(f"could not read {path!r}: {' '.join(str(exc).split())}. Use a format "
+                            "MeshLab reads (.obj, .off, .ply, .stl, ...).") from None
+    return ms
+
+
+def check_output_path(path, overwrite=False):
+    """Raise before any work if ``path`` cannot be written: it exists (and not ``overwrite``),
+    its folder does not exist, or it has no extension to pick the format."""
+    path = os.fspath(path)
+    if os.path.exists(path) and not overwrite:
+        raise FileExistsError(f"{path} exists; pass --overwrite (overwrite=True) to replace it.")
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise MeshFileError(f"cannot write {path!r}: folder {folder!r} does not exist.")
+    if not os.path.splitext(path)[1]:
+        raise MeshFileError(f"cannot write {path!r}: no file extension to choose the format from "
+                            "(use .ply to keep quality and curvature attributes, or .obj, .off, .stl).")
+    return path
+
+
+def save_options(ms, path):
+    """pymeshlab ``save_current_mesh`` options that keep quality and our attributes in PLY."""
+    if os.path.splitext(os.fspath(path))[1].lower() != ".ply":
+        return {}
+    mesh = ms.current_mesh()
+    options = {"binary": True}
+    if mesh.has_vertex_scalar():
+        options["save_vertex_quality"] = True
+    mid = ms.current_mesh_id()
+    for name, kind in sorted(WRITTEN_ATTRIBUTES.items()):
+        if vertex_attribute(ms, mid, name, kind) is not None:
+            options[("__ca_vp__" if kind == "point" else "__ca_vs__") + name.lower()] = True
+    return options
+
+
+def save_current_mesh(ms, path, *, overwrite=False):
+    """Atomically save the current mesh of ``ms`` (see the module docstring for what is kept).
+
+    Raises FileExistsError, MeshFileError (unknown format, missing folder, pymeshlab failed)."""
+    import pymeshlab
+
+    path = check_output_path(path, overwrite)
+    ext = os.path.splitext(path)[1]
+    options = save_options(ms, path)
+    fd, tmp = tempfile.mkstemp(prefix=".curvdetail-", suffix=ext,
+                               dir=os.path.dirname(os.path.abspath(path)))
+    os.close(fd)
+    try:
+        try:
+            ms.save_current_mesh(tmp, **options)
+        except pymeshlab.PyMeshLabException as exc:
+            raise MeshFileError(f"could not write {path!r}: {' '.join(str(exc).split())}") from None
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)

@@ -1,0 +1,232 @@
+"""MeshLab filter scripts (.mlx): run them on a MeshSet, with our filters mixed in, and save ours.
+
+The format is MeshLab's (and pymeshlab's ``save_filter_script``)::
+
+    <!DOCTYPE FilterScript>
+    <FilterScript>
+     <filter name="Remeshing: Isotropic Explicit Remeshing">
+      <Param name="Iterations" value="10" type="RichInt" .../>
+      ...
+     </filter>
+     <filter name="transfer_curvature_detail">
+      <Param name="sourcemesh" value="0" type="RichMesh" .../>
+      <Param name="method" value="1" type="RichEnum" enum_val0="pointwise" enum_val1="conservative" .../>
+     </filter>
+    </FilterScript>
+
+A ``<filter>`` whose name is one of ours (the snake_case name of
+:func:`~curvdetail.filters.list_filters`) runs through :func:`~curvdetail.filters.apply` with
+the ``<Param name= value=>`` pairs converted by the parameter types (an enum's value is its index,
+as MeshLab writes it, or its text; a ``PercentageValue`` is absolute, as MeshLab writes it, or
+``"1.5%"`` of the bbox diagonal). Parameters missing from the script take their defaults. Any
+other ``<filter>`` / ``<xmlfilter>`` (MeshLab GUI names) is handed to pymeshlab unchanged, one
+at a time, through a temporary script and ``load_filter_script`` / ``apply_filter_script``.
+"""
+
+import contextlib
+import os
+import sys
+import tempfile
+import xml.etree.ElementTree as ET
+
+from .dispatch import apply
+from .errors import FilterError, ScriptError
+from .registry import _REGISTRY, get_filter
+
+_RICH_TYPES = {"bool": "RichBool", "int": "RichInt", "float": "RichFloat", "str": "RichString",
+               "PercentageValue": "RichAbsPerc", "mesh": "RichMesh"}
+
+
+def _steps(path):
+    path = os.fspath(path)
+    if not os.path.isfile(path):
+        raise FileNotFoundError(f"filter script not found: {path}")
+    try:
+        root = ET.parse(path).getroot()
+    except ET.ParseError as exc:
+        raise ScriptError(f"{path} is not a MeshLab filter script: {exc}.") from None
+    if root.tag != "FilterScript":
+        raise ScriptError(f"{path}: the root element is <{root.tag}>; a MeshLab filter script has "
+                          "<FilterScript>.")
+    steps = []
+    for k, element in enumerate(root, start=1):
+        if element.tag not in ("filter", "xmlfilter") or not element.get("name"):
+            raise ScriptError(f"{path}: step {k} is <{element.tag}> without a name; expected "
+                              "<filter name=\"...\">.")
+        steps.append(element)
+    return steps
+
+
+def _our_parameters(spec, element, where):
+    params = {}
+    for child in element:
+        if child.tag not in ("Param", "xmlparam"):
+            continue
+        name, value = child.get("name"), child.get("value")
+        if name is None or value is None:
+            raise ScriptError(f"{where}: a <{child.tag}> lacks a name or a value.")
+        try:
+            params[name] = spec.parameter(name).parse(value)
+        except KeyError:
+            params[name] = value          # let apply() report it with the close matches
+        except FilterError as exc:
+            raise ScriptError(f"{where}: {exc}") from None
+    return params
+
+
+@contextlib.contextmanager
+def _quiet_output():
+    """pymeshlab prints 'Reading filter with name ...' when it loads a script; its failures come
+    back as exceptions, so its console output is dropped while a native step runs."""
+    saved = []
+    try:
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                stream.flush()
+                fd = stream.fileno()
+            except (AttributeError, OSError, ValueError):
+                continue
+            saved.append((fd, os.dup(fd)))
+        with open(os.devnull, "w") as null:
+            for fd, _ in saved:
+                os.dup2(null.fileno(), fd)
+            yield
+    finally:
+        for fd, copy in saved:
+            os.dup2(copy, fd)
+            os.close(copy)
+
+
+def _run_native(ms, element, where):
+    import pymeshlab
+
+    script = ET.Element("FilterScript")
+    script.append(element)
+    fd, tmp = tempfile.mkstemp(prefix="curvdetail-step-", suffix=".mlx")
+    os.close(fd)
+    try:
+        with open(tmp, "w", encoding="utf-8") as out:
+            out.write("<!DOCTYPE FilterScript>\n" + ET.tostring(script, encoding="unicode") + "\n")
+        try:
+            with _quiet_output():
+                ms.load_filter_script(tmp)
+                ms.apply_filter_script()
+        except pymeshlab.PyMeshLabException as exc:
+            detail = " ".join(str(exc).split())
+            raise ScriptError(f"{where}: pymeshlab failed: {detail}") from None
+    finally:
+        os.remove(tmp)
+
+
+def run_script(ms, path):
+    """Run a MeshLab filter script (.mlx) on ``ms``, step by step, in order.
+
+    Parameters
+    ----------
+    ms : pymeshlab.MeshSet   with the input mesh(es) loaded
+    path : str or os.PathLike
+
+    Returns
+    -------
+    list of dict   one per step: ``{"filter": name, "figures": dict}`` (pymeshlab's own filters
+                   give no figures through a script: ``{}``)
+
+    Raises
+    ------
+    FileNotFoundError   the script does not exist
+    ScriptError         malformed XML, or a step failed (the message names the step number and
+                        filter, then the reason)
+
+    Examples
+    --------
+    >>> import pymeshlab
+    >>> from curvdetail.data import example_path
+    >>> from curvdetail.filters import run_script, save_script
+    >>> import tempfile, os
+    >>> script = os.path.join(tempfile.mkdtemp(), "detail.mlx")
+    >>> save_script(script, ["compute_curvature_detail"])
+    >>> ms = pymeshlab.MeshSet(); ms.load_new_mesh(example_path())
+    >>> [step["filter"] for step in run_script(ms, script)]
+    ['compute_curvature_detail']
+    """
+    results = []
+    path = os.fspath(path)
+    for k, element in enumerate(_steps(path), start=1):
+        name = element.get("name")
+        where = f"{os.path.basename(path)} step {k} ({name})"
+        if name in _REGISTRY:
+            params = _our_parameters(_REGISTRY[name], element, where)
+            try:
+                figures = apply(ms, name, **params)
+            except ValueError as exc:
+                raise ScriptError(f"{where}: {exc}") from None
+        else:
+            _run_native(ms, element, where)
+            figures = {}
+        results.append({"filter": name, "figures": figures})
+    return results
+
+
+def _param_element(p, value):
+    attrs = {"name": p.name, "value": p.format(value), "type": _RICH_TYPES[p.type],
+             "description": p.name, "tooltip": p.description}
+    if p.type == "str" and p.choices is not None:
+        attrs["type"] = "RichEnum"
+        attrs["value"] = str(p.choices.index(value))
+        attrs["enum_cardinality"] = str(len(p.choices))
+        for i, c in enumerate(p.choices):
+            attrs[f"enum_val{i}"] = c
+    return ET.Element("Param", attrs)
+
+
+def save_script(path, steps, *, overwrite=False):
+    """Write our filters as a MeshLab filter script that :func:`run_script` runs.
+
+    Parameters
+    ----------
+    path : str or os.PathLike   destination (.mlx); written atomically
+    steps : list   each a filter name or ``(name, {parameter: value})``; every parameter is
+                   written (defaults for those not given), except a layer id left to the current
+                   mesh
+    overwrite : bool            replace an existing file
+
+    Raises
+    ------
+    FileExistsError        ``path`` exists and ``overwrite`` is False
+    UnknownFilterError, FilterParameterError   as :func:`~curvdetail.filters.apply`
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> path = os.path.join(tempfile.mkdtemp(), "rebuild.mlx")
+    >>> save_script(path, ["compute_curvature_detail",
+    ...                    ("apply_curvature_reconstruction", {"rows": "free"})])
+    >>> "apply_curvature_reconstruction" in open(path).read()
+    True
+    """
+    from .dispatch import complete_parameters
+
+    path = os.fspath(path)
+    if os.path.exists(path) and not overwrite:
+        raise FileExistsError(f"{path} exists; pass overwrite=True to replace it.")
+    root = ET.Element("FilterScript")
+    for step in steps:
+        name, params = (step, {}) if isinstance(step, str) else (step[0], dict(step[1] or {}))
+        spec = get_filter(name)
+        values = complete_parameters(spec, params)
+        element = ET.SubElement(root, "filter", {"name": name})
+        for p in spec.parameters:
+            if p.type == "mesh" and values[p.name] is None:
+                continue
+            element.append(_param_element(p, values[p.name]))
+    ET.indent(root, space=" ")
+    text = "<!DOCTYPE FilterScript>\n" + ET.tostring(root, encoding="unicode") + "\n"
+    folder = os.path.dirname(os.path.abspath(path))
+    fd, tmp = tempfile.mkstemp(prefix=".curvdetail-", suffix=".mlx", dir=folder)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as out:
+            out.write(text)
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)
