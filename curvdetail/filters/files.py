@@ -3,7 +3,7 @@
 Saving keeps what the format can hold: in PLY (binary, doubles) the vertex quality and every
 custom per-vertex attribute the filters wrote (``curvature_normal``, ``curvature_detail``,
 ``curvature_area``, ...; pymeshlab's PLY exporter options ``__ca_vp__<name>`` /
-``__ca_vs__<name>``); OBJ, OFF and STL hold the geometry only. The file is written from the
+``__ca_vs__<name>``), read back by :func:`load_meshset`; OBJ, OFF and STL hold the geometry only. The file is written from the
 MeshSet itself (pymeshlab crashes when a mesh with custom attributes is copied into another
 MeshSet and exported), to a temporary file in the same folder and renamed, so a failed save
 leaves nothing behind; an existing file is replaced only with ``overwrite=True``.
@@ -12,12 +12,16 @@ leaves nothing behind; an existing file is replaced only with ``overwrite=True``
 import os
 import tempfile
 
+import numpy as np
+
 from ..io import MeshFileError
-from .meshset import WRITTEN_ATTRIBUTES, vertex_attribute
+from .meshset import WRITTEN_ATTRIBUTES, set_vertex_attribute, vertex_attribute
+from .ply_attributes import read_ply_vertex_attributes
 
 
 def load_meshset(path):
-    """A new ``pymeshlab.MeshSet`` with the mesh file ``path`` loaded as layer 0.
+    """A new ``pymeshlab.MeshSet`` with the mesh file ``path`` loaded as layer 0, with the
+    custom per-vertex attributes of a PLY file (pymeshlab's loader drops them) added back.
 
     Raises FileNotFoundError if the file does not exist, MeshFileError if pymeshlab cannot
     read it."""
@@ -32,6 +36,10 @@ def load_meshset(path):
     except pymeshlab.PyMeshLabException as exc:
         raise MeshFileError(f"could not read {path!r}: {' '.join(str(exc).split())}. Use a format "
                             "MeshLab reads (.obj, .off, .ply, .stl, ...).") from None
+    n = ms.current_mesh().vertex_number()
+    for name, values in read_ply_vertex_attributes(path).items():
+        if values.shape in ((n,), (n, 3)) and np.all(np.isfinite(values)):
+            set_vertex_attribute(ms, ms.current_mesh_id(), name, values)
     return ms
 
 

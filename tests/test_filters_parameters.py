@@ -1,0 +1,92 @@
+"""Typed filter parameters: checking Python values, parsing text, bbox-diagonal lengths."""
+
+import numpy as np
+import pymeshlab
+import pytest
+
+from curvdetail.filters import BBoxLength, FilterParameterError, Parameter
+
+
+def test_percentage_value_resolves_to_a_fraction_of_the_diagonal():
+    p = Parameter("targetlen", "PercentageValue", pymeshlab.PercentageValue(1.0), "edge length")
+    assert p.default == BBoxLength(1.0, True)
+    assert p.check(pymeshlab.PercentageValue(2.5)).resolve(4.0) == pytest.approx(0.1, rel=1e-15)
+
+
+def test_pure_value_and_plain_number_are_absolute_lengths():
+    p = Parameter("targetlen", "PercentageValue", 0.5, "edge length")
+    assert p.check(pymeshlab.PureValue(0.25)).resolve(1000.0) == 0.25  # 0.25 is exact in float32
+    assert p.check(0.125).resolve(1000.0) == 0.125
+
+
+def test_percentage_text_parses_as_percent_and_number_as_absolute():
+    p = Parameter("targetlen", "PercentageValue", 0.5, "edge length")
+    assert p.parse("1.5%") == BBoxLength(1.5, True)
+    assert p.parse("0.02") == BBoxLength(0.02, False)
+
+
+def test_formatted_values_parse_back_exactly():
+    cases = [Parameter("a", "float", 1.0, "d"), Parameter("b", "bool", True, "d"),
+             Parameter("c", "int", 3, "d"), Parameter("e", "PercentageValue", 1.0, "d"),
+             Parameter("f", "str", "x", "d", choices=("x", "y"))]
+    values = [0.1 + 1e-13, False, -7, BBoxLength(1.0 / 3.0, True), "y"]
+    for p, v in zip(cases, values):
+        assert p.parse(p.format(v)) == v
+
+
+def test_wrong_type_error_names_parameter_and_expected_type():
+    p = Parameter("max_iterations", "int", 200, "steps")
+    with pytest.raises(FilterParameterError, match=r"'max_iterations' expects an int.*str"):
+        p.check("200")
+    with pytest.raises(FilterParameterError, match=r"'max_iterations' expects an int"):
+        p.check(2.5)
+
+
+def test_bool_is_not_accepted_as_a_number():
+    with pytest.raises(FilterParameterError, match="'tol' expects a float"):
+        Parameter("tol", "float", 1e-6, "tolerance").check(True)
+
+
+def test_numpy_scalars_are_accepted():
+    assert Parameter("n", "int", 1, "d").check(np.int32(4)) == 4
+    assert Parameter("x", "float", 1.0, "d").check(np.float32(0.5)) == 0.5
+
+
+def test_choice_is_case_insensitive_and_canonical():
+    p = Parameter("rows", "str", "all", "rows", choices=("all", "free"))
+    assert p.check("FREE") == "free"
+    with pytest.raises(FilterParameterError, match="one of all, free"):
+        p.check("some")
+
+
+def test_enum_index_parses_as_meshlab_writes_it():
+    p = Parameter("method", "str", "pointwise", "m", choices=("pointwise", "conservative"))
+    assert p.parse("1") == "conservative"
+
+
+def test_range_is_enforced():
+    p = Parameter("max_iterations", "int", 200, "steps", min=1)
+    with pytest.raises(FilterParameterError, match="at least 1"):
+        p.check(0)
+
+
+def test_non_finite_float_is_refused():
+    with pytest.raises(FilterParameterError, match="finite"):
+        Parameter("tol", "float", 1e-6, "tolerance").parse("nan")
+
+
+def test_unparsable_text_names_parameter():
+    with pytest.raises(FilterParameterError, match="'fix_boundary' expects true or false"):
+        Parameter("fix_boundary", "bool", True, "d").parse("maybe")
+
+
+def test_mesh_parameter_defaults_to_current_mesh():
+    p = Parameter("sourcemesh", "mesh", None, "source layer")
+    assert p.check(None) is None and p.parse("2") == 2 and p.type_label == "int"
+
+
+def test_declaration_needs_known_type_and_description():
+    with pytest.raises(TypeError, match="not one of"):
+        Parameter("x", "double", 1.0, "d")
+    with pytest.raises(TypeError, match="description"):
+        Parameter("x", "float", 1.0, " ")
