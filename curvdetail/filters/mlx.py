@@ -83,10 +83,13 @@ def _quiet_output():
         for stream in (sys.stdout, sys.stderr):
             try:
                 stream.flush()
-                fd = stream.fileno()
             except (AttributeError, OSError, ValueError):
+                pass
+        for fd in (1, 2):                  # pymeshlab writes to the process's own descriptors
+            try:
+                saved.append((fd, os.dup(fd)))
+            except OSError:
                 continue
-            saved.append((fd, os.dup(fd)))
         with open(os.devnull, "w") as null:
             for fd, _ in saved:
                 os.dup2(null.fileno(), fd)

@@ -1,0 +1,213 @@
+"""`curvdetail list / apply / run`: outputs, figures on stdout, and every error path."""
+
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from curvdetail.cli import main
+from curvdetail.filters import list_filters
+from curvdetail.filters.files import load_meshset
+from curvdetail.filters.meshset import vertex_attribute
+
+DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
+NOSE = os.path.join(DATA, "mannequin_nose.obj")
+SPOT = os.path.join(DATA, "spot.obj")
+
+
+def run_cli(capsys, *argv):
+    rc = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def assert_failed(capsys, argv, message, output=None):
+    rc, out, err = run_cli(capsys, *argv)
+    assert rc != 0
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("curvdetail: error: "), err
+    assert message in lines[0], lines[0]
+    if output is not None:
+        assert not os.path.exists(output)
+
+
+# --- list ---------------------------------------------------------------------------------------
+
+def test_list_shows_every_filter_with_its_parameters(capsys):
+    rc, out, _ = run_cli(capsys, "list")
+    assert rc == 0
+    for spec in list_filters():
+        assert spec.name in out
+        for p in spec.parameters:
+            assert f"    {p.name} : {p.type_label} = " in out
+
+
+def test_list_one_filter(capsys):
+    rc, out, _ = run_cli(capsys, "list", "apply_curvature_reconstruction")
+    assert rc == 0 and out.startswith("apply_curvature_reconstruction  [")
+    assert "rows : str = 'all'  (all | free)" in out and "generate_minimal_surface" not in out
+
+
+def test_list_unknown_filter_fails(capsys):
+    assert_failed(capsys, ["list", "generate_minimal_surfaces"], "did you mean generate_minimal_surface")
+
+
+# --- apply --------------------------------------------------------------------------------------
+
+def test_apply_writes_ply_with_attributes_and_prints_figures(capsys, tmp_path):
+    out_path = tmp_path / "d.ply"
+    rc, out, _ = run_cli(capsys, "apply", "compute_curvature_detail", NOSE, out_path)
+    assert rc == 0 and json.loads(out)["interior_vertices"] == 568
+    ms = load_meshset(out_path)
+    assert vertex_attribute(ms, 0, "curvature_detail", "point").shape == (640, 3)
+    assert ms.current_mesh().has_vertex_scalar()
+
+
+def vertices(path):
+    ms = load_meshset(path)          # keep the MeshSet alive while its mesh is read
+    return ms.current_mesh().vertex_matrix().copy()
+
+
+def quality(path):
+    ms = load_meshset(path)
+    return ms.current_mesh().vertex_scalar_array().copy()
+
+
+def test_apply_chains_through_ply_attributes(capsys, tmp_path):
+    # detail stored in d.ply by one command is read back and rebuilt by the next
+    run_cli(capsys, "apply", "compute_curvature_detail", NOSE, tmp_path / "d.ply")
+    rc, out, _ = run_cli(capsys, "apply", "apply_curvature_reconstruction", tmp_path / "d.ply",
+                         tmp_path / "r.ply", "--param", "rows=free")
+    assert rc == 0 and json.loads(out)["max_displacement"] < 1e-9
+    assert np.abs(vertices(tmp_path / "r.ply") - vertices(NOSE)).max() < 1e-9
+
+
+def test_apply_writes_the_new_current_layer(capsys, tmp_path):
+    rc, out, _ = run_cli(capsys, "apply", "generate_minimal_surface", NOSE, tmp_path / "m.obj",
+                         "--param", "max_iterations=2")
+    assert rc == 0 and json.loads(out)["iterations"] == 2
+    assert np.abs(vertices(tmp_path / "m.obj") - vertices(NOSE)).max() > 1e-3
+
+
+def test_apply_overwrite_replaces_the_output(capsys, tmp_path):
+    out_path = tmp_path / "d.ply"
+    out_path.write_text("old")
+    rc, _, _ = run_cli(capsys, "apply", "compute_curvature_detail", NOSE, out_path, "--overwrite")
+    assert rc == 0 and out_path.read_bytes().startswith(b"ply")
+
+
+def test_apply_refuses_an_existing_output(capsys, tmp_path):
+    out_path = tmp_path / "d.ply"
+    out_path.write_text("old")
+    assert_failed(capsys, ["apply", "compute_curvature_detail", NOSE, out_path], "--overwrite")
+    assert out_path.read_text() == "old"
+
+
+def test_apply_missing_input(capsys, tmp_path):
+    assert_failed(capsys, ["apply", "compute_curvature_detail", tmp_path / "none.obj", tmp_path / "o.ply"],
+                  "mesh file not found", tmp_path / "o.ply")
+
+
+def test_apply_unknown_filter(capsys, tmp_path):
+    assert_failed(capsys, ["apply", "compute_curvature_detial", NOSE, tmp_path / "o.ply"],
+                  "did you mean compute_curvature_detail", tmp_path / "o.ply")
+
+
+def test_apply_unknown_parameter(capsys, tmp_path):
+    assert_failed(capsys, ["apply", "generate_minimal_surface", NOSE, tmp_path / "o.ply", "--param",
+                           "max_iteration=3"], "did you mean max_iterations", tmp_path / "o.ply")
+
+
+def test_apply_bad_value(capsys, tmp_path):
+    assert_failed(capsys, ["apply", "apply_curvature_reconstruction", NOSE, tmp_path / "o.ply",
+                           "--param", "rows=some"], "'rows' is 'some'; it must be one of all, free",
+                  tmp_path / "o.ply")
+
+
+def test_apply_bad_param_syntax(capsys, tmp_path):
+    assert_failed(capsys, ["apply", "generate_minimal_surface", NOSE, tmp_path / "o.ply", "--param",
+                           "max_iterations"], "is not NAME=VALUE", tmp_path / "o.ply")
+
+
+def test_apply_filter_error(capsys, tmp_path):
+    assert_failed(capsys, ["apply", "apply_curvature_reconstruction", NOSE, tmp_path / "o.ply"],
+                  "no per-vertex point attribute 'curvature_detail'", tmp_path / "o.ply")
+
+
+def test_apply_constraint_error_on_closed_mesh(capsys, tmp_path):
+    assert_failed(capsys, ["apply", "generate_minimal_surface", SPOT, tmp_path / "o.ply"],
+                  "closed: a minimal surface needs a boundary", tmp_path / "o.ply")
+
+
+def test_apply_missing_output_folder(capsys, tmp_path):
+    assert_failed(capsys, ["apply", "compute_curvature_detail", NOSE, tmp_path / "no" / "o.ply"],
+                  "does not exist", tmp_path / "no" / "o.ply")
+
+
+def test_apply_unreadable_input(capsys, tmp_path):
+    bad = tmp_path / "bad.off"
+    bad.write_text("garbage")
+    assert_failed(capsys, ["apply", "compute_curvature_detail", bad, tmp_path / "o.ply"],
+                  "could not read", tmp_path / "o.ply")
+
+
+# --- run ----------------------------------------------------------------------------------------
+
+SCRIPT = """<!DOCTYPE FilterScript>
+<FilterScript>
+ <filter name="Select Border"/>
+ <filter name="compute_curvature_detail"/>
+ <filter name="generate_minimal_surface"><Param name="max_iterations" value="2"/></filter>
+</FilterScript>
+"""
+
+
+def test_run_writes_the_current_mesh_after_the_script(capsys, tmp_path):
+    (tmp_path / "s.mlx").write_text(SCRIPT)
+    rc, out, _ = run_cli(capsys, "run", tmp_path / "s.mlx", NOSE, tmp_path / "o.ply")
+    assert rc == 0
+    steps = json.loads(out)
+    assert [s["filter"] for s in steps] == ["Select Border", "compute_curvature_detail",
+                                            "generate_minimal_surface"]
+    moved = np.linalg.norm(vertices(tmp_path / "o.ply") - vertices(NOSE), axis=1)
+    assert np.allclose(quality(tmp_path / "o.ply"), moved)   # the minimal-surface layer's quality
+
+
+def test_run_missing_script(capsys, tmp_path):
+    assert_failed(capsys, ["run", tmp_path / "none.mlx", NOSE, tmp_path / "o.ply"],
+                  "filter script not found", tmp_path / "o.ply")
+
+
+def test_run_malformed_script(capsys, tmp_path):
+    (tmp_path / "s.mlx").write_text("<FilterScript><filter")
+    assert_failed(capsys, ["run", tmp_path / "s.mlx", NOSE, tmp_path / "o.ply"],
+                  "not a MeshLab filter script", tmp_path / "o.ply")
+
+
+def test_run_failing_step(capsys, tmp_path):
+    (tmp_path / "s.mlx").write_text(SCRIPT.replace("Select Border", "Select Nothing Like This"))
+    assert_failed(capsys, ["run", tmp_path / "s.mlx", NOSE, tmp_path / "o.ply"],
+                  "s.mlx step 1 (Select Nothing Like This): pymeshlab failed", tmp_path / "o.ply")
+
+
+def test_run_bad_value_in_script(capsys, tmp_path):
+    (tmp_path / "s.mlx").write_text(SCRIPT.replace('value="2"', 'value="two"'))
+    assert_failed(capsys, ["run", tmp_path / "s.mlx", NOSE, tmp_path / "o.ply"],
+                  "step 3 (generate_minimal_surface): parameter 'max_iterations' expects an integer",
+                  tmp_path / "o.ply")
+
+
+def test_run_missing_input(capsys, tmp_path):
+    (tmp_path / "s.mlx").write_text(SCRIPT)
+    assert_failed(capsys, ["run", tmp_path / "s.mlx", tmp_path / "none.obj", tmp_path / "o.ply"],
+                  "mesh file not found", tmp_path / "o.ply")
+
+
+def test_installed_command_exits_non_zero_with_one_line(tmp_path):
+    proc = subprocess.run([sys.executable, "-m", "curvdetail.cli", "apply", "nope", NOSE,
+                           str(tmp_path / "o.ply")], capture_output=True, text=True)
+    assert proc.returncode == 1 and proc.stderr.count("\n") == 1
+    assert proc.stderr.startswith("curvdetail: error: unknown filter 'nope'")

@@ -1,0 +1,76 @@
+"""Loading into a MeshSet and saving the current mesh: PLY keeps quality and attributes exactly."""
+
+import os
+
+import numpy as np
+import pytest
+
+from curvdetail.filters import apply
+from curvdetail.filters.files import check_output_path, load_meshset, save_current_mesh
+from curvdetail.filters.meshset import vertex_attribute
+from curvdetail.io import MeshFileError
+
+DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
+NOSE = os.path.join(DATA, "mannequin_nose.obj")
+ATTRIBUTES = (("curvature_normal", "point"), ("curvature_detail", "point"), ("curvature_area", "scalar"))
+
+
+def test_ply_round_trip_keeps_positions_quality_and_attributes_exactly(tmp_path):
+    ms = load_meshset(NOSE)
+    apply(ms, "compute_curvature_detail")
+    save_current_mesh(ms, tmp_path / "d.ply")
+    back = load_meshset(tmp_path / "d.ply")
+    assert np.array_equal(back.current_mesh().vertex_matrix(), ms.current_mesh().vertex_matrix())
+    assert np.array_equal(back.current_mesh().vertex_scalar_array(), ms.current_mesh().vertex_scalar_array())
+    for name, kind in ATTRIBUTES:
+        assert np.array_equal(vertex_attribute(back, 0, name, kind), vertex_attribute(ms, 0, name, kind))
+
+
+def test_scratch_attributes_are_not_saved(tmp_path):
+    ms = load_meshset(NOSE)
+    apply(ms, "compute_curvature_detail")                 # sets quality through a scratch attribute
+    save_current_mesh(ms, tmp_path / "d.ply")
+    header = (tmp_path / "d.ply").read_bytes().split(b"end_header")[0]
+    assert b"curvature_detail" in header and b"scratch" not in header
+
+
+def test_obj_output_holds_the_geometry(tmp_path):
+    ms = load_meshset(NOSE)
+    apply(ms, "compute_curvature_detail")
+    save_current_mesh(ms, tmp_path / "d.obj")
+    back = load_meshset(tmp_path / "d.obj")
+    assert np.allclose(back.current_mesh().vertex_matrix(), ms.current_mesh().vertex_matrix(), atol=1e-6)
+
+
+def test_existing_output_is_kept_unless_overwrite(tmp_path):
+    out = tmp_path / "d.ply"
+    out.write_text("keep me")
+    ms = load_meshset(NOSE)
+    with pytest.raises(FileExistsError, match="--overwrite"):
+        save_current_mesh(ms, out)
+    assert out.read_text() == "keep me"
+    save_current_mesh(ms, out, overwrite=True)
+    assert out.read_bytes().startswith(b"ply")
+
+
+def test_failed_save_leaves_no_file(tmp_path):
+    ms = load_meshset(NOSE)
+    with pytest.raises(MeshFileError, match="could not write"):
+        save_current_mesh(ms, tmp_path / "d.unknownformat")
+    assert os.listdir(tmp_path) == []
+
+
+def test_output_checks_happen_before_work(tmp_path):
+    with pytest.raises(MeshFileError, match="does not exist"):
+        check_output_path(tmp_path / "no" / "d.ply")
+    with pytest.raises(MeshFileError, match="no file extension"):
+        check_output_path(tmp_path / "d")
+
+
+def test_missing_and_unreadable_inputs_are_named(tmp_path):
+    with pytest.raises(FileNotFoundError, match="mesh file not found"):
+        load_meshset(tmp_path / "none.obj")
+    bad = tmp_path / "bad.ply"
+    bad.write_text("not a ply")
+    with pytest.raises(MeshFileError, match="could not read"):
+        load_meshset(bad)

@@ -1,0 +1,146 @@
+"""MeshLab filter scripts: save/run round trip, native pymeshlab steps mixed in, defaults, errors."""
+
+import os
+
+import numpy as np
+import pymeshlab
+import pytest
+
+from curvdetail import curvature_detail
+from curvdetail.filters import (FilterParameterError, ScriptError, UnknownFilterError, apply,
+                                run_script, save_script)
+from curvdetail.filters.meshset import vertex_attribute
+
+DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
+
+NATIVE_BORDER = '<filter name="Select Border"/>'
+NATIVE_SMOOTH = """<filter name="Laplacian Smooth">
+  <Param name="stepSmoothNum" value="2" type="RichInt" description="Smoothing steps" tooltip=""/>
+  <Param name="Boundary" value="false" type="RichBool" description="1D Boundary Smoothing" tooltip=""/>
+  <Param name="cotangentWeight" value="true" type="RichBool" description="Cotangent weighting" tooltip=""/>
+  <Param name="Selected" value="false" type="RichBool" description="Affect only selection" tooltip=""/>
+ </filter>"""
+
+
+def meshset(name="mannequin_nose.obj"):
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(os.path.join(DATA, name))
+    return ms
+
+
+def write(tmp_path, body, name="s.mlx"):
+    path = tmp_path / name
+    path.write_text(f"<!DOCTYPE FilterScript>\n<FilterScript>\n {body}\n</FilterScript>\n")
+    return path
+
+
+def test_saved_script_runs_to_the_same_mesh_as_direct_calls(tmp_path):
+    steps = [("compute_curvature_detail", {}),
+             ("apply_curvature_reconstruction", {"rows": "free", "fix_selected": False}),
+             ("generate_minimal_surface", {"max_iterations": 3, "tol": 1.0 / 3.0 * 1e-5})]
+    save_script(tmp_path / "p.mlx", steps)
+    direct, scripted = meshset(), meshset()
+    expected = [apply(direct, name, **params) for name, params in steps]
+    results = run_script(scripted, tmp_path / "p.mlx")
+    assert [r["figures"] for r in results] == expected
+    assert scripted.mesh_number() == direct.mesh_number() == 2
+    for k in range(2):
+        assert np.array_equal(scripted.mesh(k).vertex_matrix(), direct.mesh(k).vertex_matrix())
+        assert np.array_equal(scripted.mesh(k).vertex_scalar_array(), direct.mesh(k).vertex_scalar_array())
+
+
+def test_saved_script_writes_every_parameter_in_meshlab_format(tmp_path):
+    save_script(tmp_path / "p.mlx", [("apply_curvature_reconstruction", {"rows": "free"})])
+    text = (tmp_path / "p.mlx").read_text()
+    assert text.startswith("<!DOCTYPE FilterScript>\n<FilterScript>")
+    assert 'name="rows" value="1" type="RichEnum"' in text and 'enum_val1="free"' in text
+    for name in ("fix_boundary", "fix_selected", "backend"):
+        assert f'name="{name}"' in text
+
+
+def test_native_and_our_filters_mix_in_order(tmp_path):
+    # Laplacian smoothing (pymeshlab) moves interior vertices, then our detail is computed on the
+    # smoothed mesh: the stored detail must be that of the smoothed geometry, not the original
+    path = write(tmp_path, NATIVE_SMOOTH + "\n " + NATIVE_BORDER +
+                 '\n <filter name="compute_curvature_detail"/>')
+    ms = meshset()
+    V0 = ms.current_mesh().vertex_matrix().copy()
+    results = run_script(ms, path)
+    assert [r["filter"] for r in results] == ["Laplacian Smooth", "Select Border", "compute_curvature_detail"]
+    V, F = ms.current_mesh().vertex_matrix(), ms.current_mesh().face_matrix()
+    assert np.abs(V - V0).max() > 1e-4
+    assert np.array_equal(vertex_attribute(ms, 0, "curvature_detail", "point"), curvature_detail(V, F))
+    assert ms.current_mesh().selected_vertex_number() == 72      # the nose's boundary
+
+
+def test_selection_made_by_a_native_step_is_used_by_ours(tmp_path):
+    # Select Border + fix_boundary=false: the selection alone keeps the rim; rebuild is exact
+    path = write(tmp_path, NATIVE_BORDER + """
+ <filter name="compute_curvature_detail"/>
+ <filter name="apply_curvature_reconstruction"><Param name="fix_boundary" value="false"/></filter>""")
+    figures = run_script(meshset(), path)[-1]["figures"]
+    assert figures["fixed_vertices"] == 72 and figures["max_displacement"] < 1e-9
+
+
+def test_missing_parameters_take_their_defaults(tmp_path):
+    path = write(tmp_path, '<filter name="compute_curvature_detail"/>\n'
+                           ' <filter name="apply_curvature_reconstruction"/>')
+    assert run_script(meshset(), path)[-1]["figures"]["rows"] == "all"
+
+
+def test_enum_given_by_text_is_accepted(tmp_path):
+    path = write(tmp_path, '<filter name="compute_curvature_detail"/>\n <filter '
+                           'name="apply_curvature_reconstruction"><Param name="rows" value="free"/></filter>')
+    assert run_script(meshset(), path)[-1]["figures"]["rows"] == "free"
+
+
+def test_unknown_parameter_in_script_names_step_and_close_match(tmp_path):
+    path = write(tmp_path, '<filter name="generate_minimal_surface"><Param name="max_iteration" '
+                           'value="3"/></filter>')
+    with pytest.raises(ScriptError, match=r"s.mlx step 1 \(generate_minimal_surface\).*did you mean "
+                                          "max_iterations"):
+        run_script(meshset(), path)
+
+
+def test_bad_value_in_script_names_step_and_parameter(tmp_path):
+    path = write(tmp_path, NATIVE_BORDER + '\n <filter name="generate_minimal_surface">'
+                                           '<Param name="tol" value="small"/></filter>')
+    with pytest.raises(ScriptError, match=r"step 2 \(generate_minimal_surface\): parameter 'tol' expects a number"):
+        run_script(meshset(), path)
+
+
+def test_failing_native_step_names_the_step(tmp_path):
+    path = write(tmp_path, '<filter name="No Such MeshLab Filter"/>')
+    with pytest.raises(ScriptError, match=r"step 1 \(No Such MeshLab Filter\): pymeshlab failed"):
+        run_script(meshset(), path)
+
+
+def test_malformed_xml_is_refused(tmp_path):
+    path = tmp_path / "bad.mlx"
+    path.write_text("<FilterScript><filter name='x'>")
+    with pytest.raises(ScriptError, match="not a MeshLab filter script"):
+        run_script(meshset(), path)
+
+
+def test_wrong_root_element_is_refused(tmp_path):
+    path = tmp_path / "bad.mlx"
+    path.write_text("<Script/>")
+    with pytest.raises(ScriptError, match="root element is <Script>"):
+        run_script(meshset(), path)
+
+
+def test_missing_script_is_file_not_found(tmp_path):
+    with pytest.raises(FileNotFoundError, match="filter script not found"):
+        run_script(meshset(), tmp_path / "none.mlx")
+
+
+def test_save_refuses_to_overwrite_and_unknown_steps(tmp_path):
+    path = tmp_path / "p.mlx"
+    save_script(path, ["compute_curvature_detail"])
+    with pytest.raises(FileExistsError):
+        save_script(path, ["compute_curvature_detail"])
+    with pytest.raises(UnknownFilterError):
+        save_script(tmp_path / "q.mlx", ["compute_curvature_detial"])
+    with pytest.raises(FilterParameterError):
+        save_script(tmp_path / "q.mlx", [("generate_minimal_surface", {"tol": "x"})])
+    assert not (tmp_path / "q.mlx").exists()

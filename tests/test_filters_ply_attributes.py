@@ -1,0 +1,45 @@
+"""Reading pymeshlab's custom vertex attributes back from PLY (binary and ASCII)."""
+
+import os
+
+import numpy as np
+import pymeshlab
+
+from curvdetail import curvature_detail, mixed_voronoi_area, read_mesh
+from curvdetail.filters.ply_attributes import read_ply_vertex_attributes
+
+DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
+
+
+def saved(tmp_path, binary):
+    V, F = read_mesh(os.path.join(DATA, "terrainA_1k.obj"))
+    D, A = curvature_detail(V, F), mixed_voronoi_area(V, F)
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(os.path.join(DATA, "terrainA_1k.obj"))
+    ms.current_mesh().add_vertex_custom_point_attribute(D, "curvature_detail")
+    ms.current_mesh().add_vertex_custom_scalar_attribute(A, "curvature_area")
+    path = tmp_path / f"t{int(binary)}.ply"
+    ms.save_current_mesh(str(path), binary=binary, save_vertex_quality=False,
+                         __ca_vp__curvature_detail=True, __ca_vs__curvature_area=True)
+    return read_ply_vertex_attributes(path), D, A
+
+
+def test_binary_ply_attributes_are_read_exactly(tmp_path):
+    attributes, D, A = saved(tmp_path, binary=True)
+    assert np.array_equal(attributes["curvature_detail"], D)
+    assert np.array_equal(attributes["curvature_area"], A)
+
+
+def test_ascii_ply_attributes_are_read_to_six_digits(tmp_path):
+    # pymeshlab writes ASCII attributes with 6 decimals ('%f'): absolute error <= 5e-7
+    attributes, D, A = saved(tmp_path, binary=False)
+    assert np.abs(attributes["curvature_detail"] - D).max() <= 5e-7 + 1e-12
+    assert np.abs(attributes["curvature_area"] - A).max() <= 5e-7 + 1e-12
+
+
+def test_files_without_custom_attributes_give_nothing(tmp_path):
+    assert read_ply_vertex_attributes(os.path.join(DATA, "spot.obj")) == {}
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(os.path.join(DATA, "spot.obj"))
+    ms.save_current_mesh(str(tmp_path / "s.ply"))
+    assert read_ply_vertex_attributes(tmp_path / "s.ply") == {}
