@@ -21,7 +21,7 @@ from .registry import PAPER, filter
         vertex step is below tol times the bounding-box diagonal. It is the paper's validity check
         and the zero-detail baseline of the remeshing experiment. The result is added as a new
         layer (same triangles) and made current; its vertex quality is the distance each vertex
-        moved. {PAPER}, Sec. 4.
+        moved. {PAPER}, the validity check of section "Base presentation".
     """,
     parameters=[
         Parameter("max_iterations", "int", 200, "Pinkall-Polthier steps at most", min=1),

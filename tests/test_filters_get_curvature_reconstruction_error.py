@@ -1,0 +1,67 @@
+"""get_curvature_reconstruction_error: two-sided Hausdorff between layers, relative to the target."""
+
+import os
+
+import numpy as np
+import pymeshlab
+import pytest
+
+from curvdetail.curvature._validate import bbox_diagonal
+from curvdetail.curvature.testing import grid
+from curvdetail.filters import FilterError, apply
+
+DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
+
+
+def test_parallel_planes_are_their_offset_apart():
+    # unit square and a copy lifted by 0.01: every distance is 0.01 both ways (pymeshlab samples
+    # in single precision: 1e-6 relative)
+    V, F = grid(11, 11)
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(V, F.astype(np.int32)), "plane")
+    ms.add_mesh(pymeshlab.Mesh(V + [0.0, 0.0, 0.01], F.astype(np.int32)), "lifted")
+    figures = apply(ms, "get_curvature_reconstruction_error", samplenum=2000)
+    assert figures["max"] == pytest.approx(0.01, rel=1e-6)
+    assert figures["RMS"] == pytest.approx(0.01, rel=1e-6)
+    assert figures["hausdorff_max"] == pytest.approx(0.01 / np.sqrt(2.0), rel=1e-6)
+    assert np.allclose(ms.mesh(1).vertex_scalar_array(), 0.01, rtol=1e-6)
+
+
+def test_nose_against_its_minimal_surface():
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(os.path.join(DATA, "mannequin_nose.obj"))
+    apply(ms, "generate_minimal_surface", max_iterations=3)
+    figures = apply(ms, "get_curvature_reconstruction_error", samplenum=5000)
+    diag = bbox_diagonal(ms.mesh(0).vertex_matrix())
+    assert figures["diagonal"] == diag and (figures["sampledmesh"], figures["targetmesh"]) == (1, 0)
+    assert figures["hausdorff_max"] == max(figures["sampled_to_target_max"], figures["target_to_sampled_max"])
+    rms = [figures["sampled_to_target_rms"], figures["target_to_sampled_rms"]]
+    assert min(rms) <= figures["hausdorff_rms"] <= max(rms)
+    # vertex distances are among the forward samples: their max cannot exceed the forward max
+    assert ms.mesh(1).vertex_scalar_array().max() <= figures["sampled_to_target_max"] * diag * (1 + 1e-6)
+    assert figures["hausdorff_max"] > 0.05            # a nose is far from its minimal surface
+    assert ms.current_mesh_id() == 1
+
+
+def test_rebuilt_copy_of_itself_has_no_error():
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(os.path.join(DATA, "terrainA_1k.obj"))
+    ms.generate_copy_of_current_mesh()
+    apply(ms, "compute_curvature_detail")
+    apply(ms, "apply_curvature_reconstruction")
+    figures = apply(ms, "get_curvature_reconstruction_error", samplenum=5000)
+    assert figures["hausdorff_max"] < 1e-6
+
+
+def test_same_layer_twice_is_refused():
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(os.path.join(DATA, "mannequin_nose.obj"))
+    with pytest.raises(FilterError, match="both layer 0"):
+        apply(ms, "get_curvature_reconstruction_error")
+
+
+def test_missing_layer_is_refused():
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(os.path.join(DATA, "mannequin_nose.obj"))
+    with pytest.raises(FilterError, match="targetmesh layer id 3 does not exist"):
+        apply(ms, "get_curvature_reconstruction_error", targetmesh=3)
