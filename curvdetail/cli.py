@@ -89,12 +89,12 @@ def _reconstruct_command(parser):
         import numpy as np
 
         from . import boundary_vertices, curvature_detail, read_mesh, reconstruct, write_mesh
-        from .curvature._validate import bbox_diagonal, check_mesh
+        from .curvature._validate import as_index_set, bbox_diagonal, check_mesh
         from .curvature.errors import ConstraintError
 
         resolve_input_output(args)
         V, F = check_mesh(*read_mesh(args.input))
-        fixed = np.asarray(args.fix, dtype=np.int64) if args.fix else boundary_vertices(F)
+        fixed = as_index_set(args.fix, V.shape[0], "--fix") if args.fix else boundary_vertices(F)
         if fixed.size == 0:
             raise ConstraintError(f"{args.input} is closed (no boundary); name vertices to fix with --fix.")
         t = time.perf_counter()
@@ -113,7 +113,9 @@ def _reconstruct_command(parser):
 def _minimal_command(parser):
     add_input_output_arguments(parser, "mesh file with a boundary",
                                "minimal surface; quality = distance moved")
-    parser.add_argument("--max-iterations", type=int, default=200, help="Pinkall-Polthier steps at most")
+    parser.add_argument("--max-iterations", type=int, default=200,
+                        help="Pinkall-Polthier steps at most; if the shape has not settled by then, "
+                             "OUTPUT is still written and the exit status is 3")
     parser.add_argument("--tol", type=float, default=1e-4,
                         help="stop when no vertex moves more than TOL x bbox diagonal normal to the "
                              "surface in a step (tangential sliding is not counted; default 1e-4)")

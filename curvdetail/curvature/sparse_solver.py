@@ -162,10 +162,17 @@ class Factorization:
         from sksparse import cholmod
 
         try:
-            factor = cholmod.cholesky(A.tocsc())
+            if hasattr(cholmod, "cho_factor"):
+                # scikit-sparse >= 0.5: cho_factor -> CholeskyFactor with .solve(b); it wants a
+                # csc_array with sorted indices (``cholesky`` now returns the factor matrix)
+                M = sp.csc_array(A)
+                M.sort_indices()
+                self._solve = cholmod.cho_factor(M).solve
+            else:
+                # scikit-sparse 0.4: cholesky -> Factor, called as factor(b) to solve A x = b
+                self._solve = cholmod.cholesky(A.tocsc())
         except Exception as exc:
             raise SolverError(f"CHOLMOD could not factor the matrix ({exc}); it is not positive definite.") from None
-        self._solve = factor
 
     def _factor_splu(self, A):
         try:

@@ -1,0 +1,135 @@
+"""The reconstruct and minimal commands: results, --help, --example, exit codes, no output on failure."""
+
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from curvdetail import boundary_vertices, read_mesh
+from curvdetail.cli import main
+from curvdetail.curvature._validate import bbox_diagonal
+
+from conftest import data_path
+
+NOSE = data_path("mannequin_nose.obj")
+SPOT = data_path("spot.obj")
+
+
+def _error_line(capsys):
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("curvdetail: error: ")
+    return err[0]
+
+
+@pytest.mark.parametrize("rows", ["all", "free"])
+def test_reconstruct_rebuilds_the_input(tmp_path, capsys, rows):
+    out = tmp_path / "nose.ply"
+    assert main(["reconstruct", NOSE, str(out), "--rows", rows]) == 0
+    V, F = read_mesh(NOSE)
+    X, G = read_mesh(out)
+    assert np.array_equal(G, F)
+    assert np.abs(X - V).max() <= 1e-9 * bbox_diagonal(V)
+    printed = capsys.readouterr().out
+    assert "max vertex error" in printed and f"rows={rows}" in printed
+    assert float(printed.split("max vertex error ")[1].split()[0]) <= 1e-9
+
+
+def test_reconstruct_closed_mesh_with_fixed_vertices(tmp_path):
+    out = tmp_path / "spot.off"
+    assert main(["reconstruct", SPOT, str(out), "--fix", "0", "1000", "2000"]) == 0
+    V, _ = read_mesh(SPOT)
+    assert np.abs(read_mesh(out)[0] - V).max() <= 1e-9 * bbox_diagonal(V)
+
+
+def test_reconstruct_example(tmp_path, capsys):
+    out = tmp_path / "terrain.obj"
+    assert main(["reconstruct", "--example", str(out)]) == 0
+    assert out.exists() and "1089 vertices" in capsys.readouterr().out
+
+
+def test_minimal_example_converges(tmp_path, capsys):
+    out = tmp_path / "minimal.ply"
+    assert main(["minimal", "--example", str(out)]) == 0
+    assert capsys.readouterr().out.startswith("converged after")
+    V, F = read_mesh(out)
+    V0, _ = read_mesh(data_path("terrainA_1k.obj"))
+    b = boundary_vertices(F)
+    assert np.abs(V[b] - V0[b]).max() < 1e-12 * bbox_diagonal(V0)
+
+
+def test_minimal_not_converged_exits_3_and_says_so(tmp_path, capsys):
+    out = tmp_path / "minimal.ply"
+    assert main(["minimal", NOSE, str(out), "--max-iterations", "1", "--tol", "1e-12"]) == 3
+    assert "not converged" in capsys.readouterr().out and out.exists()
+
+
+@pytest.mark.parametrize("command", ["reconstruct", "minimal"])
+def test_help_describes_the_command(command, capsys):
+    with pytest.raises(SystemExit) as info:
+        main([command, "--help"])
+    assert info.value.code == 0
+    text = capsys.readouterr().out
+    assert "INPUT" in text and "OUTPUT" in text and "--example" in text and "--overwrite" in text
+
+
+def test_console_script_help_runs():
+    result = subprocess.run([sys.executable, "-m", "curvdetail.cli", "reconstruct", "--help"],
+                            capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0 and "--rows" in result.stdout
+
+
+def test_missing_input_fails_cleanly(tmp_path, capsys):
+    out = tmp_path / "x.ply"
+    assert main(["reconstruct", str(tmp_path / "absent.obj"), str(out)]) == 1
+    assert "mesh file not found" in _error_line(capsys)
+    assert not out.exists()
+
+
+def test_closed_mesh_without_fix_fails_cleanly(tmp_path, capsys):
+    out = tmp_path / "x.ply"
+    assert main(["reconstruct", SPOT, str(out)]) == 1
+    assert "closed (no boundary); name vertices to fix with --fix" in _error_line(capsys)
+    assert os.listdir(tmp_path) == []
+
+
+def test_fix_out_of_range_names_the_index(tmp_path, capsys):
+    out = tmp_path / "x.ply"
+    assert main(["reconstruct", NOSE, str(out), "--fix", "3", "640"]) == 1
+    assert "first: 640" in _error_line(capsys)
+    assert os.listdir(tmp_path) == []
+
+
+def test_existing_output_is_refused_and_kept(tmp_path, capsys):
+    out = tmp_path / "keep.ply"
+    out.write_text("precious")
+    assert main(["minimal", NOSE, str(out)]) == 1
+    assert "exists; pass --overwrite" in _error_line(capsys)
+    assert out.read_text() == "precious"
+
+
+def test_overwrite_replaces_output(tmp_path):
+    out = tmp_path / "keep.ply"
+    out.write_text("old")
+    assert main(["reconstruct", NOSE, str(out), "--overwrite"]) == 0
+    assert read_mesh(out)[0].shape == (640, 3)
+
+
+def test_minimal_on_a_closed_mesh_fails_cleanly(tmp_path, capsys):
+    out = tmp_path / "x.ply"
+    assert main(["minimal", SPOT, str(out)]) == 1
+    assert "needs a boundary" in _error_line(capsys)
+    assert not out.exists()
+
+
+def test_unknown_backend_fails_cleanly(tmp_path, capsys):
+    out = tmp_path / "x.ply"
+    assert main(["reconstruct", NOSE, str(out), "--backend", "magic"]) == 1
+    assert "unknown solver backend 'magic'" in _error_line(capsys)
+    assert not out.exists()
+
+
+def test_example_with_two_paths_is_refused(tmp_path, capsys):
+    assert main(["reconstruct", "--example", str(tmp_path / "a.ply"), str(tmp_path / "b.ply")]) == 1
+    assert "with --example give only OUTPUT" in _error_line(capsys)

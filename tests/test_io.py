@@ -1,0 +1,152 @@
+"""read_mesh / write_mesh / save_mesh: round trips per format, overwrite refusal, atomic writes."""
+
+import os
+
+import numpy as np
+import pytest
+
+from curvdetail import MeshError, read_mesh, write_mesh
+from curvdetail.io import MeshFileError, save_mesh
+
+from conftest import data_path
+
+
+@pytest.fixture
+def nose(load_mesh, rng):
+    V, F = load_mesh("mannequin_nose.obj")
+    return V + rng.normal(scale=1e-3, size=V.shape), F     # full float64 mantissas
+
+
+@pytest.mark.parametrize("ext", ["obj", "off", "ply"])
+def test_round_trip_keeps_vertices_and_faces(tmp_path, nose, ext):
+    # OBJ and OFF are text written with 17 significant digits (error ~1 ulp); PLY is binary double
+    V, F = nose
+    path = tmp_path / f"mesh.{ext}"
+    write_mesh(path, V, F)
+    W, G = read_mesh(path)
+    assert W.dtype == np.float64 and G.dtype == np.int64
+    assert np.array_equal(G, F)
+    assert np.abs(W - V).max() <= 4 * np.finfo(float).eps * np.abs(V).max()
+
+
+def test_stl_round_trip_is_float32_and_remerges_shared_vertices(tmp_path, nose):
+    # STL stores every triangle's three corners as float32 and no shared vertices; pymeshlab's
+    # loader merges coincident corners again: same vertex and face counts, the faces in order
+    # with the same corner positions (rounded to float32), but the vertices renumbered.
+    V, F = nose
+    path = tmp_path / "mesh.stl"
+    write_mesh(path, V, F)
+    W, G = read_mesh(path)
+    assert W.shape == V.shape and G.shape == F.shape
+    assert np.array_equal(W[G], V[F].astype(np.float32).astype(np.float64))
+
+
+def test_quality_is_saved_in_ply(tmp_path, nose):
+    import pymeshlab
+
+    V, F = nose
+    q = np.linspace(0.0, 1.0, V.shape[0])
+    path = tmp_path / "q.ply"
+    write_mesh(path, V, F, quality=q)
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(str(path))
+    assert np.allclose(ms.current_mesh().vertex_scalar_array(), q, atol=1e-6)   # stored as float32
+
+
+def test_existing_file_is_not_overwritten(tmp_path, nose):
+    V, F = nose
+    path = tmp_path / "keep.obj"
+    path.write_text("precious")
+    with pytest.raises(FileExistsError, match="keep.obj exists; pass overwrite=True"):
+        write_mesh(path, V, F)
+    assert path.read_text() == "precious"
+
+
+def test_overwrite_replaces_the_file(tmp_path, nose):
+    V, F = nose
+    path = tmp_path / "replace.off"
+    path.write_text("old")
+    write_mesh(path, V, F, overwrite=True)
+    assert read_mesh(path)[0].shape == V.shape
+
+
+def test_failed_write_leaves_neither_output_nor_temporary_file(tmp_path, nose, monkeypatch):
+    import pymeshlab
+
+    V, F = nose
+
+    def broken(self, path, **kwargs):
+        with open(path, "w") as fh:          # a half-written file, then a crash
+            fh.write("half")
+        raise RuntimeError("disk full")
+
+    monkeypatch.setattr(pymeshlab.MeshSet, "save_current_mesh", broken)
+    with pytest.raises(MeshFileError, match="could not write .*disk full"):
+        write_mesh(tmp_path / "out.ply", V, F)
+    assert os.listdir(tmp_path) == []
+
+
+def test_unknown_extension_is_refused_and_leaves_nothing(tmp_path, nose):
+    V, F = nose
+    with pytest.raises(MeshFileError, match="could not write"):
+        write_mesh(tmp_path / "mesh.notaformat", V, F)
+    assert os.listdir(tmp_path) == []
+
+
+def test_missing_extension_is_refused(tmp_path, nose):
+    V, F = nose
+    with pytest.raises(MeshFileError, match="no file extension"):
+        write_mesh(tmp_path / "mesh", V, F)
+
+
+def test_missing_folder_is_refused(tmp_path, nose):
+    V, F = nose
+    with pytest.raises(MeshFileError, match="does not exist"):
+        write_mesh(tmp_path / "nowhere" / "mesh.ply", V, F)
+
+
+def test_malformed_arrays_are_refused_before_writing(tmp_path, nose):
+    V, F = nose
+    bad = V.copy()
+    bad[3] = np.nan
+    with pytest.raises(MeshError, match=r"1 vertices have NaN .*first: 3"):
+        write_mesh(tmp_path / "bad.ply", bad, F)
+    with pytest.raises(MeshError, match="quality has 2 values for 640 vertices"):
+        write_mesh(tmp_path / "bad.ply", V, F, quality=[1.0, 2.0])
+    assert os.listdir(tmp_path) == []
+
+
+def test_reading_a_missing_file_raises_file_not_found(tmp_path):
+    with pytest.raises(FileNotFoundError, match="mesh file not found"):
+        read_mesh(tmp_path / "absent.obj")
+
+
+def test_reading_garbage_raises_mesh_file_error(tmp_path):
+    path = tmp_path / "garbage.ply"
+    path.write_bytes(b"\x00\x01 this is not a ply file")
+    with pytest.raises(MeshFileError, match="could not read"):
+        read_mesh(path)
+
+
+def test_reading_a_point_cloud_is_refused(tmp_path):
+    path = tmp_path / "points.off"
+    path.write_text("OFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n")
+    with pytest.raises(MeshFileError, match="3 vertices but no triangles"):
+        read_mesh(path)
+
+
+def test_reads_the_shipped_meshes_in_file_order():
+    V, F = read_mesh(data_path("terrainA_1k.obj"))
+    assert V.shape == (1089, 3) and F.shape == (2048, 3)
+    first = open(data_path("terrainA_1k.obj")).read().split("\nv ", 1)[1].split("\n", 1)[0]
+    assert np.allclose(V[0], [float(t) for t in first.split()[:3]])
+
+
+def test_save_mesh_refuses_to_overwrite(tmp_path):
+    import pymeshlab
+
+    path = tmp_path / "m.ply"
+    path.write_text("x")
+    mesh = pymeshlab.Mesh(vertex_matrix=np.eye(3), face_matrix=np.array([[0, 1, 2]], dtype=np.int32))
+    with pytest.raises(FileExistsError):
+        save_mesh(path, mesh)

@@ -1,0 +1,120 @@
+"""minimal_surface: catenoid, plane, fixed vertices, stopping rule, collapse, bad input."""
+
+import doctest
+import importlib
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from curvdetail import ConstraintError, MeshError, boundary_vertices, minimal_surface
+from curvdetail.curvature._validate import bbox_diagonal, face_double_areas
+from curvdetail.curvature.testing import cylinder, grid
+
+
+def _catenoid_parameter():
+    # a cosh(0.5 / a) = 1 has two roots; the stable (outer) catenoid is the larger, a ~ 0.848
+    a = brentq(lambda a: a * np.cosh(0.5 / a) - 1.0, 0.6, 1.0)
+    assert abs(a - 0.848) < 1e-3
+    return a
+
+
+def test_catenoid_radius_matches_cosh_profile():
+    # Two unit circles at z = +-0.5 span the catenoid r(z) = a cosh(z / a). From the 64 x 33
+    # cylinder grid the iteration's shape converges (normal step 1e-11) within 20 steps; the
+    # remaining radial error, 4.4e-4, is the cotangent discretization's (O(h^2), h ~ 0.1).
+    V, F = cylinder(radius=1.0, height=1.0, n_around=64, n_along=33)
+    X = minimal_surface(V, F, boundary_vertices(F), tol=1e-9, max_iterations=60)
+    assert X.converged
+    a = _catenoid_parameter()
+    radial_error = np.hypot(X[:, 0], X[:, 1]) - a * np.cosh(X[:, 2] / a)
+    assert np.abs(radial_error).max() < 1e-3
+
+
+def test_planar_boundary_spans_the_plane():
+    V, F = grid(9, 9)
+    V[:, 2] = V[:, 0] * (1 - V[:, 0]) * V[:, 1] * (1 - V[:, 1])
+    X = minimal_surface(V, F, boundary_vertices(F), tol=1e-12)
+    assert np.abs(X[:, 2]).max() < 1e-12
+
+
+def test_fixed_vertices_keep_their_positions(load_mesh):
+    V, F = load_mesh("mannequin_ear.obj")
+    b = boundary_vertices(F)
+    X = minimal_surface(V, F, b)
+    assert np.array_equal(X[b], V[b])
+
+
+def test_area_decreases(load_mesh):
+    # each Pinkall-Polthier step minimizes the Dirichlet energy, an upper bound of the area
+    V, F = load_mesh("mannequin_nose.obj")
+    areas = []
+    X = minimal_surface(V, F, boundary_vertices(F), max_iterations=5, tol=1e-12)
+    for k in range(1, 6):
+        Y = minimal_surface(V, F, boundary_vertices(F), max_iterations=k, tol=1e-12)
+        areas.append(face_double_areas(Y, F).sum())
+    assert np.all(np.diff([face_double_areas(V, F).sum()] + areas) < 0)
+    assert np.array_equal(Y, X)
+
+
+def test_nose_converges_with_the_default_tolerance(load_mesh):
+    # Regression: with the full step as the criterion the nose never converged (2e-4 of the
+    # diagonal after 200 steps, all of it tangential sliding); the normal step falls below the
+    # default 1e-4 after ~45 steps while vertices still slide by ~7e-4 per step.
+    V, F = load_mesh("mannequin_nose.obj")
+    X = minimal_surface(V, F, boundary_vertices(F))
+    assert X.converged and X.iterations < 200
+    assert X.last_step < 1e-4 <= X.last_full_step
+
+
+def test_callback_sees_every_step_and_the_stopping_quantity(load_mesh):
+    V, F = load_mesh("terrainA_1k.obj")
+    seen = []
+    X = minimal_surface(V, F, boundary_vertices(F), callback=lambda i, s: seen.append((i, s)))
+    assert [i for i, _ in seen] == list(range(1, X.iterations + 1))
+    assert seen[-1][1] == X.last_step < 1e-4 <= seen[-2][1]
+
+
+def test_max_iterations_stops_without_converging(load_mesh):
+    V, F = load_mesh("mannequin_nose.obj")
+    X = minimal_surface(V, F, boundary_vertices(F), max_iterations=2, tol=1e-12)
+    assert X.iterations == 2 and not X.converged and X.last_step > 1e-12
+
+
+def test_circles_too_far_apart_collapse_with_a_clear_error():
+    # no catenoid spans two unit circles more than 1.3255 apart: the neck pinches off
+    V, F = cylinder(radius=1.0, height=2.0, n_around=32, n_along=21)
+    with pytest.raises(MeshError, match=r"triangles collapsed .* no minimal surface"):
+        minimal_surface(V, F, boundary_vertices(F), max_iterations=500)
+
+
+def test_no_fixed_vertex_is_refused():
+    V, F = grid(4, 4)
+    with pytest.raises(ConstraintError, match="no fixed vertices"):
+        minimal_surface(V, F, [])
+
+
+def test_fixed_out_of_range_is_refused_with_the_index():
+    V, F = grid(4, 4)
+    with pytest.raises(ConstraintError, match=r"1 indices are outside \[0, 16\) \(first: 99\)"):
+        minimal_surface(V, F, [0, 99])
+
+
+@pytest.mark.parametrize("kwargs, pattern", [({"max_iterations": 0}, "max_iterations=0"),
+                                             ({"tol": 0.0}, "tol=0.0"), ({"tol": np.nan}, "tol=nan")])
+def test_bad_iteration_settings_are_refused(kwargs, pattern):
+    V, F = grid(4, 4)
+    with pytest.raises(ValueError, match=pattern):
+        minimal_surface(V, F, boundary_vertices(F), **kwargs)
+
+
+def test_result_is_scale_equivariant(load_mesh):
+    V, F = load_mesh("mannequin_ear.obj")
+    b = boundary_vertices(F)
+    X0 = minimal_surface(V, F, b, max_iterations=3, tol=1e-12)
+    X1 = minimal_surface(4.0 * V, F, b, max_iterations=3, tol=1e-12)
+    assert np.abs(X1 - 4.0 * X0).max() < 1e-10 * 4.0 * bbox_diagonal(V)
+
+
+def test_docstring_example_runs():
+    assert doctest.testmod(importlib.import_module("curvdetail.curvature.minimal_surface")).failed == 0

@@ -1,0 +1,111 @@
+"""sparse_solver: every installed backend solves, agrees, factors once; choice and errors."""
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from curvdetail import available_backends
+from curvdetail.curvature import sparse_solver
+from curvdetail.curvature.sparse_solver import SolverError, factorize, resolve_backend
+from curvdetail.curvature.testing import grid
+from curvdetail.curvature.cotan_laplacian import cotan_laplacian
+
+
+def _spd_system(nx=30):
+    """Free-row block of a grid Laplacian (SPD) and a known solution."""
+    V, F = grid(nx, nx)
+    V[:, 2] = np.sin(3 * V[:, 0]) * V[:, 1]
+    L = cotan_laplacian(V, F)
+    inner = np.flatnonzero((V[:, 0] > 0) & (V[:, 0] < 1) & (V[:, 1] > 0) & (V[:, 1] < 1))
+    A = L[inner][:, inner]
+    x = np.random.default_rng(3).normal(size=(inner.size, 3))
+    return A, x
+
+
+@pytest.mark.parametrize("backend", available_backends())
+def test_solves_an_spd_system_to_rounding(backend):
+    A, x = _spd_system()
+    fac = factorize(A, symmetric=True, backend=backend)
+    assert fac.backend == backend
+    # cond(A) ~ 1e3 here: the error is ~1e-13 relative
+    assert np.abs(fac.solve(A @ x) - x).max() < 1e-10 * np.abs(x).max()
+
+
+@pytest.mark.parametrize("backend", [b for b in available_backends() if b != "cholmod"])
+def test_solves_a_nonsymmetric_system(backend):
+    A, x = _spd_system()
+    A = (A + sp.diags(np.linspace(0, 0.5, A.shape[0])) @ abs(sp.triu(A, 1))).tocsr()
+    fac = factorize(A, symmetric=False, backend=backend)
+    assert np.abs(fac.solve(A @ x) - x).max() < 1e-10 * np.abs(x).max()
+
+
+@pytest.mark.parametrize("backend", available_backends())
+def test_backends_agree_with_splu(backend):
+    A, x = _spd_system(45)
+    b = A @ x
+    ref = factorize(A, backend="splu").solve(b)
+    assert np.abs(factorize(A, backend=backend).solve(b) - ref).max() < 1e-9 * np.abs(ref).max()
+
+
+@pytest.mark.parametrize("backend", available_backends())
+def test_solve_keeps_the_shape_of_the_right_hand_side(backend):
+    A, x = _spd_system(12)
+    fac = factorize(A, backend=backend)
+    assert fac.solve(A @ x[:, 0]).shape == (A.shape[0],)
+    assert fac.solve(A @ x).shape == x.shape
+
+
+def test_factorization_is_counted_once_and_solves_are_not():
+    A, x = _spd_system(12)
+    before = sparse_solver.factorization_count
+    fac = factorize(A)
+    for _ in range(5):
+        fac.solve(A @ x)
+    assert sparse_solver.factorization_count == before + 1
+
+
+def test_auto_picks_splu_for_small_systems():
+    assert resolve_backend("auto", size=sparse_solver.SMALL_SYSTEM - 1) == "splu"
+    assert resolve_backend("auto", size=sparse_solver.SMALL_SYSTEM) == available_backends()[0]
+
+
+def test_environment_variable_overrides_auto(monkeypatch):
+    monkeypatch.setenv("CURVDETAIL_SOLVER", "splu")
+    assert resolve_backend("auto", size=10 ** 6) == "splu"
+
+
+def test_unknown_backend_is_refused_with_the_choices():
+    with pytest.raises(SolverError, match="unknown solver backend 'umfpack'.*pardiso, cholmod, splu"):
+        resolve_backend("umfpack")
+
+
+def test_missing_backend_is_refused_with_the_install_hint(monkeypatch):
+    monkeypatch.setattr(sparse_solver, "_has_cholmod", lambda: False)
+    with pytest.raises(SolverError, match="'cholmod' is not installed; install SuiteSparse"):
+        resolve_backend("cholmod")
+
+
+def test_cholmod_is_refused_for_nonsymmetric_systems(monkeypatch):
+    monkeypatch.setattr(sparse_solver, "_has_cholmod", lambda: True)
+    with pytest.raises(SolverError, match="symmetric positive definite"):
+        resolve_backend("cholmod", symmetric=False)
+
+
+def test_singular_matrix_is_reported_not_returned_as_nan():
+    A, _ = _spd_system(8)
+    A = A.tolil()
+    A[3, :] = 0.0
+    A[:, 3] = 0.0
+    with pytest.raises(SolverError, match="singular"):
+        factorize(A.tocsr(), backend="splu").solve(np.ones(A.shape[0]))
+
+
+def test_non_square_matrix_is_refused():
+    with pytest.raises(SolverError, match=r"non-square matrix of shape \(3, 4\)"):
+        factorize(sp.eye(3, 4))
+
+
+def test_right_hand_side_of_the_wrong_length_is_refused():
+    A, _ = _spd_system(8)
+    with pytest.raises(SolverError, match=f"right-hand side has 5 rows; the matrix has {A.shape[0]}"):
+        factorize(A).solve(np.ones(5))

@@ -1,0 +1,175 @@
+"""Input checks (_validate): every bad-input class gets its error class and a message that names
+the count and the first offending indices; good input comes back as float64 / int64."""
+
+import numpy as np
+import pytest
+
+from curvdetail import (ConstraintError, MeshError, check_mesh, cotan_laplacian, curvature_detail,
+                        mean_curvature_normal, minimal_surface, mixed_voronoi_area, reconstruct)
+from curvdetail.curvature import boundary_edges, boundary_vertices
+from curvdetail.curvature._validate import as_index_set, as_values, vertex_components
+from curvdetail.curvature.testing import grid, icosphere
+
+OPERATORS = [cotan_laplacian, mixed_voronoi_area, mean_curvature_normal, curvature_detail]
+
+
+def _square():
+    V, F = grid(3, 3)       # 9 vertices, 8 triangles
+    return V, F
+
+
+@pytest.mark.parametrize("op", OPERATORS)
+def test_empty_vertices_are_refused(op):
+    with pytest.raises(MeshError, match=r"V is empty \(0 vertices\)"):
+        op(np.zeros((0, 3)), np.zeros((0, 3), dtype=int))
+
+
+def test_empty_faces_are_refused():
+    V, _ = _square()
+    with pytest.raises(MeshError, match=r"F is empty \(0 triangles\)"):
+        cotan_laplacian(V, np.zeros((0, 3), dtype=int))
+
+
+@pytest.mark.parametrize("shape", [(9, 2), (9,), (9, 3, 1)])
+def test_vertex_array_of_the_wrong_shape_is_refused(shape):
+    _, F = _square()
+    with pytest.raises(MeshError, match=r"V has shape .*; vertex positions must be an \(n, 3\) array"):
+        cotan_laplacian(np.zeros(shape), F)
+
+
+def test_quad_faces_are_refused():
+    V, _ = _square()
+    with pytest.raises(MeshError, match=r"F has shape \(1, 4\); triangles must be an \(m, 3\)"):
+        cotan_laplacian(V, np.array([[0, 1, 4, 3]]))
+
+
+@pytest.mark.parametrize("bad", [np.array([["a", "b", "c"]] * 9), np.ones((9, 3), dtype=complex)])
+def test_non_real_vertices_are_refused(bad):
+    _, F = _square()
+    with pytest.raises(MeshError, match="dtype"):
+        cotan_laplacian(bad, F)
+
+
+def test_ragged_input_is_refused():
+    with pytest.raises(MeshError, match="could not be read as an array"):
+        cotan_laplacian([[0, 0, 0], [1, 0]], [[0, 1, 2]])
+
+
+def test_fractional_face_indices_are_refused():
+    V, F = _square()
+    with pytest.raises(MeshError, match="non-integer entries"):
+        cotan_laplacian(V, F + 0.5)
+
+
+def test_integral_float_faces_and_integer_vertices_are_accepted():
+    V, F = _square()
+    V2, F2 = check_mesh((2 * V).astype(np.int32), F.astype(np.float32))   # coordinates 0, 1, 2
+    assert V2.dtype == np.float64 and F2.dtype == np.int64 and np.array_equal(F2, F)
+
+
+@pytest.mark.parametrize("value", [np.nan, np.inf, -np.inf])
+def test_non_finite_coordinates_are_refused_with_the_vertices(value):
+    V, F = _square()
+    V[[2, 7], 1] = value
+    with pytest.raises(MeshError, match=r"2 vertices have NaN or infinite coordinates \(first: 2, 7\)"):
+        mean_curvature_normal(V, F)
+
+
+def test_out_of_range_face_indices_are_refused_with_the_faces():
+    V, F = _square()
+    F[5, 0] = 9
+    F[6, 2] = -1
+    with pytest.raises(MeshError, match=r"2 triangles have vertex indices outside \[0, 9\) \(first: 5, 6\)"):
+        cotan_laplacian(V, F)
+
+
+def test_repeated_index_in_a_face_is_refused_with_the_face():
+    V, F = _square()
+    F[4] = [3, 4, 3]
+    with pytest.raises(MeshError, match=r"1 triangles repeat a vertex index \(first: 4\)"):
+        mixed_voronoi_area(V, F)
+
+
+def test_zero_area_faces_are_refused_with_the_faces():
+    V, F = _square()
+    V[4] = V[0] + 0.5 * (V[1] - V[0])         # centre vertex onto the bottom edge, between 0 and 1
+    bad = np.flatnonzero(np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1) == 0)
+    assert bad.size >= 1
+    with pytest.raises(MeshError, match=rf"{bad.size} triangles have zero area \(first: {bad[0]}"):
+        cotan_laplacian(V, F)
+
+
+def test_non_manifold_edge_is_refused_with_the_edge():
+    V, F = _square()
+    V = np.vstack([V, [0.25, 0.25, 1.0]])     # a fin on the interior diagonal (0, 4)
+    F = np.vstack([F, [0, 4, 9]])
+    with pytest.raises(MeshError, match=r"1 edges are shared by more than two triangles \(first: \(0, 4\)\)"):
+        cotan_laplacian(V, F)
+
+
+def test_unreferenced_vertices_are_refused_with_the_vertices():
+    V, F = _square()
+    V = np.vstack([V, [[5.0, 5, 5], [6.0, 6, 6]]])
+    with pytest.raises(MeshError, match=r"2 vertices are not used by any triangle \(first: 9, 10\)"):
+        curvature_detail(V, F)
+
+
+def test_component_without_fixed_vertex_is_refused():
+    V, F = _square()
+    V2 = np.vstack([V, V + [3.0, 0, 0]])
+    F2 = np.vstack([F, F + 9])
+    with pytest.raises(ConstraintError, match=r"1 of 2 connected components have no fixed vertex .*vertex 9"):
+        reconstruct(V2, F2, np.zeros_like(V2), [0], V2[[0]])
+    with pytest.raises(ConstraintError, match=r"vertex 9"):
+        minimal_surface(V2, F2, [0, 1, 2])
+
+
+def test_fixed_indices_out_of_range_and_repeated_are_named():
+    with pytest.raises(ConstraintError, match=r"2 indices are outside \[0, 9\) \(first: 9, -3\)"):
+        as_index_set([0, 9, -3], 9, "fixed")
+    with pytest.raises(ConstraintError, match=r"1 indices are repeated \(first: 4\)"):
+        as_index_set([4, 1, 4], 9, "fixed")
+    with pytest.raises(ConstraintError, match=r"dtype float64; pass integer"):
+        as_index_set([0.5], 9, "fixed")
+
+
+def test_index_set_keeps_the_callers_order_and_reads_masks():
+    assert as_index_set([5, 0, 3], 9, "fixed").tolist() == [5, 0, 3]
+    mask = np.zeros(9, dtype=bool)
+    mask[[7, 2]] = True
+    assert as_index_set(mask, 9, "fixed").tolist() == [2, 7]
+
+
+def test_values_of_the_wrong_shape_or_non_finite_are_named():
+    with pytest.raises(ConstraintError, match=r"detail has shape \(4, 2\); expected \(4, 3\)"):
+        as_values(np.zeros((4, 2)), 4, "detail")
+    bad = np.zeros((4, 3))
+    bad[3, 0] = np.nan
+    with pytest.raises(ConstraintError, match=r"1 rows are NaN or infinite \(first: 3\)"):
+        as_values(bad, 4, "detail")
+
+
+def test_errors_are_value_errors():
+    assert issubclass(MeshError, ValueError) and issubclass(ConstraintError, ValueError)
+
+
+def test_boundary_of_a_grid_is_its_rim_oriented_as_in_the_faces():
+    V, F = grid(5, 4)
+    E = boundary_edges(F)
+    assert E.shape == (2 * (5 - 1) + 2 * (4 - 1), 2)
+    # each boundary edge appears in a face with the same orientation
+    directed = {tuple(e) for f in F for e in ((f[0], f[1]), (f[1], f[2]), (f[2], f[0]))}
+    assert all(tuple(e) in directed for e in E)
+    rim = np.flatnonzero((V[:, 0] == 0) | (V[:, 0] == 1) | (V[:, 1] == 0) | (V[:, 1] == 1))
+    assert np.array_equal(boundary_vertices(F), rim)
+
+
+def test_closed_surface_has_no_boundary():
+    _, F = icosphere(subdivisions=1)
+    assert boundary_edges(F).shape == (0, 2) and boundary_vertices(F).size == 0
+
+
+def test_components_are_labelled():
+    V, F = _square()
+    labels, count = vertex_components(np.vstack([F, F + 9]), 18)
+    assert count == 2 and len(set(labels[:9])) == 1 and labels[0] != labels[9]
