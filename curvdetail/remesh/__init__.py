@@ -1,0 +1,20 @@
+"""The remeshing experiment of the paper's Fig. 3: retriangulate a disk patch, carry its
+curvature detail to the new triangulation, rebuild it from that detail, and measure.
+
+Depends on :mod:`curvdetail.curvature` (operators and solvers), pymeshlab (isotropic remeshing,
+closest-face grid, Hausdorff distance) and fast-simplification (decimation).
+"""
+
+from ._disk import NotADiskError, RemeshError
+from .evaluate import hausdorff, vertex_distance
+from .experiment import remesh_experiment
+from .locate import interpolate, locate, spread
+from .parameterize import flipped_triangles, harmonic_map, parameterize
+from .retriangulate import retriangulate
+from .transfer import edge_curvature_measure, transfer_curvature
+
+__all__ = [
+    "NotADiskError", "RemeshError", "edge_curvature_measure", "flipped_triangles", "harmonic_map",
+    "hausdorff", "interpolate", "locate", "parameterize", "remesh_experiment", "retriangulate", "spread",
+    "transfer_curvature", "vertex_distance",
+]

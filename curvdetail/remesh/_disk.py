@@ -1,0 +1,149 @@
+"""Disk-topology checks, the ordered boundary loop, and projection onto the boundary polyline.
+
+Private helpers of :mod:`curvdetail.remesh`. A *disk* here is a triangle mesh that is one
+connected, edge- and vertex-manifold piece with exactly one boundary loop and Euler
+characteristic 1 (no handles).
+"""
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+from scipy.spatial import cKDTree
+
+from ..curvature._validate import (bbox_diagonal, boundary_edges, check_mesh, non_manifold_edges,
+                                   undirected_edges, vertex_components)
+from ..curvature.errors import MeshError, first_indices
+
+
+class NotADiskError(MeshError):
+    """The mesh is not a disk-topology patch (one piece, one boundary loop, no handles)."""
+
+
+class RemeshError(ValueError):
+    """A remeshing option is out of range (e.g. a target edge length giving absurd sizes) or a
+    remesher produced an unusable result."""
+
+
+def check_disk(V, F, what="the source"):
+    """Validate ``(V, F)`` as a disk and return ``(V, F, loop)``.
+
+    ``loop`` is the boundary as an ordered (k,) vertex index array, oriented as the faces
+    (the mesh lies to the left when walking it with the normals up) and starting at its
+    smallest vertex index.
+
+    Raises
+    ------
+    MeshError        malformed mesh (shapes, NaN, zero-area or non-manifold edges, ...)
+    NotADiskError    closed, several boundary loops, several pieces, a pinched boundary vertex
+                     or handles; the message says what was found and what is needed
+    """
+    need = ("a disk-topology patch is needed: one connected piece with exactly one boundary loop "
+            "and no handles (cut one out, e.g. with pymeshlab's compute_selection_by_condition_per_"
+            "vertex + meshing_remove_selected_vertices, and keep its largest piece)")
+    nm = None
+    try:
+        V, F = check_mesh(V, F)
+    except MeshError as exc:
+        nm = non_manifold_edges(np.asarray(F, dtype=np.int64)) if np.asarray(F).ndim == 2 else None
+        if nm is not None and nm.shape[0]:
+            pairs = ", ".join(f"({a}, {b})" for a, b in nm[:3])
+            raise NotADiskError(f"{what} is not manifold: {nm.shape[0]} edges are shared by more than "
+                                f"two triangles (first: {pairs}); {need}.") from None
+        raise
+    n = V.shape[0]
+    _, pieces = vertex_components(F, n)
+    if pieces > 1:
+        raise NotADiskError(f"{what} has {pieces} separate pieces; {need}.")
+    B = boundary_edges(F)
+    if B.shape[0] == 0:
+        raise NotADiskError(f"{what} is closed (0 boundary loops); {need}.")
+    out_deg = np.bincount(B[:, 0], minlength=n)
+    in_deg = np.bincount(B[:, 1], minlength=n)
+    pinched = np.flatnonzero((out_deg > 1) | (in_deg > 1))
+    if pinched.size:
+        raise NotADiskError(f"{what} is not vertex-manifold: the boundary passes {pinched.size} vertices "
+                            f"more than once (first: {first_indices(pinched)}); {need}.")
+    G = sp.coo_matrix((np.ones(B.shape[0]), (B[:, 0], B[:, 1])), shape=(n, n))
+    on_boundary = np.zeros(n, dtype=bool)
+    on_boundary[B.ravel()] = True
+    _, labels = connected_components(G, directed=False)
+    loops = np.unique(labels[on_boundary]).size
+    if loops != 1:
+        raise NotADiskError(f"{what} has {loops} boundary loops (holes); {need}.")
+    n_edges = np.unique(undirected_edges(F), axis=0).shape[0]
+    chi = n - n_edges + F.shape[0]
+    if chi != 1:
+        raise NotADiskError(f"{what} has one boundary loop but Euler characteristic {chi} "
+                            f"({(1 - chi) // 2} handles); {need}.")
+    return V, F, _order_loop(B, n)
+
+
+def _order_loop(B, n):
+    """Order the single boundary loop given by its oriented edges (a walk of length k; the
+    boundary has O(sqrt(n)) vertices, so the short Python walk is not a hot path)."""
+    nxt = np.full(n, -1, dtype=np.int64)
+    nxt[B[:, 0]] = B[:, 1]
+    start = int(B[:, 0].min())
+    loop = np.empty(B.shape[0], dtype=np.int64)
+    v = start
+    for i in range(B.shape[0]):
+        loop[i] = v
+        v = int(nxt[v])
+    return loop
+
+
+def boundary_loop(F):
+    """Ordered boundary loop of a disk (no checks beyond a single loop)."""
+    F = np.asarray(F, dtype=np.int64)
+    return _order_loop(boundary_edges(F), int(F.max()) + 1)
+
+
+class Polyline:
+    """A closed polyline (the source boundary) with arc-length coordinates and projection.
+
+    Parameters
+    ----------
+    P : (k, 3) float array   the loop's points in order (closed: the last joins the first)
+    """
+
+    def __init__(self, P):
+        self.P = np.asarray(P, dtype=np.float64)
+        self.Q = np.roll(self.P, -1, axis=0)
+        seg = self.Q - self.P
+        self.length = np.linalg.norm(seg, axis=1)
+        self.s0 = np.concatenate([[0.0], np.cumsum(self.length)[:-1]])
+        self.total = float(self.length.sum())
+        self._tree = cKDTree(0.5 * (self.P + self.Q))
+
+    def project(self, X, k=8):
+        """Closest points on the polyline.
+
+        Returns ``(Y, s, dist)``: projected points (m, 3), arc-length coordinate in [0, total)
+        from the first point, and distance from ``X`` (m,).
+        """
+        X = np.asarray(X, dtype=np.float64)
+        k = min(k, self.P.shape[0])
+        _, cand = self._tree.query(X, k=k)
+        cand = cand.reshape(X.shape[0], k)
+        A, B = self.P[cand], self.Q[cand]
+        AB = B - A
+        denom = np.maximum((AB * AB).sum(-1), np.finfo(float).tiny)
+        t = np.clip(((X[:, None, :] - A) * AB).sum(-1) / denom, 0.0, 1.0)
+        Y = A + t[..., None] * AB
+        d = np.linalg.norm(Y - X[:, None, :], axis=-1)
+        best = np.argmin(d, axis=1)
+        r = np.arange(X.shape[0])
+        seg = cand[r, best]
+        s = np.mod(self.s0[seg] + t[r, best] * self.length[seg], self.total)
+        return Y[r, best], s, d[r, best]
+
+    def point_at(self, s):
+        """Points at arc-length coordinates ``s`` (m,)."""
+        s = np.mod(np.asarray(s, dtype=np.float64), self.total)
+        seg = np.clip(np.searchsorted(self.s0, s, side="right") - 1, 0, self.P.shape[0] - 1)
+        t = (s - self.s0[seg]) / np.maximum(self.length[seg], np.finfo(float).tiny)
+        return self.P[seg] + t[:, None] * (self.Q[seg] - self.P[seg])
+
+
+def diag(V):
+    return bbox_diagonal(np.asarray(V, dtype=np.float64))

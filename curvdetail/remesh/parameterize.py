@@ -1,0 +1,156 @@
+"""Map a source patch and its retriangulation onto one planar domain (paper Fig. 3, step 2)."""
+
+import numpy as np
+
+from ..curvature.cotan_laplacian import _cotan_laplacian_unchecked
+from ..curvature.sparse_solver import factorize
+from ._disk import Polyline, check_disk
+
+METHODS = ("harmonic", "meshlab_harmonic", "lscm")
+
+
+def flipped_triangles(UV, F):
+    """Indices of triangles whose orientation in the plane is reversed or degenerate (signed area
+    <= 0 relative to the orientation of the majority, by area), shape (k,)."""
+    UV = np.asarray(UV, dtype=np.float64)
+    a, b, c = UV[F[:, 0]], UV[F[:, 1]], UV[F[:, 2]]
+    signed = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
+    orientation = 1.0 if signed.sum() >= 0 else -1.0
+    return np.flatnonzero(orientation * signed <= 0)
+
+
+def harmonic_map(V, F, boundary, boundary_uv, *, backend="auto"):
+    """Cotangent harmonic map with the boundary pinned: ``L_II U_I = -L_IB U_B``.
+
+    Parameters
+    ----------
+    V : (n, 3) float array          vertex positions (supply the cotangent weights)
+    F : (m, 3) int array            triangles
+    boundary : (k,) int array       pinned vertices
+    boundary_uv : (k, 2) float      their planar positions
+    backend : str                   sparse solver backend (one factorization, two right-hand sides)
+
+    Returns
+    -------
+    UV : (n, 2) float array
+    """
+    n = V.shape[0]
+    L = _cotan_laplacian_unchecked(V, F).tocsr()
+    is_b = np.zeros(n, dtype=bool)
+    is_b[boundary] = True
+    inner = np.flatnonzero(~is_b)
+    UV = np.empty((n, 2))
+    UV[boundary] = boundary_uv
+    if inner.size:
+        rhs = -(L[inner][:, boundary] @ boundary_uv)
+        UV[inner] = factorize(L[inner][:, inner], symmetric=True, backend=backend).solve(rhs)
+    return UV
+
+
+def circle(s, total):
+    """Points on the unit circle at arc-length fractions ``s / total`` (counter-clockwise)."""
+    t = 2.0 * np.pi * np.asarray(s, dtype=np.float64) / total
+    return np.column_stack([np.cos(t), np.sin(t)])
+
+
+def parameterize(Vs, Fs, Vt=None, Ft=None, *, method="harmonic", backend="auto"):
+    """Planar parameterization of a source disk and (optionally) its retriangulation on one domain.
+
+    The source boundary loop is walked from a common anchor (its smallest vertex index) and
+    mapped to the unit circle by arc length; every target boundary vertex, which lies on the
+    source boundary polyline, goes to the circle point of its arc-length coordinate on that same
+    polyline, so both boundaries agree exactly. Interiors:
+
+    ``"harmonic"``         own cotangent harmonic map (one sparse factorization per mesh);
+    ``"meshlab_harmonic"`` pymeshlab ``compute_texcoord_parametrization_harmonic``;
+    ``"lscm"``             pymeshlab least-squares conformal maps (free boundary).
+
+    The pymeshlab maps are made independently per mesh (UVs come back as float32 and only the
+    longest boundary loop is mapped), so the target's map is aligned to the source's by the
+    similarity that best fits the boundary correspondence (least squares). Flipped triangles
+    (negative signed area in the plane) are detected and counted, not repaired: a cotangent
+    map can flip triangles with obtuse angles.
+
+    Parameters
+    ----------
+    Vs, Fs : source mesh (a disk)
+    Vt, Ft : target mesh whose boundary vertices lie on the source boundary polyline, or None
+    method : {"harmonic", "meshlab_harmonic", "lscm"}
+    backend : str   sparse solver backend for ``"harmonic"``
+
+    Returns
+    -------
+    UVs : (n_s, 2) float array     source domain positions
+    UVt : (n_t, 2) float array or None
+    info : dict                    ``flipped_source``, ``flipped_target`` (counts) and
+                                   ``boundary_mismatch`` (largest distance, in the domain, between a
+                                   target boundary vertex and the source boundary curve there)
+
+    Raises
+    ------
+    MeshError, NotADiskError   either mesh malformed or not a disk
+    ValueError                 unknown method
+
+    Examples
+    --------
+    >>> from curvdetail.curvature.testing import disk
+    >>> V, F = disk(n_rings=6); V[:, 2] = (V[:, :2] ** 2).sum(1)
+    >>> UV, _, info = parameterize(V, F)
+    >>> bool(abs(np.linalg.norm(UV, axis=1).max() - 1.0) < 1e-12), info["flipped_source"]
+    (True, 0)
+    """
+    if method not in METHODS:
+        raise ValueError(f"method={method!r} is not a parameterization; use one of {', '.join(METHODS)}.")
+    Vs, Fs, loop_s = check_disk(Vs, Fs, "the source")
+    poly = Polyline(Vs[loop_s])
+    s_src = poly.s0
+    info = {"method": method}
+    if method == "harmonic":
+        UVs = harmonic_map(Vs, Fs, loop_s, circle(s_src, poly.total), backend=backend)
+    else:
+        UVs = _meshlab_uv(Vs, Fs, method)
+    info["flipped_source"] = int(flipped_triangles(UVs, Fs).size)
+    if Vt is None:
+        return UVs, None, info
+    Vt, Ft, loop_t = check_disk(Vt, Ft, "the target")
+    _, s_t, _ = poly.project(Vt[loop_t])
+    if method == "harmonic":
+        UVt = harmonic_map(Vt, Ft, loop_t, circle(s_t, poly.total), backend=backend)
+        expected = circle(s_t, poly.total)
+    else:
+        UVt = _meshlab_uv(Vt, Ft, method)
+        # where the source's own map puts the target boundary points (along its boundary)
+        seg = np.clip(np.searchsorted(poly.s0, s_t, side="right") - 1, 0, loop_s.size - 1)
+        t = (s_t - poly.s0[seg]) / np.maximum(poly.length[seg], np.finfo(float).tiny)
+        expected = (1 - t)[:, None] * UVs[loop_s[seg]] + t[:, None] * UVs[loop_s[(seg + 1) % loop_s.size]]
+        UVt = _fit_similarity(UVt[loop_t], expected, UVt)
+    info["flipped_target"] = int(flipped_triangles(UVt, Ft).size)
+    info["boundary_mismatch"] = float(np.linalg.norm(UVt[loop_t] - expected, axis=1).max())
+    return UVs, UVt, info
+
+
+def _meshlab_uv(V, F, method):
+    import pymeshlab
+
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=V, face_matrix=F.astype(np.int32)))
+    if method == "meshlab_harmonic":
+        ms.compute_texcoord_parametrization_harmonic(harm_function=1)
+    else:
+        ms.compute_texcoord_parametrization_least_squares_conformal_maps()
+    m = ms.current_mesh()
+    if m.vertex_number() != V.shape[0]:
+        raise ValueError(f"pymeshlab's {method} map changed the vertex count ({V.shape[0]} -> "
+                         f"{m.vertex_number()}); use method='harmonic'.")
+    return np.array(m.vertex_tex_coord_matrix(), dtype=np.float64)
+
+
+def _fit_similarity(X, Y, apply_to):
+    """Least-squares similarity (rotation, reflection allowed, uniform scale, shift) taking
+    points ``X`` (k, 2) to ``Y`` (k, 2), applied to ``apply_to``."""
+    mx, my = X.mean(0), Y.mean(0)
+    Xc, Yc = X - mx, Y - my
+    U, S, Wt = np.linalg.svd(Xc.T @ Yc)
+    R = U @ Wt
+    scale = S.sum() / max((Xc ** 2).sum(), np.finfo(float).tiny)
+    return (apply_to - mx) @ R * scale + my

@@ -1,0 +1,161 @@
+"""Retriangulate a disk-topology patch, keeping its boundary curve (paper Fig. 3, step 1)."""
+
+import numpy as np
+
+from ._disk import NotADiskError, Polyline, RemeshError, check_disk, diag
+
+METHODS = ("isotropic", "decimate")
+
+#: The target edge length is refused when it would give fewer / more target vertices than this.
+MIN_VERTICES, MAX_VERTICES = 50, 5_000_000
+
+#: A boundary vertex of the remesher's result further than this (x bbox diagonal) from the source
+#: boundary polyline is an error; closer ones are projected onto the polyline.
+BOUNDARY_SNAP = 1e-6
+
+
+def estimated_vertices(V, F, target_edge):
+    """Vertices of an equilateral triangulation of the surface with edges ``target_edge`` (absolute
+    length): ``2 area / (sqrt(3) h^2)``."""
+    V = np.asarray(V, dtype=np.float64)
+    F = np.asarray(F, dtype=np.int64)
+    area = 0.5 * np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1).sum()
+    return 2.0 * area / (np.sqrt(3.0) * target_edge ** 2)
+
+
+def retriangulate(V, F, *, method="isotropic", target_edge=0.01, iterations=10, max_surface_distance=None,
+                  aggressiveness=7.0):
+    """Retriangulate a disk-topology patch; every boundary vertex of the result stays on the
+    source's boundary polyline.
+
+    Parameters
+    ----------
+    V : (n, 3) float array     source vertex positions
+    F : (m, 3) int array       source triangles (a disk: one piece, one boundary loop, no handles)
+    method : {"isotropic", "decimate"}
+        ``"isotropic"``: pymeshlab ``meshing_isotropic_explicit_remeshing`` (split, collapse,
+        flip, smooth, reproject) at the target edge length, every parameter passed explicitly.
+        ``"decimate"``: ``fast_simplification.simplify(..., preserve_border=True)`` (quadric edge
+        collapse that never touches a boundary vertex) down to the triangle count of an
+        equilateral mesh with the target edge length; it can only coarsen.
+    target_edge : float
+        target edge length as a fraction of the source's bounding-box diagonal (0.01 = 1 %).
+    iterations : int
+        isotropic remeshing iterations.
+    max_surface_distance : float or None
+        isotropic only: the largest distance (fraction of the bbox diagonal) an edge collapse or
+        flip may move the surface; ``None`` = ``target_edge``.
+    aggressiveness : float
+        decimation only: fast-simplification's ``agg`` (lower keeps the shape better, slower);
+        if the result is not a disk it is retried at lower values.
+
+    Returns
+    -------
+    Vt : (p, 3) float array    target vertex positions; boundary vertices lie on the source's
+                               boundary polyline (projected onto it, within 1e-12 of the bbox diagonal)
+    Ft : (q, 3) int array      target triangles, a disk, oriented as the source
+
+    Raises
+    ------
+    MeshError, NotADiskError   the source is malformed or not a disk (says what was found)
+    RemeshError                unknown method, a target edge length that would give fewer than
+                               50 or more than 5,000,000 vertices (the numbers are given), a
+                               decimation asked to refine, or a remesher result that is not a disk
+                               or moved the boundary
+
+    Examples
+    --------
+    >>> from curvdetail.curvature.testing import disk
+    >>> V, F = disk(n_rings=12); V[:, 2] = 0.2 * (1 - (V[:, :2] ** 2).sum(1))
+    >>> Vt, Ft = retriangulate(V, F, method="isotropic", target_edge=0.05)
+    >>> 50 < Vt.shape[0] < 5000
+    True
+    """
+    if method not in METHODS:
+        raise RemeshError(f"method={method!r} is not a retriangulation method; use 'isotropic' or 'decimate'.")
+    V, F, loop = check_disk(V, F, "the source")
+    d = diag(V)
+    try:
+        target_edge = float(target_edge)
+    except (TypeError, ValueError):
+        raise RemeshError(f"target_edge={target_edge!r} is not a number; give a fraction of the bbox "
+                          "diagonal, e.g. 0.01 for 1 %.") from None
+    if not np.isfinite(target_edge) or target_edge <= 0:
+        raise RemeshError(f"target_edge={target_edge!r} must be a positive fraction of the bbox diagonal "
+                          "(e.g. 0.01 for 1 %).")
+    h = target_edge * d
+    n_est = estimated_vertices(V, F, h)
+    if n_est < MIN_VERTICES or n_est > MAX_VERTICES:
+        side = "fewer than" if n_est < MIN_VERTICES else "more than"
+        limit = MIN_VERTICES if n_est < MIN_VERTICES else MAX_VERTICES
+        raise RemeshError(
+            f"target edge {100 * target_edge:.4g} % of the bbox diagonal ({h:.4g}) would give about "
+            f"{n_est:,.0f} target vertices, {side} {limit:,}; choose a target edge between "
+            f"{100 * target_edge * np.sqrt(n_est / MAX_VERTICES):.3g} % and "
+            f"{100 * target_edge * np.sqrt(n_est / MIN_VERTICES):.3g} % for this "
+            f"{V.shape[0]:,}-vertex patch.")
+    if method == "isotropic":
+        surf = target_edge if max_surface_distance is None else float(max_surface_distance)
+        Vt, Ft = _isotropic(V, F, h, int(iterations), surf * d)
+        try:
+            Vt, Ft, loop_t = check_disk(Vt, Ft, "the isotropic remesher's result")
+        except NotADiskError as exc:
+            raise RemeshError(f"{exc} Try another target edge.") from None
+    else:
+        Vt, Ft, loop_t = _decimate(V, F, h, float(aggressiveness))
+    return _snap_boundary(V, loop, Vt, Ft, loop_t, d)
+
+
+def _isotropic(V, F, h, iterations, max_dist):
+    import pymeshlab
+
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=V, face_matrix=F.astype(np.int32)))
+    # Every parameter explicitly: pymeshlab keeps values from earlier calls in one process.
+    ms.meshing_isotropic_explicit_remeshing(
+        iterations=iterations, adaptive=False, selectedonly=False, targetlen=pymeshlab.PureValue(h),
+        featuredeg=30.0, checksurfdist=True, maxsurfdist=pymeshlab.PureValue(max_dist),
+        splitflag=True, collapseflag=True, swapflag=True, smoothflag=True, reprojectflag=True)
+    ms.meshing_remove_unreferenced_vertices()
+    m = ms.current_mesh()
+    return np.array(m.vertex_matrix(), dtype=np.float64), np.array(m.face_matrix(), dtype=np.int64)
+
+
+def _decimate(V, F, h, agg):
+    import fast_simplification
+
+    area = 0.5 * np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1).sum()
+    target_faces = int(round(area / (np.sqrt(3.0) / 4.0 * h * h)))
+    if target_faces >= F.shape[0]:
+        raise RemeshError(
+            f"decimation can only coarsen: the target edge asks for about {target_faces:,} triangles "
+            f"but the source has {F.shape[0]:,}; give a longer target edge or use method='isotropic'.")
+    last = None
+    for a in (agg, min(agg, 3.0), 1.0):
+        P, T = fast_simplification.simplify(V, F.astype(np.int32), target_count=max(target_faces, 4), agg=a,
+                                            verbose=False, return_collapses=False, lossless=False,
+                                            preserve_border=True)
+        P = np.asarray(P, dtype=np.float64)
+        T = np.asarray(T, dtype=np.int64)
+        used = np.zeros(P.shape[0], dtype=bool)
+        used[T.ravel()] = True
+        remap = np.cumsum(used) - 1
+        P, T = P[used], remap[T]
+        try:
+            return check_disk(P, T, "the decimated mesh")
+        except ValueError as exc:  # a non-manifold edge or a zero-area triangle at high agg
+            last = exc
+    raise RemeshError(f"{last} (decimation with agg={agg}, 3 and 1); try method='isotropic'.")
+
+
+def _snap_boundary(V, loop, Vt, Ft, loop_t, d):
+    poly = Polyline(V[loop])
+    Y, _, dist = poly.project(Vt[loop_t])
+    far = np.flatnonzero(dist > BOUNDARY_SNAP * d)
+    if far.size:
+        raise RemeshError(
+            f"the remesher moved {far.size} boundary vertices off the source boundary (largest "
+            f"{dist.max() / d:.2e} of the bbox diagonal, first: {', '.join(map(str, loop_t[far[:3]]))}).")
+    Vt = Vt.copy()
+    Vt[loop_t] = Y
+    return Vt, Ft
