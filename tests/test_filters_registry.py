@@ -10,10 +10,12 @@ from curvdetail.filters import Parameter, UnknownFilterError, get_filter, list_f
 from curvdetail.filters.parameters import TYPES
 from curvdetail.filters.registry import FAMILIES, filter as declare
 
-CORE_FILTERS = {"compute_curvature_detail", "apply_curvature_reconstruction", "generate_minimal_surface"}
+CORE_FILTERS = {"compute_curvature_detail", "apply_curvature_reconstruction", "generate_minimal_surface",
+                "transfer_curvature_detail", "generate_curvature_remeshing",
+                "get_curvature_reconstruction_error"}
 
 
-def test_core_filters_are_registered():
+def test_issue_filters_are_registered():
     assert CORE_FILTERS <= {spec.name for spec in list_filters()}
 
 

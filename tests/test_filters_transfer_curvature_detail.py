@@ -60,7 +60,7 @@ def test_transfer_onto_an_identical_copy_rebuilds_the_source():
 
 
 def test_remeshed_nose_rebuilt_from_transferred_detail_is_close():
-    # measured on this 2 % remeshing: RMS 0.02-0.03 % of the diagonal (conservative, closest);
+    # measured on this 2 % remeshing (1427 vertices): RMS 0.035 %, max 0.31 % of the diagonal;
     # the paper's claim is that detail survives retriangulation: allow 0.1 % RMS, 1 % max
     ms = remeshed_nose()
     apply(ms, "transfer_curvature_detail")

@@ -41,9 +41,8 @@ from .registry import PAPER, filter
     ],
 )
 def transfer_curvature_detail(ms, *, sourcemesh, targetmesh, method, location, parameterization):
-    from ..remesh._disk import check_disk
-    from ..remesh.parameterize import parameterize
-    from ..remesh.transfer import transfer_curvature
+    from ..remesh import parameterize, transfer_curvature
+    from ..remesh._disk import check_disk          # not exported by curvdetail.remesh (yet)
 
     source = layer_id(ms, sourcemesh, "sourcemesh")
     target = layer_id(ms, targetmesh, "targetmesh")
