@@ -8,6 +8,7 @@ from .curvature import (ConstraintError, MeshError, Reconstructor, SolverError, 
                         boundary_edges, boundary_vertices, check_mesh, cotan_laplacian,
                         curvature_detail, mean_curvature_normal, minimal_surface,
                         mixed_voronoi_area, reconstruct)
+from .curvature import CurvatureEditor, curvature_coefficients, edit_boundary, sine_displacement
 from .io import read_mesh, write_mesh
 
 __version__ = "0.1.0"
@@ -17,4 +18,6 @@ __all__ = [
     "boundary_edges", "boundary_vertices", "check_mesh", "cotan_laplacian", "curvature_detail",
     "mean_curvature_normal", "minimal_surface", "mixed_voronoi_area", "read_mesh", "reconstruct",
     "write_mesh",
+    # editing issue
+    "CurvatureEditor", "curvature_coefficients", "edit_boundary", "sine_displacement",
 ]

@@ -4,8 +4,11 @@ numpy/scipy only. Every function takes ``(V, F)`` arrays and validates them at i
 """
 
 from ._validate import boundary_edges, boundary_vertices, check_mesh
+from .boundary_editing import boundary_loop, edit_boundary, sine_displacement
 from .cotan_laplacian import cotan_laplacian
+from .curvature_coefficients import CoefficientInfo, curvature_coefficients
 from .curvature_detail import curvature_detail
+from .curvature_editor import CurvatureEditor
 from .errors import ConstraintError, MeshError
 from .mean_curvature_normal import mean_curvature_normal
 from .minimal_surface import minimal_surface
@@ -17,4 +20,7 @@ __all__ = [
     "ConstraintError", "MeshError", "Reconstructor", "SolverError", "available_backends",
     "boundary_edges", "boundary_vertices", "check_mesh", "cotan_laplacian", "curvature_detail",
     "mean_curvature_normal", "minimal_surface", "mixed_voronoi_area", "reconstruct",
+    # editing issue
+    "CoefficientInfo", "CurvatureEditor", "boundary_loop", "curvature_coefficients", "edit_boundary",
+    "sine_displacement",
 ]

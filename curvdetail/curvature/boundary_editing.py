@@ -1,0 +1,163 @@
+"""Shape editing of a patch's boundary (the paper's Fig. 2b)."""
+
+import numpy as np
+
+from ._validate import as_values, boundary_edges, check_mesh
+from .cotan_laplacian import _cotan_laplacian_unchecked
+from .curvature_coefficients import DEFAULT_RCOND
+from .curvature_editor import CurvatureEditor
+from .errors import MeshError
+from .sparse_solver import factorize
+
+
+def edit_boundary(V, F, displacement, *, rcond=DEFAULT_RCOND, backend="auto", return_info=False):
+    """Move the boundary of a disk-topology patch and rebuild the surface from its detail.
+
+    Steps (the paper's shape editing: "the boundary vertices coordinate ... are modified ...
+    curvature normal of boundary is modified accordingly"):
+
+    1. The boundary loop (one loop, in the orientation of its triangles) is moved by
+       ``displacement``.
+    2. The boundary's curvature detail is updated accordingly: the displacement is spread into
+       the interior as a cotangent-harmonic field (rest weights), and the boundary details are
+       those of that provisional surface, ``D_b = (L(V') V')_b``.
+    3. A :class:`CurvatureEditor` with the boundary's positions and details constrained rebuilds
+       the interior: the curvature stage carries the interior detail (rotation- and scale-
+       invariant coefficients), the embedding places it.
+
+    Parameters
+    ----------
+    V : (n, 3) float array   rest positions of a patch with exactly one boundary loop
+    F : (m, 3) int array     triangles
+    displacement : callable or (b, 3) float array
+        ``displacement(s, P) -> (b, 3)`` with ``s`` the normalized arc length in [0, 1) of each
+        boundary vertex along the loop (starting at the loop's first vertex, see ``info``) and
+        ``P`` their (b, 3) positions; or the (b, 3) displacements themselves, row r for
+        ``info["boundary"][r]`` (loop order). :func:`sine_displacement` builds the paper's sine.
+    rcond : float            threshold of :func:`curvature_coefficients`
+    backend : str            sparse solver backend
+    return_info : bool       also return a dict with ``boundary`` (loop order), ``arc_length``
+                             (normalized, per boundary vertex), ``boundary_detail`` (the updated
+                             (b, 3) details) and ``editor`` (the factored editor, for re-solves)
+
+    Returns
+    -------
+    X : (n, 3) float array   edited positions; ``X[boundary] == V[boundary] + displacement`` exactly
+    info : dict              only with ``return_info=True``
+
+    Raises
+    ------
+    MeshError         malformed mesh, or not exactly one boundary loop
+    ConstraintError   displacement array of the wrong shape or with NaN / inf
+    ValueError        the displacement callable returned the wrong shape or non-finite values
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from curvdetail.curvature.testing import grid
+    >>> V, F = grid(12, 12); V[:, 2] = 0.05 * np.sin(6 * V[:, 0]) * np.sin(6 * V[:, 1])
+    >>> X, info = edit_boundary(V, F, sine_displacement(0.1, periods=2, axis=2), return_info=True)
+    >>> b = info["boundary"]
+    >>> bool(np.allclose(X[b, 2] - V[b, 2], 0.1 * np.sin(2 * np.pi * 2 * info["arc_length"])))
+    True
+    """
+    V, F = check_mesh(V, F)
+    loop = boundary_loop(F)
+    P = V[loop]
+    seg = np.linalg.norm(np.roll(P, -1, axis=0) - P, axis=1)
+    s = np.concatenate([[0.0], np.cumsum(seg)[:-1]]) / seg.sum()
+    if callable(displacement):
+        try:
+            d = np.asarray(displacement(s.copy(), P.copy()), dtype=np.float64)
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"the displacement callable failed ({exc}); it must map (s, P) to a "
+                             f"({loop.size}, 3) float array.") from None
+        if d.shape != (loop.size, 3) or not np.all(np.isfinite(d)):
+            raise ValueError(f"the displacement callable returned shape {d.shape} (or non-finite "
+                             f"values); it must return a finite ({loop.size}, 3) array.")
+    else:
+        d = as_values(displacement, loop.size, "displacement")
+    n = V.shape[0]
+    L = _cotan_laplacian_unchecked(V, F)
+    free = np.ones(n, dtype=bool)
+    free[loop] = False
+    inner = np.flatnonzero(free)
+    U = np.zeros((n, 3))
+    U[loop] = d
+    if inner.size:
+        Lf = L[inner][:, inner]
+        U[inner] = factorize(Lf, symmetric=True, backend=backend).solve(-(L[inner][:, loop] @ d))
+    Vp = V + U
+    Db = (_cotan_laplacian_unchecked(Vp, F) @ Vp)[loop]
+    editor = CurvatureEditor(V, F, loop, loop, rcond=rcond, backend=backend)
+    X = editor.solve(positions=P + d, details=Db)
+    if not return_info:
+        return X
+    return X, {"boundary": loop, "arc_length": s, "boundary_detail": Db, "editor": editor}
+
+
+def sine_displacement(amplitude, periods=1, axis=1, phase=0.0):
+    """The paper's boundary edit: ``amplitude * sin(2 pi (periods * s + phase))`` along one axis.
+
+    Parameters
+    ----------
+    amplitude : float   in the mesh's length unit
+    periods : float     number of periods along the whole loop (an integer closes it smoothly)
+    axis : int          0, 1 or 2 (x, y or z)
+    phase : float       in periods
+
+    Returns
+    -------
+    displacement : callable ``(s, P) -> (b, 3)`` for :func:`edit_boundary`
+
+    Examples
+    --------
+    >>> f = sine_displacement(2.0, periods=1, axis=2)
+    >>> f(np.array([0.0, 0.25]), np.zeros((2, 3)))[:, 2].round(12).tolist()
+    [0.0, 2.0]
+    """
+    if axis not in (0, 1, 2):
+        raise ValueError(f"axis={axis!r}; use 0, 1 or 2 for x, y or z.")
+
+    def displacement(s, P):
+        out = np.zeros((np.asarray(s).size, 3))
+        out[:, axis] = amplitude * np.sin(2.0 * np.pi * (periods * np.asarray(s) + phase))
+        return out
+
+    return displacement
+
+
+def boundary_loop(F):
+    """The single boundary loop of a disk-topology patch, in the orientation of its triangles.
+
+    Returns
+    -------
+    loop : (b,) int array   boundary vertices in order; ``loop[0]`` is the smallest index
+
+    Raises
+    ------
+    MeshError   the mesh has no boundary, several loops, or a vertex where the boundary
+                touches itself
+    """
+    E = boundary_edges(np.asarray(F))
+    if E.shape[0] == 0:
+        raise MeshError("the mesh is closed (no boundary loop); shape editing of a boundary needs "
+                        "a patch with one boundary loop.")
+    starts, counts = np.unique(E[:, 0], return_counts=True)
+    if np.any(counts > 1):
+        bad = starts[counts > 1]
+        raise MeshError(f"{bad.size} boundary vertices are on more than one boundary edge pair (first: "
+                        f"{', '.join(map(str, bad[:3]))}); the boundary touches itself. Repair the "
+                        "mesh so that its boundary is one simple loop.")
+    nxt = dict(zip(E[:, 0].tolist(), E[:, 1].tolist()))
+    start = int(E[:, 0].min())
+    loop = [start]
+    cur = nxt[start]
+    while cur != start and len(loop) <= E.shape[0]:
+        loop.append(cur)
+        cur = nxt[cur]
+    if len(loop) != E.shape[0]:
+        raise MeshError(f"the boundary has {E.shape[0]} edges but the loop through vertex {start} has "
+                        f"{len(loop)}: the patch has several boundary loops (holes). Fill the holes, "
+                        "e.g. with pymeshlab's meshing_close_holes, or cut a disk-topology patch.")
+    return np.asarray(loop, dtype=np.int64)

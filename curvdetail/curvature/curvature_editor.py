@@ -1,0 +1,297 @@
+"""Two-stage mesh editing with curvature coefficients (the paper's Sections 3.1-3.2)."""
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+
+from ._validate import as_index_set, as_values, bbox_diagonal, check_mesh
+from .cotan_laplacian import _cotan_laplacian_unchecked
+from .curvature_coefficients import DEFAULT_RCOND, _coefficients, _one_ring_pairs
+from .errors import ConstraintError, first_indices
+from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
+from .sparse_solver import factorize
+
+
+class CurvatureEditor:
+    """Edit a mesh through its curvature detail: factor once, re-solve for any constraint values.
+
+    Two stages (the paper's mesh editing):
+
+    1. **Curvature stage.** The details ``D_u`` of the vertices without a detail constraint
+       minimize ``|(I - C) D|^2`` over their own rows, i.e. they solve the square system
+       ``(I - C)_uu D_u = C_uk D_k`` exactly (``C`` = :func:`curvature_coefficients` of ``V``,
+       ``k`` = detail-constrained vertices and every vertex outside ``roi``). The system is not
+       symmetric; it is LU-factored once.
+    2. **Embedding stage.** Positions minimize the paper's ``E_Q = sum_i |(L X)_i - D_i|^2``
+       (``L`` = cotangent Laplacian of ``V``) over the vertices without a position constraint,
+       summed over every row that involves them (as :class:`Reconstructor` with
+       ``rows="all"``); position-constrained vertices and all vertices outside ``roi`` keep
+       their positions exactly. Normal equations, Cholesky-type factorization, once.
+
+    Vertices outside ``roi`` are fixed: position and detail as in ``V`` (a smooth transition
+    across the region's border), and they are left out of both systems, whose sizes are those
+    of the region. The constructor does all factoring; :meth:`solve` only back-substitutes.
+
+    Invariance (exact up to solver precision): with ``roi=None``, moving every position
+    constraint by a similarity ``x -> s R x + t`` and every detail constraint by its linear part
+    ``D -> s R D`` (the detail ``D = L V`` scales like a length) moves the result by the same
+    similarity, because ``C`` and ``L`` are invariant and both stages are linear.
+
+    Parameters
+    ----------
+    V : (n, 3) float array      rest positions (supply ``L``, ``C`` and the values outside ``roi``)
+    F : (m, 3) int array        triangles
+    position_constrained : (p,) int array or (n,) bool mask   vertices whose positions are given
+                                to :meth:`solve` (handles); inside ``roi``
+    detail_constrained : (q,) int array or (n,) bool mask     vertices whose curvature details
+                                are given to :meth:`solve`; inside ``roi``. May overlap
+                                ``position_constrained`` (a handle with both constrained)
+    roi : (r,) int array or (n,) bool mask or None   region of interest; None = the whole mesh
+    rcond : float               singular-value threshold of :func:`curvature_coefficients`
+    backend : str               sparse solver backend ("auto", "pardiso", "cholmod", "splu")
+
+    Attributes
+    ----------
+    position_constrained, detail_constrained : int arrays   as given (masks: increasing)
+    roi : (r,) int array        the region, increasing
+    detail : (n, 3) float array rest detail ``D = L V``
+    coefficients : (n, n) csr_matrix   ``C``
+    rank_deficient : int        vertices whose one-ring detail is rank-deficient (see
+                                :func:`curvature_coefficients`)
+    detail_islands : int        free vertices whose detail the coefficients cannot determine
+                                (groups cut off from every known detail by flat vertices, whose
+                                coefficients are zero, e.g. a bump in a plane); they keep their
+                                rest detail, like detail-constrained vertices
+
+    Raises
+    ------
+    MeshError         malformed mesh
+    ConstraintError   indices out of range or repeated; a constraint outside ``roi``; an empty
+                      ``roi``; no position constraint (or no detail constraint) while ``roi`` is
+                      the whole mesh; a connected free region that touches no position (or no
+                      detail) constraint
+    SolverError       a system could not be factored (the constraints do not determine it)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from curvdetail.curvature.testing import grid
+    >>> from curvdetail.curvature import boundary_vertices
+    >>> V, F = grid(15, 15); V[:, 2] = np.sin(3 * V[:, 0]) * np.cos(2 * V[:, 1])
+    >>> b = boundary_vertices(F)
+    >>> ed = CurvatureEditor(V, F, b, b)                   # factors both stages
+    >>> X = ed.solve(positions=V[b], details=ed.detail[b])  # back-substitution only
+    >>> bool(abs(X - V).max() < 1e-9)
+    True
+    >>> X = ed.solve(positions=V[b] + [0, 0, 0.5], details=ed.detail[b])   # lift the frame
+    >>> bool(np.allclose(X, V + [0, 0, 0.5]))
+    True
+    """
+
+    def __init__(self, V, F, position_constrained, detail_constrained, *, roi=None,
+                 rcond=DEFAULT_RCOND, backend="auto"):
+        V, F = check_mesh(V, F)
+        n = V.shape[0]
+        self.n, self.V, self.F = n, V, F
+        pc = as_index_set(position_constrained, n, "position_constrained")
+        dc = as_index_set(detail_constrained, n, "detail_constrained")
+        in_roi = np.ones(n, dtype=bool)
+        if roi is not None:
+            r = as_index_set(roi, n, "roi")
+            if r.size == 0:
+                raise ConstraintError("roi is empty: nothing would be edited. Pass the vertices to "
+                                      "edit, or roi=None for the whole mesh.")
+            in_roi[:] = False
+            in_roi[r] = True
+        whole = bool(in_roi.all())
+        for name, idx in (("position_constrained", pc), ("detail_constrained", dc)):
+            out = idx[~in_roi[idx]]
+            if out.size:
+                raise ConstraintError(
+                    f"{name}: {out.size} vertices lie outside the roi (first: {first_indices(out)}); "
+                    "vertices outside the roi are fixed already. Add them to the roi or drop them.")
+        if whole and pc.size == 0:
+            raise ConstraintError("position_constrained is empty and the roi is the whole mesh: the "
+                                  "result is only determined up to a translation. Constrain at least "
+                                  "one vertex per connected piece, or pass a smaller roi.")
+        if whole and dc.size == 0:
+            raise ConstraintError("detail_constrained is empty and the roi is the whole mesh: the "
+                                  "curvature stage is only determined up to a linear map. Constrain "
+                                  "the details of at least three vertices (e.g. the handles), or pass "
+                                  "a smaller roi.")
+        self.position_constrained, self.detail_constrained = pc, dc
+        self.roi = np.flatnonzero(in_roi)
+
+        L = _cotan_laplacian_unchecked(V, F)
+        D = L @ V
+        rows, cols = _one_ring_pairs(F, n)
+        C, rank, _ = _coefficients(D, _mixed_voronoi_area_unchecked(V, F), rows, cols, n, rcond,
+                                   bbox_diagonal(V))
+        self.detail, self.coefficients = D, C
+        self.rank_deficient = int(np.count_nonzero(rank < 3))
+        adjacency = sp.csr_matrix((np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(n, n))
+
+        # -- curvature stage: unknown details fd = roi \ dc --------------------------------
+        free_d = in_roi.copy()
+        free_d[dc] = False
+        _check_reached(adjacency, free_d, "detail", "detail_constrained")
+        island = _detail_islands(C, free_d, rank)
+        self.detail_islands = int(np.count_nonzero(island))
+        self._user_dc = dc.size
+        dc = np.concatenate([dc, np.flatnonzero(island)])     # islands keep their rest detail
+        free_d[island] = False
+        fd = np.flatnonzero(free_d)
+        self._fd, self._dc = fd, dc
+        Crows = C[fd]
+        M = (sp.identity(n, format="csr")[fd] - Crows)[:, fd]
+        C_dc = Crows[:, dc]
+        ext = np.flatnonzero(~in_roi)
+        self._d_const = Crows[:, ext] @ D[ext]                 # exterior details stay as in V
+        self._C_dc = C_dc.tocsr()
+        self._curv = factorize(M, symmetric=False, backend=backend) if fd.size else None
+
+        # -- embedding stage: unknown positions fp = roi \ pc; rows touching them ------------
+        free_p = in_roi.copy()
+        free_p[pc] = False
+        _check_reached(adjacency, free_p, "position", "position_constrained")
+        fp = np.flatnonzero(free_p)
+        touch = free_p.copy()
+        touch[cols[free_p[rows]]] = True
+        R = np.flatnonzero(touch)                              # rows of E_Q that involve fp
+        LR = L[R]
+        A = LR[:, fp]
+        known_ext = np.flatnonzero(~in_roi)
+        self._fp, self._pc, self._R = fp, pc, R
+        self._A_T = A.T.tocsr()
+        self._L_pc = LR[:, pc].tocsr()
+        self._rhs_const = -(LR[:, known_ext] @ V[known_ext])  # exterior positions stay as in V
+        # where each row of R gets its detail from: solved (fd), given (dc) or rest (exterior)
+        slot = np.full(n, -1, dtype=np.int64)
+        slot[R] = np.arange(R.size)
+        self._R_fd = (slot[fd] >= 0)
+        self._R_fd_at = slot[fd][self._R_fd]
+        self._R_dc = (slot[dc] >= 0)
+        self._R_dc_at = slot[dc][self._R_dc]
+        self._D_R_rest = D[R].copy()
+        self._embed = factorize((A.T @ A).tocsr(), symmetric=True, backend=backend) if fp.size else None
+        self.backend = {"curvature": self._curv.backend if self._curv else "none",
+                        "embedding": self._embed.backend if self._embed else "none"}
+
+    def solve_details(self, details=None):
+        """Curvature stage only: every vertex's detail, by back-substitution.
+
+        Parameters
+        ----------
+        details : (q, 3) float array or None   details of ``detail_constrained`` (row r for
+                                               vertex ``detail_constrained[r]``); None = rest values
+
+        Returns
+        -------
+        D : (n, 3) float array   given values at ``detail_constrained``, solved values elsewhere in
+                                 the roi, rest values outside it
+        """
+        Dk = self._details(details)
+        D = self.detail.copy()
+        D[self._dc] = Dk
+        if self._curv is not None:
+            D[self._fd] = self._curv.solve(self._d_const + self._C_dc @ Dk)
+        return D
+
+    def solve(self, positions=None, details=None, *, return_details=False):
+        """Edited positions for new constraint values, by back-substitution only (no factoring).
+
+        Parameters
+        ----------
+        positions : (p, 3) float array or None   positions of ``position_constrained`` (row r for
+                                                 vertex ``position_constrained[r]``); None = rest
+        details : (q, 3) float array or None     curvature details ``D = K A`` of
+                                                 ``detail_constrained``; None = rest values. Under a
+                                                 similarity with linear part ``s R`` a detail
+                                                 becomes ``s R D``
+        return_details : bool                    also return the curvature stage's details
+
+        Returns
+        -------
+        X : (n, 3) float array   ``X[position_constrained] == positions`` exactly; vertices outside
+                                 the roi keep their rest positions exactly
+        D : (n, 3) float array   only with ``return_details=True``
+        """
+        Xk = self._positions(positions)
+        Dk = self._details(details)
+        D_R = self._D_R_rest.copy()
+        Du = None
+        if self._curv is not None:
+            Du = self._curv.solve(self._d_const + self._C_dc @ Dk)
+            D_R[self._R_fd_at] = Du[self._R_fd]
+        D_R[self._R_dc_at] = Dk[self._R_dc]
+        X = self.V.copy()
+        X[self._pc] = Xk
+        if self._embed is not None:
+            rhs = self._A_T @ (D_R + self._rhs_const - self._L_pc @ Xk)
+            X[self._fp] = self._embed.solve(rhs)
+        if not return_details:
+            return X
+        D = self.detail.copy()
+        D[self._dc] = Dk
+        if Du is not None:
+            D[self._fd] = Du
+        return X, D
+
+    def _positions(self, positions):
+        if positions is None:
+            return self.V[self._pc]
+        return as_values(positions, self._pc.size, "positions")
+
+    def _details(self, details):
+        if details is None:
+            return self.detail[self._dc]
+        given = as_values(details, self._user_dc, "details")
+        if self._dc.size == self._user_dc:
+            return given
+        return np.concatenate([given, self.detail[self._dc[self._user_dc:]]])
+
+
+def _detail_islands(C, free, rank):
+    """Free vertices whose detail the coefficients cannot determine, shape (n,) bool.
+
+    ``C`` is invariant under any linear map of the detail, so a group of free vertices whose
+    coefficient rows reach no known detail (through non-zero coefficients, across flat vertices
+    whose rows are zero) has its detail fixed only up to a 3x3 linear map: the square system is
+    singular there (e.g. a bump in a flat plane). Such islands keep their rest detail.
+    """
+    n = free.size
+    nz = C.copy()
+    nz.data = (nz.data != 0).astype(np.int8)
+    nz.eliminate_zeros()
+    active = free & (rank > 0)
+    idx = np.flatnonzero(active)
+    island = np.zeros(n, dtype=bool)
+    if idx.size == 0:
+        return island
+    sub = nz[idx][:, idx]
+    count, labels = connected_components(sub + sub.T, directed=False)
+    reaches_known = np.asarray(nz[idx] @ (~free).astype(np.int8)).ravel() > 0
+    anchored = np.zeros(count, dtype=bool)
+    anchored[labels[reaches_known]] = True
+    island[idx[~anchored[labels]]] = True
+    return island
+
+
+def _check_reached(adjacency, free, what, name):
+    """Raise if a connected region of free vertices touches no constrained (or exterior) vertex."""
+    idx = np.flatnonzero(free)
+    if idx.size == 0:
+        return
+    sub = adjacency[idx][:, idx]
+    count, labels = connected_components(sub, directed=False)
+    # a free vertex with a non-free neighbour anchors its component
+    nonfree_nbr = adjacency[idx] @ (~free).astype(np.int8)
+    anchored = np.zeros(count, dtype=bool)
+    anchored[labels[np.asarray(nonfree_nbr).ravel() > 0]] = True
+    missing = np.flatnonzero(~anchored)
+    if missing.size:
+        example = [int(idx[np.flatnonzero(labels == c)[0]]) for c in missing[:3]]
+        raise ConstraintError(
+            f"{missing.size} connected free regions touch no {what} constraint (e.g. the regions "
+            f"containing vertex {', '.join(map(str, example))}); their {what}s are undetermined. "
+            f"Add a vertex of each region to {name}, or shrink the roi.")
