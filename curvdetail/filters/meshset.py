@@ -180,15 +180,13 @@ def add_layer(ms, V, F, label, *, quality=None, attributes=None):
         kwargs["v_scalar_array"] = np.ascontiguousarray(quality, dtype=np.float64)
     mesh = pymeshlab.Mesh(vertex_matrix=np.ascontiguousarray(V, dtype=np.float64),
                           face_matrix=np.ascontiguousarray(F, dtype=np.int32), **kwargs)
-    for name, values in (attributes or {}).items():
-        arr = np.ascontiguousarray(values, dtype=np.float64)
-        WRITTEN_ATTRIBUTES[name] = "point" if arr.ndim == 2 else "scalar"
-        if arr.ndim == 2:
-            mesh.add_vertex_custom_point_attribute(arr, name)
-        else:
-            mesh.add_vertex_custom_scalar_attribute(arr, name)
     ms.add_mesh(mesh, label)
-    return int(ms.current_mesh_id())
+    mid = int(ms.current_mesh_id())
+    # attributes go onto the MeshSet's own copy: pymeshlab's add_mesh copies custom attributes in
+    # a way its PLY exporter later crashes on (segmentation fault)
+    for name, values in (attributes or {}).items():
+        set_vertex_attribute(ms, mid, name, values)
+    return mid
 
 
 def vertex_normals(V, F):
