@@ -105,3 +105,11 @@ def test_docstring_examples_run(module):
     mod = importlib.import_module(f"curvdetail.filters.{module}")
     result = doctest.testmod(mod, optionflags=doctest.ELLIPSIS)
     assert result.attempted > 0 and result.failed == 0
+
+
+def test_filter_functions_get_a_docstring_from_their_declaration():
+    for spec in list_filters():
+        doc = spec.function.__doc__
+        assert doc and spec.description.split()[0] in doc, spec.name
+        for p in spec.parameters:
+            assert f"{p.name} : {p.type_label}" in doc, (spec.name, p.name)

@@ -97,9 +97,24 @@ def filter(*, name, category, description, parameters=()):  # noqa: A001 (pymesh
         spec = FilterSpec(name, category, " ".join(description.split()), params, function)
         _REGISTRY[name] = spec
         function.spec = spec
+        if not function.__doc__:
+            function.__doc__ = _docstring(spec)
         return function
 
     return register
+
+
+def _docstring(spec):
+    """A numpydoc docstring for a filter function, built from its declaration."""
+    lines = [spec.description, "", "Run it with ``curvdetail.filters.apply(ms, "
+             f"{spec.name!r}, ...)``, which checks and completes the parameters.", "",
+             "Parameters", "----------", "ms : pymeshlab.MeshSet"]
+    for p in spec.parameters:
+        extra = f", one of {', '.join(map(repr, p.choices))}" if p.choices else ""
+        lines += [f"{p.name} : {p.type_label}, default {p.default_label()}{extra}",
+                  f"    {p.description}"]
+    lines += ["", "Returns", "-------", "dict   the filter's figures"]
+    return "\n".join(lines)
 
 
 def list_filters():
