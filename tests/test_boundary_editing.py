@@ -1,0 +1,56 @@
+"""Shape editing of a boundary: the loop lands on its displaced positions, the rest follows."""
+
+import numpy as np
+import pytest
+
+from curvdetail import edit_boundary, sine_displacement
+from curvdetail.curvature.boundary_editing import boundary_loop
+from curvdetail.curvature.errors import ConstraintError, MeshError
+from curvdetail.curvature.testing import cylinder, grid
+
+
+def test_boundary_lands_exactly_on_the_sine_displacement(load_mesh):
+    V, F = load_mesh("terrainA_1k.obj")
+    amp = 0.05 * np.ptp(V[:, 0])
+    X, info = edit_boundary(V, F, sine_displacement(amp, periods=3, axis=2), return_info=True)
+    b, s = info["boundary"], info["arc_length"]
+    assert np.array_equal(X[b, :2], V[b, :2])
+    assert np.allclose(X[b, 2] - V[b, 2], amp * np.sin(2 * np.pi * 3 * s), atol=1e-12)
+    assert np.all(np.isfinite(X))
+
+
+def test_zero_displacement_reproduces_the_patch(load_mesh):
+    V, F = load_mesh("terrainA_1k.obj")
+    X = edit_boundary(V, F, lambda s, P: np.zeros_like(P))
+    assert np.abs(X - V).max() < 1e-8 * np.linalg.norm(np.ptp(V, axis=0))
+
+
+def test_rigid_translation_of_the_boundary_translates_the_patch(load_mesh):
+    V, F = load_mesh("mannequin_nose.obj")
+    shift = np.array([0.1, -0.2, 0.3])
+    X = edit_boundary(V, F, lambda s, P: np.tile(shift, (P.shape[0], 1)))
+    # L annihilates translations: the boundary detail is unchanged and the patch just moves
+    assert np.abs(X - (V + shift)).max() < 1e-8 * np.linalg.norm(np.ptp(V, axis=0))
+
+
+def test_boundary_loop_follows_the_triangles_and_covers_the_boundary():
+    V, F = grid(6, 5)
+    loop = boundary_loop(F)
+    assert loop.size == 2 * (6 + 5) - 4 and loop[0] == loop.min()
+    # consecutive loop vertices form boundary edges oriented as in their triangle
+    directed = {(int(f[a]), int(f[(a + 1) % 3])) for f in F for a in range(3)}
+    assert all((int(p), int(q)) in directed for p, q in zip(loop, np.roll(loop, -1)))
+
+
+def test_a_mesh_with_two_boundary_loops_is_refused():
+    V, F = cylinder(n_around=16, n_along=5)
+    with pytest.raises(MeshError, match="several boundary loops"):
+        edit_boundary(V, F, sine_displacement(0.1))
+
+
+def test_displacement_array_of_the_wrong_shape_is_refused(load_mesh):
+    V, F = load_mesh("mannequin_nose.obj")
+    with pytest.raises(ConstraintError, match="displacement has shape"):
+        edit_boundary(V, F, np.zeros((3, 3)))
+    with pytest.raises(ValueError, match="callable returned shape"):
+        edit_boundary(V, F, lambda s, P: np.zeros(3))

@@ -1,0 +1,110 @@
+"""Curvature coefficients: D_i = sum_j C_ij D_j, minimum norm, invariant, batched and robust."""
+
+import numpy as np
+import pytest
+
+from curvdetail import curvature_coefficients, curvature_detail
+from curvdetail.curvature.errors import MeshError
+
+
+def _rotation(rng):
+    Q, R = np.linalg.qr(rng.normal(size=(3, 3)))
+    Q = Q * np.sign(np.diag(R))
+    return Q if np.linalg.det(Q) > 0 else -Q
+
+
+@pytest.mark.parametrize("name", ["mannequin_nose.obj", "mannequin_ear.obj", "spot.obj", "terrainA_1k.obj"])
+def test_full_rank_rings_reproduce_detail_on_real_meshes(load_mesh, name):
+    V, F = load_mesh(name)
+    C, info = curvature_coefficients(V, F, return_info=True)
+    D = curvature_detail(V, F)
+    full = info.rank == 3
+    # A rank-3 ring spans R^3, so the fit is exact up to the 3x3 pseudo-inverse's roundoff
+    # (cond(G) up to ~1e10 on these meshes, i.e. ~1e-6 relative in the worst ring).
+    rel = np.linalg.norm(D - C @ D, axis=1)[full] / info.scale[full]
+    assert full.mean() > 0.99
+    assert rel.max() < 1e-6
+    assert np.allclose(info.residual, np.linalg.norm(D - C @ D, axis=1))
+    assert info.rank_deficient == np.count_nonzero(~full)
+
+
+def test_pattern_is_the_one_ring_with_zero_diagonal(load_mesh):
+    V, F = load_mesh("mannequin_nose.obj")
+    C = curvature_coefficients(V, F)
+    edges = {tuple(e) for f in F for e in ((f[0], f[1]), (f[1], f[2]), (f[2], f[0]))}
+    edges |= {(j, i) for i, j in edges}
+    coo = C.tocoo()
+    assert set(zip(coo.row.tolist(), coo.col.tolist())) == edges
+    assert np.all(C.diagonal() == 0)
+
+
+def test_coefficients_are_invariant_under_rotation_and_uniform_scale(load_mesh, rng):
+    V, F = load_mesh("spot.obj")
+    C = curvature_coefficients(V, F)
+    C2 = curvature_coefficients(2.5 * V @ _rotation(rng).T + [3.0, -1.0, 7.0], F)
+    # D -> 2.5 R D leaves the minimum-norm solution unchanged; the difference is roundoff
+    # amplified by the ring's conditioning (coefficients are O(1), max |c| ~ 6 here).
+    assert abs(C2 - C).max() < 1e-8
+
+
+def test_coefficients_are_the_minimum_norm_solution(load_mesh, rng):
+    V, F = load_mesh("mannequin_ear.obj")
+    C = curvature_coefficients(V, F).tocsr()
+    D = curvature_detail(V, F)
+    for i in rng.choice(V.shape[0], size=25, replace=False):
+        nbrs = C.indices[C.indptr[i]:C.indptr[i + 1]]
+        expected = np.linalg.pinv(D[nbrs].T, rcond=1e-6) @ D[i]
+        got = C.data[C.indptr[i]:C.indptr[i + 1]]
+        # pinv works on D_N itself, we on its Gram matrix: they agree to ~cond * 1e-16
+        assert np.allclose(got, expected, rtol=1e-6, atol=1e-7 * np.abs(expected).max())
+
+
+def test_flat_plane_rings_are_rank_deficient_with_zero_coefficients(plane_grid):
+    V, F = plane_grid
+    C, info = curvature_coefficients(V, F, return_info=True)
+    xy = V[:, :2]
+    deep = ((xy > 0.1 - 1e-9) & (xy < 0.9 + 1e-9)).all(axis=1)   # rings away from the boundary
+    assert np.all(np.isfinite(C.data))
+    assert np.all(info.rank[deep] == 0)
+    assert abs(C[np.flatnonzero(deep)]).max() == 0.0       # flat: D_i = 0 is kept exactly
+    assert info.rank_deficient == np.count_nonzero(info.rank < 3) >= deep.sum()
+    assert np.array_equal(info.rank_deficient_vertices, np.flatnonzero(info.rank < 3))
+
+
+def test_cylinder_rings_are_rank_two_and_still_reproduce_detail(open_cylinder):
+    V, F = open_cylinder
+    C, info = curvature_coefficients(V, F, return_info=True)
+    D = curvature_detail(V, F)
+    z = V[:, 2]
+    inner = (z > z.min() + 0.25) & (z < z.max() - 0.25)   # two rings away from the rims
+    assert np.all(info.rank[inner] == 2)                   # all details are radial: coplanar
+    assert info.rank_deficient >= inner.sum()
+    assert np.all(np.isfinite(C.data))
+    # the radial detail lies in the span of the radial neighbours: still represented exactly
+    rel = np.linalg.norm(D - C @ D, axis=1)[inner] / np.linalg.norm(D[inner], axis=1)
+    assert rel.max() < 1e-9
+
+
+def test_valence_two_corner_gets_the_pseudo_inverse_not_garbage():
+    # a bent strip: vertex 0 is a corner of one triangle (valence 2), its Gram matrix is singular
+    V = np.array([[0, 0, 0], [1, 0, 0.3], [0, 1, 0.2], [1, 1, 0.9], [2, 0.5, 0.1]], float)
+    F = np.array([[0, 1, 2], [1, 3, 2], [1, 4, 3]])
+    C, info = curvature_coefficients(V, F, return_info=True)
+    D = curvature_detail(V, F)
+    expected = np.linalg.pinv(D[[1, 2]].T) @ D[0]
+    assert info.rank[0] == 2
+    assert np.allclose(C[0, [1, 2]].toarray().ravel(), expected, rtol=1e-9)
+
+
+@pytest.mark.parametrize("rcond", [0.0, 1.0, -1e-3, "abc"])
+def test_bad_rcond_is_refused(plane_grid, rcond):
+    with pytest.raises(ValueError, match="rcond"):
+        curvature_coefficients(*plane_grid, rcond=rcond)
+
+
+def test_malformed_mesh_is_refused_before_any_algebra(plane_grid):
+    V, F = plane_grid
+    bad = F.copy()
+    bad[3, 1] = V.shape[0] + 5
+    with pytest.raises(MeshError, match="outside"):
+        curvature_coefficients(V, bad)

@@ -1,0 +1,137 @@
+"""CurvatureEditor: two-stage editing, exact constraints, similarity covariance, no re-factoring."""
+
+import numpy as np
+import pytest
+
+from curvdetail import CurvatureEditor, boundary_vertices, curvature_detail, reconstruct
+from curvdetail.curvature import sparse_solver
+from curvdetail.curvature.errors import ConstraintError
+from curvdetail.curvature.testing import grid
+
+
+def _rotation(rng):
+    Q, R = np.linalg.qr(rng.normal(size=(3, 3)))
+    Q = Q * np.sign(np.diag(R))
+    return Q if np.linalg.det(Q) > 0 else -Q
+
+
+def _diag(V):
+    return np.linalg.norm(V.max(0) - V.min(0))
+
+
+def test_rest_constraints_reproduce_the_patch(load_mesh):
+    V, F = load_mesh("mannequin_nose.obj")
+    b = boundary_vertices(F)
+    X = CurvatureEditor(V, F, b, b).solve()
+    # both stages reproduce the rest state exactly up to the solvers' roundoff
+    assert np.abs(X - V).max() < 1e-8 * _diag(V)
+
+
+def test_similarity_of_all_constraints_moves_the_result_by_it(load_mesh, rng):
+    V, F = load_mesh("spot.obj")
+    handles = rng.choice(V.shape[0], size=40, replace=False)
+    ed = CurvatureEditor(V, F, handles, handles)
+    # a real edit first: pull ten handles outwards and rotate their details a little
+    P = V[handles].copy()
+    P[:10] += 0.1 * (P[:10] - V.mean(0))
+    Dh = ed.detail[handles] @ _rotation(np.random.default_rng(1)).T * 0.3 + 0.7 * ed.detail[handles]
+    X1 = ed.solve(positions=P, details=Dh)
+    s, R, t = 1.7, _rotation(rng), np.array([0.3, -2.0, 5.0])
+    X2 = ed.solve(positions=s * P @ R.T + t, details=s * Dh @ R.T)
+    assert np.abs(X2 - (s * X1 @ R.T + t)).max() < 1e-8 * s * _diag(V)
+
+
+def test_solve_only_back_substitutes(load_mesh):
+    V, F = load_mesh("terrainA_1k.obj")
+    b = boundary_vertices(F)
+    ed = CurvatureEditor(V, F, b, b)
+    before = sparse_solver.factorization_count
+    for k in range(5):
+        ed.solve(positions=V[b] + [0, 0, 0.1 * k], details=ed.detail[b] * (1 + 0.1 * k))
+    ed.solve_details(ed.detail[b])
+    assert sparse_solver.factorization_count == before
+
+
+def test_constraints_are_kept_exactly_and_outside_roi_is_untouched(load_mesh):
+    V, F = load_mesh("mannequin_ear.obj")
+    centre = np.argmin(np.linalg.norm(V - V.mean(0), axis=1))
+    dist = np.linalg.norm(V - V[centre], axis=1)
+    roi = np.flatnonzero(dist < np.quantile(dist, 0.6))
+    handle = np.flatnonzero(dist < np.quantile(dist, 0.05))
+    ed = CurvatureEditor(V, F, handle, handle, roi=roi)
+    P = V[handle] + [0.0, 0.0, 0.05 * _diag(V)]
+    X = ed.solve(positions=P, details=ed.detail[handle])
+    outside = np.setdiff1d(np.arange(V.shape[0]), roi)
+    assert np.array_equal(X[handle], P)
+    assert np.array_equal(X[outside], V[outside])
+    assert np.all(np.isfinite(X))
+    # the region moved with the handle, decaying towards its border
+    moved = np.linalg.norm(X - V, axis=1)
+    assert moved[roi].max() > 0.5 * 0.05 * _diag(V)
+
+
+def test_embedding_equals_core_reconstruction_when_every_detail_is_given(load_mesh, rng):
+    V, F = load_mesh("mannequin_nose.obj")
+    b = boundary_vertices(F)
+    everything = np.arange(V.shape[0])
+    D = curvature_detail(V, F) * (1 + 0.2 * rng.random((V.shape[0], 1)))
+    X = CurvatureEditor(V, F, b, everything).solve(positions=V[b], details=D)
+    expected = reconstruct(V, F, D, b, V[b], rows="all")
+    assert np.abs(X - expected).max() < 1e-9 * _diag(V)
+
+
+def test_bump_in_a_plane_is_a_detail_island_and_keeps_its_shape():
+    V, F = grid(25, 25)
+    r2 = ((V[:, :2] - 0.5) ** 2).sum(1)
+    V[:, 2] = np.where(r2 < 0.04, (0.04 - r2) ** 2 * 100, 0.0)    # C1 bump, flat elsewhere
+    b = boundary_vertices(F)
+    ed = CurvatureEditor(V, F, b, b)
+    assert ed.detail_islands > 0            # flat rings have zero coefficients: the bump is cut off
+    X = ed.solve(positions=V[b] + [0.0, 0.0, 0.3], details=ed.detail[b])
+    assert np.abs(X - (V + [0.0, 0.0, 0.3])).max() < 1e-9
+
+
+def test_translated_frame_translates_a_rank_deficient_plane(plane_grid):
+    V, F = plane_grid
+    b = boundary_vertices(F)
+    ed = CurvatureEditor(V, F, b, b)
+    assert ed.rank_deficient > 0
+    X = ed.solve(positions=V[b] + [0.2, -0.1, 0.4], details=ed.detail[b])
+    assert np.abs(X - (V + [0.2, -0.1, 0.4])).max() < 1e-10
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(position_constrained=[0, 10**6], detail_constrained=[0]), "outside"),
+    (dict(position_constrained=[3, 3], detail_constrained=[3]), "repeated"),
+    (dict(position_constrained=[], detail_constrained=[0, 1, 2]), "position_constrained is empty"),
+    (dict(position_constrained=[0], detail_constrained=[]), "detail_constrained is empty"),
+    (dict(position_constrained=[0], detail_constrained=[0], roi=[]), "roi is empty"),
+    (dict(position_constrained=[0, 1], detail_constrained=[1], roi=np.arange(1, 100)), "outside the roi"),
+])
+def test_bad_constraint_sets_are_refused(plane_grid, kwargs, message):
+    V, F = plane_grid
+    with pytest.raises(ConstraintError, match=message):
+        CurvatureEditor(V, F, **kwargs)
+
+
+def test_a_free_piece_without_any_constraint_is_refused(plane_grid):
+    V, F = plane_grid
+    V2 = np.vstack([V, V + [2.0, 0.0, 0.0]])
+    F2 = np.vstack([F, F + V.shape[0]])
+    b = boundary_vertices(F)                               # constraints on the first piece only
+    with pytest.raises(ConstraintError, match="touch no position constraint"):
+        CurvatureEditor(V2, F2, b, np.arange(V2.shape[0]))
+    with pytest.raises(ConstraintError, match="touch no detail constraint"):
+        CurvatureEditor(V2, F2, np.arange(V2.shape[0]), b)
+
+
+def test_solve_refuses_values_of_the_wrong_shape(plane_grid):
+    V, F = plane_grid
+    b = boundary_vertices(F)
+    ed = CurvatureEditor(V, F, b, b)
+    with pytest.raises(ConstraintError, match="positions has shape"):
+        ed.solve(positions=V[b][:-1])
+    bad = ed.detail[b].copy()
+    bad[2, 0] = np.nan
+    with pytest.raises(ConstraintError, match="NaN"):
+        ed.solve(details=bad)
