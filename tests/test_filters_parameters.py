@@ -85,6 +85,11 @@ def test_mesh_parameter_defaults_to_current_mesh():
     assert p.check(None) is None and p.parse("2") == 2 and p.type_label == "int"
 
 
+def test_negative_layer_id_is_refused():
+    with pytest.raises(FilterParameterError, match="'targetmesh' is -1; a layer id is 0 or more"):
+        Parameter("targetmesh", "mesh", 0, "target layer").check(-1)
+
+
 def test_declaration_needs_known_type_and_description():
     with pytest.raises(TypeError, match="not one of"):
         Parameter("x", "double", 1.0, "d")

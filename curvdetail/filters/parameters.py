@@ -92,6 +92,9 @@ class Parameter:
                 return None
             if isinstance(value, numbers.Integral) and not isinstance(value, bool) \
                     and type(value).__name__ != "bool_":
+                if t == "mesh" and value < 0:
+                    raise FilterParameterError(f"parameter {self.name!r} is {value}; a layer id is "
+                                               "0 or more.")
                 return self._range(int(value))
             raise self._fail(value, "an int" if t == "int" else "a layer id (int) of the MeshSet")
         if t == "float":
