@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ..curvature import curvature_detail, mean_curvature_normal
+from ..curvature import curvature_detail, mixed_voronoi_area
 from ..curvature._validate import boundary_vertices
 from .meshset import layer_id, mesh_arrays, set_vertex_attribute, set_vertex_quality, vertex_normals
 from .registry import PAPER, filter
@@ -39,8 +39,9 @@ def signed_mean_curvature(V, F, K):
 def compute_curvature_detail(ms):
     mid = layer_id(ms)
     V, F = mesh_arrays(ms, mid)
-    K, A = mean_curvature_normal(V, F)
-    D = curvature_detail(V, F)
+    D = curvature_detail(V, F)                     # L V, validated once
+    A = mixed_voronoi_area(V, F)
+    K = D / A[:, None]                             # = mean_curvature_normal(V, F)[0], bit for bit
     H = signed_mean_curvature(V, F, K)
     set_vertex_attribute(ms, mid, NORMAL, K)
     set_vertex_attribute(ms, mid, DETAIL, D)
