@@ -232,7 +232,19 @@ def _run_command(parser):
 
         if not os.path.isfile(args.script):
             raise FileNotFoundError(f"filter script not found: {args.script}")
-        return _run_on_file(args, lambda ms: run_script(ms, args.script))
+        bar = Progress(0, enabled=sys.stderr.isatty())
+
+        def step(k, total, name):
+            bar.total = total
+            bar.stage(name)
+
+        def work(ms):
+            try:
+                return run_script(ms, args.script, progress=step)
+            finally:
+                bar.close()
+
+        return _run_on_file(args, work)
 
     return run
 

@@ -144,3 +144,10 @@ def test_save_refuses_to_overwrite_and_unknown_steps(tmp_path):
     with pytest.raises(FilterParameterError):
         save_script(tmp_path / "q.mlx", [("generate_minimal_surface", {"tol": "x"})])
     assert not (tmp_path / "q.mlx").exists()
+
+
+def test_progress_is_called_before_each_step(tmp_path):
+    path = write(tmp_path, NATIVE_BORDER + '\n <filter name="compute_curvature_detail"/>')
+    seen = []
+    run_script(meshset(), path, progress=lambda k, n, name: seen.append((k, n, name)))
+    assert seen == [(1, 2, "Select Border"), (2, 2, "compute_curvature_detail")]

@@ -121,13 +121,14 @@ def _run_native(ms, element, where):
         os.remove(tmp)
 
 
-def run_script(ms, path):
+def run_script(ms, path, *, progress=None):
     """Run a MeshLab filter script (.mlx) on ``ms``, step by step, in order.
 
     Parameters
     ----------
     ms : pymeshlab.MeshSet   with the input mesh(es) loaded
     path : str or os.PathLike
+    progress : callable or None   called as ``progress(step, total, name)`` before each step
 
     Returns
     -------
@@ -154,8 +155,11 @@ def run_script(ms, path):
     """
     results = []
     path = os.fspath(path)
-    for k, element in enumerate(_steps(path), start=1):
+    steps = _steps(path)
+    for k, element in enumerate(steps, start=1):
         name = element.get("name")
+        if progress is not None:
+            progress(k, len(steps), name)
         where = f"{os.path.basename(path)} step {k} ({name})"
         if name in _REGISTRY:
             params = _our_parameters(_REGISTRY[name], element, where)
