@@ -1,0 +1,68 @@
+"""`curvdetail edit MESH --sel SEL --def DEF OUTPUT`: exact constraints, images, clean failures."""
+
+import numpy as np
+
+from curvdetail import read_mesh, write_mesh
+from curvdetail.cli import main
+from curvdetail.curvature.testing import grid
+from curvdetail.deformation_benchmark import apply_transform, write_selection, write_transform
+
+
+def _case(tmp_path):
+    V, F = grid(30, 10, size=(3.0, 1.0))
+    V[:, 2] = 0.05 * np.sin(4 * V[:, 0]) * np.cos(3 * V[:, 1])
+    status = np.where(V[:, 0] < 0.6, 0, np.where(V[:, 0] > 2.4, 2, 1))
+    T = np.eye(4)
+    T[:3, :3] = [[np.cos(0.5), 0, -np.sin(0.5)], [0, 1, 0], [np.sin(0.5), 0, np.cos(0.5)]]
+    T[:3, 3] = [0.2, 0.0, 0.4]
+    paths = {k: tmp_path / f"case.{k}" for k in ("off", "sel", "def")}
+    write_mesh(paths["off"], V, F)
+    write_selection(paths["sel"], status)
+    write_transform(paths["def"], T)
+    return V, F, status, T, paths
+
+
+def test_edit_writes_the_mesh_with_fixed_and_handle_vertices_placed(tmp_path, capsys):
+    V, F, status, T, p = _case(tmp_path)
+    out, png = tmp_path / "out.ply", tmp_path / "out.png"
+    rc = main(["edit", str(p["off"]), "--sel", str(p["sel"]), "--def", str(p["def"]), str(out),
+               "--image", str(png)])
+    assert rc == 0
+    X, F2 = read_mesh(out)
+    assert np.array_equal(F2, F)
+    # PLY stores float32: exact up to its rounding
+    assert np.abs(X[status == 0] - V[status == 0]).max() < 1e-6
+    assert np.abs(X[status == 2] - apply_transform(np.loadtxt(p["def"]), V[status == 2])).max() < 1e-6
+    assert png.stat().st_size > 1000
+    assert "handles" in capsys.readouterr().out
+
+
+def test_handle_detail_free_gives_a_different_interior(tmp_path):
+    V, F, status, T, p = _case(tmp_path)
+    args = [str(p["off"]), "--sel", str(p["sel"]), "--def", str(p["def"])]
+    assert main(["edit", *args, str(tmp_path / "a.ply")]) == 0
+    assert main(["edit", *args, str(tmp_path / "b.ply"), "--handle-detail", "free"]) == 0
+    A, _ = read_mesh(tmp_path / "a.ply")
+    B, _ = read_mesh(tmp_path / "b.ply")
+    assert np.array_equal(A[status != 1], B[status != 1])
+    assert np.abs(A - B)[status == 1].max() > 1e-3
+
+
+def test_existing_output_is_refused_without_overwrite(tmp_path, capsys):
+    V, F, status, T, p = _case(tmp_path)
+    out = tmp_path / "out.ply"
+    out.write_text("keep me")
+    args = ["edit", str(p["off"]), "--sel", str(p["sel"]), "--def", str(p["def"]), str(out)]
+    assert main(args) == 1
+    assert "exists" in capsys.readouterr().err and out.read_text() == "keep me"
+    assert main(args + ["--overwrite"]) == 0
+
+
+def test_malformed_selection_fails_cleanly_and_leaves_no_output(tmp_path, capsys):
+    V, F, status, T, p = _case(tmp_path)
+    p["sel"].write_text("# bad\n" + "\n".join(["0", "1", "7"] * 100))
+    out = tmp_path / "out.ply"
+    rc = main(["edit", str(p["off"]), "--sel", str(p["sel"]), "--def", str(p["def"]), str(out)])
+    err = capsys.readouterr().err
+    assert rc == 1 and err.startswith("curvdetail: error:") and "line 4" in err
+    assert not out.exists()

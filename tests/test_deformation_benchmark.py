@@ -1,0 +1,139 @@
+"""The Botsch-Sorkine .sel/.def format and edit_with_selection's exact constraint placement."""
+
+import numpy as np
+import pytest
+
+from curvdetail.curvature.errors import ConstraintError
+from curvdetail.curvature.testing import grid
+from curvdetail.deformation_benchmark import (DeformationFileError, apply_transform,
+                                              edit_with_selection, read_selection, read_transform,
+                                              write_selection, write_transform)
+
+
+def _strip(n=14):
+    """A flat strip along x: left fifth fixed, right fifth the handle."""
+    V, F = grid(3 * n, n, size=(3.0, 1.0))
+    status = np.where(V[:, 0] < 0.6, 0, np.where(V[:, 0] > 2.4, 2, 1)).astype(np.int8)
+    return V, F, status
+
+
+def _similarity(angle, scale, shift):
+    c, s = np.cos(angle), np.sin(angle)
+    T = np.eye(4)
+    T[:3, :3] = scale * np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+    T[:3, 3] = shift
+    return T
+
+
+def test_selection_file_round_trip_keeps_comments_out(tmp_path):
+    p = tmp_path / "a.sel"
+    p.write_text("# per vertex status\n# 5 vertices\n0\n1\n\n2\n  1 \n0\n")
+    assert read_selection(p, 5).tolist() == [0, 1, 2, 1, 0]
+    q = tmp_path / "b.sel"
+    write_selection(q, [2, 1, 0])
+    assert q.read_text().startswith("#") and read_selection(q).tolist() == [2, 1, 0]
+
+
+def test_transform_file_is_read_as_a_homogeneous_matrix(tmp_path):
+    T = _similarity(0.3, 1.5, [1.0, -2.0, 0.5])
+    p = tmp_path / "a.def"
+    write_transform(p, T)
+    got = read_transform(p)
+    assert np.allclose(got, T, atol=1e-9)
+    P = np.array([[1.0, 2.0, 3.0]])
+    assert np.allclose(apply_transform(got, P), (np.c_[P, [1.0]] @ T.T)[:, :3])
+
+
+@pytest.mark.parametrize("text, message", [
+    ("# c\n0\n1\n3\n", "not a vertex status"),
+    ("# c\n0\nx\n1\n", "not a vertex status"),
+    ("# only comments\n\n", "no vertex statuses"),
+])
+def test_malformed_selection_is_refused_with_its_line(tmp_path, text, message):
+    p = tmp_path / "bad.sel"
+    p.write_text(text)
+    with pytest.raises(DeformationFileError, match=message):
+        read_selection(p)
+
+
+def test_selection_of_the_wrong_length_is_refused(tmp_path):
+    p = tmp_path / "a.sel"
+    write_selection(p, [0, 1, 2])
+    with pytest.raises(DeformationFileError, match="3 vertex statuses for a mesh of 4"):
+        read_selection(p, 4)
+
+
+@pytest.mark.parametrize("text, message", [
+    ("# c\n1 0 0 0\n0 1 0 0\n0 0 1 0\n", "3 matrix rows"),
+    ("1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0\n", "line 4 has 3 values"),
+    ("1 0 0 0\n0 1 0 0\n0 0 1 a\n0 0 0 1\n", "not 4 numbers"),
+    ("1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0.5 1\n", "last matrix row"),
+    ("0 0 0 1\n0 1 0 0\n0 0 1 0\n0 0 0 1\n", "singular"),
+])
+def test_malformed_transform_is_refused(tmp_path, text, message):
+    p = tmp_path / "bad.def"
+    p.write_text(text)
+    with pytest.raises(DeformationFileError, match=message):
+        read_transform(p)
+
+
+def test_missing_files_raise_file_not_found(tmp_path):
+    with pytest.raises(FileNotFoundError):
+        read_selection(tmp_path / "none.sel")
+    with pytest.raises(FileNotFoundError):
+        read_transform(tmp_path / "none.def")
+
+
+def test_writers_refuse_to_overwrite(tmp_path):
+    p = tmp_path / "a.sel"
+    write_selection(p, [0, 1])
+    with pytest.raises(FileExistsError):
+        write_selection(p, [1, 1])
+    write_selection(p, [1, 2], overwrite=True)
+    assert read_selection(p).tolist() == [1, 2]
+
+
+@pytest.mark.parametrize("mode", ["transform", "free"])
+def test_fixed_vertices_stay_and_handles_land_on_their_transformed_positions(mode):
+    V, F, status = _strip()
+    T = _similarity(0.4, 1.0, [0.0, 0.3, 0.5])
+    X = edit_with_selection(V, F, status, T, handle_detail=mode)
+    fixed, handles = status == 0, status == 2
+    assert np.array_equal(X[fixed], V[fixed])
+    assert np.array_equal(X[handles], apply_transform(T, V[handles]))
+    assert np.all(np.isfinite(X))
+
+
+def test_identity_transform_leaves_the_mesh_in_place(load_mesh):
+    V, F = load_mesh("mannequin_ear.obj")
+    d = np.linalg.norm(V - V[0], axis=1)
+    status = np.where(d > np.quantile(d, 0.7), 0, np.where(d < np.quantile(d, 0.1), 2, 1))
+    X = edit_with_selection(V, F, status, np.eye(4))
+    assert np.abs(X - V).max() < 1e-8 * np.linalg.norm(np.ptp(V, axis=0))
+
+
+def test_rigid_motion_of_a_fully_handled_piece_is_reproduced():
+    # every non-fixed vertex a handle with a rigid transform: the handle piece moves rigidly
+    V, F, status = _strip()
+    status[status == 1] = 2
+    T = _similarity(0.25, 1.0, [0.1, 0.2, 0.3])
+    X = edit_with_selection(V, F, status, T)
+    assert np.array_equal(X[status == 2], apply_transform(T, V[status == 2]))
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda s: s[:-1], "entries for"),
+    (lambda s: np.where(s == 2, 1, s), "no handle"),
+    (lambda s: np.where(s == 0, 1, s), "no fixed vertex"),
+    (lambda s: np.where(s == 1, 5, s), "other than 0, 1, 2"),
+])
+def test_bad_selections_are_refused(change, message):
+    V, F, status = _strip()
+    with pytest.raises(ConstraintError, match=message):
+        edit_with_selection(V, F, change(status), np.eye(4))
+
+
+def test_unknown_handle_detail_mode_is_refused():
+    V, F, status = _strip()
+    with pytest.raises(ValueError, match="handle_detail"):
+        edit_with_selection(V, F, status, np.eye(4), handle_detail="rotate")
