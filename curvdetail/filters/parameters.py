@@ -203,4 +203,6 @@ class Parameter:
             return "current mesh"
         if self.type == "str":
             return repr(self.default)
+        if self.type == "PercentageValue":
+            return f"{self.default.value:g}{'%' if self.default.percent else ''}"
         return str(self.default)
