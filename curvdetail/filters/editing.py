@@ -1,0 +1,122 @@
+"""Filter ``apply_curvature_editing``: move handles, rebuild the selection from curvature detail."""
+
+import time
+
+import numpy as np
+
+from ..curvature._validate import bbox_diagonal
+from ..curvature.curvature_editor import CurvatureEditor
+from ..curvature.errors import ConstraintError, first_indices
+from .errors import FilterParameterError
+from .meshset import get_mesh, layer_id, mesh_arrays, selected_vertices, set_vertex_positions, set_vertex_quality
+from .parameters import Parameter
+from .registry import PAPER, filter
+
+BACKENDS = ("auto", "pardiso", "cholmod", "splu")
+IDENTITY = "1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1"
+
+
+def _indices(text, n):
+    try:
+        values = [int(t) for t in str(text).replace(",", " ").split()]
+    except ValueError:
+        raise FilterParameterError(f"parameter 'handles' must be vertex indices separated by spaces "
+                                   f"or commas; got {str(text)[:40]!r}.") from None
+    idx = np.asarray(values, dtype=np.int64)
+    if idx.size == 0:
+        raise FilterParameterError("parameter 'handles' is empty; name the handle vertices, e.g. "
+                                   "handles='12 40 41'.")
+    bad = idx[(idx < 0) | (idx >= n)]
+    if bad.size:
+        raise FilterParameterError(f"parameter 'handles': {bad.size} indices are outside [0, {n}) "
+                                   f"(first: {first_indices(bad)}).")
+    uniq = np.unique(idx)
+    if uniq.size != idx.size:
+        raise FilterParameterError(f"parameter 'handles': {idx.size - uniq.size} indices are repeated.")
+    return idx
+
+
+def _matrix(text):
+    try:
+        values = [float(t) for t in str(text).replace(",", " ").split()]
+    except ValueError:
+        raise FilterParameterError(f"parameter 'transform' must be 16 numbers (a 4x4 matrix, row by "
+                                   f"row); got {str(text)[:40]!r}.") from None
+    if len(values) != 16 or not np.all(np.isfinite(values)):
+        raise FilterParameterError(f"parameter 'transform' has {len(values)} numbers (or NaN/inf); it "
+                                   "must be 16 finite numbers, a 4x4 matrix row by row.")
+    T = np.asarray(values).reshape(4, 4)
+    if not np.allclose(T[3], [0, 0, 0, 1], atol=1e-12):
+        raise FilterParameterError("parameter 'transform': the last row must be 0 0 0 1 (an affine map).")
+    return T
+
+
+@filter(
+    name="apply_curvature_editing",
+    category="Curvature detail",
+    description=f"""
+        Mesh editing with curvature coefficients: the handle vertices are moved by a 4x4
+        transform, their curvature normals are transformed by its linear part and optionally
+        scaled (a factor below 1 shortens them, which lengthens a protrusion), and the region of
+        interest - the selected vertices plus the handles - is rebuilt in two stages: the
+        details of the other region vertices from the rotation- and scale-invariant curvature
+        coefficients (min |(I - C) D|^2), then the positions from the details (E_Q). Vertices
+        outside the region do not move. Vertices move in place; the vertex quality is set to
+        the distance each vertex moved. {PAPER}, sections "Curvature coefficients" and "Mesh
+        editing".
+    """,
+    parameters=[
+        Parameter("handles", "str", "", "handle vertex indices, separated by spaces or commas"),
+        Parameter("transform", "str", IDENTITY,
+                  "4x4 handle transform, 16 numbers row by row, applied to homogeneous positions"),
+        Parameter("detail_scale", "float", 1.0,
+                  "factor on the handles' curvature normals after the transform (1 keeps them)"),
+        Parameter("move_handles", "bool", True,
+                  "constrain the handles' positions to the transformed ones; false constrains "
+                  "their curvature normals only and lets them move"),
+        Parameter("handle_detail", "str", "transform",
+                  "handles' curvature normals: 'transform' (linear part x detail_scale) or 'free' "
+                  "(solved like the other region vertices)", choices=("transform", "free")),
+        Parameter("backend", "str", "auto", "sparse solver backend", choices=BACKENDS),
+    ],
+)
+def apply_curvature_editing(ms, *, handles, transform, detail_scale, move_handles, handle_detail,
+                            backend):
+    mid = layer_id(ms)
+    V, F = mesh_arrays(ms, mid)
+    h = _indices(handles, V.shape[0])
+    T = _matrix(transform)
+    if not np.isfinite(detail_scale) or detail_scale <= 0:
+        raise FilterParameterError(f"parameter 'detail_scale' is {detail_scale}; it must be positive.")
+    if not move_handles and handle_detail == "free":
+        raise FilterParameterError("move_handles=false with handle_detail='free' leaves the handles "
+                                   "unconstrained; set one of them.")
+    selected = selected_vertices(ms, mid)
+    if selected.size == 0:
+        raise ConstraintError(
+            f"layer {mid} ({get_mesh(ms, mid).label()!r}) has no selected vertices: the selection is "
+            "the region of interest to rebuild. Select it first (e.g. with "
+            "compute_selection_by_condition_per_vertex).")
+    roi = np.union1d(selected, h)
+    if roi.size == V.shape[0]:
+        raise ConstraintError("every vertex is in the region of interest (selection plus handles), so "
+                              "nothing stays fixed; leave part of the mesh unselected.")
+    t = time.perf_counter()
+    pc = h if move_handles else np.empty(0, dtype=np.int64)
+    dc = h if handle_detail == "transform" else np.empty(0, dtype=np.int64)
+    editor = CurvatureEditor(V, F, pc, dc, roi=roi, backend=backend)
+    details = detail_scale * (editor.detail[dc] @ T[:3, :3].T) if dc.size else None
+    positions = V[pc] @ T[:3, :3].T + T[:3, 3] if pc.size else None
+    X = editor.solve(positions=positions, details=details)
+    seconds = time.perf_counter() - t
+    moved = np.linalg.norm(X - V, axis=1)
+    set_vertex_positions(ms, mid, X)
+    set_vertex_quality(ms, mid, moved)
+    return {
+        "max_displacement": float(moved.max() / bbox_diagonal(V)),
+        "roi_vertices": int(roi.size),
+        "handle_vertices": int(h.size),
+        "rank_deficient_vertices": int(editor.rank_deficient),
+        "detail_island_vertices": int(editor.detail_islands),
+        "seconds": float(seconds),
+    }

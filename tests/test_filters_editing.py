@@ -1,0 +1,78 @@
+"""apply_curvature_editing: handles land on the transform, the unselected part stays, errors."""
+
+import os
+
+import numpy as np
+import pymeshlab
+import pytest
+
+from curvdetail import ConstraintError
+from curvdetail.filters import FilterParameterError, apply, get_filter
+
+DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
+
+
+def _select(ms, mask):
+    """Replace the current mesh by a copy whose quality is ``mask`` and select where it is 1."""
+    m = ms.current_mesh()
+    copy = pymeshlab.Mesh(vertex_matrix=m.vertex_matrix(), face_matrix=m.face_matrix(),
+                          v_scalar_array=mask.astype(float))
+    ms.clear()
+    ms.add_mesh(copy)
+    ms.compute_selection_by_condition_per_vertex(condselect="(q > 0.5)")
+
+
+def _meshset_with_roi():
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(os.path.join(DATA, "mannequin_ear.obj"))
+    V = ms.current_mesh().vertex_matrix().copy()
+    d = np.linalg.norm(V - V[0], axis=1)
+    _select(ms, d < np.quantile(d, 0.6))
+    handles = np.flatnonzero(d < np.quantile(d, 0.05))
+    return ms, V, d, handles
+
+
+def test_handles_follow_the_transform_and_unselected_vertices_stay():
+    ms, V, d, handles = _meshset_with_roi()
+    T = np.eye(4)
+    T[:3, 3] = [0.0, 0.0, 0.02]
+    figures = apply(ms, "apply_curvature_editing", handles=" ".join(map(str, handles)),
+                    transform=" ".join(map(str, T.ravel())))
+    X = ms.current_mesh().vertex_matrix()
+    outside = d >= np.quantile(d, 0.6)
+    assert np.abs(X[handles] - (V[handles] + [0, 0, 0.02])).max() < 1e-12
+    assert np.array_equal(X[outside], V[outside])
+    assert np.allclose(ms.current_mesh().vertex_scalar_array(), np.linalg.norm(X - V, axis=1))
+    assert figures["handle_vertices"] == handles.size and figures["roi_vertices"] > handles.size
+
+
+def test_identity_edit_leaves_the_mesh_in_place():
+    ms, V, d, handles = _meshset_with_roi()
+    apply(ms, "apply_curvature_editing", handles=",".join(map(str, handles)))
+    X = ms.current_mesh().vertex_matrix()
+    assert np.abs(X - V).max() < 1e-8 * np.linalg.norm(np.ptp(V, axis=0))
+
+
+def test_filter_is_declared_with_its_parameters():
+    spec = get_filter("apply_curvature_editing")
+    assert spec.category == "Curvature detail"
+    assert {"handles", "transform", "detail_scale", "move_handles", "handle_detail"} <= set(spec.parameter_names)
+
+
+@pytest.mark.parametrize("params, error, message", [
+    (dict(handles=""), FilterParameterError, "empty"),
+    (dict(handles="1 2 999999"), FilterParameterError, "outside"),
+    (dict(handles="1 2", transform="1 0 0"), FilterParameterError, "16 finite numbers"),
+    (dict(handles="1 2", detail_scale=-1.0), FilterParameterError, "positive"),
+])
+def test_bad_parameters_are_refused(params, error, message):
+    ms, V, d, handles = _meshset_with_roi()
+    with pytest.raises(error, match=message):
+        apply(ms, "apply_curvature_editing", **params)
+
+
+def test_no_selection_is_refused():
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(os.path.join(DATA, "mannequin_ear.obj"))
+    with pytest.raises(ConstraintError, match="no selected vertices"):
+        apply(ms, "apply_curvature_editing", handles="1 2 3")
