@@ -182,15 +182,21 @@ def _filter_params(spec, pairs):
     return params
 
 
+def _add_layers_argument(parser):
+    parser.add_argument("--add", action="append", default=[], metavar="MESH",
+                        help="load MESH as the next layer (1, 2, ...; the last one is current), e.g. "
+                             "a retriangulation for transfer_curvature_detail")
+
+
 def _run_on_file(args, work):
-    """Check OUTPUT, load INPUT into a MeshSet, ``work(ms)``, print its figures as JSON, save
-    the current mesh (quality and curvature attributes kept in PLY)."""
+    """Check OUTPUT, load INPUT (and --add meshes) into a MeshSet, ``work(ms)``, print its figures
+    as JSON, save the current mesh (quality and curvature attributes kept in PLY)."""
     import json
 
     from .filters.files import check_output_path, load_meshset, save_current_mesh
 
     check_output_path(args.output, args.overwrite)
-    ms = load_meshset(args.input)
+    ms = load_meshset(args.input, *args.add)
     figures = work(ms)
     save_current_mesh(ms, args.output, overwrite=args.overwrite)
     print(json.dumps(figures, indent=2, default=str))
@@ -205,6 +211,7 @@ def _apply_command(parser):
                         help="the current mesh afterwards (.ply keeps quality and attributes)")
     parser.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                         help="a filter parameter (repeatable); lengths as 0.01 or 1%% of the bbox diagonal")
+    _add_layers_argument(parser)
     add_output_arguments(parser)
 
     def run(args):
@@ -223,6 +230,7 @@ def _run_command(parser):
     parser.add_argument("input", metavar="INPUT", help="mesh file (any format MeshLab reads)")
     parser.add_argument("output", metavar="OUTPUT",
                         help="the current mesh after the script (.ply keeps quality and attributes)")
+    _add_layers_argument(parser)
     add_output_arguments(parser)
 
     def run(args):

@@ -6,6 +6,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pymeshlab
 import pytest
 
 from curvdetail.cli import main
@@ -90,6 +91,28 @@ def test_apply_writes_the_new_current_layer(capsys, tmp_path):
                          "--param", "max_iterations=2")
     assert rc == 0 and json.loads(out)["iterations"] == 2
     assert np.abs(vertices(tmp_path / "m.obj") - vertices(NOSE)).max() > 1e-3
+
+
+def test_apply_with_added_layer_transfers_between_files(capsys, tmp_path):
+    # INPUT = the source (layer 0), --add = its retriangulation (layer 1, current): transfer, then
+    # rebuild the retriangulation from the stored detail in a second command
+    ms = load_meshset(NOSE)
+    ms.meshing_isotropic_explicit_remeshing(
+        iterations=10, adaptive=False, selectedonly=False, targetlen=pymeshlab.PercentageValue(2.0),
+        featuredeg=30, checksurfdist=True, maxsurfdist=pymeshlab.PercentageValue(1), splitflag=True,
+        collapseflag=True, swapflag=True, smoothflag=True, reprojectflag=True)
+    ms.save_current_mesh(str(tmp_path / "retri.ply"))
+    rc, out, _ = run_cli(capsys, "apply", "transfer_curvature_detail", NOSE, tmp_path / "t.ply",
+                         "--add", tmp_path / "retri.ply")
+    assert rc == 0 and json.loads(out)["detail_total_gap"] < 1e-12
+    rc, out, _ = run_cli(capsys, "apply", "apply_curvature_reconstruction", tmp_path / "t.ply",
+                         tmp_path / "r.ply", "--param", "rows=free")
+    assert rc == 0 and json.loads(out)["max_displacement"] < 0.01
+
+
+def test_apply_missing_added_layer(capsys, tmp_path):
+    assert_failed(capsys, ["apply", "transfer_curvature_detail", NOSE, tmp_path / "o.ply", "--add",
+                           tmp_path / "none.obj"], "mesh file not found", tmp_path / "o.ply")
 
 
 def test_apply_overwrite_replaces_the_output(capsys, tmp_path):

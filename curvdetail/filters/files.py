@@ -19,27 +19,30 @@ from .meshset import WRITTEN_ATTRIBUTES, set_vertex_attribute, vertex_attribute
 from .ply_attributes import read_ply_vertex_attributes
 
 
-def load_meshset(path):
-    """A new ``pymeshlab.MeshSet`` with the mesh file ``path`` loaded as layer 0, with the
-    custom per-vertex attributes of a PLY file (pymeshlab's loader drops them) added back.
+def load_meshset(path, *more):
+    """A new ``pymeshlab.MeshSet`` with the mesh file ``path`` as layer 0 and the files in
+    ``more`` as layers 1, 2, ... (the last one loaded is current, as with pymeshlab's
+    ``load_new_mesh``). The custom per-vertex attributes of PLY files (pymeshlab's loader drops
+    them) are added back.
 
-    Raises FileNotFoundError if the file does not exist, MeshFileError if pymeshlab cannot
-    read it."""
+    Raises FileNotFoundError if a file does not exist, MeshFileError if pymeshlab cannot read it."""
     import pymeshlab
 
-    path = os.fspath(path)
-    if not os.path.isfile(path):
-        raise FileNotFoundError(f"mesh file not found: {path}")
+    paths = [os.fspath(p) for p in (path, *more)]
+    for p in paths:
+        if not os.path.isfile(p):
+            raise FileNotFoundError(f"mesh file not found: {p}")
     ms = pymeshlab.MeshSet()
-    try:
-        ms.load_new_mesh(path)
-    except pymeshlab.PyMeshLabException as exc:
-        raise MeshFileError(f"could not read {path!r}: {' '.join(str(exc).split())}. Use a format "
-                            "MeshLab reads (.obj, .off, .ply, .stl, ...).") from None
-    n = ms.current_mesh().vertex_number()
-    for name, values in read_ply_vertex_attributes(path).items():
-        if values.shape in ((n,), (n, 3)) and np.all(np.isfinite(values)):
-            set_vertex_attribute(ms, ms.current_mesh_id(), name, values)
+    for p in paths:
+        try:
+            ms.load_new_mesh(p)
+        except pymeshlab.PyMeshLabException as exc:
+            raise MeshFileError(f"could not read {p!r}: {' '.join(str(exc).split())}. Use a format "
+                                "MeshLab reads (.obj, .off, .ply, .stl, ...).") from None
+        n = ms.current_mesh().vertex_number()
+        for name, values in read_ply_vertex_attributes(p).items():
+            if values.shape in ((n,), (n, 3)) and np.all(np.isfinite(values)):
+                set_vertex_attribute(ms, ms.current_mesh_id(), name, values)
     return ms
 
 
