@@ -105,7 +105,8 @@ def test_unknown_parameter_in_script_names_step_and_close_match(tmp_path):
 def test_bad_value_in_script_names_step_and_parameter(tmp_path):
     path = write(tmp_path, NATIVE_BORDER + '\n <filter name="generate_minimal_surface">'
                                            '<Param name="tol" value="small"/></filter>')
-    with pytest.raises(ScriptError, match=r"step 2 \(generate_minimal_surface\): parameter 'tol' expects a number"):
+    with pytest.raises(ScriptError,
+                       match=r"step 2 \(generate_minimal_surface\): parameter 'tol' expects a number"):
         run_script(meshset(), path)
 
 

@@ -24,7 +24,8 @@ BACKENDS = ("auto", "pardiso", "cholmod", "splu")
         attribute comes from compute_curvature_detail (then the mesh is reproduced to solver
         precision) or from transfer_curvature_detail (a retriangulation rebuilt from another
         mesh's curvature). Vertices move in place; the vertex quality is set to the distance each
-        vertex moved. A closed mesh needs selected vertices. {PAPER}, sections "Base presentation" (E_Q) and "Embedding".
+        vertex moved. A closed mesh needs selected vertices. {PAPER}, sections "Base
+        presentation" (E_Q) and "Embedding".
     """,
     parameters=[
         Parameter("rows", "str", "all",

@@ -32,7 +32,8 @@ def signed_mean_curvature(V, F, K):
         area-weighted vertex normal; H > 0 on a sphere with outward normals) so that MeshLab can
         colour it. Returns the range and the 10/90 percentiles of H over the interior vertices,
         like pymeshlab's compute_scalar_by_discrete_curvature_per_vertex (boundary vertices carry
-        the boundary's geodesic curvature in K and are left out of the figures). {PAPER}, section "Curvature detail representation".
+        the boundary's geodesic curvature in K and are left out of the figures). {PAPER},
+        section "Curvature detail representation".
     """,
     parameters=[],
 )

@@ -3,10 +3,11 @@
 Saving keeps what the format can hold: in PLY (binary, doubles) the vertex quality and every
 custom per-vertex attribute the filters wrote (``curvature_normal``, ``curvature_detail``,
 ``curvature_area``, ...; pymeshlab's PLY exporter options ``__ca_vp__<name>`` /
-``__ca_vs__<name>``), read back by :func:`load_meshset`; OBJ, OFF and STL hold the geometry only. The file is written from the
-MeshSet itself (pymeshlab crashes when a mesh with custom attributes is copied into another
-MeshSet and exported), to a temporary file in the same folder and renamed, so a failed save
-leaves nothing behind; an existing file is replaced only with ``overwrite=True``.
+``__ca_vs__<name>``), read back by :func:`load_meshset`; OBJ, OFF and STL hold the geometry
+only. The file is written from the MeshSet itself (pymeshlab crashes when a mesh with custom
+attributes is copied into another MeshSet and exported), to a temporary file in the same folder
+and renamed, so a failed save leaves nothing behind; an existing file is replaced only with
+``overwrite=True``.
 """
 
 import os
