@@ -17,8 +17,9 @@ from .registry import PAPER, filter
         loaded), with pymeshlab's get_hausdorff_distance sampling the faces in both directions
         (curvdetail.remesh.hausdorff, the same figures as the remeshing report). Returns the
         maximum and RMS distances as fractions of the target's bounding-box diagonal (the
-        evaluation of the paper's remeshing experiment, Fig. 3), and the one-sided figures. With set_quality the sampled layer's vertex quality becomes its distance to the
-        target, so MeshLab colours the error. {PAPER}, section "Remeshing", Fig. 3.
+        evaluation of the paper's remeshing experiment, Fig. 3), and the one-sided figures. With
+        set_quality the sampled layer's vertex quality becomes its distance to the target, so
+        MeshLab colours the error. {PAPER}, section "Remeshing", Fig. 3.
     """,
     parameters=[
         Parameter("sampledmesh", "mesh", None, "layer whose error is measured (default: current)"),
