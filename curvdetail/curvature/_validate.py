@@ -71,9 +71,12 @@ def as_faces(F, n_vertices, name="F"):
 
 def face_double_areas(V, F):
     """|(v1 - v0) x (v2 - v0)| per triangle, shape (m,)."""
-    e1 = V[F[:, 1]] - V[F[:, 0]]
-    e2 = V[F[:, 2]] - V[F[:, 0]]
-    return np.linalg.norm(np.cross(e1, e2), axis=1)
+    P0 = V[F[:, 0]]
+    a, b = V[F[:, 1]] - P0, V[F[:, 2]] - P0
+    cx = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
+    cy = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
+    cz = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    return np.sqrt(cx * cx + cy * cy + cz * cz)
 
 
 def bbox_diagonal(V):
@@ -126,16 +129,21 @@ def undirected_edges(F):
 
 
 def _edge_keys(F):
-    E = undirected_edges(F)
+    """Key ``min * n + max`` of every half-edge's undirected edge, shape (3m,), in the order of
+    :func:`undirected_edges`, and that ``n``."""
     n = int(F.max()) + 1
-    return E[:, 0] * n + E[:, 1], E
+    b = F[:, [1, 2, 0]].ravel()          # half-edge 3f + k joins corners k+1 and k+2 of face f
+    c = F[:, [2, 0, 1]].ravel()
+    return np.minimum(b, c) * n + np.maximum(b, c), n
 
 
 def non_manifold_edges(F):
-    """Undirected edges used by more than two triangles, shape (k, 2)."""
-    keys, E = _edge_keys(F)
-    uniq, first, counts = np.unique(keys, return_index=True, return_counts=True)
-    return E[first[counts > 2]]
+    """Undirected edges used by more than two triangles, shape (k, 2), sorted."""
+    keys, n = _edge_keys(F)
+    keys.sort()
+    # after sorting, an edge used three or more times has equal keys two places apart
+    bad = np.unique(keys[2:][keys[2:] == keys[:-2]])
+    return np.column_stack([bad // n, bad % n]) if bad.size else np.zeros((0, 2), dtype=F.dtype)
 
 
 def boundary_edges(F):
@@ -198,18 +206,24 @@ def as_values(values, count, name):
     return np.ascontiguousarray(arr)
 
 
-def vertex_components(F, n):
-    """Connected-component label per vertex, shape (n,), and the number of components."""
-    rows = np.concatenate([F[:, 0], F[:, 1], F[:, 2]])
-    cols = np.concatenate([F[:, 1], F[:, 2], F[:, 0]])
-    A = sp.coo_matrix((np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(n, n)).tocsr()
-    count, labels = connected_components(A, directed=False)
+def vertex_components(F, n, adjacency=None):
+    """Connected-component label per vertex, shape (n,), and the number of components.
+
+    ``adjacency``: an (n, n) sparse matrix with the mesh's edge pattern (e.g. its cotangent
+    Laplacian), used instead of building one from ``F``."""
+    if adjacency is None:
+        # two edges per triangle connect all three corners
+        rows = np.concatenate([F[:, 0], F[:, 1]])
+        cols = np.concatenate([F[:, 1], F[:, 2]])
+        adjacency = sp.csr_matrix((np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(n, n))
+    count, labels = connected_components(adjacency, directed=False)
     return labels, count
 
 
-def check_every_component_fixed(F, n, fixed):
-    """Raise ConstraintError if a connected component has no fixed vertex (the system is singular)."""
-    labels, count = vertex_components(F, n)
+def check_every_component_fixed(F, n, fixed, adjacency=None):
+    """Raise ConstraintError if a connected component has no fixed vertex (the system is singular).
+    ``adjacency``: see :func:`vertex_components`."""
+    labels, count = vertex_components(F, n, adjacency)
     has = np.zeros(count, dtype=bool)
     has[labels[fixed]] = True
     missing = np.flatnonzero(~has)

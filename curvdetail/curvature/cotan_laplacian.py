@@ -52,9 +52,11 @@ def _cotan_laplacian_unchecked(V, F):
     i = F[:, [1, 2, 0]].ravel()
     j = F[:, [2, 0, 1]].ravel()
     w = 0.5 * cot.ravel()
-    rows = np.concatenate([i, j, i, j])
-    cols = np.concatenate([j, i, i, j])
-    vals = np.concatenate([-w, -w, w, w])
-    L = sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
+    diagonal = np.bincount(i, w, minlength=n) + np.bincount(j, w, minlength=n)
+    every = np.arange(n)
+    rows = np.concatenate([i, j, every])
+    cols = np.concatenate([j, i, every])
+    vals = np.concatenate([-w, -w, diagonal])
+    L = sp.csr_matrix((vals, (rows, cols)), shape=(n, n))    # sums the two sides of each edge
     L.sum_duplicates()
     return L

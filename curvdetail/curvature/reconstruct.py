@@ -69,11 +69,11 @@ class Reconstructor:
         if self.fixed.size == 0:
             raise ConstraintError("no fixed vertices: the reconstruction is only determined up to a "
                                   "translation. Fix at least one vertex per connected piece, e.g. the boundary.")
-        check_every_component_fixed(F, n, self.fixed)
+        L = _cotan_laplacian_unchecked(V_ref, F)
+        check_every_component_fixed(F, n, self.fixed, adjacency=L)      # L has the edge pattern
         is_free = np.ones(n, dtype=bool)
         is_free[self.fixed] = False
         self.free = np.flatnonzero(is_free)
-        L = _cotan_laplacian_unchecked(V_ref, F)
         self._L = L
         L_f = L[self.free]                                       # (f, n) rows of the free vertices
         self._L_c = L.tocsc()[:, self.fixed].tocsr()             # (n, k) columns of the fixed ones

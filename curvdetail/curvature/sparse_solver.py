@@ -107,6 +107,17 @@ def _new_pardiso_solver(mtype):
         os.environ.pop("PYPARDISO_MKL_RT", None)
 
 
+def _upper_triangle(A):
+    """Upper triangle (diagonal included) of a CSR matrix with sorted indices, as CSR; a mask on
+    the stored entries, ~2x faster than ``scipy.sparse.triu`` (which goes through COO)."""
+    n = A.shape[0]
+    rows = np.repeat(np.arange(n, dtype=A.indices.dtype), np.diff(A.indptr))
+    keep = A.indices >= rows
+    indptr = np.zeros(n + 1, dtype=A.indptr.dtype)
+    np.cumsum(np.bincount(rows[keep], minlength=n), out=indptr[1:])
+    return sp.csr_matrix((A.data[keep], A.indices[keep], indptr), shape=A.shape)
+
+
 class Factorization:
     """A factored square sparse matrix. ``solve(b)`` back-substitutes only.
 
@@ -142,8 +153,8 @@ class Factorization:
         iparm[10] = 0 if self.symmetric else 1   # scaling (nonsymmetric only)
         iparm[12] = 0 if self.symmetric else 1   # weighted matching (nonsymmetric only)
         iparm[34] = 0   # one-based indices (pypardiso converts)
-        M = sp.triu(A, format="csr") if self.symmetric else A
-        M.sort_indices()
+        A.sort_indices()
+        M = _upper_triangle(A) if self.symmetric else A
         self._pardiso, self._pardiso_matrix = solver, M
         solver._check_A(M)
         solver.set_phase(12)
