@@ -67,6 +67,11 @@ def test_factorization_is_counted_once_and_solves_are_not():
 def test_auto_picks_splu_for_small_systems():
     assert resolve_backend("auto", size=sparse_solver.SMALL_SYSTEM - 1) == "splu"
     assert resolve_backend("auto", size=sparse_solver.SMALL_SYSTEM) == available_backends()[0]
+    # where the matrix is known its stored entries decide
+    assert resolve_backend("auto", size=10 ** 6, nnz=sparse_solver.SMALL_SYSTEM_NNZ - 1) == "splu"
+    assert resolve_backend("auto", size=10, nnz=sparse_solver.SMALL_SYSTEM_NNZ) == available_backends()[0]
+    A, _ = _spd_system(12)
+    assert factorize(A).backend == "splu"
 
 
 def test_environment_variable_overrides_auto(monkeypatch):

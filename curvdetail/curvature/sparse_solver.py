@@ -6,7 +6,9 @@ Backends, chosen automatically in this order where installed:
 ``"cholmod"``  SuiteSparse CHOLMOD through ``scikit-sparse`` (symmetric positive definite only).
 ``"splu"``     SciPy's SuperLU with ``MMD_AT_PLUS_A`` ordering and symmetric mode (everywhere).
 
-``"auto"`` takes SuperLU for systems under ``SMALL_SYSTEM`` unknowns (see there). The choice can be overridden per call (``backend="splu"``) or for the whole process with the
+``"auto"`` takes SuperLU for small systems (under ``SMALL_SYSTEM_NNZ`` stored entries, or
+``SMALL_SYSTEM`` unknowns where only the size is known; see there). The choice can be
+overridden per call (``backend="splu"``) or for the whole process with the
 environment variable ``CURVDETAIL_SOLVER``. All backends agree to ~1e-12 relative on the
 systems used here.
 """
@@ -63,13 +65,19 @@ def available_backends():
 #: per factorization was pypardiso's library look-up, now done once per process.)
 SMALL_SYSTEM = 5000
 
+#: Below this many stored entries ``"auto"`` picks SuperLU (used when the matrix is at hand). The
+#: crossover in the measurements above sits near 1e5 entries for both systems: ``L_ff`` has ~7
+#: entries a row (crossover ~15k unknowns), ``L^T L`` ~19 (crossover ~5k unknowns).
+SMALL_SYSTEM_NNZ = 100_000
 
-def resolve_backend(backend="auto", *, symmetric=True, size=None):
+
+def resolve_backend(backend="auto", *, symmetric=True, size=None, nnz=None):
     """Turn ``"auto"`` (or the ``CURVDETAIL_SOLVER`` setting) into an installed backend name."""
     if backend in (None, "auto"):
         backend = os.environ.get("CURVDETAIL_SOLVER", "auto") or "auto"
     if backend == "auto":
-        if size is not None and size < SMALL_SYSTEM:
+        small = nnz < SMALL_SYSTEM_NNZ if nnz is not None else (size is not None and size < SMALL_SYSTEM)
+        if small:
             return "splu"
         for name in available_backends():
             if name == "cholmod" and not symmetric:
@@ -135,7 +143,7 @@ class Factorization:
             raise SolverError(f"cannot factor a non-square matrix of shape {A.shape}.")
         self.shape = A.shape
         self.symmetric = bool(symmetric)
-        self.backend = resolve_backend(backend, symmetric=symmetric, size=A.shape[0])
+        self.backend = resolve_backend(backend, symmetric=symmetric, size=A.shape[0], nnz=A.nnz)
         factorization_count += 1
         if A.shape[0] == 0:
             self._solve = lambda b: np.zeros_like(b)
