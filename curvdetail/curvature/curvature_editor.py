@@ -1,5 +1,7 @@
 """Two-stage mesh editing with curvature coefficients (the paper's Sections 3.1-3.2)."""
 
+import time
+
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
@@ -56,6 +58,9 @@ class CurvatureEditor:
     roi : (r,) int array        the region, increasing
     detail : (n, 3) float array rest detail ``D = L V``
     coefficients : (n, n) csr_matrix   ``C``
+    timings : dict              seconds spent in the constructor: ``coefficients`` (L, D and C),
+                                ``curvature_setup`` (checks and LU of ``(I - C)_uu``),
+                                ``embedding_setup`` (normal equations and their factorization)
     rank_deficient : int        vertices whose one-ring detail is rank-deficient (see
                                 :func:`curvature_coefficients`)
     detail_islands : int        free vertices whose detail the coefficients cannot determine
@@ -122,58 +127,77 @@ class CurvatureEditor:
         self.position_constrained, self.detail_constrained = pc, dc
         self.roi = np.flatnonzero(in_roi)
 
+        t0 = time.perf_counter()
         L = _cotan_laplacian_unchecked(V, F)
         D = L @ V
         rows, cols = _one_ring_pairs(F, n)
         C, rank, _ = _coefficients(D, _mixed_voronoi_area_unchecked(V, F), rows, cols, n, rcond,
                                    bbox_diagonal(V))
+        cvals = C.data if C.nnz == rows.size else np.asarray(C[rows, cols]).ravel()  # (rows, cols) order
         self.detail, self.coefficients = D, C
         self.rank_deficient = int(np.count_nonzero(rank < 3))
-        adjacency = sp.csr_matrix((np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(n, n))
+        t1 = time.perf_counter()
 
         # -- curvature stage: unknown details fd = roi \ dc --------------------------------
         free_d = in_roi.copy()
         free_d[dc] = False
-        _check_reached(adjacency, free_d, "detail", "detail_constrained")
-        island = _detail_islands(C, free_d, rank)
+        _check_reached(rows, cols, free_d, n, "detail", "detail_constrained")
+        island = _detail_islands(rows, cols, cvals, free_d, rank, n)
         self.detail_islands = int(np.count_nonzero(island))
         self._user_dc = dc.size
         dc = np.concatenate([dc, np.flatnonzero(island)])     # islands keep their rest detail
         free_d[island] = False
         fd = np.flatnonzero(free_d)
         self._fd, self._dc = fd, dc
-        Crows = C[fd]
-        M = (sp.identity(n, format="csr")[fd] - Crows)[:, fd]
-        C_dc = Crows[:, dc]
-        ext = np.flatnonzero(~in_roi)
-        self._d_const = Crows[:, ext] @ D[ext]                 # exterior details stay as in V
-        self._C_dc = C_dc.tocsr()
+        at_fd = _positions_in(fd, n)
+        at_dc = _positions_in(dc, n)
+        r_in = free_d[rows]
+        both = r_in & free_d[cols]
+        M = sp.csr_matrix((np.concatenate([-cvals[both], np.ones(fd.size)]),
+                           (np.concatenate([at_fd[rows[both]], np.arange(fd.size)]),
+                            np.concatenate([at_fd[cols[both]], np.arange(fd.size)]))),
+                          shape=(fd.size, fd.size))
+        to_dc = r_in & (at_dc[cols] >= 0)
+        self._C_dc = sp.csr_matrix((cvals[to_dc], (at_fd[rows[to_dc]], at_dc[cols[to_dc]])),
+                                   shape=(fd.size, dc.size))
+        to_ext = r_in & ~in_roi[cols]                          # exterior details stay as in V
+        w = cvals[to_ext][:, None] * D[cols[to_ext]]
+        self._d_const = np.stack([np.bincount(at_fd[rows[to_ext]], weights=w[:, k], minlength=fd.size)
+                                  for k in range(3)], axis=1)
         self._curv = factorize(M, symmetric=False, backend=backend) if fd.size else None
+        t2 = time.perf_counter()
 
         # -- embedding stage: unknown positions fp = roi \ pc; rows touching them ------------
         free_p = in_roi.copy()
         free_p[pc] = False
-        _check_reached(adjacency, free_p, "position", "position_constrained")
+        _check_reached(rows, cols, free_p, n, "position", "position_constrained")
         fp = np.flatnonzero(free_p)
         touch = free_p.copy()
         touch[cols[free_p[rows]]] = True
         R = np.flatnonzero(touch)                              # rows of E_Q that involve fp
-        LR = L[R]
-        A = LR[:, fp]
-        known_ext = np.flatnonzero(~in_roi)
         self._fp, self._pc, self._R = fp, pc, R
+        Lc = L.tocoo()
+        li, lj, lv = Lc.row, Lc.col, Lc.data
+        at_R, at_fp, at_pc = _positions_in(R, n), _positions_in(fp, n), _positions_in(pc, n)
+        in_R = at_R[li] >= 0
+        k = in_R & (at_fp[lj] >= 0)
+        A = sp.csr_matrix((lv[k], (at_R[li[k]], at_fp[lj[k]])), shape=(R.size, fp.size))
+        k = in_R & (at_pc[lj] >= 0)
+        self._L_pc = sp.csr_matrix((lv[k], (at_R[li[k]], at_pc[lj[k]])), shape=(R.size, pc.size))
+        k = in_R & ~in_roi[lj]                                 # exterior positions stay as in V
+        w = lv[k][:, None] * V[lj[k]]
+        self._rhs_const = -np.stack([np.bincount(at_R[li[k]], weights=w[:, c], minlength=R.size)
+                                     for c in range(3)], axis=1)
         self._A_T = A.T.tocsr()
-        self._L_pc = LR[:, pc].tocsr()
-        self._rhs_const = -(LR[:, known_ext] @ V[known_ext])  # exterior positions stay as in V
         # where each row of R gets its detail from: solved (fd), given (dc) or rest (exterior)
-        slot = np.full(n, -1, dtype=np.int64)
-        slot[R] = np.arange(R.size)
-        self._R_fd = (slot[fd] >= 0)
-        self._R_fd_at = slot[fd][self._R_fd]
-        self._R_dc = (slot[dc] >= 0)
-        self._R_dc_at = slot[dc][self._R_dc]
+        self._R_fd = at_R[fd] >= 0
+        self._R_fd_at = at_R[fd][self._R_fd]
+        self._R_dc = at_R[dc] >= 0
+        self._R_dc_at = at_R[dc][self._R_dc]
         self._D_R_rest = D[R].copy()
-        self._embed = factorize((A.T @ A).tocsr(), symmetric=True, backend=backend) if fp.size else None
+        self._embed = factorize(self._A_T @ A, symmetric=True, backend=backend) if fp.size else None
+        self.timings = {"coefficients": t1 - t0, "curvature_setup": t2 - t1,
+                        "embedding_setup": time.perf_counter() - t2}
         self.backend = {"curvature": self._curv.backend if self._curv else "none",
                         "embedding": self._embed.backend if self._embed else "none"}
 
@@ -251,7 +275,23 @@ class CurvatureEditor:
         return np.concatenate([given, self.detail[self._dc[self._user_dc:]]])
 
 
-def _detail_islands(C, free, rank):
+def _positions_in(idx, n):
+    """``pos[v]`` = position of vertex ``v`` in ``idx``, -1 where absent; shape (n,)."""
+    pos = np.full(n, -1, dtype=np.int64)
+    pos[idx] = np.arange(idx.size)
+    return pos
+
+
+def _anchored_components(a, b, n, anchors):
+    """Label the graph with edges (a, b); True per vertex whose component holds an anchor."""
+    G = sp.csr_matrix((np.ones(a.size, dtype=np.int8), (a, b)), shape=(n, n))
+    count, labels = connected_components(G, directed=False)
+    anchored = np.zeros(count, dtype=bool)
+    anchored[labels[anchors]] = True
+    return anchored[labels]
+
+
+def _detail_islands(rows, cols, cvals, free, rank, n):
     """Free vertices whose detail the coefficients cannot determine, shape (n,) bool.
 
     ``C`` is invariant under any linear map of the detail, so a group of free vertices whose
@@ -259,39 +299,28 @@ def _detail_islands(C, free, rank):
     whose rows are zero) has its detail fixed only up to a 3x3 linear map: the square system is
     singular there (e.g. a bump in a flat plane). Such islands keep their rest detail.
     """
-    n = free.size
-    nz = C.copy()
-    nz.data = (nz.data != 0).astype(np.int8)
-    nz.eliminate_zeros()
     active = free & (rank > 0)
-    idx = np.flatnonzero(active)
-    island = np.zeros(n, dtype=bool)
-    if idx.size == 0:
-        return island
-    sub = nz[idx][:, idx]
-    count, labels = connected_components(sub + sub.T, directed=False)
-    reaches_known = np.asarray(nz[idx] @ (~free).astype(np.int8)).ravel() > 0
-    anchored = np.zeros(count, dtype=bool)
-    anchored[labels[reaches_known]] = True
-    island[idx[~anchored[labels]]] = True
-    return island
+    if not active.any():
+        return np.zeros(n, dtype=bool)
+    # links from an active row to an active or a known vertex (flat free vertices are D = 0)
+    k = active[rows] & (cvals != 0) & (active[cols] | ~free[cols])
+    anchored = _anchored_components(rows[k], cols[k], n, np.flatnonzero(~free))
+    return active & ~anchored
 
 
-def _check_reached(adjacency, free, what, name):
+def _check_reached(rows, cols, free, n, what, name):
     """Raise if a connected region of free vertices touches no constrained (or exterior) vertex."""
-    idx = np.flatnonzero(free)
-    if idx.size == 0:
+    if not free.any():
         return
-    sub = adjacency[idx][:, idx]
-    count, labels = connected_components(sub, directed=False)
-    # a free vertex with a non-free neighbour anchors its component
-    nonfree_nbr = adjacency[idx] @ (~free).astype(np.int8)
-    anchored = np.zeros(count, dtype=bool)
-    anchored[labels[np.asarray(nonfree_nbr).ravel() > 0]] = True
-    missing = np.flatnonzero(~anchored)
-    if missing.size:
-        example = [int(idx[np.flatnonzero(labels == c)[0]]) for c in missing[:3]]
+    k = free[rows]
+    anchored = _anchored_components(rows[k], cols[k], n, np.flatnonzero(~free))
+    lost = np.flatnonzero(free & ~anchored)
+    if lost.size:
+        G = sp.csr_matrix((np.ones(int(k.sum()), dtype=np.int8), (rows[k], cols[k])), shape=(n, n))
+        _, labels = connected_components(G, directed=False)
+        regions = np.unique(labels[lost])
+        example = [int(lost[np.flatnonzero(labels[lost] == c)[0]]) for c in regions[:3]]
         raise ConstraintError(
-            f"{missing.size} connected free regions touch no {what} constraint (e.g. the regions "
+            f"{regions.size} connected free regions touch no {what} constraint (e.g. the regions "
             f"containing vertex {', '.join(map(str, example))}); their {what}s are undetermined. "
             f"Add a vertex of each region to {name}, or shrink the roi.")
