@@ -132,6 +132,14 @@ def read_transform(path):
     return T
 
 
+def _publish(tmp, path):
+    """Give a finished temporary file the permissions of a normal new file, then rename it."""
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o666 & ~umask)
+    os.replace(tmp, path)
+
+
 def _write_text(path, text, overwrite):
     path = os.fspath(path)
     if os.path.exists(path) and not overwrite:
@@ -141,7 +149,7 @@ def _write_text(path, text, overwrite):
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as fh:
             fh.write(text)
-        os.replace(tmp, path)
+        _publish(tmp, path)
     finally:
         if os.path.exists(tmp):
             os.remove(tmp)
@@ -294,16 +302,16 @@ def render_panels(path, panels, *, elev=20.0, azim=-60.0, title=None, overwrite=
         ax.set_ylim(P[:, 1].min(), P[:, 1].max())
         ax.set_aspect("equal")
         ax.set_axis_off()
-        ax.set_title(label, fontsize=10)
+        ax.set_title(label, fontsize=9)
     if title:
         fig.suptitle(title, fontsize=11)
-    fig.tight_layout()
+    fig.tight_layout(pad=1.6)
     folder = os.path.dirname(os.path.abspath(path))
     fd, tmp = tempfile.mkstemp(prefix=".curvdetail-", suffix=".png", dir=folder)
     os.close(fd)
     try:
         fig.savefig(tmp, dpi=100, format="png")
-        os.replace(tmp, path)
+        _publish(tmp, path)
     finally:
         plt.close(fig)
         if os.path.exists(tmp):

@@ -1,0 +1,121 @@
+"""Speed of curvature-detail editing against the editing issue's targets; writes JSON.
+
+Targets:
+  * each Table 1 size (135-951 vertices) end to end (validation, coefficients, both
+    factorizations, one solve) under 20 ms;
+  * an edit re-solve (both stages, back-substitution only) on a 100k-vertex region at 20 or more
+    per second (terrainA_100k, boundary and a central handle constrained);
+  * each of the four Botsch-Sorkine benchmark cases under 2 s including setup (reading the
+    mesh, .sel and .def, building and factoring, solving).
+
+Usage: python scripts/bench_editing.py [--out out/bench_editing.json] [--skip-100k]
+Times are medians; the machine's load average is recorded beside them (the machine is shared).
+"""
+
+import argparse
+import json
+import os
+import platform
+import sys
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+from reproduce_table1 import MESHES, PAPER, table1_meshes, time_edit  # noqa: E402
+
+from curvdetail import CurvatureEditor, boundary_vertices, read_mesh  # noqa: E402
+from curvdetail.deformation_benchmark import (edit_with_selection, read_selection,  # noqa: E402
+                                              read_transform)
+
+CASES = ("bar", "cactus", "cylinder", "plane")
+
+
+def bench_table1(repeat):
+    meshes = table1_meshes()
+    rows = []
+    for name, *_ in PAPER:
+        V, F = meshes[name]
+        med, _, _ = time_edit(V, F, repeat)
+        rows.append({"model": name, "vertices": int(V.shape[0]), "end_to_end_ms": 1e3 * med["total"],
+                     "resolve_ms": 1e3 * med["resolve"], "target_ms": 20.0,
+                     "met": bool(med["total"] < 0.020)})
+    return rows
+
+
+def bench_resolve_100k(solves):
+    V, F = read_mesh(os.path.join(MESHES, "terrainA_100k.ply"))
+    b = boundary_vertices(F)
+    c = int(np.argmin(np.linalg.norm(V[:, :2] - V[:, :2].mean(0), axis=1)))
+    ring = np.unique(F[(F == c).any(axis=1)])
+    pc = np.concatenate([b, ring])
+    t = time.perf_counter()
+    ed = CurvatureEditor(V, F, pc, pc)
+    setup = time.perf_counter() - t
+    times = []
+    for k in range(solves):
+        P = V[pc].copy()
+        P[b.size:, 2] += 0.05 * (k + 1)
+        t = time.perf_counter()
+        ed.solve(positions=P)
+        times.append(time.perf_counter() - t)
+    med = float(np.median(times))
+    return {"vertices": int(V.shape[0]), "roi_vertices": int(ed.roi.size), "setup_s": setup,
+            "setup_breakdown_s": ed.timings, "backend": ed.backend, "resolve_s": med,
+            "resolves_per_second": 1.0 / med, "target_per_second": 20.0, "met": bool(1.0 / med >= 20.0)}
+
+
+def bench_cases(repeat):
+    rows = []
+    folder = os.path.join(MESHES, "deformation")
+    for name in CASES:
+        totals, resolves = [], []
+        for _ in range(repeat):
+            t = time.perf_counter()
+            V, F = read_mesh(os.path.join(folder, name + ".off"))
+            status = read_selection(os.path.join(folder, name + ".sel"), V.shape[0])
+            T = read_transform(os.path.join(folder, name + ".def"))
+            X, ed = edit_with_selection(V, F, status, T, return_editor=True)
+            totals.append(time.perf_counter() - t)
+            h = ed.position_constrained
+            t = time.perf_counter()
+            ed.solve(positions=X[h], details=ed.detail[h] @ T[:3, :3].T)
+            resolves.append(time.perf_counter() - t)
+        rows.append({"case": name, "vertices": int(V.shape[0]), "roi_vertices": int(ed.roi.size),
+                     "total_s": float(np.median(totals)), "resolve_s": float(np.median(resolves)),
+                     "target_s": 2.0, "met": bool(np.median(totals) < 2.0)})
+    return rows
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", default="out/bench_editing.json")
+    ap.add_argument("--repeat", type=int, default=7)
+    ap.add_argument("--skip-100k", action="store_true")
+    args = ap.parse_args(argv)
+    os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
+    report = {"machine": {"platform": platform.platform(), "cpus": os.cpu_count(),
+                          "load_average_before": os.getloadavg()}}
+    report["table1"] = bench_table1(args.repeat)
+    for r in report["table1"]:
+        print(f"table1 {r['model']:6s} {r['vertices']:4d} v: {r['end_to_end_ms']:.1f} ms end to end "
+              f"(target 20) re-solve {r['resolve_ms']:.2f} ms")
+    report["cases"] = bench_cases(max(1, args.repeat // 2))
+    for r in report["cases"]:
+        print(f"case {r['case']:8s} {r['vertices']:5d} v: {r['total_s']:.3f} s incl. setup (target 2), "
+              f"re-solve {1e3 * r['resolve_s']:.1f} ms")
+    if not args.skip_100k:
+        report["resolve_100k"] = bench_resolve_100k(10)
+        r = report["resolve_100k"]
+        print(f"100k region: setup {r['setup_s']:.2f} s, re-solve {1e3 * r['resolve_s']:.1f} ms = "
+              f"{r['resolves_per_second']:.1f}/s (target 20/s)")
+    report["machine"]["load_average_after"] = os.getloadavg()
+    with open(args.out, "w") as fh:
+        json.dump(report, fh, indent=2)
+    print(f"wrote {args.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,113 @@
+"""Compare curvature-detail editing with the survey's Laplacian surface editing results.
+
+For each of the four Botsch-Sorkine cases (bar, cactus, cylinder, plane): run
+``edit_with_selection`` with the handles' details transformed and solved freely, measure the
+distance of every vertex to the survey's ``NAME-laplacian_editing.off`` (same connectivity, so
+vertex-to-vertex; mean and max as fractions of the rest mesh's bounding-box diagonal), the
+first-solve time (setup + solve) and the re-solve time, and save pictures side by side.
+
+Usage: python scripts/compare_deformation_benchmark.py [--out out/compare] [--docs docs]
+Writes OUT/compare.json, OUT/compare.md and OUT/NAME.png (and docs/editing_NAME.png with --docs).
+"""
+
+import argparse
+import json
+import os
+import sys
+import time
+
+import numpy as np
+
+from curvdetail import read_mesh
+from curvdetail.curvature._validate import bbox_diagonal
+from curvdetail.deformation_benchmark import (edit_with_selection, read_selection, read_transform,
+                                              render_panels)
+
+MESHES = os.environ.get("CURVDETAIL_MESHES", os.path.join(os.path.dirname(__file__), "..", "..",
+                                                          "shared", "meshes"))
+CASES = ("bar", "cactus", "cylinder", "plane")
+VIEWS = {"bar": (15, -60), "cactus": (10, -90), "cylinder": (10, -90), "plane": (30, -60)}
+
+
+def run_case(name, folder):
+    V, F = read_mesh(os.path.join(folder, name + ".off"))
+    status = read_selection(os.path.join(folder, name + ".sel"), V.shape[0])
+    T = read_transform(os.path.join(folder, name + ".def"))
+    ref, Fr = read_mesh(os.path.join(folder, name + "-laplacian_editing.off"))
+    if not np.array_equal(Fr, F):
+        raise ValueError(f"{name}: the reference result has a different connectivity.")
+    diag = bbox_diagonal(V)
+    out = {"case": name, "vertices": int(V.shape[0]),
+           "n_fixed": int((status == 0).sum()), "n_free": int((status == 1).sum()),
+           "n_handles": int((status == 2).sum()),
+           "reference_moved_mean": float(np.linalg.norm(ref - V, axis=1).mean() / diag),
+           "reference_moved_max": float(np.linalg.norm(ref - V, axis=1).max() / diag)}
+    results = {}
+    for mode in ("transform", "free"):
+        t = time.perf_counter()
+        X, ed = edit_with_selection(V, F, status, T, handle_detail=mode, return_editor=True)
+        first = time.perf_counter() - t
+        h = ed.position_constrained
+        details = ed.detail[h] @ T[:3, :3].T if mode == "transform" else None
+        t = time.perf_counter()
+        ed.solve(positions=X[h], details=details)
+        resolve = time.perf_counter() - t
+        dist = np.linalg.norm(X - ref, axis=1) / diag
+        out[mode] = {"mean": float(dist.mean()), "max": float(dist.max()), "first_solve_s": first,
+                     "resolve_s": resolve, "rank_deficient": ed.rank_deficient,
+                     "detail_islands": ed.detail_islands, "finite": bool(np.isfinite(X).all())}
+        results[mode] = X
+    return out, (V, F, status, results, ref)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", default="out/compare")
+    ap.add_argument("--docs", default=None, help="also write small pictures docs/editing_NAME.png here")
+    args = ap.parse_args(argv)
+    os.makedirs(args.out, exist_ok=True)
+    folder = os.path.join(MESHES, "deformation")
+    rows = []
+    for name in CASES:
+        row, (V, F, status, results, ref) = run_case(name, folder)
+        rows.append(row)
+        elev, azim = VIEWS[name]
+        # a diverged result would squash the other panels: draw it clipped to the reference's box
+        lo, hi = ref.min(0), ref.max(0)
+        pad = 0.5 * (hi - lo)
+        panels = [(V, F, "rest: fixed / free / handle", status)]
+        for mode in ("transform", "free"):
+            X = np.clip(results[mode], lo - pad, hi + pad)
+            label = f"ours, handle detail {mode}\nmean {100 * row[mode]['mean']:.1f} % / max {100 * row[mode]['max']:.1f} %"
+            panels.append((X, F, label))
+        panels.append((ref, F, "survey: Laplacian editing"))
+        for target in [os.path.join(args.out, name + ".png")] + (
+                [os.path.join(args.docs, f"editing_{name}.png")] if args.docs else []):
+            small = target.startswith(args.docs) if args.docs else False
+            render_panels(target, panels, elev=elev, azim=azim, overwrite=True,
+                          panel_size=2.4 if small else 3.5)
+        print(f"{name}: transform mean {row['transform']['mean']:.4f} max {row['transform']['max']:.4f}; "
+              f"free mean {row['free']['mean']:.4f} max {row['free']['max']:.4f}; first solve "
+              f"{row['transform']['first_solve_s']:.2f} s, re-solve {1e3 * row['transform']['resolve_s']:.1f} ms")
+    lines = ["| case | vertices (fixed/free/handle) | survey result moved (mean / max) | ours, handle "
+             "detail transformed: distance to survey (mean / max) | ours, handle detail free (mean / max) "
+             "| first solve (s) | re-solve (ms) |", "|---|---|---|---|---|---|---|"]
+    for r in rows:
+        t, f = r["transform"], r["free"]
+        lines.append(f"| {r['case']} | {r['vertices']} ({r['n_fixed']}/{r['n_free']}/{r['n_handles']}) | "
+                     f"{100 * r['reference_moved_mean']:.1f} % / {100 * r['reference_moved_max']:.1f} % | "
+                     f"{100 * t['mean']:.2f} % / {100 * t['max']:.2f} % | "
+                     f"{100 * f['mean']:.2f} % / {100 * f['max']:.2f} % | "
+                     f"{t['first_solve_s']:.2f} / {f['first_solve_s']:.2f} | "
+                     f"{1e3 * t['resolve_s']:.1f} / {1e3 * f['resolve_s']:.1f} |")
+    table = "\n".join(lines)
+    print(table)
+    with open(os.path.join(args.out, "compare.json"), "w") as fh:
+        json.dump({"load_average": os.getloadavg(), "rows": rows}, fh, indent=2)
+    with open(os.path.join(args.out, "compare.md"), "w") as fh:
+        fh.write(table + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
