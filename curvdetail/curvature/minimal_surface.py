@@ -17,7 +17,7 @@ class MinimalSurfaceResult(np.ndarray):
 
 #: Default stopping tolerance of :func:`minimal_surface`: the shape moves by less than 1e-4 of the
 #: bbox diagonal in a step. The cotangent minimal surface itself is only second-order accurate
-#: (the 64 x 33 catenoid is off by 2e-4 of its diagonal), so iterating further buys nothing.
+#: (the 64 x 33 catenoid is off by 1.5e-4 of its diagonal), so iterating further buys nothing.
 DEFAULT_TOL = 1e-4
 
 
