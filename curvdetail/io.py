@@ -84,6 +84,22 @@ def write_mesh(path, V, F, *, quality=None, overwrite=False):
     FileExistsError   ``path`` exists and ``overwrite`` is False
     MeshError         malformed ``V``, ``F`` or ``quality``
     MeshFileError     the format is unknown or the folder is not writable
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from curvdetail import read_mesh, write_mesh
+    >>> from curvdetail.curvature.testing import icosphere
+    >>> V, F = icosphere(subdivisions=1)
+    >>> path = os.path.join(tempfile.mkdtemp(), "sphere.ply")
+    >>> write_mesh(path, V, F, quality=V[:, 2])
+    >>> W, G = read_mesh(path)
+    >>> bool((W == V).all() and (G == F).all())
+    True
+    >>> write_mesh(path, V, F)
+    Traceback (most recent call last):
+    ...
+    FileExistsError: ... exists; pass overwrite=True (or --overwrite) to replace it.
     """
     import pymeshlab
 
@@ -104,7 +120,34 @@ def write_mesh(path, V, F, *, quality=None, overwrite=False):
 
 def save_mesh(path, mesh, *, overwrite=False, **save_options):
     """Atomically save a ``pymeshlab.Mesh`` (with its quality, colours and custom attributes where
-    the format holds them). Used by :func:`write_mesh`, the filters and the CLI."""
+    the format holds them). Used by :func:`write_mesh`, the filters and the CLI.
+
+    The mesh is written to a temporary file in the destination folder and renamed over ``path``
+    only when the write succeeded; a failed write removes the temporary file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike   destination; the extension picks the format
+    mesh : pymeshlab.Mesh
+    overwrite : bool            replace an existing file (refused by default)
+    **save_options              passed to ``MeshSet.save_current_mesh`` (e.g. ``binary=False``);
+                                for PLY, ``save_vertex_quality`` defaults to True when the mesh
+                                has vertex quality
+
+    Raises
+    ------
+    FileExistsError   ``path`` exists and ``overwrite`` is False
+    MeshFileError     no extension, missing folder, or pymeshlab failed to write
+
+    Examples
+    --------
+    >>> import os, tempfile, numpy as np, pymeshlab
+    >>> mesh = pymeshlab.Mesh(vertex_matrix=np.eye(3), face_matrix=np.array([[0, 1, 2]], dtype=np.int32))
+    >>> path = os.path.join(tempfile.mkdtemp(), "triangle.off")
+    >>> save_mesh(path, mesh)
+    >>> os.path.exists(path)
+    True
+    """
     path = os.fspath(path)
     if os.path.exists(path) and not overwrite:
         raise FileExistsError(f"{path} exists; pass overwrite=True (or --overwrite) to replace it.")

@@ -150,3 +150,10 @@ def test_save_mesh_refuses_to_overwrite(tmp_path):
     mesh = pymeshlab.Mesh(vertex_matrix=np.eye(3), face_matrix=np.array([[0, 1, 2]], dtype=np.int32))
     with pytest.raises(FileExistsError):
         save_mesh(path, mesh)
+
+
+def test_docstring_examples_run():
+    import doctest
+    import importlib
+
+    assert doctest.testmod(importlib.import_module("curvdetail.io"), optionflags=doctest.ELLIPSIS).failed == 0

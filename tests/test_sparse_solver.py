@@ -114,3 +114,10 @@ def test_right_hand_side_of_the_wrong_length_is_refused():
     A, _ = _spd_system(8)
     with pytest.raises(SolverError, match=f"right-hand side has 5 rows; the matrix has {A.shape[0]}"):
         factorize(A).solve(np.ones(5))
+
+
+def test_docstring_examples_run():
+    import doctest
+    import importlib
+
+    assert doctest.testmod(importlib.import_module("curvdetail.curvature.sparse_solver"), optionflags=doctest.ELLIPSIS).failed == 0

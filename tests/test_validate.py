@@ -173,3 +173,10 @@ def test_components_are_labelled():
     V, F = _square()
     labels, count = vertex_components(np.vstack([F, F + 9]), 18)
     assert count == 2 and len(set(labels[:9])) == 1 and labels[0] != labels[9]
+
+
+def test_docstring_examples_run():
+    import doctest
+    import importlib
+
+    assert doctest.testmod(importlib.import_module("curvdetail.curvature._validate"), optionflags=doctest.ELLIPSIS).failed == 0

@@ -87,8 +87,36 @@ def check_mesh(V, F, *, check_manifold=True, check_unreferenced=True):
     """Validate a triangle mesh and return ``(V, F)`` as float64 / int64 arrays.
 
     Checks, in order: shapes and dtypes, emptiness, NaN/inf, index range, repeated indices in
-    a face, zero-area faces, non-manifold edges (an edge in more than two triangles) and
-    unreferenced vertices.
+    a face, zero-area faces (below ``ZERO_AREA_RELATIVE`` times the squared bbox diagonal),
+    non-manifold edges (an edge in more than two triangles) and unreferenced vertices.
+
+    Parameters
+    ----------
+    V : (n, 3) array of real numbers    vertex positions (integers are converted)
+    F : (m, 3) array of integers        triangles (integral floats are accepted)
+    check_manifold : bool               refuse edges shared by more than two triangles
+    check_unreferenced : bool           refuse vertices used by no triangle
+
+    Returns
+    -------
+    V : (n, 3) float64 C-contiguous array
+    F : (m, 3) int64 C-contiguous array
+
+    Raises
+    ------
+    MeshError   naming the problem, how many elements have it, the first few indices and the fix
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [5, 5, 5]])
+    >>> check_mesh(V, [[0, 1, 2]])
+    Traceback (most recent call last):
+    ...
+    curvdetail.curvature.errors.MeshError: 1 vertices are not used by any triangle (first: 3); remove them, e.g. with pymeshlab's meshing_remove_unreferenced_vertices.
+    >>> V, F = check_mesh(V[:3], [[0, 1, 2]])
+    >>> V.dtype, F.dtype
+    (dtype('float64'), dtype('int64'))
     """
     V = as_vertices(V)
     F = as_faces(F, V.shape[0])
@@ -147,7 +175,18 @@ def non_manifold_edges(F):
 
 
 def boundary_edges(F):
-    """Undirected edges used by exactly one triangle, shape (k, 2), oriented as in their face."""
+    """Edges used by exactly one triangle, shape (k, 2), each oriented as in its triangle (so
+    a consistently oriented disk's boundary runs counter-clockwise seen from its normals side).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> boundary_edges(np.array([[0, 1, 2], [0, 2, 3]]))     # a quad split along (0, 2)
+    array([[0, 1],
+           [3, 0],
+           [1, 2],
+           [2, 3]])
+    """
     D = np.stack([F[:, [1, 2]], F[:, [2, 0]], F[:, [0, 1]]], axis=1).reshape(-1, 2)
     keys, _ = _edge_keys(F)
     uniq, first, counts = np.unique(keys, return_index=True, return_counts=True)
@@ -155,7 +194,16 @@ def boundary_edges(F):
 
 
 def boundary_vertices(F):
-    """Sorted indices of the vertices on a boundary edge."""
+    """Sorted indices of the vertices on a boundary edge; empty for a closed surface.
+
+    Examples
+    --------
+    >>> from curvdetail.curvature.testing import grid, icosphere
+    >>> boundary_vertices(grid(3, 3)[1])
+    array([0, 1, 2, 3, 5, 6, 7, 8])
+    >>> boundary_vertices(icosphere(subdivisions=1)[1]).size
+    0
+    """
     return np.unique(boundary_edges(F))
 
 

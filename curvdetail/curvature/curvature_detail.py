@@ -19,6 +19,11 @@ def curvature_detail(V, F):
     -------
     D : (n, 3) float array   equal to ``cotan_laplacian(V, F) @ V``
 
+    Raises
+    ------
+    MeshError   if V or F is malformed, a triangle has zero area, an edge is non-manifold or a
+                vertex is unreferenced (names the first ones)
+
     Examples
     --------
     >>> import numpy as np

@@ -44,6 +44,14 @@ class Reconstructor:
     backend : str                the solver backend in use
     refinement_steps : int       refinement steps of ``rows="all"`` solves (class default 1)
 
+    Raises
+    ------
+    MeshError         malformed mesh (see :func:`check_mesh`)
+    ConstraintError   no fixed vertex, fixed indices out of range or repeated, a boolean mask of
+                      the wrong length, or a connected piece without a fixed vertex
+    ValueError        an unknown ``rows`` mode
+    SolverError       an unknown or uninstalled ``backend``
+
     Examples
     --------
     >>> from curvdetail.curvature.testing import grid
