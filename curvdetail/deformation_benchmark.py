@@ -248,6 +248,21 @@ def edit_with_selection(V, F, status, T, *, handle_detail="transform", rcond=DEF
     return (X, editor) if return_editor else X
 
 
+def _camera(elev, azim):
+    """Rotation taking world coordinates (z up) to the camera's (x right, y up, z to the viewer)."""
+    e, a = np.radians(elev), np.radians(azim)
+    Rz = np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
+    Rx = np.array([[1, 0, 0], [0, np.cos(e - np.pi / 2), -np.sin(e - np.pi / 2)],
+                   [0, np.sin(e - np.pi / 2), np.cos(e - np.pi / 2)]])
+    return Rx @ Rz.T
+
+
+def view_direction(elev, azim):
+    """Unit vector (world, z up) pointing from the scene towards the viewer of
+    :func:`render_panels` with this camera: "towards the reader"."""
+    return _camera(elev, azim)[2].copy()
+
+
 def render_panels(path, panels, *, elev=20.0, azim=-60.0, title=None, overwrite=False,
                   panel_size=4.0):
     """Save side-by-side shaded renders of meshes as a PNG (matplotlib, Agg), atomically.
@@ -271,12 +286,7 @@ def render_panels(path, panels, *, elev=20.0, azim=-60.0, title=None, overwrite=
     path = os.fspath(path)
     if os.path.exists(path) and not overwrite:
         raise FileExistsError(f"{path} exists; pass overwrite=True (or --overwrite) to replace it.")
-    e, a = np.radians(elev), np.radians(azim)
-    # camera frame: x right, y up, z towards the viewer
-    Rz = np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
-    Rx = np.array([[1, 0, 0], [0, np.cos(e - np.pi / 2), -np.sin(e - np.pi / 2)],
-                   [0, np.sin(e - np.pi / 2), np.cos(e - np.pi / 2)]])
-    R = Rx @ Rz.T
+    R = _camera(elev, azim)          # camera frame: x right, y up, z towards the viewer
     fig, axes = plt.subplots(1, len(panels), figsize=(panel_size * len(panels), panel_size),
                              squeeze=False)
     for ax, panel in zip(axes[0], panels):

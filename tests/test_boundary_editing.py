@@ -54,3 +54,21 @@ def test_displacement_array_of_the_wrong_shape_is_refused(load_mesh):
         edit_boundary(V, F, np.zeros((3, 3)))
     with pytest.raises(ValueError, match="callable returned shape"):
         edit_boundary(V, F, lambda s, P: np.zeros(3))
+
+
+def test_rest_boundary_detail_keeps_the_inside_detail(load_mesh):
+    V, F = load_mesh("terrainA_1k.obj")
+    X, info = edit_boundary(V, F, sine_displacement(0.3, periods=2, axis=2), boundary_detail="rest",
+                            return_info=True)
+    b, ed = info["boundary"], info["editor"]
+    assert np.array_equal(info["boundary_detail"], ed.detail[b])
+    # consistent detail constraints: the curvature stage gives back the rest detail everywhere
+    X2, D = ed.solve(positions=X[b], details=ed.detail[b], return_details=True)
+    assert np.abs(D - ed.detail).max() < 1e-9 * np.abs(ed.detail).max()
+    assert np.array_equal(X2, X)
+
+
+def test_unknown_boundary_detail_mode_is_refused(load_mesh):
+    V, F = load_mesh("terrainA_1k.obj")
+    with pytest.raises(ValueError, match="boundary_detail"):
+        edit_boundary(V, F, sine_displacement(0.1), boundary_detail="rotate")

@@ -10,7 +10,8 @@ from .errors import MeshError
 from .sparse_solver import factorize
 
 
-def edit_boundary(V, F, displacement, *, rcond=DEFAULT_RCOND, backend="auto", return_info=False):
+def edit_boundary(V, F, displacement, *, boundary_detail="deformed", rcond=DEFAULT_RCOND,
+                  backend="auto", return_info=False):
     """Move the boundary of a disk-topology patch and rebuild the surface from its detail.
 
     Steps (the paper's shape editing: "the boundary vertices coordinate ... are modified ...
@@ -18,9 +19,11 @@ def edit_boundary(V, F, displacement, *, rcond=DEFAULT_RCOND, backend="auto", re
 
     1. The boundary loop (one loop, in the orientation of its triangles) is moved by
        ``displacement``.
-    2. The boundary's curvature detail is updated accordingly: the displacement is spread into
-       the interior as a cotangent-harmonic field (rest weights), and the boundary details are
-       those of that provisional surface, ``D_b = (L(V') V')_b``.
+    2. The boundary's curvature detail is updated accordingly (``boundary_detail="deformed"``,
+       the paper): the displacement is spread into the interior as a cotangent-harmonic field
+       (rest weights), and the boundary details are those of that provisional surface,
+       ``D_b = (L(V') V')_b``. With ``"rest"`` the boundary keeps its rest detail (the inside
+       then keeps its rest detail too and only the embedding changes).
     3. A :class:`CurvatureEditor` with the boundary's positions and details constrained rebuilds
        the interior: the curvature stage carries the interior detail (rotation- and scale-
        invariant coefficients), the embedding places it.
@@ -34,6 +37,9 @@ def edit_boundary(V, F, displacement, *, rcond=DEFAULT_RCOND, backend="auto", re
         boundary vertex along the loop (starting at the loop's first vertex, see ``info``) and
         ``P`` their (b, 3) positions; or the (b, 3) displacements themselves, row r for
         ``info["boundary"][r]`` (loop order). :func:`sine_displacement` builds the paper's sine.
+    boundary_detail : {"deformed", "rest"}   how the boundary's detail is updated (step 2).
+                             Large displacements with ``"deformed"`` can fold triangles: the
+                             curvature stage amplifies detail changes (see docs/editing.md)
     rcond : float            threshold of :func:`curvature_coefficients`
     backend : str            sparse solver backend
     return_info : bool       also return a dict with ``boundary`` (loop order), ``arc_length``
@@ -62,6 +68,8 @@ def edit_boundary(V, F, displacement, *, rcond=DEFAULT_RCOND, backend="auto", re
     True
     """
     V, F = check_mesh(V, F)
+    if boundary_detail not in ("deformed", "rest"):
+        raise ValueError(f"boundary_detail={boundary_detail!r}; use 'deformed' or 'rest'.")
     loop = boundary_loop(F)
     P = V[loop]
     seg = np.linalg.norm(np.roll(P, -1, axis=0) - P, axis=1)
@@ -78,6 +86,13 @@ def edit_boundary(V, F, displacement, *, rcond=DEFAULT_RCOND, backend="auto", re
     else:
         d = as_values(displacement, loop.size, "displacement")
     n = V.shape[0]
+    editor = CurvatureEditor(V, F, loop, loop, rcond=rcond, backend=backend)
+    if boundary_detail == "rest":
+        X = editor.solve(positions=P + d, details=editor.detail[loop])
+        if not return_info:
+            return X
+        return X, {"boundary": loop, "arc_length": s, "boundary_detail": editor.detail[loop],
+                   "editor": editor}
     L = _cotan_laplacian_unchecked(V, F)
     free = np.ones(n, dtype=bool)
     free[loop] = False
@@ -89,7 +104,6 @@ def edit_boundary(V, F, displacement, *, rcond=DEFAULT_RCOND, backend="auto", re
         U[inner] = factorize(Lf, symmetric=True, backend=backend).solve(-(L[inner][:, loop] @ d))
     Vp = V + U
     Db = (_cotan_laplacian_unchecked(Vp, F) @ Vp)[loop]
-    editor = CurvatureEditor(V, F, loop, loop, rcond=rcond, backend=backend)
     X = editor.solve(positions=P + d, details=Db)
     if not return_info:
         return X
