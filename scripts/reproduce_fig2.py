@@ -122,7 +122,7 @@ def main(argv=None):
             ax.imshow(mpimg.imread(os.path.join(args.out, key + ".png")))
             ax.set_axis_off()
         fig.tight_layout()
-        fig.savefig(os.path.join(args.docs, "editing_fig2.png"), dpi=90)
+        fig.savefig(os.path.join(args.docs, "editing_fig2.png"), dpi=75)
         plt.close(fig)
     return 0
 
