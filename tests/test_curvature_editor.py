@@ -70,13 +70,14 @@ def test_constraints_are_kept_exactly_and_outside_roi_is_untouched(load_mesh):
     assert moved[roi].max() > 0.5 * 0.05 * _diag(V)
 
 
-def test_embedding_equals_core_reconstruction_when_every_detail_is_given(load_mesh, rng):
+@pytest.mark.parametrize("rows", ["all", "free"])
+def test_embedding_equals_core_reconstruction_when_every_detail_is_given(load_mesh, rng, rows):
     V, F = load_mesh("mannequin_nose.obj")
     b = boundary_vertices(F)
     everything = np.arange(V.shape[0])
     D = curvature_detail(V, F) * (1 + 0.2 * rng.random((V.shape[0], 1)))
-    X = CurvatureEditor(V, F, b, everything).solve(positions=V[b], details=D)
-    expected = reconstruct(V, F, D, b, V[b], rows="all")
+    X = CurvatureEditor(V, F, b, everything, rows=rows).solve(positions=V[b], details=D)
+    expected = reconstruct(V, F, D, b, V[b], rows=rows)
     assert np.abs(X - expected).max() < 1e-9 * _diag(V)
 
 
@@ -107,6 +108,7 @@ def test_translated_frame_translates_a_rank_deficient_plane(plane_grid):
     (dict(position_constrained=[0], detail_constrained=[]), "detail_constrained is empty"),
     (dict(position_constrained=[0], detail_constrained=[0], roi=[]), "roi is empty"),
     (dict(position_constrained=[0, 1], detail_constrained=[1], roi=np.arange(1, 100)), "outside the roi"),
+    (dict(position_constrained=[0], detail_constrained=[0], roi=np.arange(1, 100)), "outside the roi"),
 ])
 def test_bad_constraint_sets_are_refused(plane_grid, kwargs, message):
     V, F = plane_grid
@@ -123,6 +125,13 @@ def test_a_free_piece_without_any_constraint_is_refused(plane_grid):
         CurvatureEditor(V2, F2, b, np.arange(V2.shape[0]))
     with pytest.raises(ConstraintError, match="touch no detail constraint"):
         CurvatureEditor(V2, F2, np.arange(V2.shape[0]), b)
+
+
+def test_unknown_row_mode_is_refused(plane_grid):
+    V, F = plane_grid
+    b = boundary_vertices(F)
+    with pytest.raises(ValueError, match="row mode"):
+        CurvatureEditor(V, F, b, b, rows="some")
 
 
 def test_solve_refuses_values_of_the_wrong_shape(plane_grid):
@@ -156,3 +165,34 @@ def test_twisting_a_rank_deficient_cylinder_stays_finite_and_exact(open_cylinder
     # linear method does not rotate the inside details, so the tube narrows slightly)
     r = np.linalg.norm(X[:, :2], axis=1)
     assert np.abs(r / 0.5 - 1).max() < 0.02
+
+
+def test_precomputed_handle_response_matches_the_full_solve_without_factoring(load_mesh, rng):
+    V, F = load_mesh("terrainA_1k.obj")
+    b = boundary_vertices(F)
+    centre = np.argmin(np.linalg.norm(V[:, :2] - V[:, :2].mean(0), axis=1))
+    ring = np.unique(F[(F == centre).any(axis=1)])
+    pc = np.concatenate([b, ring])
+    ed = CurvatureEditor(V, F, pc, pc)
+    before = sparse_solver.factorization_count
+    ed.precompute_handles(ring)
+    P = V[pc].copy()
+    Dk = ed.detail[pc].copy()
+    P[b.size:] += rng.normal(scale=0.2, size=(ring.size, 3))
+    Dk[b.size:] *= 1.5
+    fast = ed.solve(positions=P, details=Dk)
+    assert sparse_solver.factorization_count == before
+    ed._response = None                       # the same edit through both back-substitutions
+    full = ed.solve(positions=P, details=Dk)
+    # one linear map evaluated two ways: equal up to roundoff of the solves
+    assert np.abs(fast - full).max() < 1e-10 * np.linalg.norm(np.ptp(V, axis=0))
+    assert np.array_equal(fast[pc], P)
+
+
+def test_precompute_refuses_unconstrained_handles(plane_grid):
+    V, F = plane_grid
+    b = boundary_vertices(F)
+    ed = CurvatureEditor(V, F, b, b)
+    inner = np.setdiff1d(np.arange(V.shape[0]), b)[:2]
+    with pytest.raises(ConstraintError, match="neither position- nor detail-constrained"):
+        ed.precompute_handles(inner)
