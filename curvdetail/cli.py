@@ -401,6 +401,12 @@ def _edit_command(parser):
               f"largest move {moved.max() / bbox_diagonal(V):.3e} of the bbox diagonal; "
               f"{editor.rank_deficient} rank-deficient rings, {editor.detail_islands} island "
               f"vertices; {seconds:.3f} s")
+        handle_move = moved[status == 2].max()
+        if moved.max() > 3.0 * handle_move + 1e-12 * bbox_diagonal(V):
+            print(f"curvdetail: warning: vertices moved up to {moved.max() / max(handle_move, 1e-300):.1f} "
+                  "times as far as the handles: the curvature stage amplified the handle details "
+                  "(ill-conditioned coefficients, see docs/editing.md); try --handle-detail free.",
+                  file=sys.stderr)
         return 0
 
     return run
