@@ -9,9 +9,11 @@ METHODS = ("isotropic", "decimate")
 #: The target edge length is refused when it would give fewer / more target vertices than this.
 MIN_VERTICES, MAX_VERTICES = 50, 5_000_000
 
-#: A boundary vertex of the remesher's result further than this (x bbox diagonal) from the source
-#: boundary polyline is an error; closer ones are projected onto the polyline.
-BOUNDARY_SNAP = 1e-6
+#: A boundary vertex of the remesher's result further than this (x the target edge length) from
+#: the source boundary polyline is an error; closer ones are projected onto the polyline. The
+#: isotropic remesher's smoothing step slides boundary vertices along a curved boundary and so
+#: moves them off it by up to ~1e-4 of the bbox diagonal (a flat disk of 24 rings at 3 %).
+BOUNDARY_SNAP = 0.1
 
 
 def estimated_vertices(V, F, target_edge):
@@ -103,7 +105,7 @@ def retriangulate(V, F, *, method="isotropic", target_edge=0.01, iterations=10, 
             raise RemeshError(f"{exc} Try another target edge.") from None
     else:
         Vt, Ft, loop_t = _decimate(V, F, h, float(aggressiveness))
-    return _snap_boundary(V, loop, Vt, Ft, loop_t, d)
+    return _snap_boundary(V, loop, Vt, Ft, loop_t, d, h)
 
 
 def _isotropic(V, F, h, iterations, max_dist):
@@ -148,14 +150,20 @@ def _decimate(V, F, h, agg):
     raise RemeshError(f"{last} (decimation with agg={agg}, 3 and 1); try method='isotropic'.")
 
 
-def _snap_boundary(V, loop, Vt, Ft, loop_t, d):
+def _snap_boundary(V, loop, Vt, Ft, loop_t, d, h):
     poly = Polyline(V[loop])
     Y, _, dist = poly.project(Vt[loop_t])
-    far = np.flatnonzero(dist > BOUNDARY_SNAP * d)
+    far = np.flatnonzero(dist > BOUNDARY_SNAP * h)
     if far.size:
         raise RemeshError(
             f"the remesher moved {far.size} boundary vertices off the source boundary (largest "
-            f"{dist.max() / d:.2e} of the bbox diagonal, first: {', '.join(map(str, loop_t[far[:3]]))}).")
+            f"{dist.max() / d:.2e} of the bbox diagonal, first: {', '.join(map(str, loop_t[far[:3]]))}); "
+            "try another target edge.")
+    _, s, _ = poly.project(Y)
+    step = np.mod(np.diff(np.append(s, s[0])), poly.total)
+    if abs(step.sum() - poly.total) > 1e-6 * poly.total:
+        raise RemeshError("the remesher's boundary does not run once around the source boundary in order "
+                          "(it folds back); try another target edge.")
     Vt = Vt.copy()
     Vt[loop_t] = Y
     return Vt, Ft

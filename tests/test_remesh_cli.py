@@ -1,0 +1,67 @@
+"""The ``curvdetail remesh`` command (curvdetail.cli, remesh section)."""
+
+import json
+import os
+
+import numpy as np
+import pytest
+
+from curvdetail import read_mesh
+from curvdetail.cli import main
+from curvdetail.curvature.testing import cylinder
+from curvdetail.io import write_mesh
+
+DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
+
+
+def test_remesh_writes_mesh_with_distance_quality_report_and_image(tmp_path, capsys):
+    out, rep, img = tmp_path / "nose.ply", tmp_path / "r.json", tmp_path / "f.png"
+    rc = main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(out), "--target-edge", "3",
+               "--report", str(rep), "--image", str(img), "--quiet"])
+    assert rc == 0
+    report = json.loads(rep.read_text())
+    assert report["target"]["vertices"] == read_mesh(str(out))[0].shape[0]
+    assert report["options"]["target_edge"] == pytest.approx(0.03)
+    assert img.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    import pymeshlab
+
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(str(out))
+    q = ms.current_mesh().vertex_scalar_array()
+    # quality = distance to the source; its max is the report's vertex_max (x bbox diagonal)
+    assert q.max() / report["source"]["bbox_diagonal"] == pytest.approx(report["error"]["vertex_max"], rel=1e-6)
+    assert "RMS" in capsys.readouterr().out
+
+
+def test_missing_source_fails_and_writes_nothing(tmp_path, capsys):
+    rc = main(["remesh", str(tmp_path / "none.obj"), str(tmp_path / "o.ply"), "--report", str(tmp_path / "r.json")])
+    assert rc == 1
+    assert "not found" in capsys.readouterr().err
+    assert os.listdir(tmp_path) == []
+
+
+def test_non_disk_source_fails_saying_what_was_found(tmp_path, capsys):
+    src = tmp_path / "tube.ply"
+    write_mesh(str(src), *cylinder(n_around=16, n_along=6))
+    rc = main(["remesh", str(src), str(tmp_path / "o.ply"), "--image", str(tmp_path / "f.png"), "--quiet"])
+    assert rc == 1
+    assert "2 boundary loops" in capsys.readouterr().err
+    assert sorted(os.listdir(tmp_path)) == ["tube.ply"]
+
+
+@pytest.mark.parametrize("pct", ["0.0001", "90"])
+def test_absurd_target_edge_fails_with_the_numbers_and_writes_nothing(tmp_path, capsys, pct):
+    rc = main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "o.ply"), "--target-edge", pct,
+               "--report", str(tmp_path / "r.json"), "--quiet"])
+    assert rc == 1
+    assert "target vertices" in capsys.readouterr().err
+    assert os.listdir(tmp_path) == []
+
+
+def test_existing_report_is_not_overwritten(tmp_path, capsys):
+    rep = tmp_path / "r.json"
+    rep.write_text("keep")
+    rc = main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "o.ply"), "--report", str(rep)])
+    assert rc == 1 and rep.read_text() == "keep"
+    assert "--overwrite" in capsys.readouterr().err
+    assert sorted(os.listdir(tmp_path)) == ["r.json"]

@@ -1,0 +1,56 @@
+"""Disk-topology checks and the boundary polyline (curvdetail.remesh._disk)."""
+
+import numpy as np
+import pytest
+
+from curvdetail.curvature.testing import cylinder, disk, icosphere
+from curvdetail.remesh import NotADiskError
+from curvdetail.remesh._disk import Polyline, check_disk
+
+
+def test_flat_disk_is_accepted_with_its_boundary_loop_in_face_order(flat_disk):
+    V, F = flat_disk
+    _, _, loop = check_disk(V, F)
+    # the outer ring of 20 rings has 6 * 20 vertices, all at radius 1, walked counter-clockwise
+    # (normals +z: the mesh lies to the left)
+    assert loop.size == 120
+    assert np.allclose(np.linalg.norm(V[loop, :2], axis=1), 1.0)
+    angle = np.unwrap(np.arctan2(V[loop, 1], V[loop, 0]))
+    assert np.all(np.diff(angle) > 0)
+
+
+def test_closed_mesh_is_refused_saying_it_is_closed():
+    with pytest.raises(NotADiskError, match="closed .0 boundary loops"):
+        check_disk(*icosphere(subdivisions=1))
+
+
+def test_open_cylinder_is_refused_with_its_two_boundary_loops(open_cylinder):
+    with pytest.raises(NotADiskError, match="2 boundary loops"):
+        check_disk(*open_cylinder)
+
+
+def test_two_pieces_are_refused_with_the_count():
+    V, F = disk(n_rings=3)
+    V2 = np.vstack([V, V + [3.0, 0.0, 0.0]])
+    F2 = np.vstack([F, F + V.shape[0]])
+    with pytest.raises(NotADiskError, match="2 separate pieces"):
+        check_disk(V2, F2)
+
+
+def test_non_manifold_edge_is_refused_as_not_manifold():
+    V, F = disk(n_rings=3)
+    a, b = F[0, 0], F[0, 1]
+    V2 = np.vstack([V, [[0.0, 0.0, 1.0]]])
+    F2 = np.vstack([F, [[a, b, V.shape[0]]]])
+    with pytest.raises(NotADiskError, match="not manifold: 1 edges"):
+        check_disk(V2, F2)
+
+
+def test_polyline_projection_gives_arc_length_and_distance():
+    square = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], float)
+    poly = Polyline(square)
+    Y, s, d = poly.project(np.array([[0.25, -0.5, 0.0], [1.2, 0.5, 0.0], [0.0, 0.5, 0.0]]))
+    assert np.allclose(Y, [[0.25, 0, 0], [1, 0.5, 0], [0, 0.5, 0]])
+    assert np.allclose(s, [0.25, 1.5, 3.5])          # hand-computed arc lengths from the first corner
+    assert np.allclose(d, [0.5, 0.2, 0.0])
+    assert np.allclose(poly.point_at(s), Y)

@@ -1,0 +1,35 @@
+"""The experiment picture (curvdetail.remesh.figure)."""
+
+import numpy as np
+import pytest
+
+from curvdetail.curvature.testing import disk
+from curvdetail.remesh.experiment import run_experiment
+from curvdetail.remesh.figure import save_figure
+
+
+@pytest.fixture(scope="module")
+def result():
+    V, F = disk(n_rings=10)
+    V[:, 2] = 0.2 * np.exp(-3.0 * (V[:, :2] ** 2).sum(1))
+    return V, F, run_experiment(V, F, target_edge=0.06)
+
+
+def test_figure_is_a_png_of_three_panels(tmp_path, result):
+    V, F, r = result
+    path = tmp_path / "f.png"
+    save_figure(str(path), V, F, r["X"], r["Ft"], r["Z"], r["distance"], r["report"])
+    import matplotlib.image as mpimg
+
+    img = mpimg.imread(str(path))
+    # three panels side by side: much wider than tall
+    assert img.shape[1] > 2 * img.shape[0]
+
+
+def test_figure_refuses_to_overwrite(tmp_path, result):
+    V, F, r = result
+    path = tmp_path / "f.png"
+    path.write_bytes(b"keep")
+    with pytest.raises(FileExistsError):
+        save_figure(str(path), V, F, r["X"], r["Ft"], r["Z"], r["distance"], r["report"])
+    assert path.read_bytes() == b"keep"

@@ -1,0 +1,57 @@
+"""Retriangulation keeps the boundary curve and the disk topology (curvdetail.remesh.retriangulate)."""
+
+import numpy as np
+import pytest
+
+from curvdetail.curvature._validate import bbox_diagonal
+from curvdetail.remesh import RemeshError, retriangulate
+from curvdetail.remesh._disk import Polyline, check_disk
+
+
+def _boundary_distance(V, F, Vt, Ft):
+    _, _, loop = check_disk(V, F)
+    _, _, loop_t = check_disk(Vt, Ft)          # the result is a disk (raises otherwise)
+    _, _, d = Polyline(V[loop]).project(Vt[loop_t])
+    return d.max() / bbox_diagonal(V)
+
+
+@pytest.mark.parametrize("method,target_edge", [("isotropic", 0.03), ("decimate", 0.06)])
+@pytest.mark.parametrize("name", ["mannequin_nose.obj", "terrainA_1k.obj"])
+def test_every_boundary_vertex_stays_on_the_source_boundary(load_mesh, name, method, target_edge):
+    V, F = load_mesh(name)
+    Vt, Ft = retriangulate(V, F, method=method, target_edge=target_edge)
+    assert _boundary_distance(V, F, Vt, Ft) <= 1e-9
+    assert Vt.shape != V.shape or not np.allclose(Vt, V)     # it really retriangulated
+
+
+def test_isotropic_edges_are_near_the_target_length(load_mesh):
+    V, F = load_mesh("terrainA_1k.obj")
+    Vt, Ft = retriangulate(V, F, method="isotropic", target_edge=0.03)
+    E = np.linalg.norm(Vt[Ft[:, [1, 2, 0]]] - Vt[Ft], axis=2)
+    # isotropic remeshing keeps edges within [4/5, 4/3] of the target; the median sits close to it
+    assert np.median(E) / (0.03 * bbox_diagonal(V)) == pytest.approx(1.0, abs=0.2)
+
+
+def test_decimation_reaches_about_the_triangle_count_of_the_target_edge(load_mesh):
+    V, F = load_mesh("terrainA_1k.obj")
+    Vt, Ft = retriangulate(V, F, method="decimate", target_edge=0.06)
+    assert Ft.shape[0] < 0.5 * F.shape[0]
+
+
+@pytest.mark.parametrize("pct,words", [(1e-5, "more than 5,000,000"), (0.9, "fewer than 50")])
+def test_absurd_target_edge_is_refused_with_the_numbers(load_mesh, pct, words):
+    V, F = load_mesh("mannequin_nose.obj")
+    with pytest.raises(RemeshError, match=words + ".*choose a target edge between"):
+        retriangulate(V, F, target_edge=pct)
+
+
+def test_decimation_refuses_to_refine(load_mesh):
+    V, F = load_mesh("mannequin_nose.obj")
+    with pytest.raises(RemeshError, match="decimation can only coarsen"):
+        retriangulate(V, F, method="decimate", target_edge=0.005)
+
+
+def test_unknown_method_is_refused(load_mesh):
+    V, F = load_mesh("mannequin_nose.obj")
+    with pytest.raises(RemeshError, match="not a retriangulation method"):
+        retriangulate(V, F, method="loop")
