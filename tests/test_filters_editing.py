@@ -44,6 +44,7 @@ def test_handles_follow_the_transform_and_unselected_vertices_stay():
     assert np.array_equal(X[outside], V[outside])
     assert np.allclose(ms.current_mesh().vertex_scalar_array(), np.linalg.norm(X - V, axis=1))
     assert figures["handle_vertices"] == handles.size and figures["roi_vertices"] > handles.size
+    assert figures["amplification"] == pytest.approx(1.0, abs=0.05)   # nothing outruns a translation
 
 
 def test_identity_edit_leaves_the_mesh_in_place():

@@ -114,6 +114,8 @@ def apply_curvature_editing(ms, *, handles, transform, detail_scale, move_handle
     set_vertex_quality(ms, mid, moved)
     return {
         "max_displacement": float(moved.max() / bbox_diagonal(V)),
+        # far above 1: the curvature stage amplified the handle details (see docs/editing.md)
+        "amplification": float(moved.max() / max(moved[h].max(), 1e-300)) if moved[h].max() > 0 else 1.0,
         "roi_vertices": int(roi.size),
         "handle_vertices": int(h.size),
         "rank_deficient_vertices": int(editor.rank_deficient),
