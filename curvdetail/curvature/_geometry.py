@@ -3,8 +3,10 @@
 import numpy as np
 
 
-def corner_cotangents(V, F):
+def corner_cotangents(V, F, *, lengths=True):
     """Cotangent of the angle at each corner and squared length of the opposite edge.
+
+    ``lengths=False`` skips the squared lengths (``sq`` is then None).
 
     Returns
     -------
@@ -22,7 +24,7 @@ def corner_cotangents(V, F):
     cy = e1[2] * e2[0] - e1[0] * e2[2]
     cz = e1[0] * e2[1] - e1[1] * e2[0]
     dbl = np.sqrt(cx * cx + cy * cy + cz * cz)
-    sq = np.stack([_dot(e0, e0), _dot(e1, e1), _dot(e2, e2)], axis=1)
+    sq = np.stack([_dot(e0, e0), _dot(e1, e1), _dot(e2, e2)], axis=1) if lengths else None
     # cot at corner k = (a . b) / |a x b| with a, b the two edges leaving it (= minus the two
     # edges that end there, hence the sign)
     inv = -1.0 / dbl

@@ -9,6 +9,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
+from ._geometry import corner_cotangents
 from .errors import ConstraintError, MeshError, first_indices
 
 # A triangle whose area is below this fraction of the squared bbox diagonal is degenerate:
@@ -118,10 +119,26 @@ def check_mesh(V, F, *, check_manifold=True, check_unreferenced=True):
     >>> V.dtype, F.dtype
     (dtype('float64'), dtype('int64'))
     """
+    return _check_mesh(V, F, check_manifold, check_unreferenced)[:2]
+
+
+def check_mesh_cotangents(V, F):
+    """:func:`check_mesh` (all checks) that also returns the corner cotangents it computed on the
+    way, ``(V, F, cot)``, so that a caller assembling the Laplacian does not compute the triangle
+    geometry twice (``cot`` as in :func:`._geometry.corner_cotangents`)."""
+    return _check_mesh(V, F, True, True, cotangents=True)
+
+
+def _check_mesh(V, F, check_manifold, check_unreferenced, cotangents=False):
     V = as_vertices(V)
     F = as_faces(F, V.shape[0])
     diag = bbox_diagonal(V)
-    dbl = face_double_areas(V, F)
+    cot = None
+    if cotangents:
+        with np.errstate(divide="ignore", invalid="ignore"):     # zero areas are refused below
+            cot, _, dbl = corner_cotangents(V, F, lengths=False)
+    else:
+        dbl = face_double_areas(V, F)
     zero = np.flatnonzero(dbl <= 2.0 * ZERO_AREA_RELATIVE * max(diag, np.finfo(float).tiny) ** 2)
     if zero.size:
         raise MeshError(
@@ -146,7 +163,7 @@ def check_mesh(V, F, *, check_manifold=True, check_unreferenced=True):
                 f"{unused.size} vertices are not used by any triangle (first: {first_indices(unused)}); "
                 "remove them, e.g. with pymeshlab's meshing_remove_unreferenced_vertices."
             )
-    return V, F
+    return V, F, cot
 
 
 def undirected_edges(F):

@@ -45,9 +45,11 @@ def cotan_laplacian(V, F):
     return _cotan_laplacian_unchecked(V, F)
 
 
-def _cotan_laplacian_unchecked(V, F):
+def _cotan_laplacian_unchecked(V, F, cot=None):
+    """``L`` without input checks; ``cot``: corner cotangents already computed for (V, F)."""
     n = V.shape[0]
-    cot, _, _ = corner_cotangents(V, F)
+    if cot is None:
+        cot, _, _ = corner_cotangents(V, F, lengths=False)
     # the edge opposite corner k joins corners k+1 and k+2
     i = F[:, [1, 2, 0]].ravel()
     j = F[:, [2, 0, 1]].ravel()

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ._validate import as_index_set, as_values, check_every_component_fixed, check_mesh
+from ._validate import as_index_set, as_values, check_every_component_fixed, check_mesh_cotangents
 from .cotan_laplacian import _cotan_laplacian_unchecked
 from .errors import ConstraintError
 from .sparse_solver import factorize
@@ -68,7 +68,7 @@ class Reconstructor:
     refinement_steps = 1
 
     def __init__(self, V_ref, F, fixed, *, rows="all", backend="auto"):
-        V_ref, F = check_mesh(V_ref, F)
+        V_ref, F, cot = check_mesh_cotangents(V_ref, F)
         if rows not in ROW_MODES:
             raise ValueError(f"rows={rows!r} is not a row mode; use 'all' (the paper's E_Q) or 'free'.")
         n = V_ref.shape[0]
@@ -77,14 +77,15 @@ class Reconstructor:
         if self.fixed.size == 0:
             raise ConstraintError("no fixed vertices: the reconstruction is only determined up to a "
                                   "translation. Fix at least one vertex per connected piece, e.g. the boundary.")
-        L = _cotan_laplacian_unchecked(V_ref, F)
+        L = _cotan_laplacian_unchecked(V_ref, F, cot)
         check_every_component_fixed(F, n, self.fixed, adjacency=L)      # L has the edge pattern
         is_free = np.ones(n, dtype=bool)
         is_free[self.fixed] = False
         self.free = np.flatnonzero(is_free)
         self._L = L
         L_f = L[self.free]                                       # (f, n) rows of the free vertices
-        self._L_c = L.tocsc()[:, self.fixed].tocsr()             # (n, k) columns of the fixed ones
+        self._L_c = L[self.fixed].T.tocsr()                      # (n, k) columns of the fixed ones
+                                                                 # (= rows, L is symmetric)
         if rows == "all":
             # L is symmetric, so L_:f = L_f:^T and the normal matrix L_:f^T L_:f is L_f: L_f:^T
             self._L_f = L_f                                      # (f, n)
