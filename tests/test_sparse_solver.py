@@ -55,6 +55,14 @@ def test_solve_keeps_the_shape_of_the_right_hand_side(backend):
     assert fac.solve(A @ x).shape == x.shape
 
 
+def test_upper_triangle_matches_scipy_triu():
+    A, _ = _spd_system(10)
+    A = (A @ A).tocsr()
+    A.sort_indices()
+    U = sparse_solver._upper_triangle(A)
+    assert (U != sp.triu(A, format="csr")).nnz == 0 and U.has_sorted_indices
+
+
 def test_factorization_is_counted_once_and_solves_are_not():
     A, x = _spd_system(12)
     before = sparse_solver.factorization_count
