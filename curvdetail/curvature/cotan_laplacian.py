@@ -4,7 +4,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ._geometry import corner_cotangents
-from ._validate import check_mesh
+from ._validate import check_mesh_cotangents
 
 
 def cotan_laplacian(V, F):
@@ -41,8 +41,8 @@ def cotan_laplacian(V, F):
     >>> float(L[1, 2])   # edge opposite the right angle: -cot(90 deg) / 2
     0.0
     """
-    V, F = check_mesh(V, F)
-    return _cotan_laplacian_unchecked(V, F)
+    V, F, cot = check_mesh_cotangents(V, F)
+    return _cotan_laplacian_unchecked(V, F, cot)
 
 
 def _cotan_laplacian_unchecked(V, F, cot=None):

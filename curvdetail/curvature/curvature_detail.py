@@ -1,6 +1,6 @@
 """Curvature detail ``D = L V`` (the paper's ``K_i A_i``)."""
 
-from ._validate import check_mesh
+from ._validate import check_mesh_cotangents
 from .cotan_laplacian import _cotan_laplacian_unchecked
 
 
@@ -34,5 +34,5 @@ def curvature_detail(V, F):
     >>> bool(np.abs(D[inner]).max() < 1e-12)     # a plane has no interior detail
     True
     """
-    V, F = check_mesh(V, F)
-    return _cotan_laplacian_unchecked(V, F) @ V
+    V, F, cot = check_mesh_cotangents(V, F)
+    return _cotan_laplacian_unchecked(V, F, cot) @ V
