@@ -44,7 +44,10 @@ def check_disk(V, F, what="the source"):
     try:
         V, F = check_mesh(V, F)
     except MeshError as exc:
-        nm = non_manifold_edges(np.asarray(F, dtype=np.int64)) if np.asarray(F).ndim == 2 else None
+        try:
+            nm = non_manifold_edges(np.asarray(F, dtype=np.int64))
+        except Exception:  # F too malformed to look at: the original message says why
+            nm = None
         if nm is not None and nm.shape[0]:
             pairs = ", ".join(f"({a}, {b})" for a, b in nm[:3])
             raise NotADiskError(f"{what} is not manifold: {nm.shape[0]} edges are shared by more than "

@@ -7,7 +7,7 @@ from scipy.spatial import cKDTree
 from ..curvature.errors import MeshError
 
 
-def locate(points, V, F, *, engine="auto", candidates=8, chunk=100_000):
+def locate(points, V, F, *, engine="auto", candidates=8, chunk=20_000):
     """Nearest triangle and barycentric coordinates of each point, vectorized.
 
     Works in the plane (a parameter domain, ``V`` of shape (n, 2)) and in space ((n, 3): the
