@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from curvdetail.curvature.testing import cylinder, disk, icosphere
+from curvdetail.curvature.testing import disk, icosphere
 from curvdetail.remesh import NotADiskError
 from curvdetail.remesh._disk import Polyline, check_disk
 
@@ -54,3 +54,18 @@ def test_polyline_projection_gives_arc_length_and_distance():
     assert np.allclose(s, [0.25, 1.5, 3.5])          # hand-computed arc lengths from the first corner
     assert np.allclose(d, [0.5, 0.2, 0.0])
     assert np.allclose(poly.point_at(s), Y)
+
+
+def test_patch_with_a_handle_is_refused_with_the_handle_count():
+    # a torus (8 x 6 periodic grid) with one triangle removed: one boundary loop, but a handle
+    n, m = 8, 6
+    i, j = np.meshgrid(np.arange(n), np.arange(m), indexing="ij")
+    u, v = 2 * np.pi * i.ravel() / n, 2 * np.pi * j.ravel() / m
+    V = np.column_stack([(2 + np.cos(v)) * np.cos(u), (2 + np.cos(v)) * np.sin(u), np.sin(v)])
+    a = (i * m + j).ravel()
+    b = (((i + 1) % n) * m + j).ravel()
+    c = (i * m + (j + 1) % m).ravel()
+    d = (((i + 1) % n) * m + (j + 1) % m).ravel()
+    F = np.concatenate([np.column_stack([a, b, d]), np.column_stack([a, d, c])])[1:]
+    with pytest.raises(NotADiskError, match="Euler characteristic -1 .1 handles"):
+        check_disk(V, F)
