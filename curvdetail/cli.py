@@ -363,6 +363,10 @@ def _edit_command(parser):
     parser.add_argument("--handle-detail", choices=("transform", "free"), default="transform",
                         help="handles' curvature details: transformed by the linear part of DEF "
                              "(default) or solved like the free vertices'")
+    parser.add_argument("--relations", choices=("one-ring", "one+two-ring"), default="one-ring",
+                        help="curvature stage: the paper's one-ring coefficients (square system) or "
+                             "one- and two-ring coefficients together (least squares; steadier "
+                             "when handle details are rotated)")
     parser.add_argument("--image", metavar="PNG", help="also save a picture: rest (by status) | edited")
     parser.add_argument("--backend", default="auto", help="sparse solver: auto, pardiso, cholmod, splu")
     add_output_arguments(parser)
@@ -386,7 +390,8 @@ def _edit_command(parser):
         progress.stage("factor and solve")
         t = time.perf_counter()
         X, editor = edit_with_selection(V, F, status, T, handle_detail=args.handle_detail,
-                                        backend=args.backend, return_editor=True)
+                                        relations=args.relations, backend=args.backend,
+                                        return_editor=True)
         seconds = time.perf_counter() - t
         progress.stage("write")
         moved = np.linalg.norm(X - V, axis=1)
@@ -405,7 +410,8 @@ def _edit_command(parser):
         if moved.max() > 3.0 * handle_move + 1e-12 * bbox_diagonal(V):
             print(f"curvdetail: warning: vertices moved up to {moved.max() / max(handle_move, 1e-300):.1f} "
                   "times as far as the handles: the curvature stage amplified the handle details "
-                  "(ill-conditioned coefficients, see docs/editing.md); try --handle-detail free.",
+                  "(ill-conditioned coefficients, see docs/editing.md); try --relations one+two-ring "
+                  "or --handle-detail free.",
                   file=sys.stderr)
         return 0
 

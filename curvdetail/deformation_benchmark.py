@@ -181,8 +181,8 @@ def apply_transform(T, P):
     return np.asarray(P, dtype=np.float64) @ T[:3, :3].T + T[:3, 3]
 
 
-def edit_with_selection(V, F, status, T, *, handle_detail="transform", rcond=DEFAULT_RCOND,
-                        backend="auto", return_editor=False):
+def edit_with_selection(V, F, status, T, *, handle_detail="transform", relations="one-ring",
+                        rcond=DEFAULT_RCOND, backend="auto", return_editor=False):
     """Deform a mesh as a benchmark case prescribes, with curvature-detail editing.
 
     Parameters
@@ -195,7 +195,9 @@ def edit_with_selection(V, F, status, T, *, handle_detail="transform", rcond=DEF
         ``"transform"``: the handles' details are constrained to ``T[:3, :3] @ D`` (exact for a
         similarity, whose linear part ``s R`` maps the detail ``D = L V`` as it maps lengths);
         ``"free"``: the handles' details are solved in the curvature stage like the free ones
-    rcond, backend            see :class:`~curvdetail.curvature.CurvatureEditor`
+    relations, rcond, backend see :class:`~curvdetail.curvature.CurvatureEditor`
+                              (``relations="one+two-ring"`` keeps rotated handle details from
+                              being amplified, see docs/editing.md)
     return_editor : bool      also return the factored editor (for re-solves)
 
     Returns
@@ -242,7 +244,8 @@ def edit_with_selection(V, F, status, T, *, handle_detail="transform", rcond=DEF
     if T.shape != (4, 4) or not np.all(np.isfinite(T)):
         raise ConstraintError(f"T has shape {T.shape}; a handle transform is a finite 4x4 matrix.")
     dc = handles if handle_detail == "transform" else np.empty(0, dtype=np.int64)
-    editor = CurvatureEditor(V, F, handles, dc, roi=roi, rcond=rcond, backend=backend)
+    editor = CurvatureEditor(V, F, handles, dc, roi=roi, relations=relations, rcond=rcond,
+                             backend=backend)
     details = editor.detail[handles] @ T[:3, :3].T if handle_detail == "transform" else None
     X = editor.solve(positions=apply_transform(T, editor.V[handles]), details=details)
     return (X, editor) if return_editor else X

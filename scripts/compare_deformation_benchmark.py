@@ -1,7 +1,8 @@
 """Compare curvature-detail editing with the survey's Laplacian surface editing results.
 
 For each of the four Botsch-Sorkine cases (bar, cactus, cylinder, plane): run
-``edit_with_selection`` with the handles' details transformed and solved freely, measure the
+``edit_with_selection`` with the handles' details transformed (one-ring relations, the paper, and
+one- plus two-ring relations) and solved freely, measure the
 distance of every vertex to the survey's ``NAME-laplacian_editing.off`` (same connectivity, so
 vertex-to-vertex; mean and max as fractions of the rest mesh's bounding-box diagonal), the
 first-solve time (setup + solve) and the re-solve time, and save pictures side by side.
@@ -26,7 +27,12 @@ from curvdetail.deformation_benchmark import (edit_with_selection, read_selectio
 MESHES = os.environ.get("CURVDETAIL_MESHES", os.path.join(os.path.dirname(__file__), "..", "..",
                                                           "shared", "meshes"))
 CASES = ("bar", "cactus", "cylinder", "plane")
-VIEWS = {"bar": (15, -60), "cactus": (10, -90), "cylinder": (10, -90), "plane": (30, -60)}
+#: (handle details, curvature-stage relations): the paper, the steadier stacked relations, free
+VARIANTS = (("transform", "one-ring"), ("transform", "one+two-ring"), ("free", "one-ring"))
+LABELS = {"transform/one-ring": "handle details transformed (paper)",
+          "transform/one+two-ring": "transformed, one+two-ring",
+          "free/one-ring": "handle details free"}
+VIEWS = {"bar": (15, -60), "cactus": (10, -90), "cylinder": (10, 0), "plane": (30, -60)}
 
 
 def run_case(name, folder):
@@ -43,12 +49,14 @@ def run_case(name, folder):
            "reference_moved_mean": float(np.linalg.norm(ref - V, axis=1).mean() / diag),
            "reference_moved_max": float(np.linalg.norm(ref - V, axis=1).max() / diag)}
     results = {}
-    for mode in ("transform", "free"):
+    for mode, relations in VARIANTS:
         t = time.perf_counter()
-        X, ed = edit_with_selection(V, F, status, T, handle_detail=mode, return_editor=True)
+        X, ed = edit_with_selection(V, F, status, T, handle_detail=mode, relations=relations,
+                                    return_editor=True)
         first = time.perf_counter() - t
         h = ed.position_constrained
         details = ed.detail[h] @ T[:3, :3].T if mode == "transform" else None
+        mode = f"{mode}/{relations}"
         t = time.perf_counter()
         ed.solve(positions=X[h], details=details)
         resolve = time.perf_counter() - t
@@ -76,9 +84,9 @@ def main(argv=None):
         lo, hi = ref.min(0), ref.max(0)
         pad = 0.5 * (hi - lo)
         panels = [(V, F, "rest: fixed / free / handle", status)]
-        for mode in ("transform", "free"):
+        for mode in LABELS:
             X = np.clip(results[mode], lo - pad, hi + pad)
-            label = f"ours, handle detail {mode}\nmean {100 * row[mode]['mean']:.1f} % / max {100 * row[mode]['max']:.1f} %"
+            label = f"{LABELS[mode]}\nmean {100 * row[mode]['mean']:.1f} % / max {100 * row[mode]['max']:.1f} %"
             panels.append((X, F, label))
         panels.append((ref, F, "survey: Laplacian editing"))
         for target in [os.path.join(args.out, name + ".png")] + (
@@ -86,20 +94,18 @@ def main(argv=None):
             small = target.startswith(args.docs) if args.docs else False
             render_panels(target, panels, elev=elev, azim=azim, overwrite=True,
                           panel_size=2.4 if small else 3.5)
-        print(f"{name}: transform mean {row['transform']['mean']:.4f} max {row['transform']['max']:.4f}; "
-              f"free mean {row['free']['mean']:.4f} max {row['free']['max']:.4f}; first solve "
-              f"{row['transform']['first_solve_s']:.2f} s, re-solve {1e3 * row['transform']['resolve_s']:.1f} ms")
-    lines = ["| case | vertices (fixed/free/handle) | survey result moved (mean / max) | ours, handle "
-             "detail transformed: distance to survey (mean / max) | ours, handle detail free (mean / max) "
-             "| first solve (s) | re-solve (ms) |", "|---|---|---|---|---|---|---|"]
+        print(name, {m: (round(row[m]["mean"], 4), round(row[m]["max"], 4)) for m in LABELS})
+    lines = ["| case | vertices (fixed/free/handle) | survey result moved from rest (mean / max) | "
+             + " | ".join(f"{LABELS[m]}: distance to survey (mean / max)" for m in LABELS)
+             + " | first solve incl. setup (s) | re-solve (ms) |",
+             "|---|---|---|" + "---|" * len(LABELS) + "---|---|"]
     for r in rows:
-        t, f = r["transform"], r["free"]
+        cells = [f"{100 * r[m]['mean']:.2f} % / {100 * r[m]['max']:.2f} %" for m in LABELS]
         lines.append(f"| {r['case']} | {r['vertices']} ({r['n_fixed']}/{r['n_free']}/{r['n_handles']}) | "
                      f"{100 * r['reference_moved_mean']:.1f} % / {100 * r['reference_moved_max']:.1f} % | "
-                     f"{100 * t['mean']:.2f} % / {100 * t['max']:.2f} % | "
-                     f"{100 * f['mean']:.2f} % / {100 * f['max']:.2f} % | "
-                     f"{t['first_solve_s']:.2f} / {f['first_solve_s']:.2f} | "
-                     f"{1e3 * t['resolve_s']:.1f} / {1e3 * f['resolve_s']:.1f} |")
+                     + " | ".join(cells) + " | "
+                     + " / ".join(f"{r[m]['first_solve_s']:.2f}" for m in LABELS) + " | "
+                     + " / ".join(f"{1e3 * r[m]['resolve_s']:.1f}" for m in LABELS) + " |")
     table = "\n".join(lines)
     print(table)
     with open(os.path.join(args.out, "compare.json"), "w") as fh:

@@ -3,11 +3,13 @@
 (a) cow: the whole head is the region of interest; its front (muzzle, ears, horns) is turned
     by 35 degrees about the vertical axis and moved towards the reader, the handles' curvature
     normals turned with it; the neck and body stay fixed. Shown with the handles' details
-    transformed (the paper) and solved freely.
+    transformed (the paper's one-ring relations, and one- plus two-ring relations) and solved
+    freely.
 (b) terrain patch (SRTM, terrainA_10k): the boundary moved by a sine along its arc length, in y
     and in z; the boundary's curvature detail is updated accordingly (recomputed on the
     harmonically deformed patch, the paper) or kept, and the inside rebuilt from the curvature
-    coefficients (``edit_boundary``). Folded triangles (normals pointing down) are counted.
+    coefficients (``edit_boundary``), with the paper's one-ring relations and with one- plus
+    two-ring relations. Folded triangles (normals pointing down) are counted.
 
 Usage: python scripts/reproduce_fig2.py [--out out/fig2] [--docs docs]
 Writes OUT/fig2.json, OUT/fig2a.png, OUT/fig2b.png (docs/editing_fig2.png with --docs).
@@ -48,9 +50,11 @@ def cow():
     T[:3, 3] = pivot - R @ pivot + 0.08 * diag * toward
     out, meshes = {"model": "cow", "vertices": int(V.shape[0]), "roi": int((status > 0).sum()),
                    "handles": int((status == 2).sum())}, {}
-    for mode in ("transform", "free"):
+    for mode, relations in (("transform", "one-ring"), ("transform", "one+two-ring"), ("free", "one-ring")):
         t = time.perf_counter()
-        X, ed = edit_with_selection(V, F, status, T, handle_detail=mode, return_editor=True)
+        X, ed = edit_with_selection(V, F, status, T, handle_detail=mode, relations=relations,
+                                    return_editor=True)
+        mode = f"{mode}/{relations}"
         out[mode] = {"seconds": time.perf_counter() - t,
                      "max_move_fraction": float(np.linalg.norm(X - V, axis=1).max() / diag),
                      "finite": bool(np.isfinite(X).all()), "rank_deficient": ed.rank_deficient}
@@ -69,13 +73,14 @@ def terrain():
     extent = np.ptp(V[:, :2], axis=0).max()
     out, meshes = {"model": "terrainA_10k", "vertices": int(V.shape[0]), "rest_folded": folded(V, F)}, {}
     for axis, name, amp in ((1, "sine_y", 0.06 * extent), (2, "sine_z", 0.08 * extent)):
-        for mode in ("deformed", "rest"):
+        for mode, relations in (("deformed", "one-ring"), ("deformed", "one+two-ring"), ("rest", "one-ring")):
             t = time.perf_counter()
             X, info = edit_boundary(V, F, sine_displacement(amp, periods=2, axis=axis),
-                                    boundary_detail=mode, return_info=True)
+                                    boundary_detail=mode, relations=relations, return_info=True)
             b = info["boundary"]
+            mode = f"{mode}/{relations}"
             out[f"{name}_{mode}"] = {
-                "amplitude": float(amp), "periods": 2, "boundary_detail": mode,
+                "amplitude": float(amp), "periods": 2, "boundary_detail": mode, "relations": relations,
                 "seconds": time.perf_counter() - t, "boundary_vertices": int(b.size),
                 "max_move_fraction": float(np.linalg.norm(X - V, axis=1).max() / bbox_diagonal(V)),
                 "height_range_ratio": float(np.ptp(X[:, 2]) / np.ptp(V[:, 2])),
@@ -93,18 +98,20 @@ def main(argv=None):
     V, F, status, meshes, info_a = cow()
     print(json.dumps(info_a))
     panels = [(V @ Y_UP.T, F, "cow: rest (fixed / region / handle)", status)]
-    for mode in ("transform", "free"):
+    for mode, label in (("transform/one-ring", "handle details turned (paper)"),
+                        ("transform/one+two-ring", "turned, one+two-ring relations"),
+                        ("free/one-ring", "handle details free")):
         X = meshes[mode]
-        panels.append((X @ Y_UP.T, F, f"head moved, handle detail {mode}", np.linalg.norm(X - V, axis=1)))
+        panels.append((X @ Y_UP.T, F, label, np.linalg.norm(X - V, axis=1)))
     render_panels(os.path.join(args.out, "fig2a.png"), panels, elev=COW_VIEW[0], azim=COW_VIEW[1],
                   overwrite=True)
     Vt, Ft, tmeshes, info_b = terrain()
     print(json.dumps(info_b))
     panels = [(Vt, Ft, "terrain: rest", Vt[:, 2])]
     for key, label in (("sine_y", "sine in y"), ("sine_z", "sine in z")):
-        for mode in ("deformed", "rest"):
+        for mode, short in (("deformed/one-ring", "(paper)"), ("deformed/one+two-ring", "one+two-ring")):
             X = tmeshes[f"{key}_{mode}"]
-            panels.append((X, Ft, f"{label}, boundary detail {mode}\n"
+            panels.append((X, Ft, f"{label} {short}\n"
                                   f"{info_b[key + '_' + mode]['folded_triangles']} folded triangles", X[:, 2]))
     render_panels(os.path.join(args.out, "fig2b.png"), panels, elev=35, azim=-60, overwrite=True,
                   panel_size=3.0)
@@ -117,7 +124,7 @@ def main(argv=None):
         import matplotlib.image as mpimg
         import matplotlib.pyplot as plt
 
-        fig, axes = plt.subplots(2, 1, figsize=(8, 5.4))
+        fig, axes = plt.subplots(2, 1, figsize=(11, 6.2))
         for ax, key in zip(axes, ("fig2a", "fig2b")):
             ax.imshow(mpimg.imread(os.path.join(args.out, key + ".png")))
             ax.set_axis_off()

@@ -72,3 +72,18 @@ def test_unknown_boundary_detail_mode_is_refused(load_mesh):
     V, F = load_mesh("terrainA_1k.obj")
     with pytest.raises(ValueError, match="boundary_detail"):
         edit_boundary(V, F, sine_displacement(0.1), boundary_detail="rotate")
+
+
+def test_stacked_relations_keep_a_large_boundary_sine_free_of_folds(load_mesh):
+    # a sine in z of 8 % of the patch's extent: the paper's one-ring curvature stage amplifies
+    # the updated boundary detail and folds triangles (6 measured); one+two-ring folds none
+    V, F = load_mesh("terrainA_1k.obj")
+    f = sine_displacement(0.08 * np.ptp(V[:, :2], axis=0).max(), periods=2, axis=2)
+
+    def folded(X):
+        nz = np.cross(X[F[:, 1]] - X[F[:, 0]], X[F[:, 2]] - X[F[:, 0]])[:, 2]
+        return int((nz < 0).sum())
+
+    assert folded(V) == 0
+    assert folded(edit_boundary(V, F, f, relations="one-ring")) > 0
+    assert folded(edit_boundary(V, F, f, relations="one+two-ring")) == 0

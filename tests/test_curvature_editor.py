@@ -19,18 +19,20 @@ def _diag(V):
     return np.linalg.norm(V.max(0) - V.min(0))
 
 
-def test_rest_constraints_reproduce_the_patch(load_mesh):
+@pytest.mark.parametrize("relations", ["one-ring", "one+two-ring"])
+def test_rest_constraints_reproduce_the_patch(load_mesh, relations):
     V, F = load_mesh("mannequin_nose.obj")
     b = boundary_vertices(F)
-    X = CurvatureEditor(V, F, b, b).solve()
+    X = CurvatureEditor(V, F, b, b, relations=relations).solve()
     # both stages reproduce the rest state exactly up to the solvers' roundoff
     assert np.abs(X - V).max() < 1e-8 * _diag(V)
 
 
-def test_similarity_of_all_constraints_moves_the_result_by_it(load_mesh, rng):
+@pytest.mark.parametrize("relations", ["one-ring", "one+two-ring"])
+def test_similarity_of_all_constraints_moves_the_result_by_it(load_mesh, rng, relations):
     V, F = load_mesh("spot.obj")
     handles = rng.choice(V.shape[0], size=40, replace=False)
-    ed = CurvatureEditor(V, F, handles, handles)
+    ed = CurvatureEditor(V, F, handles, handles, relations=relations)
     # a real edit first: pull ten handles outwards and rotate their details a little
     P = V[handles].copy()
     P[:10] += 0.1 * (P[:10] - V.mean(0))
@@ -127,11 +129,28 @@ def test_a_free_piece_without_any_constraint_is_refused(plane_grid):
         CurvatureEditor(V2, F2, np.arange(V2.shape[0]), b)
 
 
-def test_unknown_row_mode_is_refused(plane_grid):
+def test_unknown_row_mode_or_relations_are_refused(plane_grid):
     V, F = plane_grid
     b = boundary_vertices(F)
     with pytest.raises(ValueError, match="row mode"):
         CurvatureEditor(V, F, b, b, rows="some")
+    with pytest.raises(ValueError, match="relations"):
+        CurvatureEditor(V, F, b, b, relations="three-ring")
+
+
+def test_stacked_relations_solve_the_least_squares_problem_of_both_coefficient_sets(load_mesh, rng):
+    V, F = load_mesh("mannequin_nose.obj")
+    b = boundary_vertices(F)
+    ed = CurvatureEditor(V, F, b, b, relations="one+two-ring")
+    Dk = ed.detail[b] * (1 + 0.3 * rng.random((b.size, 1)))
+    D = ed.solve_details(Dk)
+    # the same minimum by dense least squares: min |(I - C1) D|^2 + |(I - C2) D|^2 over free D
+    n = V.shape[0]
+    M = np.vstack([np.eye(n) - ed.coefficients.toarray(), np.eye(n) - ed.coefficients_two_ring.toarray()])
+    free = np.setdiff1d(np.arange(n), b)
+    rhs = -M[:, b] @ Dk
+    expected = np.linalg.lstsq(M[:, free], rhs, rcond=None)[0]
+    assert np.abs(D[free] - expected).max() < 1e-8 * np.abs(expected).max()
 
 
 def test_solve_refuses_values_of_the_wrong_shape(plane_grid):

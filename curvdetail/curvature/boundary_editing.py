@@ -10,8 +10,8 @@ from .errors import MeshError
 from .sparse_solver import factorize
 
 
-def edit_boundary(V, F, displacement, *, boundary_detail="deformed", rcond=DEFAULT_RCOND,
-                  backend="auto", return_info=False):
+def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="one-ring",
+                  rcond=DEFAULT_RCOND, backend="auto", return_info=False):
     """Move the boundary of a disk-topology patch and rebuild the surface from its detail.
 
     Steps (the paper's shape editing: "the boundary vertices coordinate ... are modified ...
@@ -40,6 +40,8 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", rcond=DEFAU
     boundary_detail : {"deformed", "rest"}   how the boundary's detail is updated (step 2).
                              Large displacements with ``"deformed"`` can fold triangles: the
                              curvature stage amplifies detail changes (see docs/editing.md)
+    relations : str          curvature-stage relations of :class:`CurvatureEditor`
+                             (``"one+two-ring"`` amplifies boundary-detail changes far less)
     rcond : float            threshold of :func:`curvature_coefficients`
     backend : str            sparse solver backend
     return_info : bool       also return a dict with ``boundary`` (loop order), ``arc_length``
@@ -86,7 +88,7 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", rcond=DEFAU
     else:
         d = as_values(displacement, loop.size, "displacement")
     n = V.shape[0]
-    editor = CurvatureEditor(V, F, loop, loop, rcond=rcond, backend=backend)
+    editor = CurvatureEditor(V, F, loop, loop, relations=relations, rcond=rcond, backend=backend)
     if boundary_detail == "rest":
         X = editor.solve(positions=P + d, details=editor.detail[loop])
         if not return_info:

@@ -15,6 +15,9 @@ from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
 from .sparse_solver import factorize
 
 
+RELATIONS = ("one-ring", "one+two-ring")
+
+
 class CurvatureEditor:
     """Edit a mesh through its curvature detail: factor once, re-solve for any constraint values.
 
@@ -54,6 +57,15 @@ class CurvatureEditor:
                                 involves a free position (the paper; normal equations, 2-ring
                                 fill), ``"free"`` over the free vertices' rows only (the square
                                 system ``L_ff X_f = D_f - L_fc X_c``: sparser, faster re-solves)
+    relations : {"one-ring", "one+two-ring"}
+                                curvature stage: ``"one-ring"`` is the paper (the square system
+                                above); ``"one+two-ring"`` also computes minimum-norm coefficients
+                                over each vertex's two-ring, ``C2``, and minimizes
+                                ``|(I - C) D|^2 + |(I - C2) D|^2`` over the region's rows (normal
+                                equations). Same invariance and the same rest state, but twice the
+                                equations for the same unknowns: far less amplification of
+                                inconsistent constraints (a rotated handle), at the price of a
+                                denser factorization
     rcond : float               singular-value threshold of :func:`curvature_coefficients`
     backend : str               sparse solver backend ("auto", "pardiso", "cholmod", "splu");
                                 with "auto" the curvature stage uses SuperLU (fastest
@@ -66,6 +78,7 @@ class CurvatureEditor:
     roi : (r,) int array        the region, increasing
     detail : (n, 3) float array rest detail ``D = L V``
     coefficients : (n, n) csr_matrix   ``C``
+    coefficients_two_ring : (n, n) csr_matrix   ``C2`` (only with ``relations="one+two-ring"``)
     timings : dict              seconds spent in the constructor: ``coefficients`` (L, D and C),
                                 ``curvature_setup`` (checks and LU of ``(I - C)_uu``),
                                 ``embedding_setup`` (normal equations and their factorization)
@@ -102,10 +115,13 @@ class CurvatureEditor:
     """
 
     def __init__(self, V, F, position_constrained, detail_constrained, *, roi=None,
-                 rows="all", rcond=DEFAULT_RCOND, backend="auto"):
+                 rows="all", relations="one-ring", rcond=DEFAULT_RCOND, backend="auto"):
         V, F = check_mesh(V, F)
         if rows not in ("all", "free"):
             raise ValueError(f"rows={rows!r} is not a row mode; use 'all' (the paper's E_Q) or 'free'.")
+        if relations not in RELATIONS:
+            raise ValueError(f"relations={relations!r}; use 'one-ring' (the paper) or 'one+two-ring'.")
+        self.relations = relations
         n = V.shape[0]
         self.n, self.V, self.F, self.rows = n, V, F, rows
         pc = as_index_set(position_constrained, n, "position_constrained")
@@ -152,7 +168,16 @@ class CurvatureEditor:
         free_d = in_roi.copy()
         free_d[dc] = False
         _check_reached(rows, cols, free_d, n, "detail", "detail_constrained")
-        island = _detail_islands(rows, cols, cvals, free_d, rank, n)
+        if relations == "one+two-ring":
+            rows2, cols2 = _two_ring_pairs(rows, cols, n)
+            C2, rank2, _ = _coefficients(D, _mixed_voronoi_area_unchecked(V, F), rows2, cols2, n,
+                                         rcond, bbox_diagonal(V))
+            cvals2 = C2.data if C2.nnz == rows2.size else np.asarray(C2[rows2, cols2]).ravel()
+            self.coefficients_two_ring = C2
+            island = _detail_islands(np.concatenate([rows, rows2]), np.concatenate([cols, cols2]),
+                                     np.concatenate([cvals, cvals2]), free_d, np.maximum(rank, rank2), n)
+        else:
+            island = _detail_islands(rows, cols, cvals, free_d, rank, n)
         self.detail_islands = int(np.count_nonzero(island))
         self._user_dc = dc.size
         dc = np.concatenate([dc, np.flatnonzero(island)])     # islands keep their rest detail
@@ -161,6 +186,22 @@ class CurvatureEditor:
         self._fd, self._dc = fd, dc
         at_fd = _positions_in(fd, n)
         at_dc = _positions_in(dc, n)
+        curv_backend = "splu" if backend == "auto" and not os.environ.get("CURVDETAIL_SOLVER") else backend
+        if relations == "one+two-ring":
+            self._stacked_system(D, in_roi, fd, dc, at_fd, at_dc, (rows, cols, cvals),
+                                 (rows2, cols2, cvals2), backend)
+        else:
+            self._square_system(D, in_roi, free_d, fd, dc, at_fd, at_dc, rows, cols, cvals, curv_backend)
+        t2 = time.perf_counter()
+        self._embedding(L, V, F, in_roi, pc, rows, cols, backend)
+        self._response = None
+        self.timings = {"coefficients": t1 - t0, "curvature_setup": t2 - t1,
+                        "embedding_setup": time.perf_counter() - t2}
+        self.backend = {"curvature": self._curv.backend if self._curv else "none",
+                        "embedding": self._embed.backend if self._embed else "none"}
+
+    def _square_system(self, D, in_roi, free_d, fd, dc, at_fd, at_dc, rows, cols, cvals, curv_backend):
+        """The paper: (I - C)_uu D_u = C_uk D_k over the free rows (square, not symmetric)."""
         r_in = free_d[rows]
         both = r_in & free_d[cols]
         M = sp.csr_matrix((np.concatenate([-cvals[both], np.ones(fd.size)]),
@@ -177,11 +218,37 @@ class CurvatureEditor:
         # SuperLU (symmetric mode, no pivoting) is chosen for (I - C) unless a backend is named:
         # measured here at 100k unknowns, its back-substitution is 4x faster than PARDISO's
         # (0.07 s vs 0.30 s for three right-hand sides) at a similar factorization time.
-        curv_backend = "splu" if backend == "auto" and not os.environ.get("CURVDETAIL_SOLVER") else backend
         self._curv = factorize(M, symmetric=False, backend=curv_backend) if fd.size else None
-        t2 = time.perf_counter()
 
-        # -- embedding stage: unknown positions fp = roi \ pc; rows touching them ------------
+    def _stacked_system(self, D, in_roi, fd, dc, at_fd, at_dc, rel1, rel2, backend):
+        """Least squares over the region's rows of both (I - C1) and (I - C2): normal equations
+        ``(A_u^T A_u) D_u = -A_u^T (A_dc D_dc + A_ext D_ext)``, symmetric positive definite."""
+        n = D.shape[0]
+        roi = np.flatnonzero(in_roi)
+        at_roi = _positions_in(roi, n)
+        r_parts, c_parts, v_parts = [], [], []
+        for k, (r, c, v) in enumerate((rel1, rel2)):
+            keep = in_roi[r]
+            r_parts += [k * roi.size + at_roi[r[keep]], k * roi.size + np.arange(roi.size)]
+            c_parts += [c[keep], roi]
+            v_parts += [-v[keep], np.ones(roi.size)]
+        mr, mc, mv = np.concatenate(r_parts), np.concatenate(c_parts), np.concatenate(v_parts)
+        m = 2 * roi.size
+        k = at_fd[mc] >= 0
+        Au = sp.csr_matrix((mv[k], (mr[k], at_fd[mc[k]])), shape=(m, fd.size))
+        k = at_dc[mc] >= 0
+        Bdc = sp.csr_matrix((mv[k], (mr[k], at_dc[mc[k]])), shape=(m, dc.size))
+        k = ~in_roi[mc]
+        w = mv[k][:, None] * D[mc[k]]
+        ext = np.stack([np.bincount(mr[k], weights=w[:, j], minlength=m) for j in range(3)], axis=1)
+        AuT = Au.T.tocsr()
+        self._d_const = -(AuT @ ext)
+        self._C_dc = -(AuT @ Bdc).tocsr()
+        self._curv = factorize((AuT @ Au).tocsr(), symmetric=True, backend=backend) if fd.size else None
+
+    def _embedding(self, L, V, F, in_roi, pc, rows, cols, backend):
+        """E_Q over the rows that involve the free positions (normal equations) or the free rows."""
+        n = V.shape[0]
         free_p = in_roi.copy()
         free_p[pc] = False
         _check_reached(rows, cols, free_p, n, "position", "position_constrained")
@@ -205,21 +272,16 @@ class CurvatureEditor:
                                      for c in range(3)], axis=1)
         self._A_T = A.T.tocsr()
         # where each row of R gets its detail from: solved (fd), given (dc) or rest (exterior)
-        self._R_fd = at_R[fd] >= 0
-        self._R_fd_at = at_R[fd][self._R_fd]
-        self._R_dc = at_R[dc] >= 0
-        self._R_dc_at = at_R[dc][self._R_dc]
-        self._D_R_rest = D[R].copy()
+        self._R_fd = at_R[self._fd] >= 0
+        self._R_fd_at = at_R[self._fd][self._R_fd]
+        self._R_dc = at_R[self._dc] >= 0
+        self._R_dc_at = at_R[self._dc][self._R_dc]
+        self._D_R_rest = self.detail[R].copy()
         if self.rows == "all":                                 # normal equations of E_Q
             system = self._A_T @ A
         else:                                                  # square: L_ff X_f = D_f - L_fc X_c
             system, self._A_T = A, None
         self._embed = factorize(system, symmetric=True, backend=backend) if fp.size else None
-        self._response = None
-        self.timings = {"coefficients": t1 - t0, "curvature_setup": t2 - t1,
-                        "embedding_setup": time.perf_counter() - t2}
-        self.backend = {"curvature": self._curv.backend if self._curv else "none",
-                        "embedding": self._embed.backend if self._embed else "none"}
 
     def solve_details(self, details=None):
         """Curvature stage only: every vertex's detail, by back-substitution.
@@ -371,6 +433,17 @@ class CurvatureEditor:
         if self._dc.size == self._user_dc:
             return given
         return np.concatenate([given, self.detail[self._dc[self._user_dc:]]])
+
+
+def _two_ring_pairs(rows, cols, n):
+    """Directed pairs (i, j), j within two edges of i, i != j, sorted by i then j."""
+    P = sp.csr_matrix((np.ones(rows.size), (rows, cols)), shape=(n, n))
+    P2 = (P @ P + P).tocsr()
+    P2.setdiag(0)
+    P2.eliminate_zeros()
+    P2.sort_indices()
+    r = np.repeat(np.arange(n), np.diff(P2.indptr))
+    return r, P2.indices.astype(np.int64)
 
 
 def _positions_in(idx, n):

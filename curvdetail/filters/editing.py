@@ -77,11 +77,15 @@ def _matrix(text):
         Parameter("handle_detail", "str", "transform",
                   "handles' curvature normals: 'transform' (linear part x detail_scale) or 'free' "
                   "(solved like the other region vertices)", choices=("transform", "free")),
+        Parameter("relations", "str", "one-ring",
+                  "curvature stage: the paper's one-ring coefficients (square system) or one- and "
+                  "two-ring coefficients together (least squares, steadier for rotated handles)",
+                  choices=("one-ring", "one+two-ring")),
         Parameter("backend", "str", "auto", "sparse solver backend", choices=BACKENDS),
     ],
 )
 def apply_curvature_editing(ms, *, handles, transform, detail_scale, move_handles, handle_detail,
-                            backend):
+                            relations, backend):
     mid = layer_id(ms)
     V, F = mesh_arrays(ms, mid)
     h = _indices(handles, V.shape[0])
@@ -104,7 +108,7 @@ def apply_curvature_editing(ms, *, handles, transform, detail_scale, move_handle
     t = time.perf_counter()
     pc = h if move_handles else np.empty(0, dtype=np.int64)
     dc = h if handle_detail == "transform" else np.empty(0, dtype=np.int64)
-    editor = CurvatureEditor(V, F, pc, dc, roi=roi, backend=backend)
+    editor = CurvatureEditor(V, F, pc, dc, roi=roi, relations=relations, backend=backend)
     details = detail_scale * (editor.detail[dc] @ T[:3, :3].T) if dc.size else None
     positions = V[pc] @ T[:3, :3].T + T[:3, 3] if pc.size else None
     X = editor.solve(positions=positions, details=details)
