@@ -39,14 +39,15 @@ def test_edit_writes_the_mesh_with_fixed_and_handle_vertices_placed(tmp_path, ca
     assert "warning" not in captured.err      # a benign edit moves nothing farther than the handles
 
 
-def test_handle_detail_free_gives_a_different_interior(tmp_path):
+def test_handle_detail_and_relations_options_change_only_the_interior(tmp_path):
     V, F, status, T, p = _case(tmp_path)
     args = [str(p["off"]), "--sel", str(p["sel"]), "--def", str(p["def"])]
     assert main(["edit", *args, str(tmp_path / "a.ply")]) == 0
     assert main(["edit", *args, str(tmp_path / "b.ply"), "--handle-detail", "free"]) == 0
-    A, _ = read_mesh(tmp_path / "a.ply")
-    B, _ = read_mesh(tmp_path / "b.ply")
-    assert np.array_equal(A[status != 1], B[status != 1])
+    assert main(["edit", *args, str(tmp_path / "c.ply"), "--relations", "one+two-ring"]) == 0
+    A, B, C = (read_mesh(tmp_path / f"{k}.ply")[0] for k in "abc")
+    for other in (B, C):                      # constrained vertices: the same in all three
+        assert np.array_equal(A[status != 1], other[status != 1])
     assert np.abs(A - B)[status == 1].max() > 1e-3
 
 

@@ -93,11 +93,12 @@ def test_writers_refuse_to_overwrite(tmp_path):
     assert read_selection(p).tolist() == [1, 2]
 
 
+@pytest.mark.parametrize("relations", ["one-ring", "one+two-ring"])
 @pytest.mark.parametrize("mode", ["transform", "free"])
-def test_fixed_vertices_stay_and_handles_land_on_their_transformed_positions(mode):
+def test_fixed_vertices_stay_and_handles_land_on_their_transformed_positions(mode, relations):
     V, F, status = _strip()
     T = _similarity(0.4, 1.0, [0.0, 0.3, 0.5])
-    X = edit_with_selection(V, F, status, T, handle_detail=mode)
+    X = edit_with_selection(V, F, status, T, handle_detail=mode, relations=relations)
     fixed, handles = status == 0, status == 2
     assert np.array_equal(X[fixed], V[fixed])
     assert np.array_equal(X[handles], apply_transform(T, V[handles]))
