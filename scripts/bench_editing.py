@@ -41,8 +41,9 @@ def bench_table1(repeat):
         V, F = meshes[name]
         med, _, _ = time_edit(V, F, repeat)
         rows.append({"model": name, "vertices": int(V.shape[0]), "end_to_end_ms": 1e3 * med["total"],
+                     "end_to_end_best_ms": 1e3 * med["total_min"],
                      "resolve_ms": 1e3 * med["resolve"], "target_ms": 20.0,
-                     "met": bool(med["total"] < 0.020)})
+                     "met_median": bool(med["total"] < 0.020), "met_best": bool(med["total_min"] < 0.020)})
     return rows
 
 
@@ -118,7 +119,7 @@ def main(argv=None):
     report["table1"] = bench_table1(args.repeat)
     for r in report["table1"]:
         print(f"table1 {r['model']:6s} {r['vertices']:4d} v: {r['end_to_end_ms']:.1f} ms end to end "
-              f"(target 20) re-solve {r['resolve_ms']:.2f} ms")
+              f"(median; best {r['end_to_end_best_ms']:.1f} ms; target 20) re-solve {r['resolve_ms']:.2f} ms")
     report["cases"] = bench_cases(max(1, args.repeat // 2))
     for r in report["cases"]:
         print(f"case {r['case']:8s} {r['vertices']:5d} v: {r['total_s']:.3f} s incl. setup (target 2), "
