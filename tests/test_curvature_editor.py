@@ -108,6 +108,7 @@ def test_translated_frame_translates_a_rank_deficient_plane(plane_grid):
     (dict(position_constrained=[3, 3], detail_constrained=[3]), "repeated"),
     (dict(position_constrained=[], detail_constrained=[0, 1, 2]), "position_constrained is empty"),
     (dict(position_constrained=[0], detail_constrained=[]), "detail_constrained is empty"),
+    (dict(position_constrained=[0], detail_constrained=[0, 1]), "has only 2 vertices"),
     (dict(position_constrained=[0], detail_constrained=[0], roi=[]), "roi is empty"),
     (dict(position_constrained=[0, 1], detail_constrained=[1], roi=np.arange(1, 100)), "outside the roi"),
     (dict(position_constrained=[0], detail_constrained=[0], roi=np.arange(1, 100)), "outside the roi"),

@@ -145,11 +145,12 @@ class CurvatureEditor:
             raise ConstraintError("position_constrained is empty and the roi is the whole mesh: the "
                                   "result is only determined up to a translation. Constrain at least "
                                   "one vertex per connected piece, or pass a smaller roi.")
-        if whole and dc.size == 0:
-            raise ConstraintError("detail_constrained is empty and the roi is the whole mesh: the "
-                                  "curvature stage is only determined up to a linear map. Constrain "
-                                  "the details of at least three vertices (e.g. the handles), or pass "
-                                  "a smaller roi.")
+        if whole and dc.size < 3:
+            state = "is empty" if dc.size == 0 else f"has only {dc.size} vertices"
+            raise ConstraintError(f"detail_constrained {state} and the roi is the whole mesh: the "
+                                  "curvature stage is only determined up to a linear map (9 unknowns, "
+                                  "3 per constrained detail). Constrain the details of at least three "
+                                  "vertices (e.g. the handles), or pass a smaller roi.")
         self.position_constrained, self.detail_constrained = pc, dc
         self.roi = np.flatnonzero(in_roi)
 
