@@ -93,9 +93,10 @@ class CurvatureEditor:
     ------
     MeshError         malformed mesh
     ConstraintError   indices out of range or repeated; a constraint outside ``roi``; an empty
-                      ``roi``; no position constraint (or no detail constraint) while ``roi`` is
-                      the whole mesh; a connected free region that touches no position (or no
+                      ``roi``; no position constraint (or fewer than three detail constraints)
+                      while ``roi`` is the whole mesh; a connected free region that touches no position (or no
                       detail) constraint
+    ValueError        unknown ``rows`` or ``relations``
     SolverError       a system could not be factored (the constraints do not determine it)
 
     Examples
