@@ -140,7 +140,8 @@ def _minimal_command(parser):
         progress.close()
         write_mesh(args.output, X, F, quality=np.linalg.norm(X - V, axis=1), overwrite=args.overwrite)
         state = "converged" if X.converged else "stopped (not converged)"
-        print(f"{state} after {X.iterations} steps, last step {X.last_step:.2e} of the bbox diagonal")
+        print(f"{state} after {X.iterations} steps, last step {X.last_step:.2e} of the bbox diagonal "
+              f"normal to the surface ({X.last_full_step:.2e} with tangential sliding)")
         return 0 if X.converged else 3
 
     return run
