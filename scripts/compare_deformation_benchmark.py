@@ -86,7 +86,8 @@ def main(argv=None):
         panels = [(V, F, "rest: fixed / free / handle", status)]
         for mode in LABELS:
             X = np.clip(results[mode], lo - pad, hi + pad)
-            label = f"{LABELS[mode]}\nmean {100 * row[mode]['mean']:.1f} % / max {100 * row[mode]['max']:.1f} %"
+            label = (f"{LABELS[mode]}\nmean {100 * row[mode]['mean']:.1f} % / "
+                     f"max {100 * row[mode]['max']:.1f} %")
             panels.append((X, F, label))
         panels.append((ref, F, "survey: Laplacian editing"))
         for target in [os.path.join(args.out, name + ".png")] + (

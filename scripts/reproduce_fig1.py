@@ -108,7 +108,8 @@ def devil():
     info = summary("mannequin_devil", V, X, ed, time.perf_counter() - t)
     for scale, r in results.items():
         info[f"detail_x{scale}"] = {k: v for k, v in r.items() if k != "X"}
-    info["extra_panel"] = (results[0.5]["X"], f"horn detail x0.5: horn length x{results[0.5]['horn_length_ratio']:.2f}")
+    info["extra_panel"] = (results[0.5]["X"],
+                           f"horn detail x0.5: horn length x{results[0.5]['horn_length_ratio']:.2f}")
     info["edited_label"] = (f"horn detail x2: horn length x{results[2.0]['horn_length_ratio']:.2f},\n"
                             f"|K| at the tip x{results[2.0]['tip_curvature_normal_ratio']:.2f}")
     return V, F, X, info, False

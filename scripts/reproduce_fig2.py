@@ -111,8 +111,8 @@ def main(argv=None):
     for key, label in (("sine_y", "sine in y"), ("sine_z", "sine in z")):
         for mode, short in (("deformed/one-ring", "(paper)"), ("deformed/one+two-ring", "one+two-ring")):
             X = tmeshes[f"{key}_{mode}"]
-            panels.append((X, Ft, f"{label} {short}\n"
-                                  f"{info_b[key + '_' + mode]['folded_triangles']} folded triangles", X[:, 2]))
+            folds = info_b[key + "_" + mode]["folded_triangles"]
+            panels.append((X, Ft, f"{label} {short}\n{folds} folded triangles", X[:, 2]))
     render_panels(os.path.join(args.out, "fig2b.png"), panels, elev=35, azim=-60, overwrite=True,
                   panel_size=3.0)
     with open(os.path.join(args.out, "fig2.json"), "w") as fh:

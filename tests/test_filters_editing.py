@@ -57,7 +57,8 @@ def test_identity_edit_leaves_the_mesh_in_place():
 def test_filter_is_declared_with_its_parameters():
     spec = get_filter("apply_curvature_editing")
     assert spec.category == "Curvature detail"
-    assert {"handles", "transform", "detail_scale", "move_handles", "handle_detail"} <= set(spec.parameter_names)
+    expected = {"handles", "transform", "detail_scale", "move_handles", "handle_detail", "relations"}
+    assert expected <= set(spec.parameter_names)
 
 
 @pytest.mark.parametrize("params, error, message", [

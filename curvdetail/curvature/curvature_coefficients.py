@@ -150,7 +150,8 @@ def _coefficients(D, A, rows, cols, n, rcond, diag, *, want_scale=False):
     for a in range(3):
         for b in range(a, 3):
             g[a, b] = np.bincount(rows, weights=Dj[:, a] * Dj[:, b], minlength=n)
-    area_scale = np.sqrt(np.bincount(rows, weights=A[cols] ** 2, minlength=n)) / max(diag, np.finfo(float).tiny)
+    area_scale = (np.sqrt(np.bincount(rows, weights=A[cols] ** 2, minlength=n))
+                  / max(diag, np.finfo(float).tiny))
     # closed form where G is safely full rank: adjugate / det
     c00 = g[1, 1] * g[2, 2] - g[1, 2] ** 2
     c01 = g[0, 2] * g[1, 2] - g[0, 1] * g[2, 2]

@@ -8,7 +8,8 @@ from ..curvature._validate import bbox_diagonal
 from ..curvature.curvature_editor import CurvatureEditor
 from ..curvature.errors import ConstraintError, first_indices
 from .errors import FilterParameterError
-from .meshset import get_mesh, layer_id, mesh_arrays, selected_vertices, set_vertex_positions, set_vertex_quality
+from .meshset import (get_mesh, layer_id, mesh_arrays, selected_vertices, set_vertex_positions,
+                      set_vertex_quality)
 from .parameters import Parameter
 from .registry import PAPER, filter
 
