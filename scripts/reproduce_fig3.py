@@ -8,7 +8,8 @@ configuration is also run with decimation, and on terrainA_100k for the timing a
 
 Writes (paths relative to the repository):
   out/fig3/results.json           every report
-  docs/fig3_table.md              the markdown tables (also pasted into docs/remeshing.md)
+  docs/fig3_table.md              the markdown tables (also copied into docs/remeshing.md,
+                                  between its <!-- fig3-table --> markers)
   docs/fig3.png                   the Fig. 3 patches, default configuration
 
 Usage: python scripts/reproduce_fig3.py [--meshes DIR] [--quick]
@@ -151,6 +152,14 @@ def main():
                   + "\n".join(params) + "\n")
     with open(os.path.join(ROOT, "docs", "fig3_table.md"), "w") as fh:
         fh.write(table)
+    doc = os.path.join(ROOT, "docs", "remeshing.md")
+    if os.path.exists(doc):   # refresh the copy between the markers in docs/remeshing.md
+        text = open(doc).read()
+        a, b = "<!-- fig3-table -->\n", "<!-- /fig3-table -->"
+        if a in text and b in text:
+            text = text[:text.index(a) + len(a)] + table + text[text.index(b):]
+            with open(doc, "w") as fh:
+                fh.write(text)
     if figure_inputs:
         _figure(figure_inputs, os.path.join(ROOT, "docs", "fig3.png"))
     print(table)
