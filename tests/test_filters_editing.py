@@ -7,7 +7,7 @@ import pymeshlab
 import pytest
 
 from curvdetail import ConstraintError
-from curvdetail.filters import FilterParameterError, apply, get_filter
+from curvdetail.filters import BBoxLength, FilterParameterError, apply, get_filter
 
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
 
@@ -71,6 +71,25 @@ def test_bad_parameters_are_refused(params, error, message):
     ms, V, d, handles = _meshset_with_roi()
     with pytest.raises(error, match=message):
         apply(ms, "apply_curvature_editing", **params)
+
+
+def test_region_radius_makes_the_region_without_a_selection():
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(os.path.join(DATA, "mannequin_ear.obj"))
+    V = ms.current_mesh().vertex_matrix().copy()
+    d = np.linalg.norm(V - V[0], axis=1)
+    handles = np.flatnonzero(d < np.quantile(d, 0.03))
+    radius = np.quantile(d, 0.5)
+    figures = apply(ms, "apply_curvature_editing", handles=" ".join(map(str, handles)),
+                    region_radius=BBoxLength(radius, percent=False),
+                    transform="1 0 0 0 0 1 0 0 0 0 1 0.01 0 0 0 1")
+    X = ms.current_mesh().vertex_matrix()
+    # the region is every vertex within the radius of a handle; everything beyond stays put
+    from scipy.spatial import cKDTree
+    dist = cKDTree(V[handles]).query(V)[0]
+    assert figures["roi_vertices"] == int((dist <= radius).sum())
+    assert np.array_equal(X[dist > radius], V[dist > radius])
+    assert np.allclose(X[handles, 2], V[handles, 2] + 0.01)
 
 
 def test_no_selection_is_refused():

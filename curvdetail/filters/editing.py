@@ -10,7 +10,7 @@ from ..curvature.errors import ConstraintError, first_indices
 from .errors import FilterParameterError
 from .meshset import (get_mesh, layer_id, mesh_arrays, selected_vertices, set_vertex_positions,
                       set_vertex_quality)
-from .parameters import Parameter
+from .parameters import BBoxLength, Parameter
 from .registry import PAPER, filter
 
 BACKENDS = ("auto", "pardiso", "cholmod", "splu")
@@ -59,7 +59,8 @@ def _matrix(text):
         Mesh editing with curvature coefficients: the handle vertices are moved by a 4x4
         transform, their curvature normals are transformed by its linear part and optionally
         scaled (a factor below 1 shortens them, which lengthens a protrusion), and the region of
-        interest - the selected vertices plus the handles - is rebuilt in two stages: the
+        interest - the selected vertices, the handles and, with region_radius, every vertex that
+        close to a handle - is rebuilt in two stages: the
         details of the other region vertices from the rotation- and scale-invariant curvature
         coefficients (min |(I - C) D|^2), then the positions from the details (E_Q). Vertices
         outside the region do not move. Vertices move in place; the vertex quality is set to
@@ -68,6 +69,10 @@ def _matrix(text):
     """,
     parameters=[
         Parameter("handles", "str", "", "handle vertex indices, separated by spaces or commas"),
+        Parameter("region_radius", "PercentageValue", BBoxLength(0.0, percent=True),
+                  "also put every vertex within this distance of a handle into the region of "
+                  "interest (0: the selection alone); a percentage of the bbox diagonal or absolute",
+                  min=0.0),
         Parameter("transform", "str", IDENTITY,
                   "4x4 handle transform, 16 numbers row by row, applied to homogeneous positions"),
         Parameter("detail_scale", "float", 1.0,
@@ -85,8 +90,8 @@ def _matrix(text):
         Parameter("backend", "str", "auto", "sparse solver backend", choices=BACKENDS),
     ],
 )
-def apply_curvature_editing(ms, *, handles, transform, detail_scale, move_handles, handle_detail,
-                            relations, backend):
+def apply_curvature_editing(ms, *, handles, region_radius, transform, detail_scale, move_handles,
+                            handle_detail, relations, backend):
     mid = layer_id(ms)
     V, F = mesh_arrays(ms, mid)
     h = _indices(handles, V.shape[0])
@@ -97,11 +102,17 @@ def apply_curvature_editing(ms, *, handles, transform, detail_scale, move_handle
         raise FilterParameterError("move_handles=false with handle_detail='free' leaves the handles "
                                    "unconstrained; set one of them.")
     selected = selected_vertices(ms, mid)
+    radius = region_radius.resolve(bbox_diagonal(V))
+    if radius > 0:
+        from scipy.spatial import cKDTree
+
+        near = np.flatnonzero(cKDTree(V[h]).query(V, distance_upper_bound=radius)[0] <= radius)
+        selected = np.union1d(selected, near)
     if selected.size == 0:
         raise ConstraintError(
-            f"layer {mid} ({get_mesh(ms, mid).label()!r}) has no selected vertices: the selection is "
-            "the region of interest to rebuild. Select it first (e.g. with "
-            "compute_selection_by_condition_per_vertex).")
+            f"layer {mid} ({get_mesh(ms, mid).label()!r}) has no selected vertices and "
+            "region_radius is 0: the region of interest to rebuild is empty. Select it first (e.g. "
+            "with compute_selection_by_condition_per_vertex) or set region_radius (e.g. 20%).")
     roi = np.union1d(selected, h)
     if roi.size == V.shape[0]:
         raise ConstraintError("every vertex is in the region of interest (selection plus handles), so "
