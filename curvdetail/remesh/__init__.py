@@ -5,7 +5,7 @@ Depends on :mod:`curvdetail.curvature` (operators and solvers), pymeshlab (isotr
 closest-face grid, Hausdorff distance) and fast-simplification (decimation).
 """
 
-from ._disk import NotADiskError, RemeshError
+from ._disk import NotADiskError, RemeshError, check_disk
 from .evaluate import hausdorff, vertex_distance
 from .experiment import remesh_experiment
 from .locate import interpolate, locate, spread
@@ -14,7 +14,7 @@ from .retriangulate import retriangulate
 from .transfer import edge_curvature_measure, transfer_curvature
 
 __all__ = [
-    "NotADiskError", "RemeshError", "edge_curvature_measure", "flipped_triangles", "harmonic_map",
+    "NotADiskError", "RemeshError", "check_disk", "edge_curvature_measure", "flipped_triangles", "harmonic_map",
     "hausdorff", "interpolate", "locate", "parameterize", "remesh_experiment", "retriangulate", "spread",
     "transfer_curvature", "vertex_distance",
 ]
