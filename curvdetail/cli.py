@@ -184,6 +184,9 @@ def _remesh_command(parser):
         from .remesh.experiment import run_experiment
 
         resolve_input_output(args)
+        if not (args.target_edge > 0 and args.target_edge < float("inf")):
+            raise ValueError(f"--target-edge {args.target_edge:g}: give a positive percentage of the bbox "
+                             "diagonal, e.g. 1 for 1 %.")
         for extra in (args.report, args.image):
             if extra is not None:
                 _refuse_existing(extra, args.overwrite)

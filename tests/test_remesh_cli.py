@@ -48,6 +48,13 @@ def test_non_disk_source_fails_saying_what_was_found(tmp_path, capsys):
     assert sorted(os.listdir(tmp_path)) == ["tube.ply"]
 
 
+def test_non_positive_target_edge_is_refused_in_percent(tmp_path, capsys):
+    rc = main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "o.ply"), "--target-edge", "-1"])
+    assert rc == 1
+    assert "positive percentage" in capsys.readouterr().err
+    assert os.listdir(tmp_path) == []
+
+
 @pytest.mark.parametrize("pct", ["0.0001", "90"])
 def test_absurd_target_edge_fails_with_the_numbers_and_writes_nothing(tmp_path, capsys, pct):
     rc = main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "o.ply"), "--target-edge", pct,
