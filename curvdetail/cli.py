@@ -176,23 +176,22 @@ def _remesh_command(parser):
     add_output_arguments(parser)
 
     def run(args):
+        import contextlib
         import json
         import os
-        import tempfile
 
-        from .io import read_mesh, write_mesh
+        from ._output import atomic_output, check_output_path
+        from .io import MeshFileError, read_mesh, write_mesh
         from .remesh.experiment import run_experiment
 
         resolve_input_output(args)
         if not (args.target_edge > 0 and args.target_edge < float("inf")):
             raise ValueError(f"--target-edge {args.target_edge:g}: give a positive percentage of the bbox "
                              "diagonal, e.g. 1 for 1 %.")
+        check_output_path(args.output, args.overwrite, error=MeshFileError)
         for extra in (args.report, args.image):
             if extra is not None:
-                _refuse_existing(extra, args.overwrite)
-                folder = os.path.dirname(os.path.abspath(extra))
-                if not os.path.isdir(folder):
-                    raise FileNotFoundError(f"cannot write {extra}: folder {folder} does not exist.")
+                check_output_path(extra, args.overwrite, hint=None, error=FileNotFoundError)
         if args.image is not None and not args.image.lower().endswith(".png"):
             raise ValueError(f"--image {args.image}: only PNG pictures are written; end the name in .png.")
         V, F = read_mesh(args.input)
@@ -204,34 +203,25 @@ def _remesh_command(parser):
                                     parameterization=args.parameterization, backend=args.backend,
                                     source_path=os.path.abspath(args.input), progress=progress.stage)
             report = result["report"]
-            temps = []
-            try:
+            # all outputs appear together, only once every one of them is written
+            with contextlib.ExitStack() as outputs:
                 if args.image is not None:
                     progress.stage("image")
                     from .remesh.figure import save_figure
 
-                    fd, tmp = tempfile.mkstemp(prefix=".curvdetail-", suffix=".png",
-                                               dir=os.path.dirname(os.path.abspath(args.image)))
-                    os.close(fd)
-                    temps.append((tmp, args.image))
-                    save_figure(tmp, V, F, result["X"], result["Ft"], result["Z"], result["distance"], report,
-                                overwrite=True)
+                    tmp = outputs.enter_context(atomic_output(args.image, overwrite=args.overwrite,
+                                                              hint=None, error=FileNotFoundError))
+                    save_figure(tmp, V, F, result["X"], result["Ft"], result["Z"], result["distance"],
+                                report, overwrite=True)
                 if args.report is not None:
-                    fd, tmp = tempfile.mkstemp(prefix=".curvdetail-", suffix=".json",
-                                               dir=os.path.dirname(os.path.abspath(args.report)))
-                    with os.fdopen(fd, "w") as fh:
+                    tmp = outputs.enter_context(atomic_output(args.report, overwrite=args.overwrite,
+                                                              hint=None, error=FileNotFoundError))
+                    with open(tmp, "w", encoding="utf-8") as fh:
                         json.dump(report, fh, indent=2)
                         fh.write("\n")
-                    temps.append((tmp, args.report))
-                write_mesh(args.output, result["X"], result["Ft"], quality=result["distance"],
-                           overwrite=args.overwrite)
-                for tmp, final in temps:
-                    os.replace(tmp, final)
-                temps = []
-            finally:
-                for tmp, _ in temps:
-                    if os.path.exists(tmp):
-                        os.remove(tmp)
+                tmp = outputs.enter_context(atomic_output(args.output, overwrite=args.overwrite,
+                                                          error=MeshFileError))
+                write_mesh(tmp, result["X"], result["Ft"], quality=result["distance"], overwrite=True)
         finally:
             progress.close()
         e, b, fl = report["error"], report["baseline_zero_detail"], report["floor_retriangulated"]
@@ -376,16 +366,20 @@ def _edit_command(parser):
     add_output_arguments(parser)
 
     def run(args):
+        import contextlib
+
         import numpy as np
 
         from . import read_mesh, write_mesh
+        from ._output import atomic_output, check_output_path
         from .curvature._validate import bbox_diagonal, check_mesh
         from .deformation_benchmark import (edit_with_selection, read_selection, read_transform,
                                             render_panels)
+        from .io import MeshFileError
 
-        _refuse_existing(args.output, args.overwrite)
+        check_output_path(args.output, args.overwrite, error=MeshFileError)
         if args.image:
-            _refuse_existing(args.image, args.overwrite)
+            check_output_path(args.image, args.overwrite, hint=None, error=FileNotFoundError)
         progress = Progress(3, enabled=sys.stderr.isatty())
         progress.stage("read")
         V, F = check_mesh(*read_mesh(args.mesh))
@@ -399,11 +393,17 @@ def _edit_command(parser):
         seconds = time.perf_counter() - t
         progress.stage("write")
         moved = np.linalg.norm(X - V, axis=1)
-        if args.image:
-            render_panels(args.image, [(V, F, "rest (status 0/1/2)", status),
-                                       (X, F, f"edited (handle detail: {args.handle_detail})", moved)],
-                          overwrite=args.overwrite)
-        write_mesh(args.output, X, F, quality=moved, overwrite=args.overwrite)
+        # the picture and the mesh appear together, only once both are written
+        with contextlib.ExitStack() as outputs:
+            if args.image:
+                tmp = outputs.enter_context(atomic_output(args.image, overwrite=args.overwrite,
+                                                          hint=None, error=FileNotFoundError))
+                render_panels(tmp, [(V, F, "rest (status 0/1/2)", status),
+                                    (X, F, f"edited (handle detail: {args.handle_detail})", moved)],
+                              overwrite=True)
+            tmp = outputs.enter_context(atomic_output(args.output, overwrite=args.overwrite,
+                                                      error=MeshFileError))
+            write_mesh(tmp, X, F, quality=moved, overwrite=True)
         progress.close()
         counts = np.bincount(status, minlength=3)
         print(f"{V.shape[0]} vertices ({counts[0]} fixed, {counts[1]} free, {counts[2]} handles); "

@@ -15,10 +15,10 @@ transformed by its linear part (``handle_detail="transform"``) or solved like th
 """
 
 import os
-import tempfile
 
 import numpy as np
 
+from ._output import atomic_output, check_output_path
 from .curvature.curvature_coefficients import DEFAULT_RCOND
 from .curvature.curvature_editor import CurvatureEditor
 from .curvature.errors import ConstraintError, first_indices
@@ -132,27 +132,10 @@ def read_transform(path):
     return T
 
 
-def _publish(tmp, path):
-    """Give a finished temporary file the permissions of a normal new file, then rename it."""
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(tmp, 0o666 & ~umask)
-    os.replace(tmp, path)
-
-
 def _write_text(path, text, overwrite):
-    path = os.fspath(path)
-    if os.path.exists(path) and not overwrite:
-        raise FileExistsError(f"{path} exists; pass overwrite=True (or --overwrite) to replace it.")
-    folder = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix=".curvdetail-", suffix=".tmp", dir=folder)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+    with atomic_output(path, overwrite=overwrite, hint=None, error=FileNotFoundError) as tmp:
+        with open(tmp, "w", encoding="utf-8") as fh:
             fh.write(text)
-        _publish(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.remove(tmp)
 
 
 def write_selection(path, status, *, overwrite=False):
@@ -286,9 +269,7 @@ def render_panels(path, panels, *, elev=20.0, azim=-60.0, title=None, overwrite=
     import matplotlib.pyplot as plt
     from matplotlib.collections import PolyCollection
 
-    path = os.fspath(path)
-    if os.path.exists(path) and not overwrite:
-        raise FileExistsError(f"{path} exists; pass overwrite=True (or --overwrite) to replace it.")
+    path = check_output_path(path, overwrite, hint=None, error=FileNotFoundError)
     R = _camera(elev, azim)          # camera frame: x right, y up, z towards the viewer
     fig, axes = plt.subplots(1, len(panels), figsize=(panel_size * len(panels), panel_size),
                              squeeze=False)
@@ -319,13 +300,8 @@ def render_panels(path, panels, *, elev=20.0, azim=-60.0, title=None, overwrite=
     if title:
         fig.suptitle(title, fontsize=11)
     fig.tight_layout(pad=1.6)
-    folder = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix=".curvdetail-", suffix=".png", dir=folder)
-    os.close(fd)
     try:
-        fig.savefig(tmp, dpi=100, format="png")
-        _publish(tmp, path)
+        with atomic_output(path, overwrite=overwrite, hint=None, error=FileNotFoundError) as tmp:
+            fig.savefig(tmp, dpi=100, format="png")
     finally:
         plt.close(fig)
-        if os.path.exists(tmp):
-            os.remove(tmp)

@@ -11,13 +11,15 @@ and renamed, so a failed save leaves nothing behind; an existing file is replace
 """
 
 import os
-import tempfile
 
 import numpy as np
 
+from .. import _output
 from ..io import MeshFileError
 from .meshset import WRITTEN_ATTRIBUTES, set_vertex_attribute, vertex_attribute
 from .ply_attributes import read_ply_vertex_attributes
+
+_HINT = "use .ply to keep quality and curvature attributes, or .obj, .off, .stl"
 
 
 def load_meshset(path, *more):
@@ -50,16 +52,7 @@ def load_meshset(path, *more):
 def check_output_path(path, overwrite=False):
     """Raise before any work if ``path`` cannot be written: it exists (and not ``overwrite``),
     its folder does not exist, or it has no extension to pick the format."""
-    path = os.fspath(path)
-    if os.path.exists(path) and not overwrite:
-        raise FileExistsError(f"{path} exists; pass --overwrite (overwrite=True) to replace it.")
-    folder = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(folder):
-        raise MeshFileError(f"cannot write {path!r}: folder {folder!r} does not exist.")
-    if not os.path.splitext(path)[1]:
-        raise MeshFileError(f"cannot write {path!r}: no file extension to choose the format from "
-                            "(use .ply to keep quality and curvature attributes, or .obj, .off, .stl).")
-    return path
+    return _output.check_output_path(path, overwrite, hint=_HINT, error=MeshFileError)
 
 
 def save_options(ms, path):
@@ -83,18 +76,9 @@ def save_current_mesh(ms, path, *, overwrite=False):
     Raises FileExistsError, MeshFileError (unknown format, missing folder, pymeshlab failed)."""
     import pymeshlab
 
-    path = check_output_path(path, overwrite)
-    ext = os.path.splitext(path)[1]
     options = save_options(ms, path)
-    fd, tmp = tempfile.mkstemp(prefix=".curvdetail-", suffix=ext,
-                               dir=os.path.dirname(os.path.abspath(path)))
-    os.close(fd)
-    try:
+    with _output.atomic_output(path, overwrite=overwrite, hint=_HINT, error=MeshFileError) as tmp:
         try:
             ms.save_current_mesh(tmp, **options)
         except pymeshlab.PyMeshLabException as exc:
-            raise MeshFileError(f"could not write {path!r}: {' '.join(str(exc).split())}") from None
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.remove(tmp)
+            raise MeshFileError(f"could not write {os.fspath(path)!r}: {' '.join(str(exc).split())}") from None

@@ -29,6 +29,7 @@ import sys
 import tempfile
 import xml.etree.ElementTree as ET
 
+from .._output import atomic_output, check_output_path
 from .dispatch import apply
 from .errors import FilterError, ScriptError
 from .registry import _REGISTRY, get_filter
@@ -200,6 +201,7 @@ def save_script(path, steps, *, overwrite=False):
     Raises
     ------
     FileExistsError        ``path`` exists and ``overwrite`` is False
+    FileNotFoundError      the destination folder does not exist
     UnknownFilterError, FilterParameterError   as :func:`~curvdetail.filters.apply`
 
     Examples
@@ -213,9 +215,7 @@ def save_script(path, steps, *, overwrite=False):
     """
     from .dispatch import complete_parameters
 
-    path = os.fspath(path)
-    if os.path.exists(path) and not overwrite:
-        raise FileExistsError(f"{path} exists; pass overwrite=True to replace it.")
+    path = check_output_path(path, overwrite, hint=None, error=FileNotFoundError)
     root = ET.Element("FilterScript")
     for step in steps:
         name, params = (step, {}) if isinstance(step, str) else (step[0], dict(step[1] or {}))
@@ -228,12 +228,6 @@ def save_script(path, steps, *, overwrite=False):
             element.append(_param_element(p, values[p.name]))
     ET.indent(root, space=" ")
     text = "<!DOCTYPE FilterScript>\n" + ET.tostring(root, encoding="unicode") + "\n"
-    folder = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix=".curvdetail-", suffix=".mlx", dir=folder)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as out:
+    with atomic_output(path, overwrite=overwrite, hint=None, error=FileNotFoundError) as tmp:
+        with open(tmp, "w", encoding="utf-8") as out:
             out.write(text)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.remove(tmp)

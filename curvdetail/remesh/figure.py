@@ -2,9 +2,10 @@
 baseline (matplotlib, headless)."""
 
 import os
-import tempfile
 
 import numpy as np
+
+from .._output import atomic_output, check_output_path
 
 
 def _view_frame(V, F):
@@ -64,9 +65,7 @@ def save_figure(path, V, F, X, Ft, Z, distance, report, *, overwrite=False, dpi=
     matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
 
-    path = os.fspath(path)
-    if os.path.exists(path) and not overwrite:
-        raise FileExistsError(f"{path} exists; pass overwrite=True (or --overwrite) to replace it.")
+    path = check_output_path(path, overwrite, hint=None, error=FileNotFoundError)
     R = _view_frame(V, F)
     centre = 0.5 * (V.max(0) + V.min(0))
     P = (V - centre) @ R.T
@@ -94,13 +93,8 @@ def save_figure(path, V, F, X, Ft, Z, distance, report, *, overwrite=False, dpi=
     cb = fig.colorbar(sm, ax=fig.axes[1], shrink=0.6, pad=0.02, orientation="horizontal")
     cb.set_label("distance to source, % of bbox diagonal", fontsize=8)
     fig.suptitle("Remeshing from curvature detail (all figures: % of the source's bbox diagonal)", fontsize=10)
-    folder = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix=".curvdetail-", suffix=".png", dir=folder)
-    os.close(fd)
     try:
-        fig.savefig(tmp, dpi=dpi, bbox_inches="tight")
-        os.replace(tmp, path)
+        with atomic_output(path, overwrite=overwrite, hint=None, error=FileNotFoundError) as tmp:
+            fig.savefig(tmp, dpi=dpi, bbox_inches="tight", format="png")
     finally:
         plt.close(fig)
-        if os.path.exists(tmp):
-            os.remove(tmp)
