@@ -41,8 +41,7 @@ from .registry import PAPER, filter
     ],
 )
 def transfer_curvature_detail(ms, *, sourcemesh, targetmesh, method, location, parameterization):
-    from ..remesh import parameterize, transfer_curvature
-    from ..remesh._disk import check_disk          # not exported by curvdetail.remesh (yet)
+    from ..remesh import check_disk, parameterize, transfer_curvature
 
     source = layer_id(ms, sourcemesh, "sourcemesh")
     target = layer_id(ms, targetmesh, "targetmesh")

@@ -1,4 +1,4 @@
-"""Disk-topology checks, the ordered boundary loop, and projection onto the boundary polyline.
+"""Disk-topology checks and projection onto the boundary polyline.
 
 Private helpers of :mod:`curvdetail.remesh`. A *disk* here is a triangle mesh that is one
 connected, edge- and vertex-manifold piece with exactly one boundary loop and Euler
@@ -10,8 +10,9 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-from ..curvature._validate import (bbox_diagonal, boundary_edges, check_mesh, non_manifold_edges,
-                                   undirected_edges, vertex_components)
+from ..curvature._validate import (boundary_edges, check_mesh, non_manifold_edges, undirected_edges,
+                                   vertex_components)
+from ..curvature.boundary_editing import boundary_loop
 from ..curvature.errors import MeshError, first_indices
 
 
@@ -78,27 +79,7 @@ def check_disk(V, F, what="the source"):
     if chi != 1:
         raise NotADiskError(f"{what} has one boundary loop but Euler characteristic {chi} "
                             f"({(1 - chi) // 2} handles); {need}.")
-    return V, F, _order_loop(B, n)
-
-
-def _order_loop(B, n):
-    """Order the single boundary loop given by its oriented edges (a walk of length k; the
-    boundary has O(sqrt(n)) vertices, so the short Python walk is not a hot path)."""
-    nxt = np.full(n, -1, dtype=np.int64)
-    nxt[B[:, 0]] = B[:, 1]
-    start = int(B[:, 0].min())
-    loop = np.empty(B.shape[0], dtype=np.int64)
-    v = start
-    for i in range(B.shape[0]):
-        loop[i] = v
-        v = int(nxt[v])
-    return loop
-
-
-def boundary_loop(F):
-    """Ordered boundary loop of a disk (no checks beyond a single loop)."""
-    F = np.asarray(F, dtype=np.int64)
-    return _order_loop(boundary_edges(F), int(F.max()) + 1)
+    return V, F, boundary_loop(F)
 
 
 class Polyline:
@@ -147,6 +128,3 @@ class Polyline:
         t = (s - self.s0[seg]) / np.maximum(self.length[seg], np.finfo(float).tiny)
         return self.P[seg] + t[:, None] * (self.Q[seg] - self.P[seg])
 
-
-def diag(V):
-    return bbox_diagonal(np.asarray(V, dtype=np.float64))

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ..curvature._validate import check_mesh
+from ..curvature._validate import check_mesh, face_double_areas
 from .locate import locate
 
 #: Face samples per direction: ``SAMPLES_PER_FACE`` times the sampled mesh's triangle count,
@@ -95,7 +95,7 @@ def vertex_distance(V, Vs, Fs, *, far=False):
 
 def _area_samples(V, F, n, rng):
     """``n`` points uniformly distributed by area, with their triangle, plus every vertex."""
-    area = np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1)
+    area = face_double_areas(V, F)
     face = rng.choice(F.shape[0], size=n, p=area / area.sum())
     r1, r2 = rng.random(n), rng.random(n)
     s = np.sqrt(r1)

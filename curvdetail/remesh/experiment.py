@@ -4,8 +4,10 @@ import time
 
 import numpy as np
 
+from ..curvature._validate import bbox_diagonal
+from ..curvature.boundary_editing import boundary_loop
 from ..curvature.reconstruct import ROW_MODES, Reconstructor
-from ._disk import boundary_loop, check_disk, diag
+from ._disk import check_disk
 from .evaluate import hausdorff, vertex_distance
 from .parameterize import METHODS as PARAMETERIZATIONS
 from .parameterize import parameterize
@@ -111,7 +113,7 @@ def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="cons
     _check_choice("location", location, LOCATIONS)
     _check_choice("parameterization", parameterization, PARAMETERIZATIONS)
     V, F, _ = check_disk(V, F, "the source")
-    d = diag(V)
+    d = bbox_diagonal(V)
     seconds = dict.fromkeys(STAGES, 0.0)
     t_all = time.perf_counter()
 

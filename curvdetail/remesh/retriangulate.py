@@ -2,7 +2,8 @@
 
 import numpy as np
 
-from ._disk import NotADiskError, Polyline, RemeshError, check_disk, diag
+from ..curvature._validate import bbox_diagonal, face_double_areas
+from ._disk import NotADiskError, Polyline, RemeshError, check_disk
 
 METHODS = ("isotropic", "decimate")
 
@@ -21,7 +22,7 @@ def estimated_vertices(V, F, target_edge):
     length): ``2 area / (sqrt(3) h^2)``."""
     V = np.asarray(V, dtype=np.float64)
     F = np.asarray(F, dtype=np.int64)
-    area = 0.5 * np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1).sum()
+    area = 0.5 * face_double_areas(V, F).sum()
     return 2.0 * area / (np.sqrt(3.0) * target_edge ** 2)
 
 
@@ -76,7 +77,7 @@ def retriangulate(V, F, *, method="isotropic", target_edge=0.01, iterations=10, 
     if method not in METHODS:
         raise RemeshError(f"method={method!r} is not a retriangulation method; use 'isotropic' or 'decimate'.")
     V, F, loop = check_disk(V, F, "the source")
-    d = diag(V)
+    d = bbox_diagonal(V)
     try:
         target_edge = float(target_edge)
     except (TypeError, ValueError):
@@ -126,7 +127,7 @@ def _isotropic(V, F, h, iterations, max_dist):
 def _decimate(V, F, h, agg):
     import fast_simplification
 
-    area = 0.5 * np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1).sum()
+    area = 0.5 * face_double_areas(V, F).sum()
     target_faces = int(round(area / (np.sqrt(3.0) / 4.0 * h * h)))
     if target_faces >= F.shape[0]:
         raise RemeshError(
