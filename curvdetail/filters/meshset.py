@@ -17,6 +17,7 @@ import itertools
 import numpy as np
 
 from ..curvature.errors import MeshError
+from ..curvature.minimal_surface import _vertex_normals as vertex_normals  # noqa: F401  (area-weighted, unit)
 from .errors import FilterError
 
 _scratch_ids = itertools.count()
@@ -187,13 +188,3 @@ def add_layer(ms, V, F, label, *, quality=None, attributes=None):
     for name, values in (attributes or {}).items():
         set_vertex_attribute(ms, mid, name, values)
     return mid
-
-
-def vertex_normals(V, F):
-    """Area-weighted vertex normals (unit; sum of the incident faces' cross products), (n, 3)."""
-    N = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
-    idx = F.ravel()
-    out = np.stack([np.bincount(idx, weights=np.repeat(N[:, c], 3), minlength=V.shape[0])
-                    for c in range(3)], axis=1)
-    norm = np.linalg.norm(out, axis=1)
-    return out / np.where(norm > 0, norm, 1.0)[:, None]
