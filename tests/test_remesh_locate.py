@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from curvdetail.curvature.errors import MeshError
 from curvdetail.remesh import interpolate, locate, spread
 
 
@@ -61,3 +62,22 @@ def test_spread_is_the_adjoint_of_interpolate_and_conserves_the_total(load_mesh,
     g = rng.normal(size=face.size)
     assert np.dot(interpolate(f, F, face, bary), g) == pytest.approx(np.dot(f, spread(g, F, face, bary, V.shape[0])[:, 0]))
     assert spread(g, F, face, bary, V.shape[0]).sum() == pytest.approx(g.sum(), abs=1e-12)
+
+
+@pytest.mark.parametrize("engine", ["auto", "numpy"])
+@pytest.mark.parametrize("dim", [2, 3])
+def test_nan_points_are_refused_naming_them_not_a_crash(flat_disk, engine, dim):
+    # pymeshlab's nearest-face grid used to die with a segmentation fault on a NaN point
+    V, F = flat_disk
+    P = V[:4, :dim].copy()
+    P[2, 0] = np.nan
+    with pytest.raises(MeshError, match=r"points: 1 rows are NaN or infinite \(first: 2\)"):
+        locate(P, V[:, :dim], F, engine=engine)
+
+
+def test_triangle_indices_outside_v_are_refused(flat_disk):
+    V, F = flat_disk
+    G = F.copy()
+    G[5, 1] = V.shape[0]
+    with pytest.raises(MeshError, match=r"1 triangles have vertex indices outside .*first: 5"):
+        locate(V[:3], V, G)

@@ -4,7 +4,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
-from ..curvature.errors import MeshError
+from ..curvature.errors import MeshError, first_indices
 
 
 def locate(points, V, F, *, engine="auto", candidates=8, chunk=20_000):
@@ -38,7 +38,8 @@ def locate(points, V, F, *, engine="auto", candidates=8, chunk=20_000):
 
     Raises
     ------
-    MeshError   mismatched dimensions or empty input
+    MeshError   mismatched dimensions, empty ``F``, NaN or infinite coordinates, or triangle
+                indices outside ``V``
 
     Examples
     --------
@@ -55,6 +56,16 @@ def locate(points, V, F, *, engine="auto", candidates=8, chunk=20_000):
         raise MeshError(f"points {P.shape} and V {V.shape} must both be (k, 2) or both (k, 3).")
     if F.ndim != 2 or F.shape[1] != 3 or F.shape[0] == 0:
         raise MeshError(f"F has shape {F.shape}; pass a non-empty (m, 3) triangle array.")
+    # pymeshlab's grid and matplotlib's trapezoid map crash (segmentation fault) on NaN input
+    for name, X in (("points", P), ("V", V)):
+        bad = np.flatnonzero(~np.isfinite(X).all(axis=1))
+        if bad.size:
+            raise MeshError(f"{name}: {bad.size} rows are NaN or infinite (first: {first_indices(bad)}); "
+                            "pass finite coordinates.")
+    bad = np.flatnonzero(((F < 0) | (F >= V.shape[0])).any(axis=1))
+    if bad.size:
+        raise MeshError(f"F: {bad.size} triangles have vertex indices outside [0, {V.shape[0]}) "
+                        f"(first: {first_indices(bad)}); indices are 0-based into V.")
     if engine not in ("auto", "numpy"):
         raise ValueError(f"engine={engine!r}; use 'auto' or 'numpy'.")
     if P.shape[0] == 0:
