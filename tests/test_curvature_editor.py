@@ -139,6 +139,16 @@ def test_unknown_row_mode_or_relations_are_refused(plane_grid):
         CurvatureEditor(V, F, b, b, relations="three-ring")
 
 
+@pytest.mark.parametrize("rcond", [float("nan"), -1.0, 0.0, 1.0, "tiny"])
+def test_rcond_outside_zero_one_is_refused_like_curvature_coefficients(plane_grid, rcond):
+    # NaN used to be accepted silently (every ring counted as rank-deficient) and -1 ended in a
+    # singular-factor SolverError
+    V, F = plane_grid
+    b = boundary_vertices(F)
+    with pytest.raises(ValueError, match="rcond="):
+        CurvatureEditor(V, F, b, b, rcond=rcond)
+
+
 def test_stacked_relations_solve_the_least_squares_problem_of_both_coefficient_sets(load_mesh, rng):
     V, F = load_mesh("mannequin_nose.obj")
     b = boundary_vertices(F)

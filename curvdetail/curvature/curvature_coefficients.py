@@ -105,12 +105,7 @@ def curvature_coefficients(V, F, *, rcond=DEFAULT_RCOND, return_info=False):
     0
     """
     V, F = check_mesh(V, F)
-    try:
-        rcond = float(rcond)
-    except (TypeError, ValueError):
-        raise ValueError(f"rcond={rcond!r} is not a number; pass a threshold in (0, 1), e.g. 1e-6.") from None
-    if not 0.0 < rcond < 1.0:
-        raise ValueError(f"rcond={rcond!r} is outside (0, 1); pass a relative threshold such as 1e-6.")
+    rcond = check_rcond(rcond)
     n = V.shape[0]
     D = _cotan_laplacian_unchecked(V, F) @ V
     A = _mixed_voronoi_area_unchecked(V, F)
@@ -140,6 +135,17 @@ def _one_ring_pairs(F, n):
 #: Gram matrices with ``det(G) > WELL_CONDITIONED * trace(G)^3`` (hence ``cond(G) < 1e6``) are
 #: inverted in closed form; the others go through the eigendecomposition.
 WELL_CONDITIONED = 1e-6
+
+
+def check_rcond(rcond):
+    """``rcond`` as a float in (0, 1), or ValueError naming the value and the fix."""
+    try:
+        rcond = float(rcond)
+    except (TypeError, ValueError):
+        raise ValueError(f"rcond={rcond!r} is not a number; pass a threshold in (0, 1), e.g. 1e-6.") from None
+    if not 0.0 < rcond < 1.0:
+        raise ValueError(f"rcond={rcond!r} is outside (0, 1); pass a relative threshold such as 1e-6.")
+    return rcond
 
 
 def _coefficients(D, A, rows, cols, n, rcond, diag, *, want_scale=False):

@@ -9,7 +9,7 @@ from scipy.sparse.csgraph import connected_components
 
 from ._validate import as_index_set, as_values, bbox_diagonal, check_mesh
 from .cotan_laplacian import _cotan_laplacian_unchecked
-from .curvature_coefficients import DEFAULT_RCOND, _coefficients, _one_ring_pairs
+from .curvature_coefficients import DEFAULT_RCOND, _coefficients, _one_ring_pairs, check_rcond
 from .errors import ConstraintError, first_indices
 from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
 from .sparse_solver import factorize
@@ -96,7 +96,7 @@ class CurvatureEditor:
                       ``roi``; no position constraint (or fewer than three detail constraints)
                       while ``roi`` is the whole mesh; a connected free region that touches no position (or no
                       detail) constraint
-    ValueError        unknown ``rows`` or ``relations``
+    ValueError        unknown ``rows`` or ``relations``; ``rcond`` outside (0, 1)
     SolverError       a system could not be factored (the constraints do not determine it)
 
     Examples
@@ -122,6 +122,7 @@ class CurvatureEditor:
             raise ValueError(f"rows={rows!r} is not a row mode; use 'all' (the paper's E_Q) or 'free'.")
         if relations not in RELATIONS:
             raise ValueError(f"relations={relations!r}; use 'one-ring' (the paper) or 'one+two-ring'.")
+        rcond = check_rcond(rcond)
         self.relations = relations
         n = V.shape[0]
         self.n, self.V, self.F, self.rows = n, V, F, rows
@@ -159,8 +160,8 @@ class CurvatureEditor:
         L = _cotan_laplacian_unchecked(V, F)
         D = L @ V
         rows, cols = _one_ring_pairs(F, n)
-        C, rank, _ = _coefficients(D, _mixed_voronoi_area_unchecked(V, F), rows, cols, n, rcond,
-                                   bbox_diagonal(V))
+        A, diag = _mixed_voronoi_area_unchecked(V, F), bbox_diagonal(V)
+        C, rank, _ = _coefficients(D, A, rows, cols, n, rcond, diag)
         cvals = C.data if C.nnz == rows.size else np.asarray(C[rows, cols]).ravel()  # (rows, cols) order
         self.detail, self.coefficients = D, C
         self.rank_deficient = int(np.count_nonzero(rank < 3))
@@ -172,8 +173,7 @@ class CurvatureEditor:
         _check_reached(rows, cols, free_d, n, "detail", "detail_constrained")
         if relations == "one+two-ring":
             rows2, cols2 = _two_ring_pairs(rows, cols, n)
-            C2, rank2, _ = _coefficients(D, _mixed_voronoi_area_unchecked(V, F), rows2, cols2, n,
-                                         rcond, bbox_diagonal(V))
+            C2, rank2, _ = _coefficients(D, A, rows2, cols2, n, rcond, diag)
             cvals2 = C2.data if C2.nnz == rows2.size else np.asarray(C2[rows2, cols2]).ravel()
             self.coefficients_two_ring = C2
             island = _detail_islands(np.concatenate([rows, rows2]), np.concatenate([cols, cols2]),
