@@ -32,3 +32,11 @@ def test_kdtree_engine_agrees_with_meshlab_on_far_surfaces(load_mesh):
 def test_vertex_distance_of_a_lifted_grid_is_the_lift():
     V, F = grid(6, 6)
     assert np.allclose(vertex_distance(V + [0.0, 0.0, 0.3], V, F), 0.3)
+
+
+@pytest.mark.parametrize("samples", [0, -1, 0.5, "many"])
+def test_sample_counts_below_one_are_refused_not_a_nan_rms(samples):
+    # samples=-1 or 0.5 used to give {'rms': nan, 'samples': 0}
+    V, F = grid(5, 5)
+    with pytest.raises(ValueError, match="at least 1"):
+        hausdorff(V, F, V, F, samples=samples)

@@ -55,3 +55,20 @@ def test_unknown_method_is_refused(load_mesh):
     V, F = load_mesh("mannequin_nose.obj")
     with pytest.raises(RemeshError, match="not a retriangulation method"):
         retriangulate(V, F, method="loop")
+
+
+@pytest.mark.parametrize("kwargs, words", [
+    ({"iterations": 0}, "at least 1"),
+    ({"iterations": "ten"}, "not a whole number"),
+    ({"iterations": 2.5}, "not a whole number"),
+    ({"max_surface_distance": -0.01}, "positive fraction"),
+    ({"max_surface_distance": float("nan")}, "positive fraction"),
+    ({"method": "decimate", "aggressiveness": float("nan")}, "from 0 to 10"),
+    ({"method": "decimate", "aggressiveness": 11}, "from 0 to 10"),
+])
+def test_out_of_range_remesher_options_are_refused_before_remeshing(load_mesh, kwargs, words):
+    # they used to be passed on: -1 iterations returned the source unchanged, a negative surface
+    # distance and a NaN aggressiveness were handed to the remeshers
+    V, F = load_mesh("mannequin_nose.obj")
+    with pytest.raises(RemeshError, match=words):
+        retriangulate(V, F, target_edge=0.05, **kwargs)

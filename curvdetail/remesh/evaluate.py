@@ -1,5 +1,7 @@
 """Two-sided surface distances between meshes (paper Fig. 3, evaluation)."""
 
+import operator
+
 import numpy as np
 
 from ..curvature._validate import check_mesh, face_double_areas
@@ -43,6 +45,7 @@ def hausdorff(Va, Fa, Vb, Fb, *, samples=None, engine="meshlab", seed=0):
     Raises
     ------
     MeshError   malformed meshes
+    ValueError  unknown ``engine``; ``samples`` not a whole number of at least 1
 
     Examples
     --------
@@ -57,6 +60,14 @@ def hausdorff(Va, Fa, Vb, Fb, *, samples=None, engine="meshlab", seed=0):
     Vb, Fb = check_mesh(Vb, Fb)
     if engine not in ("meshlab", "kdtree"):
         raise ValueError(f"engine={engine!r}; use 'meshlab' or 'kdtree'.")
+    if samples is not None:
+        try:
+            count = operator.index(samples)
+        except TypeError:
+            count = 0
+        if count < 1:
+            raise ValueError(f"samples={samples!r} must be a whole number of at least 1, or None for "
+                             "10 per triangle (100,000 to 1,000,000).")
     if engine == "kdtree":
         return _hausdorff_kdtree(Va, Fa, Vb, Fb, samples, seed)
     ms = pymeshlab.MeshSet()

@@ -1,5 +1,8 @@
 """Retriangulate a disk-topology patch, keeping its boundary curve (paper Fig. 3, step 1)."""
 
+import numbers
+import operator
+
 import numpy as np
 
 from ..curvature._validate import bbox_diagonal, face_double_areas
@@ -61,7 +64,9 @@ def retriangulate(V, F, *, method="isotropic", target_edge=0.01, iterations=10, 
     Raises
     ------
     MeshError, NotADiskError   the source is malformed or not a disk (says what was found)
-    RemeshError                unknown method, a target edge length that would give fewer than
+    RemeshError                unknown method, ``iterations`` below 1, a ``max_surface_distance``
+                               that is not positive, ``aggressiveness`` outside [0, 10], a
+                               target edge length that would give fewer than
                                50 or more than 5,000,000 vertices (the numbers are given), a
                                decimation asked to refine, or a remesher result that is not a disk
                                or moved the boundary
@@ -86,6 +91,19 @@ def retriangulate(V, F, *, method="isotropic", target_edge=0.01, iterations=10, 
     if not np.isfinite(target_edge) or target_edge <= 0:
         raise RemeshError(f"target_edge={target_edge!r} must be a positive fraction of the bbox diagonal "
                           "(e.g. 0.01 for 1 %).")
+    try:
+        iterations = operator.index(iterations)
+    except TypeError:
+        raise RemeshError(f"iterations={iterations!r} is not a whole number; give the isotropic remeshing "
+                          "iterations, e.g. 10.") from None
+    if iterations < 1:
+        raise RemeshError(f"iterations={iterations} must be at least 1 (e.g. 10).")
+    if max_surface_distance is not None and not _positive(max_surface_distance):
+        raise RemeshError(f"max_surface_distance={max_surface_distance!r} must be a positive fraction of the "
+                          "bbox diagonal, or None for the target edge.")
+    if not (_positive(aggressiveness) or aggressiveness == 0) or aggressiveness > 10:
+        raise RemeshError(f"aggressiveness={aggressiveness!r} must be a number from 0 to 10 "
+                          "(fast-simplification's agg; default 7).")
     h = target_edge * d
     n_est = estimated_vertices(V, F, h)
     if n_est < MIN_VERTICES or n_est > MAX_VERTICES:
@@ -99,7 +117,7 @@ def retriangulate(V, F, *, method="isotropic", target_edge=0.01, iterations=10, 
             f"{V.shape[0]:,}-vertex patch.")
     if method == "isotropic":
         surf = target_edge if max_surface_distance is None else float(max_surface_distance)
-        Vt, Ft = _isotropic(V, F, h, int(iterations), surf * d)
+        Vt, Ft = _isotropic(V, F, h, iterations, surf * d)
         try:
             Vt, Ft, loop_t = check_disk(Vt, Ft, "the isotropic remesher's result")
         except NotADiskError as exc:
@@ -107,6 +125,10 @@ def retriangulate(V, F, *, method="isotropic", target_edge=0.01, iterations=10, 
     else:
         Vt, Ft, loop_t = _decimate(V, F, h, float(aggressiveness))
     return _snap_boundary(V, loop, Vt, Ft, loop_t, d, h)
+
+
+def _positive(x):
+    return isinstance(x, numbers.Real) and bool(np.isfinite(x)) and x > 0
 
 
 def _isotropic(V, F, h, iterations, max_dist):
