@@ -10,8 +10,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-from ..curvature._validate import (boundary_edges, check_mesh, non_manifold_edges, undirected_edges,
-                                   vertex_components)
+from ..curvature._validate import boundary_edges, check_mesh, non_manifold_edges, vertex_components
 from ..curvature.boundary_editing import boundary_loop
 from ..curvature.errors import MeshError, first_indices
 
@@ -74,7 +73,9 @@ def check_disk(V, F, what="the source"):
     loops = np.unique(labels[on_boundary]).size
     if loops != 1:
         raise NotADiskError(f"{what} has {loops} boundary loops (holes); {need}.")
-    n_edges = np.unique(undirected_edges(F), axis=0).shape[0]
+    # check_mesh refused edges in more than two triangles: every interior edge is two of the 3m
+    # half-edges, every boundary edge one (np.unique over the edge rows took 1.6 s at 200k faces)
+    n_edges = (3 * F.shape[0] + B.shape[0]) // 2
     chi = n - n_edges + F.shape[0]
     if chi != 1:
         raise NotADiskError(f"{what} has one boundary loop but Euler characteristic {chi} "
