@@ -2,8 +2,9 @@
 
 import numpy as np
 
-from ..curvature import curvature_detail, mixed_voronoi_area
-from ..curvature._validate import boundary_vertices
+from ..curvature._validate import boundary_vertices, check_mesh_cotangents
+from ..curvature.cotan_laplacian import _cotan_laplacian_unchecked
+from ..curvature.mixed_voronoi_area import _mixed_voronoi_area_unchecked
 from .meshset import layer_id, mesh_arrays, set_vertex_attribute, set_vertex_quality, vertex_normals
 from .registry import PAPER, filter
 
@@ -40,8 +41,9 @@ def signed_mean_curvature(V, F, K):
 def compute_curvature_detail(ms):
     mid = layer_id(ms)
     V, F = mesh_arrays(ms, mid)
-    D = curvature_detail(V, F)                     # L V, validated once
-    A = mixed_voronoi_area(V, F)
+    V, F, cot = check_mesh_cotangents(V, F)        # validated once, cotangents reused for L
+    D = _cotan_laplacian_unchecked(V, F, cot) @ V  # = curvature_detail(V, F)
+    A = _mixed_voronoi_area_unchecked(V, F)        # = mixed_voronoi_area(V, F)
     K = D / A[:, None]                             # = mean_curvature_normal(V, F)[0], bit for bit
     H = signed_mean_curvature(V, F, K)
     set_vertex_attribute(ms, mid, NORMAL, K)
