@@ -1,0 +1,21 @@
+"""The Examples sections of the remeshing, filter and editing modules run as written (the core
+modules' doctests run in their own test files)."""
+
+import doctest
+import importlib
+
+import pytest
+
+MODULES = [
+    "curvdetail.remesh.evaluate", "curvdetail.remesh.experiment", "curvdetail.remesh.locate",
+    "curvdetail.remesh.parameterize", "curvdetail.remesh.retriangulate", "curvdetail.remesh.transfer",
+    "curvdetail.filters.dispatch", "curvdetail.filters.mlx", "curvdetail.filters.parameters",
+    "curvdetail.deformation_benchmark", "curvdetail.curvature.curvature_editor",
+    "curvdetail.curvature.curvature_coefficients", "curvdetail.curvature.boundary_editing",
+]
+
+
+@pytest.mark.parametrize("name", MODULES)
+def test_examples_run_as_written(name):
+    result = doctest.testmod(importlib.import_module(name), optionflags=doctest.ELLIPSIS)
+    assert result.attempted > 0 and result.failed == 0
