@@ -192,8 +192,7 @@ def _remesh_command(parser):
         for extra in (args.report, args.image):
             if extra is not None:
                 check_output_path(extra, args.overwrite, hint=None, error=FileNotFoundError)
-        if args.image is not None and not args.image.lower().endswith(".png"):
-            raise ValueError(f"--image {args.image}: only PNG pictures are written; end the name in .png.")
+        _check_image_and_distinct(args.image, args.output, args.report)
         V, F = read_mesh(args.input)
         stages = 4 + (args.location == "uv") + (args.image is not None)
         progress = Progress(stages, enabled=not args.quiet)
@@ -380,6 +379,7 @@ def _edit_command(parser):
         check_output_path(args.output, args.overwrite, error=MeshFileError)
         if args.image:
             check_output_path(args.image, args.overwrite, hint=None, error=FileNotFoundError)
+        _check_image_and_distinct(args.image, args.output)
         progress = Progress(3, enabled=sys.stderr.isatty())
         progress.stage("read")
         V, F = check_mesh(*read_mesh(args.mesh))
@@ -424,6 +424,19 @@ def _edit_command(parser):
 
 
 # --- entry point ----------------------------------------------------------------------------
+
+def _check_image_and_distinct(image, *others):
+    """``--image`` must end in .png (only PNG is written), and no two outputs may be one file."""
+    import os
+
+    if image is not None and not image.lower().endswith(".png"):
+        raise ValueError(f"--image {image}: only PNG pictures are written; end the name in .png.")
+    paths = [p for p in (image, *others) if p is not None]
+    real = [os.path.realpath(p) for p in paths]
+    for k, r in enumerate(real):
+        if r in real[:k]:
+            raise ValueError(f"{paths[k]} is given for two outputs; name a separate file for each.")
+
 
 def _refuse_existing(path, overwrite):
     import os

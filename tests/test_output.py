@@ -154,3 +154,20 @@ def test_selection_file_has_normal_permissions(tmp_path, umask_022):
     V, _ = grid(3, 3)
     write_selection(tmp_path / "a.sel", np.zeros(V.shape[0], dtype=int))
     assert _mode(tmp_path / "a.sel") == umask_022
+
+
+def test_remesh_refuses_one_file_for_two_outputs(tmp_path, capsys):
+    out = tmp_path / "o.ply"
+    rc = main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(out), "--report", str(out), "--quiet"])
+    assert rc == 1
+    assert "given for two outputs" in capsys.readouterr().err
+    assert os.listdir(tmp_path) == []
+
+
+def test_edit_refuses_a_picture_that_is_not_png_before_work(tmp_path, capsys):
+    rc = main(["edit", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "o.ply"),
+               "--sel", str(tmp_path / "missing.sel"), "--def", str(tmp_path / "missing.def"),
+               "--image", str(tmp_path / "e.jpg")])
+    assert rc == 1
+    assert "only PNG pictures" in capsys.readouterr().err
+    assert os.listdir(tmp_path) == []
