@@ -95,3 +95,13 @@ def test_run_experiment_returns_exact_per_vertex_distances(height_field):
     assert np.allclose(r["zero_distance"], vertex_distance(r["Z"], V, F), atol=1e-12)
     assert r["distance"].max() / r["report"]["source"]["bbox_diagonal"] == pytest.approx(
         r["report"]["error"]["vertex_max"])
+
+
+def test_unknown_backend_is_refused_before_retriangulating(height_field, monkeypatch):
+    # it used to surface only at the reconstruction, after the remeshing had been paid for
+    import curvdetail.remesh.experiment as experiment
+    from curvdetail.curvature.sparse_solver import SolverError
+
+    monkeypatch.setattr(experiment, "retriangulate", lambda *a, **k: pytest.fail("remeshed first"))
+    with pytest.raises(SolverError, match="unknown solver backend 'umfpack'"):
+        remesh_experiment(*height_field, backend="umfpack")

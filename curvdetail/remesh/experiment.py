@@ -7,6 +7,7 @@ import numpy as np
 from ..curvature._validate import bbox_diagonal
 from ..curvature.boundary_editing import boundary_loop
 from ..curvature.reconstruct import ROW_MODES, Reconstructor
+from ..curvature.sparse_solver import resolve_backend
 from ._disk import check_disk
 from .evaluate import hausdorff, vertex_distance
 from .parameterize import METHODS as PARAMETERIZATIONS
@@ -80,6 +81,7 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="c
     MeshError, NotADiskError   malformed source or not a disk (says what was found)
     RemeshError                absurd target edge (with the numbers) or a failed retriangulation
     ValueError                 unknown option values
+    SolverError                unknown or uninstalled ``backend`` (before any work)
 
     Examples
     --------
@@ -112,6 +114,7 @@ def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="cons
     _check_choice("rows", rows, ROW_MODES)
     _check_choice("location", location, LOCATIONS)
     _check_choice("parameterization", parameterization, PARAMETERIZATIONS)
+    resolve_backend(backend)               # an unknown or missing backend fails before the work
     V, F, _ = check_disk(V, F, "the source")
     d = bbox_diagonal(V)
     seconds = dict.fromkeys(STAGES, 0.0)
