@@ -226,3 +226,14 @@ def test_precompute_refuses_unconstrained_handles(plane_grid):
     inner = np.setdiff1d(np.arange(V.shape[0]), b)[:2]
     with pytest.raises(ConstraintError, match="neither position- nor detail-constrained"):
         ed.precompute_handles(inner)
+
+
+def test_unknown_backend_is_refused_before_computing_coefficients(plane_grid, monkeypatch):
+    import curvdetail.curvature.curvature_editor as module
+    from curvdetail.curvature.sparse_solver import SolverError
+
+    monkeypatch.setattr(module, "_coefficients", lambda *a, **k: pytest.fail("coefficients computed"))
+    V, F = plane_grid
+    b = boundary_vertices(F)
+    with pytest.raises(SolverError, match="unknown solver backend 'umfpack'"):
+        CurvatureEditor(V, F, b, b, backend="umfpack")

@@ -12,7 +12,7 @@ from .cotan_laplacian import _cotan_laplacian_unchecked
 from .curvature_coefficients import DEFAULT_RCOND, _coefficients, _one_ring_pairs, check_rcond
 from .errors import ConstraintError, first_indices
 from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
-from .sparse_solver import factorize
+from .sparse_solver import factorize, resolve_backend
 
 
 RELATIONS = ("one-ring", "one+two-ring")
@@ -97,7 +97,8 @@ class CurvatureEditor:
                       while ``roi`` is the whole mesh; a connected free region that touches no position (or no
                       detail) constraint
     ValueError        unknown ``rows`` or ``relations``; ``rcond`` outside (0, 1)
-    SolverError       a system could not be factored (the constraints do not determine it)
+    SolverError       unknown or uninstalled ``backend`` (before any work); a system could not
+                      be factored (the constraints do not determine it)
 
     Examples
     --------
@@ -123,6 +124,7 @@ class CurvatureEditor:
         if relations not in RELATIONS:
             raise ValueError(f"relations={relations!r}; use 'one-ring' (the paper) or 'one+two-ring'.")
         rcond = check_rcond(rcond)
+        resolve_backend(backend)           # an unknown or missing backend fails before the work
         self.relations = relations
         n = V.shape[0]
         self.n, self.V, self.F, self.rows = n, V, F, rows
