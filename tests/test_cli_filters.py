@@ -7,7 +7,6 @@ import sys
 
 import numpy as np
 import pymeshlab
-import pytest
 
 from curvdetail.cli import main
 from curvdetail.filters import list_filters
