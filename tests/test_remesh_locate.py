@@ -81,3 +81,17 @@ def test_triangle_indices_outside_v_are_refused(flat_disk):
     G[5, 1] = V.shape[0]
     with pytest.raises(MeshError, match=r"1 triangles have vertex indices outside .*first: 5"):
         locate(V[:3], V, G)
+
+
+def test_interpolate_and_spread_refuse_located_points_that_do_not_fit(flat_disk):
+    # they used to fail with numpy's IndexError from deep inside the indexing
+    V, F = flat_disk
+    face, bary, _ = locate(V[:5], V, F)
+    with pytest.raises(MeshError, match=r"spread: 1 face indices are outside"):
+        spread(np.ones(5), F, np.r_[face[:4], F.shape[0]], bary, V.shape[0])
+    with pytest.raises(MeshError, match="vertex indices outside"):
+        spread(np.ones(5), F, face, bary, 3)
+    with pytest.raises(MeshError, match="4 values for 5 located points"):
+        spread(np.ones(4), F, face, bary, V.shape[0])
+    with pytest.raises(MeshError, match="vertex indices outside"):
+        interpolate(np.ones(3), F, face, bary)

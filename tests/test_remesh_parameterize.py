@@ -47,3 +47,13 @@ def test_flipped_triangles_are_detected():
     UV = np.array([[0, 0], [1, 0], [0, 1], [1, 1], [2, 2]], float)
     F = np.array([[0, 1, 2], [1, 3, 2], [3, 4, 1]])   # the last is clockwise
     assert flipped_triangles(UV, F).tolist() == [2]
+
+
+def test_flipped_triangles_refuses_uv_that_does_not_fit_f():
+    from curvdetail.curvature.errors import MeshError
+
+    V, F = disk(n_rings=4)
+    with pytest.raises(MeshError, match="one UV row per vertex"):
+        flipped_triangles(V[:3, :2], F)
+    with pytest.raises(MeshError, match=r"UV has shape \(.*, 3\)"):
+        flipped_triangles(V, F)

@@ -231,9 +231,28 @@ def _closest_barycentric(P, T):
     return bary, np.linalg.norm(X - P, axis=-1)
 
 
+def _located(F, face, bary, n, what):
+    """``(F, face, bary)`` as arrays, or MeshError if they do not fit each other and ``n`` vertices."""
+    F = np.asarray(F)
+    face = np.asarray(face)
+    bary = np.asarray(bary, dtype=np.float64)
+    if F.ndim != 2 or F.shape[1] != 3 or face.ndim != 1 or bary.shape != (face.shape[0], 3):
+        raise MeshError(f"{what}: F {F.shape}, face {face.shape} and bary {bary.shape} must be (m, 3), "
+                        "(k,) and (k, 3), as locate() returns them.")
+    bad = np.flatnonzero((face < 0) | (face >= F.shape[0]))
+    if bad.size:
+        raise MeshError(f"{what}: {bad.size} face indices are outside [0, {F.shape[0]}) (first: "
+                        f"{first_indices(bad)}); pass the faces locate() found in this F.")
+    if F.size and (F.min() < 0 or F.max() >= n):
+        raise MeshError(f"{what}: F has vertex indices outside [0, {n}); pass the F the points were "
+                        "located in, with one value per vertex.")
+    return F, face, bary
+
+
 def interpolate(values, F, face, bary):
     """Values at located points: ``sum_k bary_k values[F[face, k]]`` (values (n,) or (n, c))."""
     vals = np.asarray(values)
+    F, face, bary = _located(F, face, bary, vals.shape[0] if vals.ndim else 0, "interpolate")
     corner = vals[F[face]]                                   # (k, 3) or (k, 3, c)
     if corner.ndim == 2:
         return (bary * corner).sum(1)
@@ -244,7 +263,12 @@ def spread(values, F, face, bary, n):
     """Adjoint of :func:`interpolate`: each point's value split over the 3 corners of its
     triangle by barycentric weights and summed per vertex, shape (n, c). The sum is conserved
     exactly (up to rounding), since the weights of a point sum to 1."""
-    vals = np.asarray(values, dtype=np.float64).reshape(face.shape[0], -1)
+    F, face, bary = _located(F, face, bary, int(n), "spread")
+    vals = np.asarray(values, dtype=np.float64)
+    if vals.shape[:1] != face.shape:
+        raise MeshError(f"spread: {vals.shape[0] if vals.ndim else 0} values for {face.shape[0]} located "
+                        "points; give one value (or row) per point.")
+    vals = vals.reshape(face.shape[0], -1)
     rows = F[face].ravel()
     W = sp.csr_matrix((bary.ravel(), (rows, np.repeat(np.arange(face.shape[0]), 3))), shape=(n, face.shape[0]))
     return W @ vals
