@@ -40,3 +40,14 @@ def test_sample_counts_below_one_are_refused_not_a_nan_rms(samples):
     V, F = grid(5, 5)
     with pytest.raises(ValueError, match="at least 1"):
         hausdorff(V, F, V, F, samples=samples)
+
+
+@pytest.mark.parametrize("far", [False, True])
+def test_vertex_distance_refuses_nan_points_naming_them(far):
+    from curvdetail.curvature.errors import MeshError
+
+    V, F = grid(5, 5)
+    P = V[:3].copy()
+    P[1, 2] = np.inf
+    with pytest.raises(MeshError, match=r"points: 1 rows are NaN or infinite \(first: 1\)"):
+        vertex_distance(P, V, F, far=far)

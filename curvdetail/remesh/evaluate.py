@@ -5,7 +5,7 @@ import operator
 import numpy as np
 
 from ..curvature._validate import check_mesh, face_double_areas
-from .locate import locate
+from .locate import check_points_and_mesh, locate
 
 #: Face samples per direction: ``SAMPLES_PER_FACE`` times the sampled mesh's triangle count,
 #: clamped to [MIN_SAMPLES, MAX_SAMPLES].
@@ -96,12 +96,10 @@ def vertex_distance(V, Vs, Fs, *, far=False):
     ``far=True`` uses the kd-tree candidates of :func:`hausdorff`'s ``"kdtree"`` engine (fast for
     points far from the surface, overestimating by at most ~``r^2 / 2d``) instead of the exact
     :func:`locate` (whose grid search slows down with the distance)."""
-    P = np.asarray(V, dtype=np.float64)
     if far:
-        Vs = np.asarray(Vs, dtype=np.float64)
-        Fs = np.asarray(Fs, dtype=np.int64)
+        P, Vs, Fs = check_points_and_mesh(V, Vs, Fs)
         return _one_sided_kdtree(P, Vs, Fs, Vs[Fs].mean(axis=1), np.arange(Fs.shape[0]))
-    return locate(P, Vs, Fs)[2]
+    return locate(V, Vs, Fs)[2]
 
 
 def _area_samples(V, F, n, rng):

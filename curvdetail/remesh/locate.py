@@ -49,23 +49,7 @@ def locate(points, V, F, *, engine="auto", candidates=8, chunk=20_000):
     >>> face.tolist(), np.round(bary, 3).tolist()
     ([0, 1], [[0.5, 0.25, 0.25], [0.2, 0.7, 0.1]])
     """
-    P = np.asarray(points, dtype=np.float64)
-    V = np.asarray(V, dtype=np.float64)
-    F = np.asarray(F, dtype=np.int64)
-    if P.ndim != 2 or V.ndim != 2 or P.shape[1] != V.shape[1] or V.shape[1] not in (2, 3):
-        raise MeshError(f"points {P.shape} and V {V.shape} must both be (k, 2) or both (k, 3).")
-    if F.ndim != 2 or F.shape[1] != 3 or F.shape[0] == 0:
-        raise MeshError(f"F has shape {F.shape}; pass a non-empty (m, 3) triangle array.")
-    # pymeshlab's grid and matplotlib's trapezoid map crash (segmentation fault) on NaN input
-    for name, X in (("points", P), ("V", V)):
-        bad = np.flatnonzero(~np.isfinite(X).all(axis=1))
-        if bad.size:
-            raise MeshError(f"{name}: {bad.size} rows are NaN or infinite (first: {first_indices(bad)}); "
-                            "pass finite coordinates.")
-    bad = np.flatnonzero(((F < 0) | (F >= V.shape[0])).any(axis=1))
-    if bad.size:
-        raise MeshError(f"F: {bad.size} triangles have vertex indices outside [0, {V.shape[0]}) "
-                        f"(first: {first_indices(bad)}); indices are 0-based into V.")
+    P, V, F = check_points_and_mesh(points, V, F)
     if engine not in ("auto", "numpy"):
         raise ValueError(f"engine={engine!r}; use 'auto' or 'numpy'.")
     if P.shape[0] == 0:
@@ -84,6 +68,29 @@ def locate(points, V, F, *, engine="auto", candidates=8, chunk=20_000):
         f2, b2, d2 = _locate_kdtree(P[bad], V, F, candidates, chunk)
         face[bad], bary[bad], dist[bad] = f2, b2, d2
     return face, bary, dist
+
+
+def check_points_and_mesh(points, V, F):
+    """``(P, V, F)`` as float64 / float64 / int64 arrays, or MeshError: mismatched dimensions,
+    empty ``F``, NaN or infinite coordinates, triangle indices outside ``V``."""
+    P = np.asarray(points, dtype=np.float64)
+    V = np.asarray(V, dtype=np.float64)
+    F = np.asarray(F, dtype=np.int64)
+    if P.ndim != 2 or V.ndim != 2 or P.shape[1] != V.shape[1] or V.shape[1] not in (2, 3):
+        raise MeshError(f"points {P.shape} and V {V.shape} must both be (k, 2) or both (k, 3).")
+    if F.ndim != 2 or F.shape[1] != 3 or F.shape[0] == 0:
+        raise MeshError(f"F has shape {F.shape}; pass a non-empty (m, 3) triangle array.")
+    # pymeshlab's grid and matplotlib's trapezoid map crash (segmentation fault) on NaN input
+    for name, X in (("points", P), ("V", V)):
+        bad = np.flatnonzero(~np.isfinite(X).all(axis=1))
+        if bad.size:
+            raise MeshError(f"{name}: {bad.size} rows are NaN or infinite (first: {first_indices(bad)}); "
+                            "pass finite coordinates.")
+    bad = np.flatnonzero(((F < 0) | (F >= V.shape[0])).any(axis=1))
+    if bad.size:
+        raise MeshError(f"F: {bad.size} triangles have vertex indices outside [0, {V.shape[0]}) "
+                        f"(first: {first_indices(bad)}); indices are 0-based into V.")
+    return P, V, F
 
 
 def _trifinder(P, V, F):
