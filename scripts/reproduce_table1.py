@@ -21,11 +21,9 @@ import sys
 import time
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
 from curvdetail import CurvatureEditor, boundary_vertices, read_mesh
-from curvdetail.curvature._validate import check_mesh
+from curvdetail.curvature._validate import bbox_diagonal, check_mesh, vertex_components
 from curvdetail.deformation_benchmark import render_panels
 
 MESHES = os.environ.get("CURVDETAIL_MESHES", os.path.join(os.path.dirname(__file__), "..", "..",
@@ -38,8 +36,7 @@ PAPER = [("Cat", 135, 257, 0.5), ("Nose2", 383, 732, 2.6), ("Nose1", 601, 1135, 
 
 def _largest_piece(V, F):
     n = V.shape[0]
-    A = sp.coo_matrix((np.ones(3 * len(F)), (F.ravel(), np.roll(F, 1, axis=1).ravel())), shape=(n, n))
-    _, labels = connected_components(A, directed=False)
+    labels, _ = vertex_components(F, n)
     used = np.zeros(n, dtype=bool)
     used[F.ravel()] = True
     big = np.bincount(labels[used]).argmax()
@@ -120,7 +117,7 @@ def edit_case(V, F):
     fn = np.cross(e1, e2)
     normal = fn[(F == seed).any(axis=1)].sum(0)
     normal /= np.linalg.norm(normal)
-    lift = 0.1 * np.linalg.norm(np.ptp(V, axis=0)) * normal
+    lift = 0.1 * bbox_diagonal(V) * normal
     pc = np.concatenate([b, ring])
     positions = np.vstack([V[b], V[ring] + lift])
     return pc, positions, pc
@@ -146,7 +143,7 @@ def time_edit(V, F, repeat):
     med["total_min"] = float(min(r["total"] for r in rows))    # best run: least disturbed by load
     med["rank_deficient"] = ed.rank_deficient
     med["detail_islands"] = ed.detail_islands
-    med["max_move_fraction"] = float(np.linalg.norm(X - V, axis=1).max() / np.linalg.norm(np.ptp(V, axis=0)))
+    med["max_move_fraction"] = float(np.linalg.norm(X - V, axis=1).max() / bbox_diagonal(V))
     return med, X, Dsolved
 
 

@@ -4,7 +4,7 @@ import operator
 
 import numpy as np
 
-from ..curvature._validate import check_mesh, face_double_areas
+from ..curvature._validate import bbox_diagonal, check_mesh, face_double_areas
 from .locate import check_points_and_mesh, locate
 
 #: Face samples per direction: ``SAMPLES_PER_FACE`` times the sampled mesh's triangle count,
@@ -73,7 +73,7 @@ def hausdorff(Va, Fa, Vb, Fb, *, samples=None, engine="meshlab", seed=0):
     ms = pymeshlab.MeshSet()
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=Va, face_matrix=Fa.astype(np.int32)))
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=Vb, face_matrix=Fb.astype(np.int32)))
-    diag = float(np.linalg.norm(np.vstack([Va, Vb]).max(0) - np.vstack([Va, Vb]).min(0)))
+    diag = bbox_diagonal(np.vstack([Va, Vb]))
     out = []
     for sampled, target, m in ((0, 1, Fa.shape[0]), (1, 0, Fb.shape[0])):
         n = int(samples) if samples else int(np.clip(SAMPLES_PER_FACE * m, MIN_SAMPLES, MAX_SAMPLES))

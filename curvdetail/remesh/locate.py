@@ -4,6 +4,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
+from ..curvature._validate import bbox_diagonal
 from ..curvature.errors import MeshError, first_indices
 
 
@@ -133,7 +134,7 @@ def _locate_kdtree(P, V, F, candidates, chunk):
     T = V[F]
     centroid = T.mean(axis=1)
     radius = np.linalg.norm(T - centroid[:, None, :], axis=-1).max(axis=1)
-    eps = 1e-12 * float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
+    eps = 1e-12 * bbox_diagonal(V)
     tree_c = cKDTree(centroid)
     tree_v = cKDTree(V)
     ring = _padded_rings(F, V.shape[0])
