@@ -351,6 +351,8 @@ def main(argv=None):
     parser.add_argument("--mem-limit-gb", type=float, default=16.0,
                         help="stop a case whose resident memory passes this (default 16; the "
                              "machine is shared)")
+    parser.add_argument("--force", action="store_true",
+                        help="also run the cases left out by default (naive spsolve and CHOLMOD at 1M)")
     parser.add_argument("--case", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
 
@@ -382,7 +384,7 @@ def main(argv=None):
                     results = [r for r in results if any(r[k] != v for k, v in case.items())]
                     if method not in available:
                         r = dict(case, skipped=f"{method} is not installed")
-                    elif (method, size) in SKIP and args.methods is None:
+                    elif (method, size) in SKIP and not args.force:
                         r = dict(case, skipped=SKIP[(method, size)])
                     else:
                         r = run_in_subprocess(case, args.timeout, args.mem_limit_gb)
