@@ -44,6 +44,15 @@ def test_rows_all_refinement_reaches_the_square_systems_accuracy(load_mesh):
     rec.refinement_steps = 0
     plain = np.abs(rec.solve(D, V[fixed]) - V).max() / bbox_diagonal(V)
     assert refined < 1e-13 < plain
+    unrefined = Reconstructor(V, F, fixed, rows="all", backend="splu", refinement_steps=0)
+    assert np.array_equal(unrefined.solve(D, V[fixed]), rec.solve(D, V[fixed]))
+
+
+@pytest.mark.parametrize("steps", [-1, 1.5, True, "1"])
+def test_refinement_steps_must_be_a_whole_number(load_mesh, steps):
+    V, F, fixed = _problem(load_mesh, "spot.obj")
+    with pytest.raises(ValueError, match="refinement_steps"):
+        Reconstructor(V, F, fixed, refinement_steps=steps)
 
 
 @pytest.mark.parametrize("rows", ROWS)

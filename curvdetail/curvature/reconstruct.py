@@ -36,6 +36,9 @@ class Reconstructor:
     fixed : (k,) int array or (n,) bool mask   constrained vertices
     rows : {"all", "free"}       which residual rows enter the energy
     backend : str                sparse solver: "auto", "pardiso", "cholmod" or "splu"
+    refinement_steps : int, optional   refinement steps of ``rows="all"`` solves (default: the
+                                 class attribute, 1). 0 halves the back-substitution time and
+                                 gives the plain normal-equation solution (~cond^2 eps).
 
     Attributes
     ----------
@@ -67,10 +70,16 @@ class Reconstructor:
     #: back-substitution); 0 gives the plain normal-equation solution
     refinement_steps = 1
 
-    def __init__(self, V_ref, F, fixed, *, rows="all", backend="auto"):
+    def __init__(self, V_ref, F, fixed, *, rows="all", backend="auto", refinement_steps=None):
         V_ref, F, cot = check_mesh_cotangents(V_ref, F)
         if rows not in ROW_MODES:
             raise ValueError(f"rows={rows!r} is not a row mode; use 'all' (the paper's E_Q) or 'free'.")
+        if refinement_steps is not None:
+            if isinstance(refinement_steps, bool) or not isinstance(refinement_steps, (int, np.integer)) \
+                    or refinement_steps < 0:
+                raise ValueError(f"refinement_steps={refinement_steps!r} must be a whole number >= 0 "
+                                 "(1, the default, gives solver precision; 0 skips the refinement).")
+            self.refinement_steps = int(refinement_steps)
         n = V_ref.shape[0]
         self.n, self.rows = n, rows
         self.fixed = as_index_set(fixed, n, "fixed")

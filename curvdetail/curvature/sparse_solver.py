@@ -178,8 +178,13 @@ class Factorization:
             raise SolverError(f"PARDISO could not factor the matrix ({exc}); it may be singular.") from None
 
         def solve(b):
+            # One call per column: MKL's multi-right-hand-side solve took 0.09-0.16 s for three
+            # columns at 100k unknowns (2 cores) against 0.03 s for three single-column calls.
             solver.set_phase(33)
-            return solver._call_pardiso(M, np.asfortranarray(b, dtype=np.float64))
+            if b.ndim == 1:
+                return solver._call_pardiso(M, np.ascontiguousarray(b, dtype=np.float64))
+            return np.column_stack([solver._call_pardiso(M, np.ascontiguousarray(b[:, j], dtype=np.float64))
+                                    for j in range(b.shape[1])]).reshape(b.shape)
 
         self._solve = solve
 
