@@ -6,10 +6,10 @@ unless ``overwrite=True``.
 """
 
 import os
-import tempfile
 
 import numpy as np
 
+from ._output import atomic_output, check_output_path
 from .curvature._validate import as_faces, as_vertices
 from .curvature.errors import MeshError
 
@@ -99,13 +99,11 @@ def write_mesh(path, V, F, *, quality=None, overwrite=False):
     >>> write_mesh(path, V, F)
     Traceback (most recent call last):
     ...
-    FileExistsError: ... exists; pass overwrite=True (or --overwrite) to replace it.
+    FileExistsError: ... exists; pass --overwrite (overwrite=True) to replace it.
     """
     import pymeshlab
 
-    path = os.fspath(path)
-    if os.path.exists(path) and not overwrite:
-        raise FileExistsError(f"{path} exists; pass overwrite=True (or --overwrite) to replace it.")
+    check_output_path(path, overwrite, error=MeshFileError)
     V = as_vertices(V)
     F = as_faces(F, V.shape[0])
     kwargs = {}
@@ -122,8 +120,9 @@ def save_mesh(path, mesh, *, overwrite=False, **save_options):
     """Atomically save a ``pymeshlab.Mesh`` (with its quality, colours and custom attributes where
     the format holds them). Used by :func:`write_mesh`, the filters and the CLI.
 
-    The mesh is written to a temporary file in the destination folder and renamed over ``path``
-    only when the write succeeded; a failed write removes the temporary file.
+    The mesh is written to a temporary file in the destination folder (with ``path``'s
+    extension) and renamed over ``path`` only when the write succeeded, with the permissions the
+    umask gives a new file; a failed write removes the temporary file.
 
     Parameters
     ----------
@@ -148,29 +147,14 @@ def save_mesh(path, mesh, *, overwrite=False, **save_options):
     >>> os.path.exists(path)
     True
     """
-    path = os.fspath(path)
-    if os.path.exists(path) and not overwrite:
-        raise FileExistsError(f"{path} exists; pass overwrite=True (or --overwrite) to replace it.")
-    folder = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(folder):
-        raise MeshFileError(f"cannot write {path!r}: folder {folder!r} does not exist.")
-    ext = os.path.splitext(path)[1].lower()
-    if not ext:
-        raise MeshFileError(f"cannot write {path!r}: no file extension to choose the format from "
-                            "(use .ply, .obj, .off, .stl, ...).")
-    ms = _meshset()
-    ms.add_mesh(mesh)
-    fd, tmp = tempfile.mkstemp(prefix=".curvdetail-", suffix=ext, dir=folder)
-    os.close(fd)
-    try:
-        options = dict(save_options)
-        if ext == ".ply" and mesh.has_vertex_scalar():
-            options.setdefault("save_vertex_quality", True)
+    options = dict(save_options)
+    if os.path.splitext(os.fspath(path))[1].lower() == ".ply" and mesh.has_vertex_scalar():
+        options.setdefault("save_vertex_quality", True)
+    # the temporary file keeps path's extension: pymeshlab picks the format from it
+    with atomic_output(path, overwrite=overwrite, error=MeshFileError) as tmp:
+        ms = _meshset()
+        ms.add_mesh(mesh)
         try:
             ms.save_current_mesh(tmp, **options)
         except Exception as exc:
-            raise MeshFileError(f"could not write {path!r}: {exc}") from None
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.remove(tmp)
+            raise MeshFileError(f"could not write {os.fspath(path)!r}: {exc}") from None

@@ -1,6 +1,7 @@
 """read_mesh / write_mesh / save_mesh: round trips per format, overwrite refusal, atomic writes."""
 
 import os
+import stat
 
 import numpy as np
 import pytest
@@ -57,7 +58,7 @@ def test_existing_file_is_not_overwritten(tmp_path, nose):
     V, F = nose
     path = tmp_path / "keep.obj"
     path.write_text("precious")
-    with pytest.raises(FileExistsError, match="keep.obj exists; pass overwrite=True"):
+    with pytest.raises(FileExistsError, match=r"keep.obj exists; pass --overwrite \(overwrite=True\)"):
         write_mesh(path, V, F)
     assert path.read_text() == "precious"
 
@@ -68,6 +69,48 @@ def test_overwrite_replaces_the_file(tmp_path, nose):
     path.write_text("old")
     write_mesh(path, V, F, overwrite=True)
     assert read_mesh(path)[0].shape == V.shape
+
+
+@pytest.mark.parametrize("umask", [0o022, 0o027, 0o002], ids=["022", "027", "002"])
+def test_written_file_has_the_umask_permissions_not_0600(tmp_path, nose, umask):
+    # tempfile.mkstemp alone creates 0600; a normal new file gets 0666 & ~umask
+    V, F = nose
+    old = os.umask(umask)
+    try:
+        write_mesh(tmp_path / "mesh.ply", V, F)
+    finally:
+        os.umask(old)
+    assert stat.S_IMODE(os.stat(tmp_path / "mesh.ply").st_mode) == 0o666 & ~umask
+
+
+def test_overwritten_file_gets_the_umask_permissions(tmp_path, nose):
+    V, F = nose
+    path = tmp_path / "mesh.off"
+    path.write_text("old")
+    os.chmod(path, 0o600)
+    old = os.umask(0o022)
+    try:
+        write_mesh(path, V, F, overwrite=True)
+    finally:
+        os.umask(old)
+    assert stat.S_IMODE(os.stat(path).st_mode) == 0o644
+
+
+def test_temporary_file_keeps_the_extension_and_sits_beside_the_output(tmp_path, nose, monkeypatch):
+    # pymeshlab picks the format from the extension, so the temporary name must end in it
+    import pymeshlab
+
+    seen = []
+    real = pymeshlab.MeshSet.save_current_mesh
+
+    def spy(self, path, **kwargs):
+        seen.append(path)
+        return real(self, path, **kwargs)
+
+    monkeypatch.setattr(pymeshlab.MeshSet, "save_current_mesh", spy)
+    write_mesh(tmp_path / "mesh.obj", *nose)
+    assert len(seen) == 1 and seen[0].endswith(".obj") and os.path.dirname(seen[0]) == str(tmp_path)
+    assert os.listdir(tmp_path) == ["mesh.obj"]
 
 
 def test_failed_write_leaves_neither_output_nor_temporary_file(tmp_path, nose, monkeypatch):
@@ -148,8 +191,23 @@ def test_save_mesh_refuses_to_overwrite(tmp_path):
     path = tmp_path / "m.ply"
     path.write_text("x")
     mesh = pymeshlab.Mesh(vertex_matrix=np.eye(3), face_matrix=np.array([[0, 1, 2]], dtype=np.int32))
-    with pytest.raises(FileExistsError):
+    with pytest.raises(FileExistsError, match="m.ply exists; pass --overwrite"):
         save_mesh(path, mesh)
+    assert path.read_text() == "x" and os.listdir(tmp_path) == ["m.ply"]
+
+
+def test_failed_overwrite_keeps_the_old_file(tmp_path, nose, monkeypatch):
+    import pymeshlab
+
+    def broken(self, path, **kwargs):
+        raise RuntimeError("disk full")
+
+    path = tmp_path / "keep.ply"
+    path.write_text("old")
+    monkeypatch.setattr(pymeshlab.MeshSet, "save_current_mesh", broken)
+    with pytest.raises(MeshFileError, match="could not write .*keep.ply.*disk full"):
+        write_mesh(path, *nose, overwrite=True)
+    assert path.read_text() == "old" and os.listdir(tmp_path) == ["keep.ply"]
 
 
 def test_docstring_examples_run():
