@@ -60,7 +60,9 @@ def add_input_output_arguments(parser, input_help, output_help):
 
 
 def resolve_input_output(args):
-    """Fill ``args.input`` / ``args.output`` from ``--example`` and check both are given."""
+    """Fill ``args.input`` / ``args.output`` from ``--example``, check both are given and that
+    OUTPUT can be written (:func:`curvdetail._output.check_output_path`: existing file, folder,
+    extension), before any work."""
     if args.example:
         if args.output is not None:
             raise ValueError("with --example give only OUTPUT, not INPUT and OUTPUT.")
@@ -69,7 +71,10 @@ def resolve_input_output(args):
         args.input, args.output = example_path(), args.input
     if args.input is None or args.output is None:
         raise ValueError("missing INPUT or OUTPUT (or use --example OUTPUT).")
-    _refuse_existing(args.output, args.overwrite)
+    from ._output import check_output_path
+    from .io import MeshFileError
+
+    check_output_path(args.output, args.overwrite, error=MeshFileError)
 
 
 # --- reconstruct / minimal (core issue) -----------------------------------------------------
@@ -184,11 +189,10 @@ def _remesh_command(parser):
         from .io import MeshFileError, read_mesh, write_mesh
         from .remesh.experiment import run_experiment
 
-        resolve_input_output(args)
+        resolve_input_output(args)      # checks OUTPUT
         if not (args.target_edge > 0 and args.target_edge < float("inf")):
             raise ValueError(f"--target-edge {args.target_edge:g}: give a positive percentage of the bbox "
                              "diagonal, e.g. 1 for 1 %.")
-        check_output_path(args.output, args.overwrite, error=MeshFileError)
         for extra in (args.report, args.image):
             if extra is not None:
                 check_output_path(extra, args.overwrite, hint=None, error=FileNotFoundError)
@@ -436,13 +440,6 @@ def _check_image_and_distinct(image, *others):
     for k, r in enumerate(real):
         if r in real[:k]:
             raise ValueError(f"{paths[k]} is given for two outputs; name a separate file for each.")
-
-
-def _refuse_existing(path, overwrite):
-    import os
-
-    if os.path.exists(path) and not overwrite:
-        raise FileExistsError(f"{path} exists; pass --overwrite to replace it.")
 
 
 def build_parser():

@@ -133,3 +133,34 @@ def test_unknown_backend_fails_cleanly(tmp_path, capsys):
 def test_example_with_two_paths_is_refused(tmp_path, capsys):
     assert main(["reconstruct", "--example", str(tmp_path / "a.ply"), str(tmp_path / "b.ply")]) == 1
     assert "with --example give only OUTPUT" in _error_line(capsys)
+
+
+def _existing_output_message(tmp_path, capsys, argv):
+    out = tmp_path / "keep.ply"
+    out.write_text("precious")
+    assert main(argv(str(out))) == 1
+    assert out.read_text() == "precious"
+    return _error_line(capsys).replace(str(out), "OUTPUT")
+
+
+def test_every_command_refuses_an_existing_output_with_one_message(tmp_path, capsys):
+    commands = {
+        "reconstruct": lambda out: ["reconstruct", NOSE, out],
+        "minimal": lambda out: ["minimal", NOSE, out],
+        "remesh": lambda out: ["remesh", NOSE, out, "--quiet"],
+        "apply": lambda out: ["apply", "compute_curvature_detail", NOSE, out],
+        "edit": lambda out: ["edit", NOSE, out, "--sel", "absent.sel", "--def", "absent.def"],
+    }
+    messages = {name: _existing_output_message(tmp_path, capsys, argv) for name, argv in commands.items()}
+    assert set(messages.values()) == {
+        "curvdetail: error: OUTPUT exists; pass --overwrite (overwrite=True) to replace it."}, messages
+
+
+@pytest.mark.parametrize("command", ["reconstruct", "minimal"])
+@pytest.mark.parametrize("output, problem", [("nose", "no file extension"),
+                                              ("nowhere/nose.ply", "does not exist")])
+def test_unwritable_output_is_refused_before_reading_the_input(tmp_path, capsys, command, output, problem):
+    # the input does not exist either: the output is checked first, before any work
+    assert main([command, str(tmp_path / "absent.obj"), str(tmp_path / output)]) == 1
+    assert problem in _error_line(capsys)
+    assert os.listdir(tmp_path) == []
