@@ -178,6 +178,87 @@ def test_reading_a_point_cloud_is_refused(tmp_path):
         read_mesh(path)
 
 
+# A unit square as two triangles, with a non-finite vertex 1 that no face uses: pymeshlab's loader
+# drops vertex 1 and renumbers the faces, so without the count check read_mesh would return 4
+# vertices, V[1] being the file's vertex 2.
+_SQUARE = [(0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (1.0, 1.0, 0.0)]
+_SQUARE_FACES = [(0, 1, 2), (1, 3, 2)]
+
+
+def _with_bad_vertex(token):
+    return _SQUARE[:1] + [(token, "0", "0")] + _SQUARE[1:], [[i + (i > 0) for i in f] for f in _SQUARE_FACES]
+
+
+@pytest.mark.parametrize("token", ["nan", "inf", "-inf", "1e400"])
+def test_obj_with_a_non_finite_vertex_is_refused_with_both_counts(tmp_path, token):
+    V, F = _with_bad_vertex(token)
+    path = tmp_path / "bad.obj"
+    path.write_text("".join(f"v {x} {y} {z}\n" for x, y, z in V) +
+                    "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in F))
+    with pytest.raises(MeshFileError, match=r"bad.obj' has 5 vertices but pymeshlab loaded 4: 1 "
+                                            r"were dropped, most likely for non-finite .*Fix or remove"):
+        read_mesh(path)
+
+
+def test_off_with_a_nan_vertex_is_refused(tmp_path):
+    V, F = _with_bad_vertex("nan")
+    path = tmp_path / "bad.off"
+    path.write_text("OFF\n# a comment\n5 2 0\n" + "".join(f"{x} {y} {z}\n" for x, y, z in V) +
+                    "".join(f"3 {a} {b} {c}\n" for a, b, c in F))
+    with pytest.raises(MeshFileError, match=r"has 5 vertices but pymeshlab loaded 4.*non-finite"):
+        read_mesh(path)
+
+
+@pytest.mark.parametrize("fmt", ["ascii", "binary_little_endian"])
+def test_ply_with_a_nan_vertex_is_refused(tmp_path, fmt):
+    V, F = _with_bad_vertex("nan")
+    V = np.array(V, dtype=float)
+    header = (f"ply\nformat {fmt} 1.0\nelement vertex 5\nproperty double x\nproperty double y\n"
+              "property double z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n")
+    if fmt == "ascii":
+        body = ("".join(f"{x} {y} {z}\n" for x, y, z in V) +
+                "".join(f"3 {a} {b} {c}\n" for a, b, c in F)).encode()
+    else:
+        faces = np.zeros(2, dtype=[("n", "u1"), ("i", "<i4", 3)])
+        faces["n"], faces["i"] = 3, F
+        body = V.astype("<f8").tobytes() + faces.tobytes()
+    path = tmp_path / "bad.ply"
+    path.write_bytes(header.encode() + body)
+    with pytest.raises(MeshFileError, match=r"has 5 vertices but pymeshlab loaded 4"):
+        read_mesh(path)
+
+
+def test_obj_with_unreferenced_vertices_and_texture_lines_is_read_in_file_order(tmp_path):
+    # pymeshlab merges nothing and keeps unreferenced vertices: vt/vn/vp, comments, groups and
+    # polygon faces with texture and normal indices do not change the vertex count
+    path = tmp_path / "ok.obj"
+    path.write_text("# square plus an unreferenced vertex\nmtllib none.mtl\no square\n"
+                    "v 0 0 0\nv 5 5 5\nv 1 0 0\r\nv\t0 1 0\nv 1 1 0 0.5 0.5 0.5\n"
+                    "vt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\nvp 0.5\ng top\n"
+                    "f 1/1/1 3/2/1 5/3/1 4/3/1\n")
+    V, F = read_mesh(path)
+    assert np.array_equal(V, [[0, 0, 0], [5, 5, 5], [1, 0, 0], [0, 1, 0], [1, 1, 0]])
+    assert F.shape == (2, 3) and 1 not in F
+
+
+def test_off_with_counts_on_the_header_line_and_colours_is_read(tmp_path):
+    path = tmp_path / "ok.off"
+    path.write_text("COFF 4 2 0\n" + "".join(f"{x} {y} {z} 255 0 0 255\n" for x, y, z in _SQUARE) +
+                    "".join(f"3 {a} {b} {c}\n" for a, b, c in _SQUARE_FACES))
+    V, F = read_mesh(path)
+    assert np.array_equal(V, _SQUARE) and np.array_equal(F, _SQUARE_FACES)
+
+
+@pytest.mark.parametrize("chunk", [1, 2, 3, 5, 64])
+def test_obj_vertex_lines_are_counted_across_chunk_boundaries(tmp_path, monkeypatch, chunk):
+    import curvdetail.io as io
+
+    path = tmp_path / "m.obj"
+    path.write_bytes(b"v 0 0 0\nvt 1 1\nv\t1 0 0\r\n  v 9 9 9\nvn 0 0 1\nv 0 1 0\nf 1 2 3\nv 1 1 1")
+    monkeypatch.setattr(io, "_CHUNK", chunk)
+    assert io._obj_vertex_count(str(path)) == 4       # the indented line is not a vertex to pymeshlab
+
+
 def test_reads_the_shipped_meshes_in_file_order():
     V, F = read_mesh(data_path("terrainA_1k.obj"))
     assert V.shape == (1089, 3) and F.shape == (2048, 3)
