@@ -74,3 +74,17 @@ def test_missing_and_unreadable_inputs_are_named(tmp_path):
     bad.write_text("not a ply")
     with pytest.raises(MeshFileError, match="could not read"):
         load_meshset(bad)
+
+
+def test_file_with_a_nan_vertex_is_refused_not_renumbered(tmp_path, capsys):
+    # pymeshlab's loader drops the NaN vertex 1 and renumbers the faces; load_meshset (and so
+    # `curvdetail apply`) refuses the file as read_mesh does
+    from curvdetail.cli import main
+
+    path = tmp_path / "bad.obj"
+    path.write_text("v 0 0 0\nv nan 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 3 4\nf 3 5 4\n")
+    with pytest.raises(MeshFileError, match=r"has 5 vertices but pymeshlab loaded 4.*non-finite"):
+        load_meshset(NOSE, path)
+    assert main(["apply", "compute_curvature_detail", str(path), str(tmp_path / "out.ply")]) == 1
+    assert "has 5 vertices but pymeshlab loaded 4" in capsys.readouterr().err
+    assert sorted(os.listdir(tmp_path)) == ["bad.obj"]

@@ -15,7 +15,7 @@ import os
 import numpy as np
 
 from .. import _output
-from ..io import MeshFileError
+from ..io import MeshFileError, _check_vertex_count
 from .meshset import WRITTEN_ATTRIBUTES, set_vertex_attribute, vertex_attribute
 from .ply_attributes import read_ply_vertex_attributes
 
@@ -28,7 +28,9 @@ def load_meshset(path, *more):
     ``load_new_mesh``). The custom per-vertex attributes of PLY files (pymeshlab's loader drops
     them) are added back.
 
-    Raises FileNotFoundError if a file does not exist, MeshFileError if pymeshlab cannot read it."""
+    Raises FileNotFoundError if a file does not exist, MeshFileError if pymeshlab cannot read it
+    or dropped vertices of an OBJ, OFF or PLY file (NaN or infinite coordinates; see
+    :func:`curvdetail.read_mesh`)."""
     import pymeshlab
 
     paths = [os.fspath(p) for p in (path, *more)]
@@ -43,6 +45,7 @@ def load_meshset(path, *more):
             raise MeshFileError(f"could not read {p!r}: {' '.join(str(exc).split())}. Use a format "
                                 "MeshLab reads (.obj, .off, .ply, .stl, ...).") from None
         n = ms.current_mesh().vertex_number()
+        _check_vertex_count(p, n)        # pymeshlab drops NaN/inf vertices without a word
         for name, values in read_ply_vertex_attributes(p).items():
             if values.shape in ((n,), (n, 3)) and np.all(np.isfinite(values)):
                 set_vertex_attribute(ms, ms.current_mesh_id(), name, values)
