@@ -107,6 +107,19 @@ def test_non_manifold_edge_is_refused_with_the_edge():
         cotan_laplacian(V, F)
 
 
+@pytest.mark.parametrize("entry", [check_mesh, cotan_laplacian, curvature_detail, mixed_voronoi_area,
+                                   lambda V, F: reconstruct(V, F, np.zeros_like(V), [0], V[[0]])])
+def test_non_manifold_edges_are_counted_and_listed_in_order_by_every_entry_point(entry):
+    # check_mesh sorts the half-edges; the Laplacian's entry points count triangles per edge
+    # during assembly instead: both must name the same edges in the same order
+    V, F = _square()
+    V = np.vstack([V, [[0.25, 0.25, 1.0], [0.75, 0.75, 1.0], [0.5, 0.0, 1.0]]])
+    F = np.vstack([F, [[0, 4, 9], [4, 8, 10], [1, 4, 11]]])   # fins on (0, 4), (4, 8), (1, 4)
+    with pytest.raises(MeshError, match=r"3 edges are shared by more than two triangles "
+                                        r"\(first: \(0, 4\), \(1, 4\), \(4, 8\)\)"):
+        entry(V, F)
+
+
 def test_unreferenced_vertices_are_refused_with_the_vertices():
     V, F = _square()
     V = np.vstack([V, [[5.0, 5, 5], [6.0, 6, 6]]])

@@ -122,13 +122,6 @@ def check_mesh(V, F, *, check_manifold=True, check_unreferenced=True):
     return _check_mesh(V, F, check_manifold, check_unreferenced)[:2]
 
 
-def check_mesh_cotangents(V, F):
-    """:func:`check_mesh` (all checks) that also returns the corner cotangents it computed on the
-    way, ``(V, F, cot)``, so that a caller assembling the Laplacian does not compute the triangle
-    geometry twice (``cot`` as in :func:`._geometry.corner_cotangents`)."""
-    return _check_mesh(V, F, True, True, cotangents=True)
-
-
 def _check_mesh(V, F, check_manifold, check_unreferenced, cotangents=False):
     V = as_vertices(V)
     F = as_faces(F, V.shape[0])
@@ -148,12 +141,7 @@ def _check_mesh(V, F, check_manifold, check_unreferenced, cotangents=False):
     if check_manifold:
         bad = non_manifold_edges(F)
         if bad.shape[0]:
-            pairs = ", ".join(f"({a}, {b})" for a, b in bad[:3])
-            raise MeshError(
-                f"{bad.shape[0]} edges are shared by more than two triangles (first: {pairs}); "
-                "the mesh is not manifold. Repair it, e.g. with pymeshlab's "
-                "meshing_repair_non_manifold_edges."
-            )
+            raise non_manifold_error(bad.shape[0], bad[:3])
     if check_unreferenced:
         used = np.zeros(V.shape[0], dtype=bool)
         used[F.ravel()] = True
@@ -164,6 +152,15 @@ def _check_mesh(V, F, check_manifold, check_unreferenced, cotangents=False):
                 "remove them, e.g. with pymeshlab's meshing_remove_unreferenced_vertices."
             )
     return V, F, cot
+
+
+def non_manifold_error(count, first):
+    """The MeshError for ``count`` edges on three or more triangles, ``first``: a few (a, b)."""
+    pairs = ", ".join(f"({a}, {b})" for a, b in first)
+    return MeshError(
+        f"{count} edges are shared by more than two triangles (first: {pairs}); "
+        "the mesh is not manifold. Repair it, e.g. with pymeshlab's meshing_repair_non_manifold_edges."
+    )
 
 
 def undirected_edges(F):

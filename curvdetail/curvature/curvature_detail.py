@@ -1,7 +1,6 @@
 """Curvature detail ``D = L V`` (the paper's ``K_i A_i``)."""
 
-from ._validate import check_mesh_cotangents
-from .cotan_laplacian import _cotan_laplacian_unchecked
+from .cotan_laplacian import checked_cotan_laplacian
 
 
 def curvature_detail(V, F):
@@ -34,5 +33,5 @@ def curvature_detail(V, F):
     >>> bool(np.abs(D[inner]).max() < 1e-12)     # a plane has no interior detail
     True
     """
-    V, F, cot = check_mesh_cotangents(V, F)
-    return _cotan_laplacian_unchecked(V, F, cot) @ V
+    V, F, L = checked_cotan_laplacian(V, F)
+    return L @ V

@@ -2,8 +2,8 @@
 
 import numpy as np
 
-from ._validate import as_index_set, as_values, check_every_component_fixed, check_mesh_cotangents
-from .cotan_laplacian import _cotan_laplacian_unchecked
+from ._validate import as_index_set, as_values, check_every_component_fixed
+from .cotan_laplacian import checked_cotan_laplacian
 from .errors import ConstraintError
 from .sparse_solver import factorize
 
@@ -71,7 +71,7 @@ class Reconstructor:
     refinement_steps = 1
 
     def __init__(self, V_ref, F, fixed, *, rows="all", backend="auto", refinement_steps=None):
-        V_ref, F, cot = check_mesh_cotangents(V_ref, F)
+        V_ref, F, L = checked_cotan_laplacian(V_ref, F)
         if rows not in ROW_MODES:
             raise ValueError(f"rows={rows!r} is not a row mode; use 'all' (the paper's E_Q) or 'free'.")
         if refinement_steps is not None:
@@ -86,7 +86,6 @@ class Reconstructor:
         if self.fixed.size == 0:
             raise ConstraintError("no fixed vertices: the reconstruction is only determined up to a "
                                   "translation. Fix at least one vertex per connected piece, e.g. the boundary.")
-        L = _cotan_laplacian_unchecked(V_ref, F, cot)
         check_every_component_fixed(F, n, self.fixed, adjacency=L)      # L has the edge pattern
         is_free = np.ones(n, dtype=bool)
         is_free[self.fixed] = False

@@ -105,11 +105,15 @@ _MKL_RT = None   # path of the MKL runtime found by the first PARDISO solver in 
 
 def _new_pardiso_solver(mtype):
     """A fresh ``pypardiso.PyPardisoSolver``. Its constructor looks the MKL runtime up with
-    ``ctypes.util.find_library`` (a subprocess, ~0.2 s, on every call); the path found the first
-    time is handed to later constructors through pypardiso's ``PYPARDISO_MKL_RT`` setting."""
+    ``ctypes.util.find_library`` (a subprocess) and a recursive glob of ``sys.prefix`` (0.2-0.6 s
+    in all) on every call; the path that the import of pypardiso already found is handed to our
+    constructors through pypardiso's ``PYPARDISO_MKL_RT`` setting."""
     global _MKL_RT
     import pypardiso
 
+    if _MKL_RT is None:
+        # importing pypardiso already built one solver (``pypardiso.ps``), library found
+        _MKL_RT = getattr(getattr(getattr(pypardiso, "ps", None), "libmkl", None), "_name", None)
     if _MKL_RT is None or os.environ.get("PYPARDISO_MKL_RT"):
         solver = pypardiso.PyPardisoSolver(mtype=mtype)
         _MKL_RT = getattr(solver.libmkl, "_name", None) or _MKL_RT

@@ -2,8 +2,8 @@
 
 import numpy as np
 
-from ..curvature._validate import boundary_vertices, check_mesh_cotangents
-from ..curvature.cotan_laplacian import _cotan_laplacian_unchecked
+from ..curvature._validate import boundary_vertices
+from ..curvature.cotan_laplacian import checked_cotan_laplacian
 from ..curvature.mixed_voronoi_area import _mixed_voronoi_area_unchecked
 from .meshset import layer_id, mesh_arrays, set_vertex_attribute, set_vertex_quality, vertex_normals
 from .registry import PAPER, filter
@@ -41,8 +41,8 @@ def signed_mean_curvature(V, F, K):
 def compute_curvature_detail(ms):
     mid = layer_id(ms)
     V, F = mesh_arrays(ms, mid)
-    V, F, cot = check_mesh_cotangents(V, F)        # validated once, cotangents reused for L
-    D = _cotan_laplacian_unchecked(V, F, cot) @ V  # = curvature_detail(V, F)
+    V, F, L = checked_cotan_laplacian(V, F)        # validated once
+    D = L @ V                                      # = curvature_detail(V, F)
     A = _mixed_voronoi_area_unchecked(V, F)        # = mixed_voronoi_area(V, F)
     K = D / A[:, None]                             # = mean_curvature_normal(V, F)[0], bit for bit
     H = signed_mean_curvature(V, F, K)
