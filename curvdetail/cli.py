@@ -121,9 +121,11 @@ def _minimal_command(parser):
     parser.add_argument("--max-iterations", type=int, default=200,
                         help="Pinkall-Polthier steps at most; if the shape has not settled by then, "
                              "OUTPUT is still written and the exit status is 3")
-    parser.add_argument("--tol", type=float, default=1e-4,
+    from .curvature.minimal_surface import DEFAULT_TOL
+
+    parser.add_argument("--tol", type=float, default=DEFAULT_TOL,
                         help="stop when no vertex moves more than TOL x bbox diagonal normal to the "
-                             "surface in a step (tangential sliding is not counted; default 1e-4)")
+                             f"surface in a step (tangential sliding is not counted; default {DEFAULT_TOL:g})")
     parser.add_argument("--backend", default="auto", help="sparse solver: auto, pardiso, cholmod, splu")
     add_output_arguments(parser)
 

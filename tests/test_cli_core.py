@@ -164,3 +164,11 @@ def test_unwritable_output_is_refused_before_reading_the_input(tmp_path, capsys,
     assert main([command, str(tmp_path / "absent.obj"), str(tmp_path / output)]) == 1
     assert problem in _error_line(capsys)
     assert os.listdir(tmp_path) == []
+
+
+def test_minimal_tol_default_is_the_core_default():
+    from curvdetail.cli import build_parser
+    from curvdetail.curvature.minimal_surface import DEFAULT_TOL
+
+    args = build_parser().parse_args(["minimal", "in.obj", "out.ply"])
+    assert args.tol == DEFAULT_TOL

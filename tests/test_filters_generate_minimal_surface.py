@@ -29,7 +29,7 @@ def test_terrain_gets_a_new_current_layer_with_the_same_boundary_and_less_area()
     ms = pymeshlab.MeshSet()
     ms.load_new_mesh(os.path.join(DATA, "terrainA_1k.obj"))
     V, F = ms.current_mesh().vertex_matrix().copy(), ms.current_mesh().face_matrix().copy()
-    figures = apply(ms, "generate_minimal_surface", max_iterations=5)
+    figures = apply(ms, "generate_minimal_surface", max_iterations=5, tol=1e-9)   # stops at the cap
     assert ms.mesh_number() == 2 and ms.current_mesh_id() == 1
     assert ms.current_mesh().label() == "terrainA_1k.obj minimal surface"
     X = ms.current_mesh().vertex_matrix()
@@ -46,3 +46,24 @@ def test_closed_mesh_is_refused():
     with pytest.raises(ConstraintError, match="closed: a minimal surface needs a boundary"):
         apply(ms, "generate_minimal_surface")
     assert ms.mesh_number() == 1
+
+
+def test_tol_defaults_to_the_core_tolerance_on_the_normal_step():
+    # the core stops on the largest step normal to the surface (DEFAULT_TOL = 1e-4); the filter
+    # must not keep its own, 100 times tighter default that described the full vertex step
+    from curvdetail.curvature.minimal_surface import DEFAULT_TOL
+    from curvdetail.filters import get_filter
+
+    spec = get_filter("generate_minimal_surface")
+    tol = spec.parameter("tol")
+    assert tol.default == DEFAULT_TOL
+    assert "normal to the surface" in tol.description and "normal to the surface" in spec.description
+
+
+def test_default_tolerance_converges_on_the_terrain():
+    # with the old 1e-6 default the terrain still slid tangentially after 200 steps and was
+    # reported as not converged; on the normal step with 1e-4 it settles in a few steps
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(os.path.join(DATA, "terrainA_1k.obj"))
+    figures = apply(ms, "generate_minimal_surface")
+    assert figures["converged"] and figures["iterations"] < 20 and figures["last_step"] < 1e-4

@@ -3,6 +3,7 @@
 import numpy as np
 
 from ..curvature import minimal_surface
+from ..curvature.minimal_surface import DEFAULT_TOL
 from ..curvature._validate import bbox_diagonal, boundary_vertices, face_double_areas
 from ..curvature.errors import ConstraintError
 from .apply_curvature_reconstruction import BACKENDS
@@ -17,16 +18,19 @@ from .registry import PAPER, filter
     description=f"""
         Generate the minimal surface spanned by the current mesh's boundary: zero curvature
         detail (D = 0) with the boundary vertices fixed, found by cotangent-harmonic steps with the
-        weights recomputed from the current surface (Pinkall and Polthier 1993) until the largest
-        vertex step is below tol times the bounding-box diagonal. It is the paper's validity check
+        weights recomputed from the current surface (Pinkall and Polthier 1993) until no vertex
+        moves more than tol times the bounding-box diagonal normal to the surface in a step
+        (vertices keep sliding within the surface on irregular meshes; that is not counted, and
+        last_step is this normal step). It is the paper's validity check
         and the zero-detail baseline of the remeshing experiment. The result is added as a new
         layer (same triangles) and made current; its vertex quality is the distance each vertex
         moved. {PAPER}, the validity check of section "Base presentation".
     """,
     parameters=[
         Parameter("max_iterations", "int", 200, "Pinkall-Polthier steps at most", min=1),
-        Parameter("tol", "float", 1e-6,
-                  "stop when the largest vertex step is below tol x the bbox diagonal", min=0.0),
+        Parameter("tol", "float", DEFAULT_TOL,
+                  "stop when no vertex moves more than tol x the bbox diagonal normal to the "
+                  "surface in a step (tangential sliding is not counted)", min=0.0),
         Parameter("backend", "str", "auto", "sparse solver backend", choices=BACKENDS),
     ],
 )
