@@ -71,3 +71,12 @@ def test_existing_report_is_not_overwritten(tmp_path, capsys):
     assert rc == 1 and rep.read_text() == "keep"
     assert "--overwrite" in capsys.readouterr().err
     assert sorted(os.listdir(tmp_path)) == ["r.json"]
+
+
+def test_decimation_that_would_refine_names_the_command_line_option(tmp_path, capsys):
+    rc = main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "o.ply"),
+               "--method", "decimate", "--target-edge", "0.5", "--quiet"])
+    assert rc == 1
+    err = capsys.readouterr().err
+    assert "decimation can only coarsen" in err and "--method isotropic" in err and "method='" not in err
+    assert os.listdir(tmp_path) == []

@@ -45,10 +45,31 @@ def test_absurd_target_edge_is_refused_with_the_numbers(load_mesh, pct, words):
         retriangulate(V, F, target_edge=pct)
 
 
+# the decimation messages reach Python callers, the filter and the command line alike
+_USE_ISOTROPIC = r'use method "isotropic" \(--method isotropic on the command line\)\.$'
+
+
 def test_decimation_refuses_to_refine(load_mesh):
     V, F = load_mesh("mannequin_nose.obj")
-    with pytest.raises(RemeshError, match="decimation can only coarsen"):
+    with pytest.raises(RemeshError, match="decimation can only coarsen.*longer target edge or " + _USE_ISOTROPIC):
         retriangulate(V, F, method="decimate", target_edge=0.005)
+
+
+def test_failed_decimation_points_to_isotropic_for_api_and_command_line(load_mesh, monkeypatch):
+    import sys
+
+    module = sys.modules["curvdetail.remesh.retriangulate"]     # the package exports the function
+    real = module.check_disk
+
+    def no_decimated_disk(V, F, what="the mesh"):
+        if what == "the decimated mesh":
+            raise ValueError("the decimated mesh has 2 non-manifold edges")
+        return real(V, F, what)
+
+    monkeypatch.setattr(module, "check_disk", no_decimated_disk)
+    V, F = load_mesh("mannequin_nose.obj")
+    with pytest.raises(RemeshError, match=r"non-manifold edges \(decimation with agg=.*, 3 and 1\); " + _USE_ISOTROPIC):
+        retriangulate(V, F, method="decimate", target_edge=0.06)
 
 
 def test_unknown_method_is_refused(load_mesh):

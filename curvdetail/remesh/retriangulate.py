@@ -146,6 +146,10 @@ def _isotropic(V, F, h, iterations, max_dist):
     return np.array(m.vertex_matrix(), dtype=np.float64), np.array(m.face_matrix(), dtype=np.int64)
 
 
+# shown by retriangulate, the generate_curvature_remeshing filter and `curvdetail remesh` alike
+_USE_ISOTROPIC = 'use method "isotropic" (--method isotropic on the command line)'
+
+
 def _decimate(V, F, h, agg):
     import fast_simplification
 
@@ -154,7 +158,7 @@ def _decimate(V, F, h, agg):
     if target_faces >= F.shape[0]:
         raise RemeshError(
             f"decimation can only coarsen: the target edge asks for about {target_faces:,} triangles "
-            f"but the source has {F.shape[0]:,}; give a longer target edge or use method='isotropic'.")
+            f"but the source has {F.shape[0]:,}; give a longer target edge or {_USE_ISOTROPIC}.")
     last = None
     for a in (agg, min(agg, 3.0), 1.0):
         P, T = fast_simplification.simplify(V, F.astype(np.int32), target_count=max(target_faces, 4), agg=a,
@@ -170,7 +174,7 @@ def _decimate(V, F, h, agg):
             return check_disk(P, T, "the decimated mesh")
         except ValueError as exc:  # a non-manifold edge or a zero-area triangle at high agg
             last = exc
-    raise RemeshError(f"{last} (decimation with agg={agg}, 3 and 1); try method='isotropic'.")
+    raise RemeshError(f"{last} (decimation with agg={agg}, 3 and 1); {_USE_ISOTROPIC}.")
 
 
 def _snap_boundary(V, loop, Vt, Ft, loop_t, d, h):
