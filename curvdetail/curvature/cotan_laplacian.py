@@ -80,11 +80,15 @@ def _assemble(V, F, cot, check_manifold):
     else:
         U = sp.csr_matrix((w, (lo, hi)), shape=(n, n))
         U.sum_duplicates()
-    L = (U + U.T).tocsr()
-    diagonal = -np.asarray(L.sum(axis=1)).ravel()
-    L = L + sp.diags(diagonal, format="csr")
-    L.sum_duplicates()
-    return L
+    # lower triangle, diagonal, upper triangle in this order: the stable row sort of the COO -> CSR
+    # conversion then leaves every row's columns increasing, with no duplicates to sum
+    ur = np.repeat(np.arange(n, dtype=U.indices.dtype), np.diff(U.indptr))
+    uc, uv = U.indices, U.data
+    diagonal = -(np.bincount(ur, uv, minlength=n) + np.bincount(uc, uv, minlength=n))
+    every = np.arange(n, dtype=U.indices.dtype)
+    return sp.csr_matrix((np.concatenate([uv, diagonal, uv]),
+                          (np.concatenate([uc, every, ur]), np.concatenate([ur, every, uc]))),
+                         shape=(n, n))
 
 
 def _refuse_non_manifold(U, n):
