@@ -47,6 +47,18 @@ def test_backends_agree_with_splu(backend):
     assert np.abs(factorize(A, backend=backend).solve(b) - ref).max() < 1e-9 * np.abs(ref).max()
 
 
+@pytest.mark.skipif("pardiso" not in available_backends(), reason="PARDISO (pypardiso) not installed")
+@pytest.mark.parametrize("symmetric", [True, False])
+def test_pardiso_parallel_ordering_solves_the_same(monkeypatch, symmetric):
+    # large systems are ordered with parallel METIS; lower the threshold to take that path here
+    A, x = _spd_system()
+    monkeypatch.setattr(sparse_solver, "PARALLEL_ORDERING", 10)
+    fac = factorize(A, symmetric=symmetric, backend="pardiso")
+    assert fac._pardiso.iparm[1] == 3
+    assert np.abs(fac.solve(A @ x) - x).max() < 1e-10 * np.abs(x).max()
+    assert np.abs(fac.solve(np.asfortranarray(A @ x)) - x).max() < 1e-10 * np.abs(x).max()
+
+
 @pytest.mark.parametrize("backend", available_backends())
 def test_solve_keeps_the_shape_of_the_right_hand_side(backend):
     A, x = _spd_system(12)
