@@ -65,6 +65,7 @@ def test_solve_keeps_the_shape_of_the_right_hand_side(backend):
     fac = factorize(A, backend=backend)
     assert fac.solve(A @ x[:, 0]).shape == (A.shape[0],)
     assert fac.solve(A @ x).shape == x.shape
+    assert fac.solve(np.zeros((A.shape[0], 0))).shape == (A.shape[0], 0)
 
 
 def test_upper_triangle_matches_scipy_triu():

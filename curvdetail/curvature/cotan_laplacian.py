@@ -75,7 +75,7 @@ def _assemble(V, F, cot, check_manifold):
         # the imaginary part counts the triangles on each edge
         U = sp.csr_matrix((w + 1j, (lo, hi)), shape=(n, n))
         U.sum_duplicates()
-        _refuse_non_manifold(U, n)
+        _refuse_non_manifold(U)
         U = sp.csr_matrix((U.data.real.copy(), U.indices, U.indptr), shape=(n, n))
     else:
         U = sp.csr_matrix((w, (lo, hi)), shape=(n, n))
@@ -91,7 +91,7 @@ def _assemble(V, F, cot, check_manifold):
                          shape=(n, n))
 
 
-def _refuse_non_manifold(U, n):
+def _refuse_non_manifold(U):
     bad = np.flatnonzero(U.data.imag > 2.5)
     if bad.size:
         rows = np.searchsorted(U.indptr, bad, side="right") - 1

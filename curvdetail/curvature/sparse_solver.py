@@ -193,8 +193,10 @@ class Factorization:
             solver.set_phase(33)
             if b.ndim == 1:
                 return solver._call_pardiso(M, np.ascontiguousarray(b, dtype=np.float64))
-            return np.column_stack([solver._call_pardiso(M, np.ascontiguousarray(b[:, j], dtype=np.float64))
-                                    for j in range(b.shape[1])]).reshape(b.shape)
+            x = np.empty(b.shape)
+            for j in range(b.shape[1]):
+                x[:, j] = solver._call_pardiso(M, np.ascontiguousarray(b[:, j], dtype=np.float64))
+            return x
 
         self._solve = solve
 
