@@ -31,7 +31,7 @@ def test_solves_an_spd_system_to_rounding(backend):
     assert np.abs(fac.solve(A @ x) - x).max() < 1e-10 * np.abs(x).max()
 
 
-@pytest.mark.parametrize("backend", [b for b in available_backends() if b != "cholmod"])
+@pytest.mark.parametrize("backend", [b for b in available_backends() if b not in ("cholmod", "banded")])
 def test_solves_a_nonsymmetric_system(backend):
     A, x = _spd_system()
     A = (A + sp.diags(np.linspace(0, 0.5, A.shape[0])) @ abs(sp.triu(A, 1))).tocsr()
@@ -95,13 +95,44 @@ def test_auto_picks_splu_for_small_systems():
     assert factorize(A).backend == "splu"
 
 
+def _normal_equations(nx):
+    """``L_f: L_f:^T`` of a grid (2-ring rows, ~19 stored entries each) and a known solution."""
+    V, F = grid(nx, nx)
+    V[:, 2] = np.sin(3 * V[:, 0]) * V[:, 1]
+    L = cotan_laplacian(V, F)
+    inner = np.flatnonzero((V[:, 0] > 0) & (V[:, 0] < 1) & (V[:, 1] > 0) & (V[:, 1] < 1))
+    A = (L[inner] @ L[inner].T).tocsr()
+    return A, np.random.default_rng(5).normal(size=(inner.size, 3))
+
+
+def test_auto_picks_the_banded_cholesky_for_small_systems_with_dense_rows():
+    A, x = _normal_equations(20)                  # 324 unknowns, ~17 entries a row
+    assert A.nnz >= sparse_solver.BANDED_MIN_ROW_ENTRIES * A.shape[0]
+    fac = factorize(A)
+    assert fac.backend == "banded"
+    ref = factorize(A, backend="splu").solve(A @ x)
+    assert np.abs(fac.solve(A @ x) - ref).max() < 1e-9 * np.abs(ref).max()
+    assert factorize(A, symmetric=False).backend == "splu"       # LU for a nonsymmetric system
+    assert factorize(_spd_system(20)[0]).backend == "splu"       # 5-point rows: SuperLU is faster
+
+
+def test_banded_cholesky_refuses_indefinite_and_oversized_systems(monkeypatch):
+    A, _ = _spd_system(10)
+    with pytest.raises(SolverError, match="not positive definite"):
+        factorize(-A, backend="banded")
+    monkeypatch.setattr(sparse_solver, "BANDED_MAX_BYTES", 1000)
+    with pytest.raises(SolverError, match=r"would need .* GB for a band of width \d+ over \d+ unknowns"):
+        factorize(A, backend="banded")
+
+
 def test_environment_variable_overrides_auto(monkeypatch):
     monkeypatch.setenv("CURVDETAIL_SOLVER", "splu")
     assert resolve_backend("auto", size=10 ** 6) == "splu"
+    assert factorize(_normal_equations(20)[0]).backend == "splu"     # not swapped for banded
 
 
 def test_unknown_backend_is_refused_with_the_choices():
-    with pytest.raises(SolverError, match="unknown solver backend 'umfpack'.*pardiso, cholmod, splu"):
+    with pytest.raises(SolverError, match="unknown solver backend 'umfpack'.*pardiso, cholmod, splu, banded"):
         resolve_backend("umfpack")
 
 
@@ -115,6 +146,8 @@ def test_cholmod_is_refused_for_nonsymmetric_systems(monkeypatch):
     monkeypatch.setattr(sparse_solver, "_has_cholmod", lambda: True)
     with pytest.raises(SolverError, match="symmetric positive definite"):
         resolve_backend("cholmod", symmetric=False)
+    with pytest.raises(SolverError, match="banded Cholesky factors symmetric positive definite"):
+        resolve_backend("banded", symmetric=False)
 
 
 def test_singular_matrix_is_reported_not_returned_as_nan():

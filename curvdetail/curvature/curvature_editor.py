@@ -67,7 +67,7 @@ class CurvatureEditor:
                                 inconsistent constraints (a rotated handle), at the price of a
                                 denser factorization
     rcond : float               singular-value threshold of :func:`curvature_coefficients`
-    backend : str               sparse solver backend ("auto", "pardiso", "cholmod", "splu");
+    backend : str               sparse solver backend ("auto", "pardiso", "cholmod", "splu", "banded");
                                 with "auto" the curvature stage uses SuperLU (fastest
                                 back-substitution for ``(I - C)`` here), the embedding the core's
                                 automatic choice

@@ -5,9 +5,12 @@ Backends, chosen automatically in this order where installed:
 ``"pardiso"``  Intel MKL PARDISO through ``pypardiso`` (x86-64). Fastest and leanest here.
 ``"cholmod"``  SuiteSparse CHOLMOD through ``scikit-sparse`` (symmetric positive definite only).
 ``"splu"``     SciPy's SuperLU with ``MMD_AT_PLUS_A`` ordering and symmetric mode (everywhere).
+``"banded"``   LAPACK's banded Cholesky (``scipy.linalg.cholesky_banded``) in reverse
+               Cuthill-McKee order (everywhere; symmetric positive definite, small systems).
 
 ``"auto"`` takes SuperLU for small systems (under ``SMALL_SYSTEM_NNZ`` stored entries, or
-``SMALL_SYSTEM`` unknowns where only the size is known; see there). The choice can be
+``SMALL_SYSTEM`` unknowns where only the size is known; see there), and among those the banded
+Cholesky for small symmetric systems with dense rows (see ``BANDED_MAX_SIZE``). The choice can be
 overridden per call (``backend="splu"``) or for the whole process with the
 environment variable ``CURVDETAIL_SOLVER``. All backends agree to ~1e-12 relative on the
 systems used here.
@@ -19,7 +22,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-BACKENDS = ("pardiso", "cholmod", "splu")
+BACKENDS = ("pardiso", "cholmod", "splu", "banded")
 
 #: Number of numeric factorizations performed in this process (a solver that promises
 #: back-substitution only can be checked against it).
@@ -47,19 +50,19 @@ def _has_cholmod():
 
 
 def available_backends():
-    """Names of the installed backends, fastest first; ``"splu"`` is always there.
+    """Names of the installed backends, fastest first; ``"splu"`` and ``"banded"`` are always there.
 
     Examples
     --------
-    >>> available_backends()[-1]
-    'splu'
+    >>> available_backends()[-2:]
+    ['splu', 'banded']
     """
     found = []
     if _has_pardiso():
         found.append("pardiso")
     if _has_cholmod():
         found.append("cholmod")
-    found.append("splu")
+    found += ["splu", "banded"]
     return found
 
 
@@ -70,6 +73,19 @@ def available_backends():
 #: 0.168 / 0.344 s. Below ~5k both take a few milliseconds. (PARDISO's former ~0.2 s fixed cost
 #: per factorization was pypardiso's library look-up, now done once per process.)
 SMALL_SYSTEM = 5000
+
+#: ``"auto"`` factors a small symmetric system (one it would give to SuperLU) with the banded
+#: Cholesky when it has at most this many unknowns and at least ``BANDED_MIN_ROW_ENTRIES`` stored
+#: entries a row: the normal equations ``L^T L`` (2-ring rows, ~19 entries) fill SuperLU's factors
+#: much more than a narrow band does. Measured (factor, 2 cores): ``L^T L`` of grids at 873 / 1849
+#: / 3364 / 5329 unknowns 3.6 / 6.1 / 13 / 26 ms banded against 6.1 / 12.7 / 28 / 59 ms SuperLU;
+#: the sparser ``L_ff`` (7 a row) is faster with SuperLU (1849 unknowns: 5.9 against 7.8 ms).
+BANDED_MAX_SIZE = 6000
+BANDED_MIN_ROW_ENTRIES = 12
+
+#: An explicitly requested banded factorization whose band would take more memory than this
+#: is refused (the band grows with the square root of the size on a mesh).
+BANDED_MAX_BYTES = 1 << 30
 
 #: Below this many stored entries ``"auto"`` picks SuperLU (used when the matrix is at hand). The
 #: crossover in the measurements above sits near 1e5 entries for both systems: ``L_ff`` has ~7
@@ -86,7 +102,7 @@ def resolve_backend(backend="auto", *, symmetric=True, size=None, nnz=None):
         if small:
             return "splu"
         for name in available_backends():
-            if name == "cholmod" and not symmetric:
+            if name in ("cholmod", "banded") and not symmetric:
                 continue
             return name
     if backend not in BACKENDS:
@@ -95,8 +111,9 @@ def resolve_backend(backend="auto", *, symmetric=True, size=None, nnz=None):
         hint = {"pardiso": "pip install pypardiso (x86-64 only)",
                 "cholmod": "install SuiteSparse (apt install libsuitesparse-dev) and pip install scikit-sparse"}
         raise SolverError(f"solver backend {backend!r} is not installed; {hint[backend]}, or use backend='auto'.")
-    if backend == "cholmod" and not symmetric:
-        raise SolverError("CHOLMOD factors symmetric positive definite matrices only; use 'pardiso' or 'splu'.")
+    if backend in ("cholmod", "banded") and not symmetric:
+        name = {"cholmod": "CHOLMOD", "banded": "The banded Cholesky"}[backend]
+        raise SolverError(f"{name} factors symmetric positive definite matrices only; use 'pardiso' or 'splu'.")
     return backend
 
 
@@ -146,7 +163,7 @@ class Factorization:
     ----------
     A : (n, n) scipy.sparse matrix
     symmetric : bool   True if A is symmetric positive definite (uses a Cholesky-type factorization)
-    backend : str      ``"auto"``, ``"pardiso"``, ``"cholmod"`` or ``"splu"``
+    backend : str      ``"auto"``, ``"pardiso"``, ``"cholmod"``, ``"splu"`` or ``"banded"``
     """
 
     def __init__(self, A, *, symmetric=True, backend="auto"):
@@ -157,6 +174,10 @@ class Factorization:
         self.shape = A.shape
         self.symmetric = bool(symmetric)
         self.backend = resolve_backend(backend, symmetric=symmetric, size=A.shape[0], nnz=A.nnz)
+        if (self.backend == "splu" and backend in (None, "auto") and self.symmetric
+                and not os.environ.get("CURVDETAIL_SOLVER") and 0 < A.shape[0] <= BANDED_MAX_SIZE
+                and A.nnz >= BANDED_MIN_ROW_ENTRIES * A.shape[0]):
+            self.backend = "banded"
         factorization_count += 1
         if A.shape[0] == 0:
             self._solve = lambda b: np.zeros_like(b)
@@ -216,6 +237,38 @@ class Factorization:
         except Exception as exc:
             raise SolverError(f"CHOLMOD could not factor the matrix ({exc}); it is not positive definite.") from None
 
+    def _factor_banded(self, A):
+        from scipy.linalg import LinAlgError, cho_solve_banded, cholesky_banded
+        from scipy.sparse.csgraph import reverse_cuthill_mckee
+
+        n = A.shape[0]
+        A.sort_indices()
+        p = reverse_cuthill_mckee(A, symmetric_mode=True)
+        at = np.empty(n, dtype=np.int64)
+        at[p] = np.arange(n)                   # new index of each old one
+        B = A.tocoo()
+        rows, cols = at[B.row], at[B.col]
+        upper = cols >= rows
+        rows, cols = rows[upper], cols[upper]
+        width = int((cols - rows).max())
+        if (width + 1) * n * 8 > BANDED_MAX_BYTES:
+            raise SolverError(f"the banded Cholesky would need {(width + 1) * n * 8 / 2**30:.1f} GB for a band "
+                              f"of width {width} over {n} unknowns; use 'auto', 'pardiso' or 'splu'.")
+        band = np.zeros((width + 1, n))        # LAPACK upper band storage: A[i, j] at [w + i - j, j]
+        band[width + rows - cols, cols] = B.data[upper]
+        try:
+            factor = cholesky_banded(band, lower=False, overwrite_ab=True, check_finite=False)
+        except LinAlgError as exc:
+            raise SolverError(f"the banded Cholesky could not factor the matrix ({exc}); it is not "
+                              "positive definite.") from None
+
+        def solve(b):
+            x = np.empty_like(b)
+            x[p] = cho_solve_banded((factor, False), b[p], check_finite=False)
+            return x
+
+        self._solve = solve
+
     def _factor_splu(self, A):
         try:
             lu = spla.splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
@@ -261,7 +314,7 @@ def factorize(A, *, symmetric=True, backend="auto"):
     ----------
     A : (n, n) scipy.sparse matrix
     symmetric : bool   True for a symmetric positive definite ``A`` (Cholesky-type factorization)
-    backend : str      ``"auto"``, ``"pardiso"``, ``"cholmod"`` or ``"splu"``
+    backend : str      ``"auto"``, ``"pardiso"``, ``"cholmod"``, ``"splu"`` or ``"banded"``
 
     Returns
     -------

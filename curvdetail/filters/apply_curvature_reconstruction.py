@@ -5,13 +5,14 @@ import numpy as np
 from ..curvature import reconstruct
 from ..curvature._validate import bbox_diagonal, boundary_vertices
 from ..curvature.errors import ConstraintError
+from ..curvature.sparse_solver import BACKENDS as _SOLVERS
 from .compute_curvature_detail import DETAIL
 from .meshset import (get_mesh, layer_id, mesh_arrays, require_vertex_attribute, selected_vertices,
                       set_vertex_positions, set_vertex_quality)
 from .parameters import Parameter
 from .registry import PAPER, filter
 
-BACKENDS = ("auto", "pardiso", "cholmod", "splu")
+BACKENDS = ("auto",) + _SOLVERS
 
 
 @filter(

@@ -7,13 +7,13 @@ import numpy as np
 from ..curvature._validate import bbox_diagonal
 from ..curvature.curvature_editor import CurvatureEditor
 from ..curvature.errors import ConstraintError, first_indices
+from .apply_curvature_reconstruction import BACKENDS
 from .errors import FilterParameterError
 from .meshset import (get_mesh, layer_id, mesh_arrays, selected_vertices, set_vertex_positions,
                       set_vertex_quality)
 from .parameters import BBoxLength, Parameter
 from .registry import PAPER, filter
 
-BACKENDS = ("auto", "pardiso", "cholmod", "splu")
 IDENTITY = "1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1"
 
 
