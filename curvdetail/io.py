@@ -9,6 +9,7 @@ import os
 
 import numpy as np
 
+from ._file_counts import check_loaded
 from ._output import atomic_output, check_output_path
 from .curvature._validate import as_faces, as_vertices
 from .curvature.errors import MeshError
@@ -39,10 +40,11 @@ def read_mesh(path):
     Raises
     ------
     FileNotFoundError   the file does not exist
-    MeshFileError       the format is unknown, the file is unreadable or holds no triangles, or
-                        (OBJ, OFF, PLY) the loader dropped vertices: pymeshlab silently removes
-                        vertices with NaN or infinite coordinates and the faces using them, so
-                        the file's vertex order would no longer hold
+    MeshFileError       the format is unknown, the file is unreadable or holds no triangles, a
+                        face index is out of range, or (OBJ, OFF, PLY) the loader dropped
+                        vertices or faces: pymeshlab silently removes vertices with NaN or
+                        infinite coordinates (and renumbers the rest) and OBJ faces with
+                        out-of-range or repeated indices
 
     Examples
     --------
@@ -64,83 +66,11 @@ def read_mesh(path):
     mesh = ms.current_mesh()
     V = np.ascontiguousarray(mesh.vertex_matrix(), dtype=np.float64)
     F = np.ascontiguousarray(mesh.face_matrix(), dtype=np.int64)
-    _check_vertex_count(path, V.shape[0])
+    check_loaded(path, V.shape[0], F, error=MeshFileError)
     if F.shape[0] == 0:
         raise MeshFileError(f"{path!r} holds {V.shape[0]} vertices but no triangles; a surface mesh "
                             "is needed.")
     return V, F
-
-
-_CHUNK = 1 << 20
-_HEADER_LINES = 10_000
-
-
-def _obj_vertex_count(path):
-    """Number of ``v`` lines of an OBJ file, counted in 1 MiB chunks (never the whole file in
-    memory). Like pymeshlab's loader, a vertex line starts at the beginning of a line with ``v``
-    and a space or tab (``vt``, ``vn``, ``vp`` and indented lines are not vertices)."""
-    count, tail = 0, b"\n"
-    with open(path, "rb") as f:
-        while True:
-            chunk = f.read(_CHUNK)
-            if not chunk:
-                return count
-            text = tail + chunk          # a match may straddle two chunks, never lie in tail alone
-            count += text.count(b"\nv ") + text.count(b"\nv\t")
-            tail = text[-2:]
-
-
-def _off_vertex_count(path):
-    """The vertex count in an ASCII OFF header (``[ST][C][N][4]OFF`` then ``nv nf ne``, on the
-    same line or the next one, comments allowed), or None if the header is not of that form."""
-    words = []
-    with open(path, "rb") as f:
-        for _ in range(_HEADER_LINES):
-            line = f.readline()
-            if not line:
-                break
-            words += line.split(b"#", 1)[0].decode("ascii", "replace").split()
-            if len(words) >= 2:
-                break
-    if not words or not words[0].endswith("OFF") or "n" in words[0] or len(words) < 2:
-        return None                      # not OFF, nOFF (dimension first) or too short
-    try:
-        return int(words[1])             # "OFF BINARY" is not an int: no check
-    except ValueError:
-        return None
-
-
-def _ply_vertex_count(path):
-    """``N`` of ``element vertex N`` in a PLY header (ASCII or binary; only the header is read),
-    or None if there is no such header."""
-    with open(path, "rb") as f:
-        if f.readline().strip() != b"ply":
-            return None
-        for _ in range(_HEADER_LINES):
-            words = f.readline().split()
-            if not words or words[0] == b"end_header":
-                return None
-            if words[:2] == [b"element", b"vertex"] and len(words) == 3 and words[2].isdigit():
-                return int(words[2])
-    return None
-
-
-_DECLARED_VERTEX_COUNT = {".obj": _obj_vertex_count, ".off": _off_vertex_count, ".ply": _ply_vertex_count}
-
-
-def _check_vertex_count(path, loaded):
-    """Raise MeshFileError if ``path`` (OBJ, OFF or PLY) declares another number of vertices than
-    pymeshlab loaded. Its loader drops vertices with NaN or infinite coordinates (and the faces
-    using them) without a word; ``V[i]`` would then no longer be vertex ``i`` of the file."""
-    count = _DECLARED_VERTEX_COUNT.get(os.path.splitext(path)[1].lower())
-    declared = count(path) if count is not None else None
-    if declared is None or declared <= loaded:
-        return                           # more than declared: a file our count misreads
-    raise MeshFileError(
-        f"{path!r} has {declared} vertices but pymeshlab loaded {loaded}: {declared - loaded} were "
-        "dropped, most likely for non-finite (NaN or inf) coordinates, together with the faces "
-        "using them, so the vertex order no longer matches the file. Fix or remove those vertices "
-        "(and their faces) in the file and read it again.")
 
 
 def write_mesh(path, V, F, *, quality=None, overwrite=False):

@@ -249,14 +249,24 @@ def test_off_with_counts_on_the_header_line_and_colours_is_read(tmp_path):
     assert np.array_equal(V, _SQUARE) and np.array_equal(F, _SQUARE_FACES)
 
 
-@pytest.mark.parametrize("chunk", [1, 2, 3, 5, 64])
-def test_obj_vertex_lines_are_counted_across_chunk_boundaries(tmp_path, monkeypatch, chunk):
-    import curvdetail.io as io
+@pytest.mark.parametrize("name, text", [
+    ("out_of_range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\nf 2 9 3\n"),
+    ("repeated.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\nf 2 2 3\n"),
+])
+def test_obj_faces_the_loader_drops_are_reported(tmp_path, name, text):
+    # pymeshlab drops these faces without a word: the mesh would silently get a hole
+    path = tmp_path / name
+    path.write_text(text)
+    with pytest.raises(MeshFileError, match=r"has 3 faces but pymeshlab loaded 2 triangles: at least 1 "
+                                           r"were dropped, most likely for vertex indices out of range"):
+        read_mesh(path)
 
-    path = tmp_path / "m.obj"
-    path.write_bytes(b"v 0 0 0\nvt 1 1\nv\t1 0 0\r\n  v 9 9 9\nvn 0 0 1\nv 0 1 0\nf 1 2 3\nv 1 1 1")
-    monkeypatch.setattr(io, "_CHUNK", chunk)
-    assert io._obj_vertex_count(str(path)) == 4       # the indented line is not a vertex to pymeshlab
+
+def test_polygons_are_triangulated_not_reported(tmp_path):
+    path = tmp_path / "quad.obj"
+    path.write_text("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n")
+    V, F = read_mesh(path)
+    assert V.shape == (4, 3) and F.shape == (2, 3)
 
 
 def test_reads_the_shipped_meshes_in_file_order():

@@ -15,7 +15,8 @@ import os
 import numpy as np
 
 from .. import _output
-from ..io import MeshFileError, _check_vertex_count
+from .._file_counts import check_loaded
+from ..io import MeshFileError
 from .meshset import WRITTEN_ATTRIBUTES, set_vertex_attribute, vertex_attribute
 from .ply_attributes import read_ply_vertex_attributes
 
@@ -29,8 +30,8 @@ def load_meshset(path, *more):
     them) are added back.
 
     Raises FileNotFoundError if a file does not exist, MeshFileError if pymeshlab cannot read it
-    or dropped vertices of an OBJ, OFF or PLY file (NaN or infinite coordinates; see
-    :func:`curvdetail.read_mesh`)."""
+    or dropped vertices or faces of an OBJ, OFF or PLY file, or a face index is out of range
+    (see :func:`curvdetail.read_mesh`)."""
     import pymeshlab
 
     paths = [os.fspath(p) for p in (path, *more)]
@@ -45,7 +46,7 @@ def load_meshset(path, *more):
             raise MeshFileError(f"could not read {p!r}: {' '.join(str(exc).split())}. Use a format "
                                 "MeshLab reads (.obj, .off, .ply, .stl, ...).") from None
         n = ms.current_mesh().vertex_number()
-        _check_vertex_count(p, n)        # pymeshlab drops NaN/inf vertices without a word
+        check_loaded(p, n, ms.current_mesh().face_matrix(), error=MeshFileError)   # what pymeshlab dropped
         for name, values in read_ply_vertex_attributes(p).items():
             if values.shape in ((n,), (n, 3)) and np.all(np.isfinite(values)):
                 set_vertex_attribute(ms, ms.current_mesh_id(), name, values)
