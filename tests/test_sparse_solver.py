@@ -129,6 +129,8 @@ def test_environment_variable_overrides_auto(monkeypatch):
     monkeypatch.setenv("CURVDETAIL_SOLVER", "splu")
     assert resolve_backend("auto", size=10 ** 6) == "splu"
     assert factorize(_normal_equations(20)[0]).backend == "splu"     # not swapped for banded
+    monkeypatch.setenv("CURVDETAIL_SOLVER", "auto")
+    assert factorize(_normal_equations(20)[0]).backend == "banded"   # "auto" spelled out is auto
 
 
 def test_unknown_backend_is_refused_with_the_choices():

@@ -175,7 +175,8 @@ class Factorization:
         self.symmetric = bool(symmetric)
         self.backend = resolve_backend(backend, symmetric=symmetric, size=A.shape[0], nnz=A.nnz)
         if (self.backend == "splu" and backend in (None, "auto") and self.symmetric
-                and not os.environ.get("CURVDETAIL_SOLVER") and 0 < A.shape[0] <= BANDED_MAX_SIZE
+                and os.environ.get("CURVDETAIL_SOLVER", "auto") in ("", "auto")
+                and 0 < A.shape[0] <= BANDED_MAX_SIZE
                 and A.nnz >= BANDED_MIN_ROW_ENTRIES * A.shape[0]):
             self.backend = "banded"
         factorization_count += 1
