@@ -100,7 +100,9 @@ def resolve_backend(backend="auto", *, symmetric=True, size=None, nnz=None):
     if backend == "auto":
         small = nnz < SMALL_SYSTEM_NNZ if nnz is not None else (size is not None and size < SMALL_SYSTEM)
         if small:
-            return "splu"
+            dense_rows = (nnz is not None and size is not None and 0 < size <= BANDED_MAX_SIZE
+                          and nnz >= BANDED_MIN_ROW_ENTRIES * size)
+            return "banded" if symmetric and dense_rows else "splu"
         for name in available_backends():
             if name in ("cholmod", "banded") and not symmetric:
                 continue
@@ -174,11 +176,6 @@ class Factorization:
         self.shape = A.shape
         self.symmetric = bool(symmetric)
         self.backend = resolve_backend(backend, symmetric=symmetric, size=A.shape[0], nnz=A.nnz)
-        if (self.backend == "splu" and backend in (None, "auto") and self.symmetric
-                and os.environ.get("CURVDETAIL_SOLVER", "auto") in ("", "auto")
-                and 0 < A.shape[0] <= BANDED_MAX_SIZE
-                and A.nnz >= BANDED_MIN_ROW_ENTRIES * A.shape[0]):
-            self.backend = "banded"
         factorization_count += 1
         if A.shape[0] == 0:
             self._solve = lambda b: np.zeros_like(b)
