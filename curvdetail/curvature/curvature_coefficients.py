@@ -5,8 +5,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ._validate import bbox_diagonal, check_mesh
-from .cotan_laplacian import _cotan_laplacian_unchecked
+from ._validate import bbox_diagonal
+from .cotan_laplacian import checked_cotan_laplacian
 from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
 
 #: Default relative threshold on the singular values of a one-ring's detail matrix (see
@@ -104,10 +104,10 @@ def curvature_coefficients(V, F, *, rcond=DEFAULT_RCOND, return_info=False):
     >>> info.rank_deficient
     0
     """
-    V, F = check_mesh(V, F)
+    V, F, L = checked_cotan_laplacian(V, F)
     rcond = check_rcond(rcond)
     n = V.shape[0]
-    D = _cotan_laplacian_unchecked(V, F) @ V
+    D = L @ V
     A = _mixed_voronoi_area_unchecked(V, F)
     rows, cols = _one_ring_pairs(F, n)
     C, rank, scale = _coefficients(D, A, rows, cols, n, rcond, bbox_diagonal(V), want_scale=return_info)

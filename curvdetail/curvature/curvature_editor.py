@@ -7,8 +7,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from ._validate import as_index_set, as_values, bbox_diagonal, check_mesh
-from .cotan_laplacian import _cotan_laplacian_unchecked
+from ._validate import as_index_set, as_values, bbox_diagonal
+from .cotan_laplacian import checked_cotan_laplacian
 from .curvature_coefficients import DEFAULT_RCOND, _coefficients, _one_ring_pairs, check_rcond
 from .errors import ConstraintError, first_indices
 from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
@@ -118,7 +118,7 @@ class CurvatureEditor:
 
     def __init__(self, V, F, position_constrained, detail_constrained, *, roi=None,
                  rows="all", relations="one-ring", rcond=DEFAULT_RCOND, backend="auto"):
-        V, F = check_mesh(V, F)
+        V, F, L = checked_cotan_laplacian(V, F)       # every mesh check, and L in the same pass
         if rows not in ("all", "free"):
             raise ValueError(f"rows={rows!r} is not a row mode; use 'all' (the paper's E_Q) or 'free'.")
         if relations not in RELATIONS:
@@ -159,7 +159,6 @@ class CurvatureEditor:
         self.roi = np.flatnonzero(in_roi)
 
         t0 = time.perf_counter()
-        L = _cotan_laplacian_unchecked(V, F)
         D = L @ V
         rows, cols = _one_ring_pairs(F, n)
         A, diag = _mixed_voronoi_area_unchecked(V, F), bbox_diagonal(V)

@@ -1,7 +1,6 @@
 """Mean curvature normal per vertex (Meyer et al. 2002)."""
 
-from ._validate import check_mesh
-from .cotan_laplacian import _cotan_laplacian_unchecked
+from .cotan_laplacian import checked_cotan_laplacian
 from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
 
 
@@ -33,7 +32,6 @@ def mean_curvature_normal(V, F):
     >>> bool(np.allclose(np.linalg.norm(K, axis=1), 1.0, atol=2e-2))
     True
     """
-    V, F = check_mesh(V, F)
-    L = _cotan_laplacian_unchecked(V, F)
+    V, F, L = checked_cotan_laplacian(V, F)
     A = _mixed_voronoi_area_unchecked(V, F)
     return (L @ V) / A[:, None], A
