@@ -51,6 +51,12 @@ def add_output_arguments(parser):
     parser.add_argument("--overwrite", action="store_true", help="replace OUTPUT if it exists")
 
 
+def add_backend_argument(parser):
+    from .curvature.sparse_solver import BACKENDS
+
+    parser.add_argument("--backend", default="auto", help="sparse solver: " + ", ".join(("auto",) + BACKENDS))
+
+
 def add_input_output_arguments(parser, input_help, output_help):
     """``INPUT OUTPUT`` positionals, or ``--example OUTPUT`` for the bundled example mesh."""
     parser.add_argument("input", metavar="INPUT", nargs="?", help=input_help)
@@ -87,7 +93,7 @@ def _reconstruct_command(parser):
                         help="residual rows in E_Q: all vertices (the paper) or free ones only")
     parser.add_argument("--fix", type=int, nargs="*", default=None, metavar="I",
                         help="vertex indices to fix (default: the boundary; a closed mesh needs some)")
-    parser.add_argument("--backend", default="auto", help="sparse solver: auto, pardiso, cholmod, splu, banded")
+    add_backend_argument(parser)
     add_output_arguments(parser)
 
     def run(args):
@@ -126,7 +132,7 @@ def _minimal_command(parser):
     parser.add_argument("--tol", type=float, default=DEFAULT_TOL,
                         help="stop when no vertex moves more than TOL x bbox diagonal normal to the "
                              f"surface in a step (tangential sliding is not counted; default {DEFAULT_TOL:g})")
-    parser.add_argument("--backend", default="auto", help="sparse solver: auto, pardiso, cholmod, splu, banded")
+    add_backend_argument(parser)
     add_output_arguments(parser)
 
     def run(args):
@@ -175,7 +181,7 @@ def _remesh_command(parser):
                         help="locate points by 3D closest point (default) or in a shared planar domain")
     parser.add_argument("--parameterization", choices=("harmonic", "meshlab_harmonic", "lscm"),
                         default="harmonic", help="planar domain for --location uv (default: harmonic)")
-    parser.add_argument("--backend", default="auto", help="sparse solver: auto, pardiso, cholmod, splu, banded")
+    add_backend_argument(parser)
     parser.add_argument("--report", metavar="R.json", default=None, help="write the JSON report here")
     parser.add_argument("--image", metavar="FIG.png", default=None,
                         help="write a picture: source, rebuilt coloured by error, zero-detail baseline")
@@ -367,7 +373,7 @@ def _edit_command(parser):
                              "one- and two-ring coefficients together (least squares; steadier "
                              "when handle details are rotated)")
     parser.add_argument("--image", metavar="PNG", help="also save a picture: rest (by status) | edited")
-    parser.add_argument("--backend", default="auto", help="sparse solver: auto, pardiso, cholmod, splu, banded")
+    add_backend_argument(parser)
     add_output_arguments(parser)
 
     def run(args):
