@@ -6,7 +6,7 @@ import importlib
 import numpy as np
 import pytest
 
-from curvdetail import (ConstraintError, MeshError, Reconstructor, available_backends,
+from curvdetail import (ConstraintError, MeshError, Reconstructor, available_backends, cotan_laplacian,
                         boundary_vertices, curvature_detail, reconstruct)
 from curvdetail.curvature import sparse_solver
 from curvdetail.curvature._validate import bbox_diagonal
@@ -226,3 +226,21 @@ def test_malformed_mesh_is_refused_before_solving():
 
 def test_docstring_example_runs():
     assert doctest.testmod(importlib.import_module("curvdetail.curvature.reconstruct")).failed == 0
+
+
+@pytest.mark.parametrize("keep_every", [1, 2, 3, 7])
+def test_principal_upper_triangle_is_the_sliced_upper_triangle(keep_every):
+    import scipy.sparse as sp
+
+    from curvdetail.curvature.reconstruct import _principal_upper_triangle
+
+    V, F = grid(9, 7)
+    V[:, 2] = np.sin(V[:, 0]) * V[:, 1]
+    L = cotan_laplacian(V, F)
+    keep = np.arange(V.shape[0]) % keep_every != 1 if keep_every > 1 else np.ones(V.shape[0], bool)
+    expected = sp.triu(L[keep][:, keep], format="csr")
+    expected.sort_indices()
+    got = _principal_upper_triangle(sp.triu(L, k=1, format="csr"), L.diagonal(), keep)
+    assert got.shape == expected.shape
+    assert np.array_equal(got.indptr, expected.indptr) and np.array_equal(got.indices, expected.indices)
+    assert np.array_equal(got.data, expected.data)

@@ -5,7 +5,7 @@ import pytest
 import scipy.sparse as sp
 
 from curvdetail import available_backends
-from curvdetail.curvature import sparse_solver
+from curvdetail.curvature import _pardiso, sparse_solver
 from curvdetail.curvature.sparse_solver import SolverError, factorize, resolve_backend
 from curvdetail.curvature.testing import grid
 from curvdetail.curvature.cotan_laplacian import cotan_laplacian
@@ -52,7 +52,7 @@ def test_backends_agree_with_splu(backend):
 def test_pardiso_parallel_ordering_solves_the_same(monkeypatch, symmetric):
     # large systems are ordered with parallel METIS; lower the threshold to take that path here
     A, x = _spd_system()
-    monkeypatch.setattr(sparse_solver, "PARALLEL_ORDERING", 10)
+    monkeypatch.setattr(_pardiso, "PARALLEL_ORDERING", 10)
     fac = factorize(A, symmetric=symmetric, backend="pardiso")
     assert fac._pardiso.iparm[1] == 3
     assert np.abs(fac.solve(A @ x) - x).max() < 1e-10 * np.abs(x).max()
@@ -66,6 +66,30 @@ def test_solve_keeps_the_shape_of_the_right_hand_side(backend):
     assert fac.solve(A @ x[:, 0]).shape == (A.shape[0],)
     assert fac.solve(A @ x).shape == x.shape
     assert fac.solve(np.zeros((A.shape[0], 0))).shape == (A.shape[0], 0)
+
+
+@pytest.mark.parametrize("backend", available_backends())
+def test_upper_triangle_input_solves_like_the_whole_matrix(backend):
+    A, x = _spd_system(30)
+    b = A @ x
+    U = sp.triu(A, format="csr")
+    fac = factorize(U, backend=backend, upper=True)
+    assert fac.backend == backend
+    assert np.abs(fac.solve(b) - x).max() < 1e-9 * np.abs(x).max()
+
+
+def test_upper_triangle_input_needs_a_symmetric_matrix():
+    A, _ = _spd_system(5)
+    with pytest.raises(SolverError, match="symmetric=False"):
+        factorize(sp.triu(A), symmetric=False, upper=True)
+
+
+@pytest.mark.skipif("pardiso" not in available_backends(), reason="PARDISO (pypardiso) not installed")
+def test_pardiso_refuses_an_empty_row_instead_of_crashing():
+    A = sp.csr_matrix(np.diag([2.0, 0.0, 3.0]))
+    A.eliminate_zeros()
+    with pytest.raises(SolverError, match="row 1 has no stored entries"):
+        factorize(A, backend="pardiso")
 
 
 def test_upper_triangle_matches_scipy_triu():

@@ -1,6 +1,23 @@
 """Per-triangle quantities shared by the cotangent Laplacian and the mixed Voronoi area."""
 
+import os
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
+
+#: Meshes with at least this many triangles have their corner cotangents computed in blocks on
+#: a few threads (numpy's arithmetic releases the GIL): 2M triangles on 2 cores, 0.32 -> 0.15 s.
+THREADED_TRIANGLES = 200_000
+
+_pool = None
+
+
+def _thread_count():
+    try:
+        cores = len(os.sched_getaffinity(0))
+    except AttributeError:           # not on Linux
+        cores = os.cpu_count() or 1
+    return max(1, min(4, cores))
 
 
 def corner_cotangents(V, F, *, lengths=True):
@@ -10,15 +27,42 @@ def corner_cotangents(V, F, *, lengths=True):
 
     Returns
     -------
-    cot : (m, 3) float   cot of the angle at corner k of each triangle
+    cot : (m, 3) float   cot of the angle at corner k of each triangle (the transpose of a
+                         contiguous (3, m) array)
     sq  : (m, 3) float   squared length of the edge opposite corner k (joining corners k+1, k+2)
     dbl : (m,) float     twice the triangle's area
     """
-    # coordinate-major (3, m) arrays: every operation below runs on contiguous rows; np.take
-    # gathers ~3x faster than fancy indexing, and the in-place arithmetic halves the time at 2M
-    # triangles (0.54 -> 0.28 s), bit for bit the same values
+    global _pool
+    # coordinate-major (3, m) arrays: every operation below runs on contiguous rows
     Vt = np.ascontiguousarray(V.T)
     Ft = np.ascontiguousarray(F.T)
+    m = Ft.shape[1]
+    cot = np.empty((3, m))
+    sq = np.empty((3, m)) if lengths else None
+    dbl = np.empty(m)
+    threads = _thread_count() if m >= THREADED_TRIANGLES else 1
+    bounds = np.linspace(0, m, threads + 1).astype(int)
+    blocks = [slice(a, b) for a, b in zip(bounds[:-1], bounds[1:])]
+
+    caller_errstate = np.geterr()     # numpy's error state is per thread: take the caller's along
+
+    def block(s):
+        with np.errstate(**caller_errstate):
+            _corner_cotangents_into(Vt, Ft[:, s], cot[:, s], None if sq is None else sq[:, s], dbl[s])
+
+    if threads == 1:
+        block(slice(0, m))
+    else:
+        if _pool is None:
+            _pool = ThreadPoolExecutor(max_workers=4, thread_name_prefix="curvdetail")
+        list(_pool.map(block, blocks))
+    return cot.T, None if sq is None else sq.T, dbl
+
+
+def _corner_cotangents_into(Vt, Ft, cot, sq, dbl):
+    """corner_cotangents for one block of triangles, written into the (3, b) / (b,) outputs."""
+    # np.take gathers ~3x faster than fancy indexing, and the in-place arithmetic halves the time
+    # at 2M triangles (0.54 -> 0.28 s), bit for bit the same values
     P0, P1, P2 = (np.take(Vt, Ft[k], axis=1) for k in range(3))
     # edge opposite corner k, as a vector
     e0 = P2 - P1
@@ -35,16 +79,17 @@ def corner_cotangents(V, F, *, lengths=True):
     cz *= cz
     cx += cy
     cx += cz
-    dbl = np.sqrt(cx, out=cx)
-    sq = np.stack([_dot(e0, e0), _dot(e1, e1), _dot(e2, e2)], axis=1) if lengths else None
+    np.sqrt(cx, out=dbl)
+    if sq is not None:
+        _dot(e0, e0, out=sq[0])
+        _dot(e1, e1, out=sq[1])
+        _dot(e2, e2, out=sq[2])
     # cot at corner k = (a . b) / |a x b| with a, b the two edges leaving it (= minus the two
     # edges that end there, hence the sign)
-    cot = np.empty((3, dbl.shape[0]))
     _dot(e1, e2, out=cot[0])
     _dot(e2, e0, out=cot[1])
     _dot(e0, e1, out=cot[2])
     cot *= np.divide(-1.0, dbl)
-    return cot.T, sq, dbl
 
 
 def _dot(a, b, out=None):

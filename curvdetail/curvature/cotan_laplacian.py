@@ -44,33 +44,38 @@ def cotan_laplacian(V, F):
     return checked_cotan_laplacian(V, F)[2]
 
 
-def checked_cotan_laplacian(V, F):
+def checked_cotan_laplacian(V, F, *, strict_upper=False):
     """Every :func:`check_mesh` check and ``L`` in one pass: ``(V, F, L)`` with V, F converted.
 
     The non-manifold edge check is folded into the assembly (each edge's triangle count is
     summed alongside its weight), which saves a separate sort of all half-edges (0.27 s at 1M
-    vertices)."""
+    vertices). ``strict_upper=True`` also returns the strict upper triangle ``U`` of ``L`` (CSR,
+    sorted), which the assembly builds on the way: ``(V, F, L, U)``."""
     V, F, cot = _check_mesh(V, F, check_manifold=False, check_unreferenced=True, cotangents=True)
-    return V, F, _assemble(V, F, cot, check_manifold=True)
+    L, U = _assemble(V, F, cot, check_manifold=True)
+    return (V, F, L, U) if strict_upper else (V, F, L)
 
 
 def _cotan_laplacian_unchecked(V, F, cot=None):
     """``L`` without input checks; ``cot``: corner cotangents already computed for (V, F)."""
     if cot is None:
         cot, _, _ = corner_cotangents(V, F, lengths=False)
-    return _assemble(V, F, cot, check_manifold=False)
+    return _assemble(V, F, cot, check_manifold=False)[0]
 
 
 def _assemble(V, F, cot, check_manifold):
     n = V.shape[0]
     # the edge opposite corner k joins corners k+1 and k+2; assemble the strict upper triangle
-    # (one entry per half-edge, summed per edge), then L = U + U^T - diag(row sums)
-    i = F[:, [1, 2, 0]].ravel()
-    j = F[:, [2, 0, 1]].ravel()
+    # (one entry per half-edge, summed per edge), then L = U + U^T - diag(row sums). The half-edges
+    # are listed corner by corner from the (3, m) transposes, which are contiguous (cot comes from
+    # corner_cotangents that way): 0.33 -> 0.25 s at 2M triangles, the same L bit for bit
     index = np.int32 if n < 2**31 - 1 else np.int64
-    lo = np.minimum(i, j).astype(index, copy=False)
-    hi = np.maximum(i, j).astype(index, copy=False)
-    w = -0.5 * cot.ravel()
+    Ft = F.T.astype(index)
+    i = Ft[[1, 2, 0]].ravel()
+    j = Ft[[2, 0, 1]].ravel()
+    lo = np.minimum(i, j)
+    hi = np.maximum(i, j, out=i)
+    w = np.ascontiguousarray(cot.T).ravel() * -0.5
     if check_manifold:
         # the imaginary part counts the triangles on each edge
         U = sp.csr_matrix((w + 1j, (lo, hi)), shape=(n, n))
@@ -86,9 +91,10 @@ def _assemble(V, F, cot, check_manifold):
     uc, uv = U.indices, U.data
     diagonal = -(np.bincount(ur, uv, minlength=n) + np.bincount(uc, uv, minlength=n))
     every = np.arange(n, dtype=U.indices.dtype)
-    return sp.csr_matrix((np.concatenate([uv, diagonal, uv]),
-                          (np.concatenate([uc, every, ur]), np.concatenate([ur, every, uc]))),
-                         shape=(n, n))
+    L = sp.csr_matrix((np.concatenate([uv, diagonal, uv]),
+                       (np.concatenate([uc, every, ur]), np.concatenate([ur, every, uc]))),
+                      shape=(n, n))
+    return L, U
 
 
 def _refuse_non_manifold(U):

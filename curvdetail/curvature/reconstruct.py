@@ -1,6 +1,7 @@
 """Rebuild vertex positions from curvature detail (the paper's embedding, energy ``E_Q``)."""
 
 import numpy as np
+import scipy.sparse as sp
 
 from ._validate import as_index_set, as_values, check_every_component_fixed
 from .cotan_laplacian import checked_cotan_laplacian
@@ -71,7 +72,7 @@ class Reconstructor:
     refinement_steps = 1
 
     def __init__(self, V_ref, F, fixed, *, rows="all", backend="auto", refinement_steps=None):
-        V_ref, F, L = checked_cotan_laplacian(V_ref, F)
+        V_ref, F, L, U = checked_cotan_laplacian(V_ref, F, strict_upper=True)
         if rows not in ROW_MODES:
             raise ValueError(f"rows={rows!r} is not a row mode; use 'all' (the paper's E_Q) or 'free'.")
         if refinement_steps is not None:
@@ -86,22 +87,25 @@ class Reconstructor:
         if self.fixed.size == 0:
             raise ConstraintError("no fixed vertices: the reconstruction is only determined up to a "
                                   "translation. Fix at least one vertex per connected piece, e.g. the boundary.")
-        check_every_component_fixed(F, n, self.fixed, adjacency=L)      # L has the edge pattern
+        # U, L's strict upper triangle, has the edge pattern at half L's size
+        check_every_component_fixed(F, n, self.fixed, adjacency=U)
         is_free = np.ones(n, dtype=bool)
         is_free[self.fixed] = False
         self.free = np.flatnonzero(is_free)
         self._L = L
-        L_f = L[self.free]                                       # (f, n) rows of the free vertices
         self._L_c = L[self.fixed].T.tocsr()                      # (n, k) columns of the fixed ones
                                                                  # (= rows, L is symmetric)
         if rows == "all":
             # L is symmetric, so L_:f = L_f:^T and the normal matrix L_:f^T L_:f is L_f: L_f:^T
-            self._L_f = L_f                                      # (f, n)
-            system = L_f @ L_f.T
+            self._L_f = L[self.free]                             # (f, n) rows of the free vertices
+            system, upper = self._L_f @ self._L_f.T, False
         else:
             self._L_fc = self._L_c[self.free]                    # (f, k)
-            system = L_f[:, self.free]
-        self._factor = factorize(system, symmetric=True, backend=backend) if self.free.size else None
+            # the solvers take the upper triangle of L_ff; cut straight from U (1M vertices:
+            # 0.05 s against 0.24 s for slicing L_ff out of L and then its triangle)
+            system, upper = _principal_upper_triangle(U, L.diagonal(), is_free), True
+        self._factor = (factorize(system, symmetric=True, backend=backend, upper=upper)
+                        if self.free.size else None)
         self.backend = self._factor.backend if self._factor is not None else "none"
 
     def solve(self, detail, fixed_positions):
@@ -138,6 +142,31 @@ class Reconstructor:
         for _ in range(self.refinement_steps):
             X[self.free] += self._factor.solve(self._L_f @ (D - self._L @ X))
         return X
+
+
+def _principal_upper_triangle(U, diagonal, keep):
+    """Upper triangle, diagonal included, of the principal submatrix ``A[keep][:, keep]`` of a
+    symmetric ``A`` given by its strict upper triangle ``U`` (CSR, sorted) and ``diagonal``;
+    CSR with sorted indices, renumbered to ``0 .. keep.sum() - 1``."""
+    n = U.shape[0]
+    index = U.indices.dtype
+    rows = np.repeat(np.arange(n, dtype=index), np.diff(U.indptr))
+    kept = keep[rows] & keep[U.indices]
+    renumber = (np.cumsum(keep) - 1).astype(index)
+    r, c, v = renumber[rows[kept]], renumber[U.indices[kept]], U.data[kept]
+    m = renumber[-1] + 1 if n else 0
+    indptr = np.zeros(m + 1, dtype=index)
+    np.cumsum(np.bincount(r, minlength=m) + 1, out=indptr[1:])
+    data = np.empty(indptr[-1])
+    cols = np.empty(indptr[-1], dtype=index)
+    # each row: its diagonal first, then its entries in their (increasing) order; the k-th kept
+    # entry, in row r, follows k entries and the r + 1 diagonals of rows 0..r
+    cols[indptr[:-1]] = np.arange(m, dtype=index)
+    data[indptr[:-1]] = diagonal[keep]
+    at = np.arange(v.size, dtype=np.int64) + r + 1
+    cols[at] = c
+    data[at] = v
+    return sp.csr_matrix((data, cols, indptr), shape=(m, m))
 
 
 def reconstruct(V_ref, F, detail, fixed, fixed_positions, *, rows="all", backend="auto"):

@@ -119,34 +119,6 @@ def resolve_backend(backend="auto", *, symmetric=True, size=None, nnz=None):
     return backend
 
 
-#: From this many unknowns PARDISO orders with parallel METIS (``iparm[1] = 3``).
-PARALLEL_ORDERING = 50_000
-
-_MKL_RT = None   # path of the MKL runtime found by the first PARDISO solver in this process
-
-
-def _new_pardiso_solver(mtype):
-    """A fresh ``pypardiso.PyPardisoSolver``. Its constructor looks the MKL runtime up with
-    ``ctypes.util.find_library`` (a subprocess) and a recursive glob of ``sys.prefix`` (0.2-0.6 s
-    in all) on every call; the path that the import of pypardiso already found is handed to our
-    constructors through pypardiso's ``PYPARDISO_MKL_RT`` setting."""
-    global _MKL_RT
-    import pypardiso
-
-    if _MKL_RT is None:
-        # importing pypardiso already built one solver (``pypardiso.ps``), library found
-        _MKL_RT = getattr(getattr(getattr(pypardiso, "ps", None), "libmkl", None), "_name", None)
-    if _MKL_RT is None or os.environ.get("PYPARDISO_MKL_RT"):
-        solver = pypardiso.PyPardisoSolver(mtype=mtype)
-        _MKL_RT = getattr(solver.libmkl, "_name", None) or _MKL_RT
-        return solver
-    os.environ["PYPARDISO_MKL_RT"] = _MKL_RT
-    try:
-        return pypardiso.PyPardisoSolver(mtype=mtype)
-    finally:
-        os.environ.pop("PYPARDISO_MKL_RT", None)
-
-
 def _upper_triangle(A):
     """Upper triangle (diagonal included) of a CSR matrix with sorted indices, as CSR; a mask on
     the stored entries, ~2x faster than ``scipy.sparse.triu`` (which goes through COO)."""
@@ -166,58 +138,46 @@ class Factorization:
     A : (n, n) scipy.sparse matrix
     symmetric : bool   True if A is symmetric positive definite (uses a Cholesky-type factorization)
     backend : str      ``"auto"``, ``"pardiso"``, ``"cholmod"``, ``"splu"`` or ``"banded"``
+    upper : bool       True if ``A`` holds only the upper triangle (diagonal included) of the
+                       symmetric matrix: PARDISO takes it as it is, which saves extracting it
     """
 
-    def __init__(self, A, *, symmetric=True, backend="auto"):
+    def __init__(self, A, *, symmetric=True, backend="auto", upper=False):
         global factorization_count
         A = sp.csr_matrix(A, dtype=np.float64)
         if A.shape[0] != A.shape[1]:
             raise SolverError(f"cannot factor a non-square matrix of shape {A.shape}.")
+        if upper and not symmetric:
+            raise SolverError("upper=True stores half of a symmetric matrix; pass the whole matrix "
+                              "with symmetric=False.")
         self.shape = A.shape
         self.symmetric = bool(symmetric)
-        self.backend = resolve_backend(backend, symmetric=symmetric, size=A.shape[0], nnz=A.nnz)
+        self.upper = bool(upper)
+        full_nnz = 2 * A.nnz - A.shape[0] if upper else A.nnz     # as stored in full (about)
+        self.backend = resolve_backend(backend, symmetric=symmetric, size=A.shape[0], nnz=full_nnz)
         factorization_count += 1
         if A.shape[0] == 0:
             self._solve = lambda b: np.zeros_like(b)
             return
+        A.sort_indices()
+        if upper and self.backend != "pardiso":
+            A = (A + sp.triu(A, k=1, format="csr").T).tocsr()     # the other backends take it whole
+            A.sort_indices()
         getattr(self, "_factor_" + self.backend)(A)
 
     # -- backends ---------------------------------------------------------------------------
     def _factor_pardiso(self, A):
-        solver = _new_pardiso_solver(mtype=2 if self.symmetric else 11)
-        iparm = solver.iparm
-        iparm[0] = 1    # use the values below instead of all defaults
-        # nested-dissection ordering: METIS, or its OpenMP version above PARALLEL_ORDERING unknowns
-        # (factor of L_ff at 1M: 7.3 -> 5.1 s, of L^T L: 12.6 -> 9.9 s, same fill and solve time;
-        # at 10k it costs 0.02 s more)
-        iparm[1] = 3 if A.shape[0] >= PARALLEL_ORDERING else 2
-        iparm[7] = 0    # no iterative refinement: it triples the re-solve time for nothing here
-        iparm[9] = 8 if self.symmetric else 13   # pivot perturbation 1e-8 / 1e-13
-        iparm[10] = 0 if self.symmetric else 1   # scaling (nonsymmetric only)
-        iparm[12] = 0 if self.symmetric else 1   # weighted matching (nonsymmetric only)
-        iparm[34] = 0   # one-based indices (pypardiso converts)
-        A.sort_indices()
-        M = _upper_triangle(A) if self.symmetric else A
-        self._pardiso, self._pardiso_matrix = solver, M
-        solver._check_A(M)
-        solver.set_phase(12)
+        from ._pardiso import PardisoError, PardisoFactor
+
+        M = A if (self.upper or not self.symmetric) else _upper_triangle(A)
+        if not np.diff(M.indptr).all():        # MKL crashes on an empty row instead of failing
+            row = int(np.flatnonzero(np.diff(M.indptr) == 0)[0])
+            raise SolverError(f"the matrix is singular: row {row} has no stored entries.")
         try:
-            solver._call_pardiso(M, np.zeros((M.shape[0], 1)))
-        except Exception as exc:
+            self._pardiso = PardisoFactor(M, symmetric=self.symmetric)
+        except PardisoError as exc:
             raise SolverError(f"PARDISO could not factor the matrix ({exc}); it may be singular.") from None
-
-        def solve(b):
-            # One call per column: MKL's multi-right-hand-side solve took 0.09-0.16 s for three
-            # columns at 100k unknowns (2 cores) against 0.03 s for three single-column calls.
-            solver.set_phase(33)
-            if b.ndim == 1:
-                return solver._call_pardiso(M, np.ascontiguousarray(b, dtype=np.float64))
-            x = np.empty(b.shape)
-            for j in range(b.shape[1]):
-                x[:, j] = solver._call_pardiso(M, np.ascontiguousarray(b[:, j], dtype=np.float64))
-            return x
-
-        self._solve = solve
+        self._solve = self._pardiso.solve
 
     def _factor_cholmod(self, A):
         from sksparse import cholmod
@@ -296,16 +256,9 @@ class Factorization:
                               "numerically degenerate (check for collapsed triangles).")
         return x
 
-    def __del__(self):
-        solver = getattr(self, "_pardiso", None)
-        if solver is not None:
-            try:
-                solver.free_memory(everything=False)
-            except Exception:
-                pass
 
 
-def factorize(A, *, symmetric=True, backend="auto"):
+def factorize(A, *, symmetric=True, backend="auto", upper=False):
     """Factor ``A`` once; ``.solve(b)`` then back-substitutes. See :class:`Factorization`.
 
     Parameters
@@ -313,6 +266,7 @@ def factorize(A, *, symmetric=True, backend="auto"):
     A : (n, n) scipy.sparse matrix
     symmetric : bool   True for a symmetric positive definite ``A`` (Cholesky-type factorization)
     backend : str      ``"auto"``, ``"pardiso"``, ``"cholmod"``, ``"splu"`` or ``"banded"``
+    upper : bool       ``A`` is the upper triangle (diagonal included) of a symmetric matrix
 
     Returns
     -------
@@ -331,4 +285,4 @@ def factorize(A, *, symmetric=True, backend="auto"):
     >>> bool(np.allclose(A @ x, 1.0))
     True
     """
-    return Factorization(A, symmetric=symmetric, backend=backend)
+    return Factorization(A, symmetric=symmetric, backend=backend, upper=upper)
