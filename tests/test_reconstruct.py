@@ -229,18 +229,23 @@ def test_docstring_example_runs():
 
 
 @pytest.mark.parametrize("keep_every", [1, 2, 3, 7])
-def test_principal_upper_triangle_is_the_sliced_upper_triangle(keep_every):
+def test_free_system_is_the_sliced_matrix(keep_every):
     import scipy.sparse as sp
 
-    from curvdetail.curvature.reconstruct import _principal_upper_triangle
+    from curvdetail.curvature.reconstruct import _free_system
 
     V, F = grid(9, 7)
     V[:, 2] = np.sin(V[:, 0]) * V[:, 1]
     L = cotan_laplacian(V, F)
-    keep = np.arange(V.shape[0]) % keep_every != 1 if keep_every > 1 else np.ones(V.shape[0], bool)
-    expected = sp.triu(L[keep][:, keep], format="csr")
+    n = V.shape[0]
+    is_free = np.arange(n) % keep_every != 1 if keep_every > 1 else np.ones(n, bool)
+    is_free[[4, 30]] = False
+    fixed = np.flatnonzero(~is_free)[::-1]               # the caller's order, not increasing
+    expected = sp.triu(L[is_free][:, is_free], format="csr")
     expected.sort_indices()
-    got = _principal_upper_triangle(sp.triu(L, k=1, format="csr"), L.diagonal(), keep)
-    assert got.shape == expected.shape
-    assert np.array_equal(got.indptr, expected.indptr) and np.array_equal(got.indices, expected.indices)
-    assert np.array_equal(got.data, expected.data)
+    upper, L_fc = _free_system(sp.triu(L, k=1, format="csr"), L.diagonal(), is_free, fixed)
+    assert upper.shape == expected.shape
+    assert np.array_equal(upper.indptr, expected.indptr) and np.array_equal(upper.indices, expected.indices)
+    assert np.array_equal(upper.data, expected.data)
+    assert L_fc.shape == (is_free.sum(), fixed.size)
+    assert np.array_equal(L_fc.toarray(), L[is_free][:, fixed].toarray())
