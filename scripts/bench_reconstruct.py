@@ -353,12 +353,15 @@ def main(argv=None):
                              "machine is shared)")
     parser.add_argument("--force", action="store_true",
                         help="also run the cases left out by default (naive spsolve and CHOLMOD at 1M)")
+    parser.add_argument("--trials", type=int, default=None,
+                        help="factor + solve runs per case, the fastest kept (default 2, 1 at 1M)")
     parser.add_argument("--case", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
 
     if args.case:
         case = json.loads(args.case)
-        print(json.dumps(run_case(case["surface"], case["size"], case["rows"], case["method"])))
+        print(json.dumps(run_case(case["surface"], case["size"], case["rows"], case["method"],
+                                  trials=case.get("trials"))))
         return 0
 
     import scipy
@@ -382,6 +385,8 @@ def main(argv=None):
                 for method in methods:
                     case = {"surface": surface, "size": size, "rows": rows, "method": method}
                     results = [r for r in results if any(r[k] != v for k, v in case.items())]
+                    if args.trials:
+                        case["trials"] = args.trials
                     if method not in available:
                         r = dict(case, skipped=f"{method} is not installed")
                     elif (method, size) in SKIP and not args.force:

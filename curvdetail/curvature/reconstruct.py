@@ -94,7 +94,6 @@ class Reconstructor:
         self.free = np.flatnonzero(is_free)
         if rows == "all":
             L = _symmetric_from_upper(U, diagonal)
-            self._L = L
             self._L_c = L[self.fixed].T.tocsr()                  # (n, k) columns of the fixed ones
                                                                  # (= rows, L is symmetric)
             # L is symmetric, so L_:f = L_f:^T and the normal matrix L_:f^T L_:f is L_f: L_f:^T
@@ -138,11 +137,14 @@ class Reconstructor:
             return X
         # Normal equations L_:f^T L_:f X_f = L_:f^T r with r = D - L_:c X_c, then corrected
         # semi-normal refinement: the correction is computed from the least-squares residual
-        # D - L X itself (not from the normal-equation residual, which carries the squared
-        # condition number), which brings the error from ~cond(L_:f)^2 eps to ~cond(L_:f) eps.
-        X[self.free] = self._factor.solve(self._L_f @ (D - self._L_c @ Xc))
+        # D - L X = r - L_:f X_f itself (not from the normal-equation residual, which carries the
+        # squared condition number), which brings the error from ~cond(L_:f)^2 eps to
+        # ~cond(L_:f) eps. L_:f is L_f:^T (L is symmetric).
+        r = D - self._L_c @ Xc
+        X_f = self._factor.solve(self._L_f @ r)
         for _ in range(self.refinement_steps):
-            X[self.free] += self._factor.solve(self._L_f @ (D - self._L @ X))
+            X_f += self._factor.solve(self._L_f @ (r - self._L_f.T @ X_f))
+        X[self.free] = X_f
         return X
 
 
