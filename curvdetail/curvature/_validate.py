@@ -269,6 +269,8 @@ def as_values(values, count, name):
         raise ConstraintError(f"{name} could not be read as a float array ({exc}).") from None
     if arr.shape != (count, 3):
         raise ConstraintError(f"{name} has shape {arr.shape}; expected ({count}, 3), one row per vertex.")
+    if np.isfinite(arr).all():      # one flat pass; the per-row search below only on failure
+        return np.ascontiguousarray(arr)
     bad = np.flatnonzero(~np.isfinite(arr).all(axis=1))
     if bad.size:
         raise ConstraintError(f"{name}: {bad.size} rows are NaN or infinite (first: {first_indices(bad)}).")
