@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from curvdetail import ConstraintError, MeshError, boundary_vertices, minimal_surface
+from curvdetail import (ConstraintError, MeshError, available_backends, boundary_vertices, cotan_laplacian,
+                        minimal_surface)
 from curvdetail.curvature._validate import bbox_diagonal, face_double_areas
 from curvdetail.curvature.testing import cylinder, grid
 
@@ -118,3 +119,25 @@ def test_result_is_scale_equivariant(load_mesh):
 
 def test_docstring_example_runs():
     assert doctest.testmod(importlib.import_module("curvdetail.curvature.minimal_surface")).failed == 0
+
+
+@pytest.mark.parametrize("backend", available_backends())
+def test_steps_are_the_textbook_iteration_with_one_symbolic_analysis(load_mesh, backend):
+    # three Pinkall-Polthier steps written out with scipy's spsolve, against minimal_surface,
+    # which factors once and then only refactors the numeric values on the same pattern
+    import scipy.sparse.linalg as spla
+
+    from curvdetail.curvature import sparse_solver
+
+    V, F = load_mesh("mannequin_nose.obj")
+    fixed = boundary_vertices(F)
+    free = np.setdiff1d(np.arange(V.shape[0]), fixed)
+    X = V.copy()
+    for _ in range(3):
+        L = cotan_laplacian(X, F).tocsr()
+        X = X.copy()
+        X[free] = spla.spsolve(L[free][:, free].tocsc(), -(L[free][:, fixed] @ X[fixed]))
+    before = sparse_solver.factorization_count
+    got = minimal_surface(V, F, fixed, max_iterations=3, tol=1e-300, backend=backend)
+    assert got.iterations == 3 and sparse_solver.factorization_count == before + 3
+    assert np.abs(got - X).max() < 1e-10 * np.abs(V).max()

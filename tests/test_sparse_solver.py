@@ -201,3 +201,29 @@ def test_docstring_examples_run():
     import importlib
 
     assert doctest.testmod(importlib.import_module("curvdetail.curvature.sparse_solver"), optionflags=doctest.ELLIPSIS).failed == 0
+
+
+@pytest.mark.parametrize("upper", [False, True])
+@pytest.mark.parametrize("backend", available_backends())
+def test_refactor_solves_like_a_fresh_factorization(backend, upper):
+    A, x = _spd_system(30)
+    B = (A + sp.diags(np.linspace(0.5, 2.0, A.shape[0]))).tocsr()    # same pattern, new values
+    pick = (lambda M: sp.triu(M, format="csr")) if upper else (lambda M: M)
+    fac = factorize(pick(A), backend=backend, upper=upper)
+    before = sparse_solver.factorization_count
+    fac.refactor(pick(B))
+    assert sparse_solver.factorization_count == before + 1
+    fresh = factorize(pick(B), backend=backend, upper=upper).solve(B @ x)
+    assert np.abs(fac.solve(B @ x) - x).max() < 1e-9 * np.abs(x).max()
+    assert np.abs(fac.solve(B @ x) - fresh).max() < 1e-9 * np.abs(x).max()
+
+
+@pytest.mark.parametrize("backend", available_backends())
+def test_refactor_refuses_another_pattern_or_shape(backend):
+    A, _ = _spd_system(12)
+    fac = factorize(A, backend=backend)
+    other = (A + sp.eye(A.shape[0], k=5)).tocsr()
+    with pytest.raises(SolverError, match="stored sparsity pattern"):
+        fac.refactor(other + other.T)
+    with pytest.raises(SolverError, match="shape"):
+        fac.refactor(sp.eye(3))

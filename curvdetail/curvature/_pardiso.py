@@ -87,6 +87,17 @@ class PardisoFactor:
         self._holds_memory = True                     # from the first call on, even a failed one
         self._call(12, np.zeros(n), np.zeros(n))     # analysis and numeric factorization
 
+    def refactor(self, M):
+        """Numeric factorization of new values on the stored pattern (PARDISO phase 22: the
+        ordering and symbolic analysis are kept)."""
+        same = (M.shape[0] == self._n and np.array_equal(M.indptr, self._indptr)
+                and np.array_equal(M.indices, self._indices))
+        if not same:
+            raise ValueError("refactor needs the stored sparsity pattern of the first matrix "
+                             "(explicit zeros included); factor a new system from scratch instead.")
+        self._data = np.ascontiguousarray(M.data, dtype=np.float64)
+        self._call(22, np.zeros(self._n), np.zeros(self._n))
+
     def _call(self, phase, b, x, columns=1):
         error = ctypes.c_int32(0)
         one = ctypes.c_int32(1)

@@ -2,10 +2,12 @@
 
 import numpy as np
 
-from ._validate import (as_index_set, bbox_diagonal, check_every_component_fixed, check_mesh,
-                        face_double_areas, ZERO_AREA_RELATIVE)
-from .cotan_laplacian import _cotan_laplacian_unchecked
+from ._geometry import corner_cotangents
+from ._validate import (as_index_set, bbox_diagonal, check_every_component_fixed, face_double_areas,
+                        ZERO_AREA_RELATIVE)
+from .cotan_laplacian import _assemble_upper, checked_cotan_triangle
 from .errors import ConstraintError, MeshError, first_indices
+from .reconstruct import _free_system
 from .sparse_solver import factorize
 
 
@@ -80,29 +82,39 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, backend
     >>> bool(abs(X[:, 2]).max() < 1e-9)      # the plane spanned by a planar boundary
     True
     """
-    V, F = check_mesh(V, F)
+    V, F, U, diagonal = checked_cotan_triangle(V, F)     # every mesh check; L of the first step
     n = V.shape[0]
     fixed = as_index_set(fixed, n, "fixed")
     if fixed.size == 0:
         raise ConstraintError("no fixed vertices: a minimal surface needs a fixed boundary; pass e.g. "
                               "boundary_vertices(F).")
-    check_every_component_fixed(F, n, fixed)
+    check_every_component_fixed(F, n, fixed, adjacency=U)
     if int(max_iterations) < 1:
         raise ValueError(f"max_iterations={max_iterations} must be at least 1.")
     if not (np.isfinite(tol) and tol > 0):
         raise ValueError(f"tol={tol} must be a positive number (relative to the bbox diagonal).")
-    free = np.setdiff1d(np.arange(n), fixed)
+    is_free = np.ones(n, dtype=bool)
+    is_free[fixed] = False
+    free = np.flatnonzero(is_free)
     diag = bbox_diagonal(V)
+    factor = None
     X = V.copy()
     converged = free.size == 0
     step = full_step = 0.0 if converged else np.inf
     it = 0
     while not converged and it < int(max_iterations):
-        L = _cotan_laplacian_unchecked(X, F)
-        Lf = L[free]
-        rhs = -(Lf[:, fixed] @ X[fixed])
+        if it > 0:                          # weights of the current surface
+            cot, _, _ = corner_cotangents(X, F, lengths=False)
+            U, diagonal = _assemble_upper(X, F, cot, check_manifold=False)
+        system, L_fc = _free_system(U, diagonal, is_free, fixed)
+        # the pattern of L_ff never changes: the solver keeps its ordering and symbolic analysis
+        # and redoes only the numeric factorization (PARDISO, 1M vertices: ~1.5 of ~5.5 s)
+        if factor is None:
+            factor = factorize(system, symmetric=True, backend=backend, upper=True)
+        else:
+            factor.refactor(system)
         X_new = X.copy()
-        X_new[free] = factorize(Lf[:, free], symmetric=True, backend=backend).solve(rhs)
+        X_new[free] = factor.solve(-(L_fc @ X[fixed]))
         dbl = face_double_areas(X_new, F)
         collapsed = np.flatnonzero(dbl <= 2.0 * ZERO_AREA_RELATIVE * diag ** 2)
         if collapsed.size:

@@ -160,10 +160,59 @@ class Factorization:
             self._solve = lambda b: np.zeros_like(b)
             return
         A.sort_indices()
-        if upper and self.backend != "pardiso":
+        self._pattern = (A.indptr.copy(), A.indices.copy())    # for refactor
+        getattr(self, "_factor_" + self.backend)(self._as_backend_wants(A))
+
+    def _as_backend_wants(self, A):
+        A.sort_indices()
+        if self.upper and self.backend != "pardiso":
             A = (A + sp.triu(A, k=1, format="csr").T).tocsr()     # the other backends take it whole
             A.sort_indices()
-        getattr(self, "_factor_" + self.backend)(A)
+        return A
+
+    def refactor(self, A):
+        """Factor new values that have the sparsity pattern of the matrix factored first.
+
+        PARDISO keeps its fill-reducing ordering and symbolic analysis and redoes only the
+        numeric factorization (at 1M unknowns ~1.5 s of a 5-6 s factorization); the other
+        backends factor afresh. For iterations whose matrix changes only in its values, such
+        as :func:`minimal_surface`.
+
+        Parameters
+        ----------
+        A : (n, n) scipy.sparse matrix   same shape, stored pattern and ``upper`` convention as
+                                         the first matrix (explicit zeros count as stored)
+
+        Raises
+        ------
+        SolverError   the shape or the stored pattern differs, or the factorization fails
+        """
+        global factorization_count
+        A = sp.csr_matrix(A, dtype=np.float64)
+        if A.shape != self.shape:
+            raise SolverError(f"refactor needs a matrix of shape {self.shape}, not {A.shape}; "
+                              "use factorize for a new system.")
+        if A.shape[0] == 0:
+            factorization_count += 1
+            return
+        A.sort_indices()
+        if not (np.array_equal(A.indptr, self._pattern[0]) and np.array_equal(A.indices, self._pattern[1])):
+            raise SolverError("refactor needs the stored sparsity pattern of the first matrix (explicit "
+                              "zeros included); use factorize for a system with another pattern.")
+        factorization_count += 1
+        A = self._as_backend_wants(A)
+        if self.backend != "pardiso":
+            getattr(self, "_factor_" + self.backend)(A)
+            return
+        from ._pardiso import PardisoError
+
+        M = A if (self.upper or not self.symmetric) else _upper_triangle(A)
+        try:
+            self._pardiso.refactor(M)
+        except ValueError as exc:            # another pattern
+            raise SolverError(str(exc)) from None
+        except PardisoError as exc:
+            raise SolverError(f"PARDISO could not factor the matrix ({exc}); it may be singular.") from None
 
     # -- backends ---------------------------------------------------------------------------
     def _factor_pardiso(self, A):
