@@ -52,9 +52,10 @@ class PardisoFactor:
     M : (n, n) scipy.sparse.csr_matrix with sorted indices; for ``symmetric=True`` its upper
         triangle only, diagonal included (PARDISO's storage for symmetric matrices)
     symmetric : bool   real symmetric positive definite (mtype 2) or real nonsymmetric (mtype 11)
+    analyze_only : bool   stop after the symbolic analysis; :meth:`factor_values` finishes
     """
 
-    def __init__(self, M, *, symmetric):
+    def __init__(self, M, *, symmetric, analyze_only=False):
         n = M.shape[0]
         # kept referenced: PARDISO reads them again in every solve
         self._data = np.ascontiguousarray(M.data, dtype=np.float64)
@@ -85,7 +86,14 @@ class PardisoFactor:
         iparm[34] = 1   # zero-based indices
         self.iparm = iparm
         self._holds_memory = True                     # from the first call on, even a failed one
-        self._call(12, np.zeros(n), np.zeros(n))     # analysis and numeric factorization
+        # 11: ordering and symbolic analysis (reads the pattern only); 12: both phases
+        self._call(11 if analyze_only else 12, np.zeros(n), np.zeros(n))
+
+    def factor_values(self, data):
+        """Numeric factorization (phase 22) with ``data``, the values of the analysed pattern in
+        its order."""
+        self._data = np.ascontiguousarray(data, dtype=np.float64)
+        self._call(22, np.zeros(self._n), np.zeros(self._n))
 
     def refactor(self, M):
         """Numeric factorization of new values on the stored pattern (PARDISO phase 22: the
@@ -95,8 +103,7 @@ class PardisoFactor:
         if not same:
             raise ValueError("refactor needs the stored sparsity pattern of the first matrix "
                              "(explicit zeros included); factor a new system from scratch instead.")
-        self._data = np.ascontiguousarray(M.data, dtype=np.float64)
-        self._call(22, np.zeros(self._n), np.zeros(self._n))
+        self.factor_values(M.data)
 
     def _call(self, phase, b, x, columns=1):
         error = ctypes.c_int32(0)

@@ -7,7 +7,7 @@ from ._validate import (as_index_set, bbox_diagonal, check_every_component_fixed
                         ZERO_AREA_RELATIVE)
 from .cotan_laplacian import _assemble_upper, checked_cotan_triangle
 from .errors import ConstraintError, MeshError, first_indices
-from .reconstruct import _free_system
+from .reconstruct import _FreeSystemLayout
 from .sparse_solver import factorize
 
 
@@ -98,6 +98,7 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, backend
     free = np.flatnonzero(is_free)
     diag = bbox_diagonal(V)
     factor = None
+    layout = _FreeSystemLayout(U, is_free, fixed)    # the same for every step: F does not change
     X = V.copy()
     converged = free.size == 0
     step = full_step = 0.0 if converged else np.inf
@@ -106,7 +107,7 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, backend
         if it > 0:                          # weights of the current surface
             cot, _, _ = corner_cotangents(X, F, lengths=False)
             U, diagonal = _assemble_upper(X, F, cot, check_manifold=False)
-        system, L_fc = _free_system(U, diagonal, is_free, fixed)
+        system, L_fc = layout.values(U, diagonal)
         # the pattern of L_ff never changes: the solver keeps its ordering and symbolic analysis
         # and redoes only the numeric factorization (PARDISO, 1M vertices: ~1.5 of ~5.5 s)
         if factor is None:

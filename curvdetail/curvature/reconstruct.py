@@ -3,10 +3,10 @@
 import numpy as np
 import scipy.sparse as sp
 
-from ._validate import as_index_set, as_values, check_every_component_fixed
-from .cotan_laplacian import _symmetric_from_upper, checked_cotan_triangle
+from ._validate import as_faces, as_index_set, as_values, as_vertices, check_every_component_fixed
+from .cotan_laplacian import _edge_pattern, _symmetric_from_upper, checked_cotan_triangle
 from .errors import ConstraintError
-from .sparse_solver import factorize
+from .sparse_solver import SMALL_SYSTEM_NNZ, PendingFactorization, factorize, resolve_backend
 
 ROW_MODES = ("all", "free")
 
@@ -72,7 +72,6 @@ class Reconstructor:
     refinement_steps = 1
 
     def __init__(self, V_ref, F, fixed, *, rows="all", backend="auto", refinement_steps=None):
-        V_ref, F, U, diagonal = checked_cotan_triangle(V_ref, F)
         if rows not in ROW_MODES:
             raise ValueError(f"rows={rows!r} is not a row mode; use 'all' (the paper's E_Q) or 'free'.")
         if refinement_steps is not None:
@@ -81,8 +80,27 @@ class Reconstructor:
                 raise ValueError(f"refinement_steps={refinement_steps!r} must be a whole number >= 0 "
                                  "(1, the default, gives solver precision; 0 skips the refinement).")
             self.refinement_steps = int(refinement_steps)
+        self.rows = rows
+        started = _start_free_factorization(V_ref, F, fixed, backend) if rows == "free" else None
+        try:
+            system = self._build(V_ref, F, fixed, started)
+        except BaseException:
+            if started is not None:
+                started[1].cancel()
+            raise
+        if not self.free.size:
+            self._factor = None
+        elif started is not None:
+            self._factor = started[1].finish(system.data)
+        else:
+            self._factor = factorize(system, symmetric=True, backend=backend, upper=rows == "free")
+        self.backend = self._factor.backend if self._factor is not None else "none"
+
+    def _build(self, V_ref, F, fixed, started):
+        """Every check, then the system to factor (``rows="free"``: its upper triangle)."""
+        V_ref, F, U, diagonal = checked_cotan_triangle(V_ref, F)
         n = V_ref.shape[0]
-        self.n, self.rows = n, rows
+        self.n = n
         self.fixed = as_index_set(fixed, n, "fixed")
         if self.fixed.size == 0:
             raise ConstraintError("no fixed vertices: the reconstruction is only determined up to a "
@@ -92,22 +110,19 @@ class Reconstructor:
         is_free = np.ones(n, dtype=bool)
         is_free[self.fixed] = False
         self.free = np.flatnonzero(is_free)
-        if rows == "all":
-            L = _symmetric_from_upper(U, diagonal)
-            self._L_c = L[self.fixed].T.tocsr()                  # (n, k) columns of the fixed ones
-                                                                 # (= rows, L is symmetric)
-            # L is symmetric, so L_:f = L_f:^T and the normal matrix L_:f^T L_:f is L_f: L_f:^T
-            self._L_f = L[self.free]                             # (f, n) rows of the free vertices
-            system, upper = self._L_f @ self._L_f.T, False
-        else:
+        if self.rows == "free":
             # the solvers take the upper triangle of L_ff: cut it, and L_fc, straight from U
             # (1M vertices: 0.15 s, against 0.45 s for building L, slicing it and cutting L_ff's
             # triangle)
-            system, self._L_fc = _free_system(U, diagonal, is_free, self.fixed)
-            upper = True
-        self._factor = (factorize(system, symmetric=True, backend=backend, upper=upper)
-                        if self.free.size else None)
-        self.backend = self._factor.backend if self._factor is not None else "none"
+            layout = started[0] if started is not None else _FreeSystemLayout(U, is_free, self.fixed)
+            system, self._L_fc = layout.values(U, diagonal)
+            return system
+        L = _symmetric_from_upper(U, diagonal)
+        self._L_c = L[self.fixed].T.tocsr()                      # (n, k) columns of the fixed ones
+                                                                 # (= rows, L is symmetric)
+        # L is symmetric, so L_:f = L_f:^T and the normal matrix L_:f^T L_:f is L_f: L_f:^T
+        self._L_f = L[self.free]                                 # (f, n) rows of the free vertices
+        return self._L_f @ self._L_f.T
 
     def solve(self, detail, fixed_positions):
         """Positions whose detail best matches ``detail``, by back-substitution only.
@@ -152,40 +167,90 @@ class Reconstructor:
         return X
 
 
+#: From this many free vertices, ``rows="free"`` with PARDISO starts the solver's ordering and
+#: symbolic analysis from the mesh's edges alone, in a background thread, while the checks and
+#: the Laplacian's values are computed (see :func:`_start_free_factorization`).
+OVERLAP_MIN_FREE = 50_000
+
+
+def _start_free_factorization(V_ref, F, fixed, backend):
+    """``(layout, PendingFactorization)`` for ``rows="free"``: the pattern of ``L_ff``'s upper
+    triangle depends on the triangles and the fixed set only, so PARDISO can order and analyse
+    it (~2/3 of its factorization time at 1M unknowns, on both cores but not fully) while this
+    thread checks the mesh and assembles the values. None where that does not pay (small
+    systems, another backend) or the input is malformed: the checks in their usual order then
+    report it. (A check that fails after the start waits for the analysis to end.)"""
+    try:
+        V = as_vertices(V_ref)
+        n = V.shape[0]
+        F = as_faces(F, n)
+        fixed = as_index_set(fixed, n, "fixed")
+    except ValueError:
+        return None
+    free = n - fixed.size
+    if fixed.size == 0 or free < OVERLAP_MIN_FREE or \
+            resolve_backend(backend, symmetric=True, size=free, nnz=SMALL_SYSTEM_NNZ) != "pardiso":
+        return None
+    is_free = np.ones(n, dtype=bool)
+    is_free[fixed] = False
+    layout = _FreeSystemLayout(_edge_pattern(F, n), is_free, fixed)
+    return layout, PendingFactorization(layout.pattern, backend=backend)
+
+
+class _FreeSystemLayout:
+    """Where the entries of a symmetric ``L``, given by its strict upper triangle ``U`` (CSR,
+    sorted) and diagonal, go in the free-row system: the upper triangle, diagonal included, of
+    ``L[free][:, free]`` (CSR, sorted, renumbered to ``0 .. f - 1``) and ``L[free][:, fixed]``
+    (CSR, columns in the order of ``fixed``). Built from ``U``'s pattern alone, so that it serves
+    every ``U`` with that pattern (the steps of :func:`minimal_surface`)."""
+
+    def __init__(self, U, is_free, fixed):
+        n = U.shape[0]
+        index = U.indices.dtype
+        self._indptr_U, self._indices_U = U.indptr, U.indices
+        rows = np.repeat(np.arange(n, dtype=index), np.diff(U.indptr))
+        row_free, col_free = is_free[rows], is_free[U.indices]
+        self._kept = row_free & col_free
+        renumber = (np.cumsum(is_free) - 1).astype(index)
+        r, c = renumber[rows[self._kept]], renumber[U.indices[self._kept]]
+        f = int(renumber[-1]) + 1 if n else 0
+        indptr = np.zeros(f + 1, dtype=index)
+        np.cumsum(np.bincount(r, minlength=f) + 1, out=indptr[1:])
+        cols = np.empty(indptr[-1], dtype=index)
+        # each row: its diagonal first, then its entries in their (increasing) order; the k-th
+        # kept entry, in row r, follows k entries and the r + 1 diagonals of rows 0..r
+        cols[indptr[:-1]] = np.arange(f, dtype=index)
+        self._at = np.arange(r.size, dtype=np.int64) + r + 1
+        cols[self._at] = c
+        self.pattern = sp.csr_matrix((np.zeros(cols.size), cols, indptr), shape=(f, f))
+        self._is_free = is_free
+        # L_fc: the edges between a free and a fixed vertex, from either side of the triangle
+        position = np.empty(n, dtype=np.int64)
+        position[fixed] = np.arange(fixed.size)
+        self._mixed = np.flatnonzero(row_free != col_free)
+        a, b = rows[self._mixed], U.indices[self._mixed]
+        free_end = np.where(row_free[self._mixed], a, b)
+        fixed_end = np.where(row_free[self._mixed], b, a)
+        self._L_fc_index = (renumber[free_end], position[fixed_end])
+        self._L_fc_shape = (f, fixed.size)
+
+    def values(self, U, diagonal):
+        """``(upper triangle of L_ff, L_fc)`` for a ``U`` with the layout's pattern."""
+        if not (U.indptr is self._indptr_U or np.array_equal(U.indptr, self._indptr_U)) or \
+                not (U.indices is self._indices_U or np.array_equal(U.indices, self._indices_U)):
+            raise RuntimeError("internal error: the strict upper triangle changed its pattern")
+        data = np.empty(self.pattern.nnz)
+        data[self.pattern.indptr[:-1]] = diagonal[self._is_free]
+        data[self._at] = U.data[self._kept]
+        upper = sp.csr_matrix((data, self.pattern.indices, self.pattern.indptr), shape=self.pattern.shape)
+        upper.has_sorted_indices = True
+        L_fc = sp.csr_matrix((U.data[self._mixed], self._L_fc_index), shape=self._L_fc_shape)
+        return upper, L_fc
+
+
 def _free_system(U, diagonal, is_free, fixed):
-    """The free-row system of a symmetric ``L`` given by its strict upper triangle ``U`` (CSR,
-    sorted) and ``diagonal``: the upper triangle, diagonal included, of ``L[free][:, free]`` (CSR,
-    sorted, renumbered to ``0 .. f - 1``), and ``L[free][:, fixed]`` (CSR, columns in the order of
-    ``fixed``)."""
-    n = U.shape[0]
-    index = U.indices.dtype
-    rows = np.repeat(np.arange(n, dtype=index), np.diff(U.indptr))
-    row_free, col_free = is_free[rows], is_free[U.indices]
-    kept = row_free & col_free
-    renumber = (np.cumsum(is_free) - 1).astype(index)
-    r, c, v = renumber[rows[kept]], renumber[U.indices[kept]], U.data[kept]
-    f = int(renumber[-1]) + 1 if n else 0
-    indptr = np.zeros(f + 1, dtype=index)
-    np.cumsum(np.bincount(r, minlength=f) + 1, out=indptr[1:])
-    data = np.empty(indptr[-1])
-    cols = np.empty(indptr[-1], dtype=index)
-    # each row: its diagonal first, then its entries in their (increasing) order; the k-th kept
-    # entry, in row r, follows k entries and the r + 1 diagonals of rows 0..r
-    cols[indptr[:-1]] = np.arange(f, dtype=index)
-    data[indptr[:-1]] = diagonal[is_free]
-    at = np.arange(v.size, dtype=np.int64) + r + 1
-    cols[at] = c
-    data[at] = v
-    upper = sp.csr_matrix((data, cols, indptr), shape=(f, f))
-    # L_fc: the edges between a free and a fixed vertex, from either side of the triangle
-    position = np.empty(n, dtype=np.int64)
-    position[fixed] = np.arange(fixed.size)
-    mixed = np.flatnonzero(row_free != col_free)
-    a, b = rows[mixed], U.indices[mixed]
-    free_end = np.where(row_free[mixed], a, b)
-    fixed_end = np.where(row_free[mixed], b, a)
-    L_fc = sp.csr_matrix((U.data[mixed], (renumber[free_end], position[fixed_end])), shape=(f, fixed.size))
-    return upper, L_fc
+    """``(upper triangle of L_ff, L_fc)``, see :class:`_FreeSystemLayout`."""
+    return _FreeSystemLayout(U, is_free, fixed).values(U, diagonal)
 
 
 def reconstruct(V_ref, F, detail, fixed, fixed_positions, *, rows="all", backend="auto"):
