@@ -227,3 +227,24 @@ def test_refactor_refuses_another_pattern_or_shape(backend):
         fac.refactor(other + other.T)
     with pytest.raises(SolverError, match="shape"):
         fac.refactor(sp.eye(3))
+
+
+@pytest.mark.parametrize("backend", available_backends())
+def test_pending_factorization_finishes_like_factorize(backend):
+    A, x = _spd_system(30)
+    U = sp.triu(A, format="csr")
+    U.sort_indices()
+    pattern = sp.csr_matrix((np.zeros(U.nnz), U.indices, U.indptr), shape=U.shape)
+    pending = sparse_solver.PendingFactorization(pattern, backend=backend)
+    fac = pending.finish(U.data)
+    assert fac.backend == backend
+    assert np.abs(fac.solve(A @ x) - x).max() < 1e-9 * np.abs(x).max()
+    fac.refactor(U)                                      # the same pattern: accepted
+    sparse_solver.PendingFactorization(pattern, backend=backend).cancel()     # nothing left behind
+
+
+@pytest.mark.skipif("pardiso" not in available_backends(), reason="PARDISO (pypardiso) not installed")
+def test_pending_factorization_refuses_an_empty_row():
+    pattern = sp.csr_matrix((np.ones(2), [0, 2], [0, 1, 1, 2]), shape=(3, 3))
+    with pytest.raises(SolverError, match="row 1 has no stored entries"):
+        sparse_solver.PendingFactorization(pattern, backend="pardiso")
