@@ -2,7 +2,8 @@
 
 Backends, chosen automatically in this order where installed:
 
-``"pardiso"``  Intel MKL PARDISO through ``pypardiso`` (x86-64). Fastest and leanest here.
+``"pardiso"``  Intel MKL PARDISO (x86-64; the MKL runtime comes with ``pypardiso``, the calls go
+               through the small ctypes binding in ``_pardiso``). Fastest and leanest here.
 ``"cholmod"``  SuiteSparse CHOLMOD through ``scikit-sparse`` (symmetric positive definite only).
 ``"splu"``     SciPy's SuperLU with ``MMD_AT_PLUS_A`` ordering and symmetric mode (everywhere).
 ``"banded"``   LAPACK's banded Cholesky (``scipy.linalg.cholesky_banded``) in reverse
@@ -14,6 +15,10 @@ Cholesky for small symmetric systems with dense rows (see ``BANDED_MAX_SIZE``). 
 overridden per call (``backend="splu"``) or for the whole process with the
 environment variable ``CURVDETAIL_SOLVER``. All backends agree to ~1e-12 relative on the
 systems used here.
+
+A :class:`Factorization` refactors new values on the same pattern (:meth:`Factorization.refactor`:
+PARDISO keeps its ordering and symbolic analysis), and a :class:`PendingFactorization` starts
+PARDISO's analysis from the pattern alone while the caller computes the values.
 """
 
 import os
