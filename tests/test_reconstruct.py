@@ -232,7 +232,7 @@ def test_docstring_example_runs():
 def test_free_system_is_the_sliced_matrix(keep_every):
     import scipy.sparse as sp
 
-    from curvdetail.curvature.reconstruct import _free_system
+    from curvdetail.curvature.reconstruct import _FreeSystemLayout
 
     V, F = grid(9, 7)
     V[:, 2] = np.sin(V[:, 0]) * V[:, 1]
@@ -243,7 +243,8 @@ def test_free_system_is_the_sliced_matrix(keep_every):
     fixed = np.flatnonzero(~is_free)[::-1]               # the caller's order, not increasing
     expected = sp.triu(L[is_free][:, is_free], format="csr")
     expected.sort_indices()
-    upper, L_fc = _free_system(sp.triu(L, k=1, format="csr"), L.diagonal(), is_free, fixed)
+    U = sp.triu(L, k=1, format="csr")
+    upper, L_fc = _FreeSystemLayout(U, is_free, fixed).values(U, L.diagonal())
     assert upper.shape == expected.shape
     assert np.array_equal(upper.indptr, expected.indptr) and np.array_equal(upper.indices, expected.indices)
     assert np.array_equal(upper.data, expected.data)

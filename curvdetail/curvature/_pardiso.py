@@ -95,16 +95,6 @@ class PardisoFactor:
         self._data = np.ascontiguousarray(data, dtype=np.float64)
         self._call(22, np.zeros(self._n), np.zeros(self._n))
 
-    def refactor(self, M):
-        """Numeric factorization of new values on the stored pattern (PARDISO phase 22: the
-        ordering and symbolic analysis are kept)."""
-        same = (M.shape[0] == self._n and np.array_equal(M.indptr, self._indptr)
-                and np.array_equal(M.indices, self._indices))
-        if not same:
-            raise ValueError("refactor needs the stored sparsity pattern of the first matrix "
-                             "(explicit zeros included); factor a new system from scratch instead.")
-        self.factor_values(M.data)
-
     def _call(self, phase, b, x, columns=1):
         error = ctypes.c_int32(0)
         one = ctypes.c_int32(1)

@@ -252,11 +252,6 @@ class _FreeSystemLayout:
         return upper, L_fc
 
 
-def _free_system(U, diagonal, is_free, fixed):
-    """``(upper triangle of L_ff, L_fc)``, see :class:`_FreeSystemLayout`."""
-    return _FreeSystemLayout(U, is_free, fixed).values(U, diagonal)
-
-
 def reconstruct(V_ref, F, detail, fixed, fixed_positions, *, rows="all", backend="auto"):
     """Rebuild positions from curvature detail with some vertices fixed (one-off solve).
 

@@ -213,9 +213,7 @@ class Factorization:
 
         M = A if (self.upper or not self.symmetric) else _upper_triangle(A)
         try:
-            self._pardiso.refactor(M)
-        except ValueError as exc:            # another pattern
-            raise SolverError(str(exc)) from None
+            self._pardiso.factor_values(M.data)            # the pattern was checked above
         except PardisoError as exc:
             raise SolverError(f"PARDISO could not factor the matrix ({exc}); it may be singular.") from None
 
