@@ -2,8 +2,8 @@
 
 import numpy as np
 
-from ._validate import as_values, boundary_edges, check_mesh
-from .cotan_laplacian import _cotan_laplacian_unchecked
+from ._validate import as_values, boundary_edges
+from .cotan_laplacian import _cotan_laplacian_unchecked, checked_cotan_laplacian
 from .curvature_coefficients import DEFAULT_RCOND
 from .curvature_editor import CurvatureEditor
 from .errors import MeshError
@@ -69,7 +69,7 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
     >>> bool(np.allclose(X[b, 2] - V[b, 2], 0.1 * np.sin(2 * np.pi * 2 * info["arc_length"])))
     True
     """
-    V, F = check_mesh(V, F)
+    V, F, L = checked_cotan_laplacian(V, F)       # every mesh check, and L of the rest shape
     if boundary_detail not in ("deformed", "rest"):
         raise ValueError(f"boundary_detail={boundary_detail!r}; use 'deformed' or 'rest'.")
     loop = boundary_loop(F)
@@ -95,7 +95,6 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
             return X
         return X, {"boundary": loop, "arc_length": s, "boundary_detail": editor.detail[loop],
                    "editor": editor}
-    L = _cotan_laplacian_unchecked(V, F)
     free = np.ones(n, dtype=bool)
     free[loop] = False
     inner = np.flatnonzero(free)
