@@ -20,11 +20,18 @@ _pardiso_function = None
 
 
 def _library_path():
-    """Path of the MKL runtime that importing pypardiso located (it builds one solver, ``ps``)."""
+    """Path of the MKL runtime that pypardiso located: importing it builds one solver (``ps``);
+    a fresh solver looks again where that attribute is missing."""
     import pypardiso
 
-    path = getattr(getattr(getattr(pypardiso, "ps", None), "libmkl", None), "_name", None)
-    return os.environ.get("PYPARDISO_MKL_RT") or path
+    if os.environ.get("PYPARDISO_MKL_RT"):
+        return os.environ["PYPARDISO_MKL_RT"]
+    solver = getattr(pypardiso, "ps", None) or pypardiso.PyPardisoSolver()
+    path = getattr(getattr(solver, "libmkl", None), "_name", None)
+    if not path:
+        raise PardisoError("pypardiso found no MKL runtime (mkl_rt); reinstall pypardiso and mkl, "
+                           "or choose another solver backend")
+    return path
 
 
 def _function():
