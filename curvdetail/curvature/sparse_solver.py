@@ -124,6 +124,14 @@ def resolve_backend(backend="auto", *, symmetric=True, size=None, nnz=None):
     return backend
 
 
+def _refuse_empty_rows(indptr):
+    """MKL PARDISO crashes on a row without stored entries instead of failing: refuse it."""
+    counts = np.diff(indptr)
+    if not counts.all():
+        row = int(np.flatnonzero(counts == 0)[0])
+        raise SolverError(f"the matrix is singular: row {row} has no stored entries.")
+
+
 def _upper_triangle(A):
     """Upper triangle (diagonal included) of a CSR matrix with sorted indices, as CSR; a mask on
     the stored entries, ~2x faster than ``scipy.sparse.triu`` (which goes through COO)."""
@@ -147,7 +155,7 @@ class Factorization:
                        symmetric matrix: PARDISO takes it as it is, which saves extracting it
     """
 
-    def __init__(self, A, *, symmetric=True, backend="auto", upper=False):
+    def __init__(self, A, *, symmetric=True, backend="auto", upper=False, _analysis=None):
         global factorization_count
         A = sp.csr_matrix(A, dtype=np.float64)
         if A.shape[0] != A.shape[1]:
@@ -161,6 +169,9 @@ class Factorization:
         full_nnz = 2 * A.nnz - A.shape[0] if upper else A.nnz     # as stored in full (about)
         self.backend = resolve_backend(backend, symmetric=symmetric, size=A.shape[0], nnz=full_nnz)
         factorization_count += 1
+        # PARDISO's ordering and symbolic analysis of A's pattern, where a PendingFactorization
+        # has run them already; refactor reuses the same
+        self._pardiso = _analysis
         if A.shape[0] == 0:
             self._solve = lambda b: np.zeros_like(b)
             return
@@ -169,7 +180,7 @@ class Factorization:
         getattr(self, "_factor_" + self.backend)(self._as_backend_wants(A))
 
     def _as_backend_wants(self, A):
-        A.sort_indices()
+        """``A`` (sorted) as the backend takes it: the whole matrix, except PARDISO's triangle."""
         if self.upper and self.backend != "pardiso":
             A = (A + sp.triu(A, k=1, format="csr").T).tocsr()     # the other backends take it whole
             A.sort_indices()
@@ -205,28 +216,19 @@ class Factorization:
             raise SolverError("refactor needs the stored sparsity pattern of the first matrix (explicit "
                               "zeros included); use factorize for a system with another pattern.")
         factorization_count += 1
-        A = self._as_backend_wants(A)
-        if self.backend != "pardiso":
-            getattr(self, "_factor_" + self.backend)(A)
-            return
-        from ._pardiso import PardisoError
-
-        M = A if (self.upper or not self.symmetric) else _upper_triangle(A)
-        try:
-            self._pardiso.factor_values(M.data)            # the pattern was checked above
-        except PardisoError as exc:
-            raise SolverError(f"PARDISO could not factor the matrix ({exc}); it may be singular.") from None
+        getattr(self, "_factor_" + self.backend)(self._as_backend_wants(A))
 
     # -- backends ---------------------------------------------------------------------------
     def _factor_pardiso(self, A):
         from ._pardiso import PardisoError, PardisoFactor
 
         M = A if (self.upper or not self.symmetric) else _upper_triangle(A)
-        if not np.diff(M.indptr).all():        # MKL crashes on an empty row instead of failing
-            row = int(np.flatnonzero(np.diff(M.indptr) == 0)[0])
-            raise SolverError(f"the matrix is singular: row {row} has no stored entries.")
+        _refuse_empty_rows(M.indptr)
         try:
-            self._pardiso = PardisoFactor(M, symmetric=self.symmetric)
+            if self._pardiso is None:
+                self._pardiso = PardisoFactor(M, symmetric=self.symmetric)
+            else:                              # analysed before (pattern checked): numeric phase only
+                self._pardiso.factor_values(M.data)
         except PardisoError as exc:
             raise SolverError(f"PARDISO could not factor the matrix ({exc}); it may be singular.") from None
         self._solve = self._pardiso.solve
@@ -339,9 +341,7 @@ class PendingFactorization:
 
             from ._pardiso import PardisoFactor
 
-            if not np.diff(self._indptr).all():
-                row = int(np.flatnonzero(np.diff(self._indptr) == 0)[0])
-                raise SolverError(f"the matrix is singular: row {row} has no stored entries.")
+            _refuse_empty_rows(self._indptr)
             if _background_pool is None:
                 _background_pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="curvdetail-analysis")
             M = sp.csr_matrix((np.zeros(pattern.nnz), self._indices, self._indptr), shape=self.shape)
@@ -350,7 +350,6 @@ class PendingFactorization:
     def finish(self, data):
         """The :class:`Factorization` of the matrix with these values (in the pattern's stored
         order)."""
-        global factorization_count
         A = sp.csr_matrix((np.asarray(data, dtype=np.float64), self._indices, self._indptr), shape=self.shape)
         A.has_sorted_indices = True
         if self._future is None:
@@ -359,16 +358,10 @@ class PendingFactorization:
 
         future, self._future = self._future, None
         try:
-            pardiso = future.result()
-            pardiso.factor_values(A.data)
+            analysis = future.result()
         except PardisoError as exc:
-            raise SolverError(f"PARDISO could not factor the matrix ({exc}); it may be singular.") from None
-        fac = Factorization.__new__(Factorization)
-        fac.shape, fac.symmetric, fac.upper, fac.backend = self.shape, True, True, "pardiso"
-        fac._pattern = (A.indptr.copy(), A.indices.copy())
-        fac._pardiso, fac._solve = pardiso, pardiso.solve
-        factorization_count += 1
-        return fac
+            raise SolverError(f"PARDISO could not analyse the matrix ({exc}).") from None
+        return Factorization(A, symmetric=True, backend="pardiso", upper=True, _analysis=analysis)
 
     def cancel(self):
         """Give up (after an error in the caller): wait for the background analysis to end and
