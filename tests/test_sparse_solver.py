@@ -149,6 +149,22 @@ def test_banded_cholesky_refuses_indefinite_and_oversized_systems(monkeypatch):
         factorize(A, backend="banded")
 
 
+def test_auto_falls_back_to_lu_where_the_banded_cholesky_meets_a_non_positive_pivot(monkeypatch):
+    # a symmetric system with dense rows that is not positive definite: L^T L shifted past its
+    # smallest eigenvalue. "auto" would take the banded Cholesky; it hands over to SuperLU.
+    A, x = _normal_equations(20)
+    smallest = np.linalg.eigvalsh(A.toarray())[:2]
+    A = (A - sp.identity(A.shape[0]) * smallest.mean()).tocsr()
+    fac = factorize(A)
+    assert fac.backend == "splu"
+    assert np.abs(fac.solve(A @ x) - x).max() < 1e-6 * np.abs(x).max()    # cond ~ 1e5
+    with pytest.raises(SolverError, match="not positive definite"):
+        factorize(A, backend="banded")                  # a named backend reports it
+    monkeypatch.setenv("CURVDETAIL_SOLVER", "banded")
+    with pytest.raises(SolverError, match="not positive definite"):
+        factorize(A)
+
+
 def test_environment_variable_overrides_auto(monkeypatch):
     monkeypatch.setenv("CURVDETAIL_SOLVER", "splu")
     assert resolve_backend("auto", size=10 ** 6) == "splu"

@@ -11,7 +11,8 @@ Backends, chosen automatically in this order where installed:
 
 ``"auto"`` takes SuperLU for small systems (under ``SMALL_SYSTEM_NNZ`` stored entries, or
 ``SMALL_SYSTEM`` unknowns where only the size is known; see there), and among those the banded
-Cholesky for small symmetric systems with dense rows (see ``BANDED_MAX_SIZE``). The choice can be
+Cholesky for small symmetric systems with dense rows (see ``BANDED_MAX_SIZE``; where that meets a
+non-positive pivot, SuperLU takes over). The choice can be
 overridden per call (``backend="splu"``) or for the whole process with the
 environment variable ``CURVDETAIL_SOLVER``. All backends agree to ~1e-12 relative on the
 systems used here.
@@ -124,6 +125,11 @@ def resolve_backend(backend="auto", *, symmetric=True, size=None, nnz=None):
     return backend
 
 
+def _chosen_automatically(backend):
+    """True if ``backend`` leaves the choice to :func:`resolve_backend` (no name, no setting)."""
+    return backend in (None, "auto") and (os.environ.get("CURVDETAIL_SOLVER", "auto") or "auto") == "auto"
+
+
 def _refuse_empty_rows(indptr):
     """MKL PARDISO crashes on a row without stored entries instead of failing: refuse it."""
     counts = np.diff(indptr)
@@ -177,7 +183,16 @@ class Factorization:
             return
         A.sort_indices()
         self._pattern = (A.indptr.copy(), A.indices.copy())    # for refactor
-        getattr(self, "_factor_" + self.backend)(self._as_backend_wants(A))
+        try:
+            getattr(self, "_factor_" + self.backend)(self._as_backend_wants(A))
+        except SolverError:
+            # the banded Cholesky stops at the first non-positive pivot; a symmetric matrix that is
+            # only semi-definite in floating point (a curvature stage with an undetermined mode)
+            # still has an LU factorization. "auto" takes it; a named backend reports the failure.
+            if self.backend != "banded" or not _chosen_automatically(backend):
+                raise
+            self.backend = "splu"
+            self._factor_splu(A)
 
     def _as_backend_wants(self, A):
         """``A`` (sorted) as the backend takes it: the whole matrix, except PARDISO's triangle."""
