@@ -280,6 +280,13 @@ def test_a_check_failing_after_the_early_analysis_still_reports_its_error(monkey
     both = np.vstack([F, F + V.shape[0]])
     with pytest.raises(ConstraintError, match="no fixed vertex"):          # the second piece
         Reconstructor(two, both, boundary_vertices(F), rows="free", backend="pardiso")
+    edges = np.sort(np.vstack([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
+    unique, count = np.unique(edges, axis=0, return_counts=True)
+    a, b = unique[count == 2][0]                                            # an interior edge
+    fin = np.vstack([V, (V[a] + V[b]) / 2 + [0.0, 0.0, 1.0]])               # and a third triangle on it
+    with pytest.raises(MeshError, match=rf"1 edges are shared by more than two triangles \(first: \({a}, {b}\)\)"):
+        Reconstructor(fin, np.vstack([F, [a, b, V.shape[0]]]), [0], rows="free",
+                      backend="pardiso")                                    # (counted by the analysis' pattern)
     V[F[3]] = V[F[3, 0]]                                                    # collapse a triangle
     with pytest.raises(MeshError, match="zero area"):
         Reconstructor(V, F, boundary_vertices(F), rows="free", backend="pardiso")

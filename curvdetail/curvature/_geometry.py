@@ -32,7 +32,6 @@ def corner_cotangents(V, F, *, lengths=True):
     sq  : (m, 3) float   squared length of the edge opposite corner k (joining corners k+1, k+2)
     dbl : (m,) float     twice the triangle's area
     """
-    global _pool
     # coordinate-major (3, m) arrays: every operation below runs on contiguous rows
     Vt = np.ascontiguousarray(V.T)
     Ft = np.ascontiguousarray(F.T)
@@ -53,10 +52,16 @@ def corner_cotangents(V, F, *, lengths=True):
     if threads == 1:
         block(slice(0, m))
     else:
-        if _pool is None:
-            _pool = ThreadPoolExecutor(max_workers=4, thread_name_prefix="curvdetail")
-        list(_pool.map(block, blocks))
+        list(thread_pool().map(block, blocks))
     return cot.T, None if sq is None else sq.T, dbl
+
+
+def thread_pool():
+    """The package's few worker threads, for numpy and SciPy work that releases the GIL."""
+    global _pool
+    if _pool is None:
+        _pool = ThreadPoolExecutor(max_workers=4, thread_name_prefix="curvdetail")
+    return _pool
 
 
 def _corner_cotangents_into(Vt, Ft, cot, sq, dbl):

@@ -3,7 +3,7 @@
 import numpy as np
 import scipy.sparse as sp
 
-from ._geometry import corner_cotangents
+from ._geometry import corner_cotangents, thread_pool
 from ._validate import _check_mesh, non_manifold_error
 
 
@@ -48,18 +48,19 @@ def checked_cotan_laplacian(V, F):
     """Every :func:`check_mesh` check and ``L`` in one pass: ``(V, F, L)`` with V, F converted.
 
     The non-manifold edge check is folded into the assembly (each edge's triangle count is
-    summed alongside its weight), which saves a separate sort of all half-edges (0.27 s at 1M
-    vertices)."""
+    summed in a second thread alongside its weight), which saves a separate sort of all
+    half-edges (0.27 s at 1M vertices)."""
     V, F, U, diagonal = checked_cotan_triangle(V, F)
     return V, F, _symmetric_from_upper(U, diagonal)
 
 
-def checked_cotan_triangle(V, F):
+def checked_cotan_triangle(V, F, *, edge_counts=None):
     """Like :func:`checked_cotan_laplacian`, with ``L`` as its strict upper triangle ``U`` (CSR,
     sorted, explicit zeros kept: it has the edge pattern) and its diagonal: ``(V, F, U, diagonal)``.
-    A caller that needs only part of ``L`` is spared building all of it (0.2 s at 1M vertices)."""
+    A caller that needs only part of ``L`` is spared building all of it (0.2 s at 1M vertices).
+    ``edge_counts``: :func:`_edge_pattern` of these triangles where the caller has it already."""
     V, F, cot = _check_mesh(V, F, check_manifold=False, check_unreferenced=True, cotangents=True)
-    U, diagonal = _assemble_upper(V, F, cot, check_manifold=True)
+    U, diagonal = _assemble_upper(V, F, cot, check_manifold=True, edge_counts=edge_counts)
     return V, F, U, diagonal
 
 
@@ -70,25 +71,26 @@ def _cotan_laplacian_unchecked(V, F, cot=None):
     return _symmetric_from_upper(*_assemble_upper(V, F, cot, check_manifold=False))
 
 
-def _assemble_upper(V, F, cot, check_manifold):
-    """Strict upper triangle ``U`` and diagonal of ``L``."""
+def _assemble_upper(V, F, cot, check_manifold, edge_counts=None):
+    """Strict upper triangle ``U`` and diagonal of ``L``; ``check_manifold`` refuses an edge of
+    more than two triangles (counted by :func:`_edge_pattern`, or taken from ``edge_counts``)."""
     n = V.shape[0]
     # the edge opposite corner k joins corners k+1 and k+2; assemble the strict upper triangle
     # (one entry per half-edge, summed per edge); L = U + U^T - diag(row sums). The half-edges
     # are listed corner by corner from the (3, m) transposes, which are contiguous (cot comes from
     # corner_cotangents that way): 0.33 -> 0.25 s at 2M triangles, the same L bit for bit
     lo, hi = _half_edges(F, n)
+    counting = None
+    if check_manifold and edge_counts is None:
+        # SciPy's COO -> CSR releases the GIL: count the triangles on each edge alongside the
+        # weights' assembly (1M vertices: 0.5 s for one complex-valued pass, 0.2 s for these two)
+        counting = thread_pool().submit(_edge_pattern, F, n, (lo, hi))
     w = np.ascontiguousarray(cot.T).ravel() * -0.5
-    if check_manifold:
-        # the imaginary part counts the triangles on each edge
-        U = sp.csr_matrix((w + 1j, (lo, hi)), shape=(n, n))
-        U.sum_duplicates()
-        _refuse_non_manifold(U)
-        U = sp.csr_matrix((U.data.real.copy(), U.indices, U.indptr), shape=(n, n))
-    else:
-        U = sp.csr_matrix((w, (lo, hi)), shape=(n, n))
-        U.sum_duplicates()
+    U = sp.csr_matrix((w, (lo, hi)), shape=(n, n))
+    U.sum_duplicates()
     U.has_sorted_indices = True          # sum_duplicates sorted them
+    if check_manifold:
+        _refuse_non_manifold(edge_counts if counting is None else counting.result())
     diagonal = -(U @ np.ones(n) + np.bincount(U.indices, U.data, minlength=n))
     return U, diagonal
 
@@ -103,11 +105,11 @@ def _half_edges(F, n):
     return np.minimum(i, j), np.maximum(i, j, out=i)
 
 
-def _edge_pattern(F, n):
+def _edge_pattern(F, n, half_edges=None):
     """The pattern of ``L``'s strict upper triangle from the triangles alone: a CSR matrix with
     the same ``indptr`` and ``indices`` as the ``U`` of :func:`checked_cotan_triangle` (values:
-    triangles per edge)."""
-    lo, hi = _half_edges(F, n)
+    triangles per edge). ``half_edges``: :func:`_half_edges` of ``F`` where already at hand."""
+    lo, hi = _half_edges(F, n) if half_edges is None else half_edges
     P = sp.csr_matrix((np.ones(lo.size, dtype=np.float32), (lo, hi)), shape=(n, n))
     P.sum_duplicates()
     return P
@@ -126,8 +128,9 @@ def _symmetric_from_upper(U, diagonal):
                          shape=(n, n))
 
 
-def _refuse_non_manifold(U):
-    bad = np.flatnonzero(U.data.imag > 2.5)
+def _refuse_non_manifold(counts):
+    """``counts``: :func:`_edge_pattern` (triangles per edge)."""
+    bad = np.flatnonzero(counts.data > 2.5)
     if bad.size:
-        rows = np.searchsorted(U.indptr, bad, side="right") - 1
-        raise non_manifold_error(bad.size, zip(rows[:3], U.indices[bad[:3]]))
+        rows = np.searchsorted(counts.indptr, bad, side="right") - 1
+        raise non_manifold_error(bad.size, zip(rows[:3], counts.indices[bad[:3]]))

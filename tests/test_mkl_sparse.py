@@ -1,0 +1,74 @@
+"""MKL's sparse BLAS product (used for the rows="all" normal matrix with PARDISO)."""
+
+import importlib
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from curvdetail import Reconstructor, available_backends, curvature_detail
+from curvdetail.curvature import boundary_vertices
+from curvdetail.curvature.testing import grid
+
+reconstruct_module = importlib.import_module("curvdetail.curvature.reconstruct")
+
+pytestmark = pytest.mark.skipif("pardiso" not in available_backends(),
+                                reason="the MKL runtime comes with pypardiso (x86-64)")
+
+
+def test_gram_upper_is_the_upper_triangle_of_the_product():
+    from curvdetail.curvature._mkl_sparse import gram_upper
+
+    rng = np.random.default_rng(0)
+    A = sp.random(300, 200, density=0.03, random_state=rng, format="csr")
+    A = sp.vstack([A, sp.csr_matrix((5, 200))]).tocsr()          # rows with no entries
+    A.indices = A.indices.copy()
+    for r in range(A.shape[0]):                                   # unsorted rows in the input
+        A.indices[A.indptr[r]:A.indptr[r + 1]] = A.indices[A.indptr[r]:A.indptr[r + 1]][::-1]
+        A.data[A.indptr[r]:A.indptr[r + 1]] = A.data[A.indptr[r]:A.indptr[r + 1]][::-1]
+    A.has_sorted_indices = False
+    C = gram_upper(A)
+    expected = sp.triu(A @ A.T).toarray()
+    assert C.shape == (305, 305)
+    assert np.abs(C.toarray() - expected).max() <= 1e-15 * np.abs(expected).max()
+    assert all(np.all(np.diff(C.indices[C.indptr[r]:C.indptr[r + 1]]) > 0) for r in range(305))
+    rows = np.repeat(np.arange(305), np.diff(C.indptr))
+    assert np.all(C.indices >= rows)
+
+
+def test_gram_upper_of_an_empty_matrix():
+    from curvdetail.curvature._mkl_sparse import gram_upper
+
+    assert gram_upper(sp.csr_matrix((4, 3))).shape == (4, 4)
+    assert gram_upper(sp.csr_matrix((4, 3))).nnz == 0
+
+
+def test_rows_all_with_the_mkl_product_solves_like_scipys(monkeypatch):
+    V, F = grid(40, 40)
+    V[:, 2] = np.sin(3 * V[:, 0]) * V[:, 1] ** 2
+    b = boundary_vertices(F)
+    D = curvature_detail(V, F)
+    monkeypatch.setattr(reconstruct_module, "MKL_GRAM_MIN_FREE", 10 ** 9)
+    plain = Reconstructor(V, F, b, backend="pardiso")
+    monkeypatch.setattr(reconstruct_module, "MKL_GRAM_MIN_FREE", 1)
+    mkl = Reconstructor(V, F, b, backend="pardiso")
+    assert mkl._upper and not plain._upper
+    X1, X2 = plain.solve(1.5 * D, 1.5 * V[b]), mkl.solve(1.5 * D, 1.5 * V[b])
+    assert np.array_equal(X1, X2)                                 # the same values, bit for bit
+    assert np.abs(X2 - 1.5 * V).max() < 1e-12
+
+
+def test_rows_all_falls_back_to_scipys_product_where_mkl_refuses(monkeypatch):
+    from curvdetail.curvature import _mkl_sparse
+
+    def refuse(A):
+        raise _mkl_sparse.MklSparseError("MKL sparse BLAS: mkl_sparse_syrk returned status 2")
+
+    monkeypatch.setattr(reconstruct_module, "MKL_GRAM_MIN_FREE", 1)
+    monkeypatch.setattr(_mkl_sparse, "gram_upper", refuse)
+    V, F = grid(12, 12)
+    V[:, 2] = V[:, 0] * V[:, 1]
+    b = boundary_vertices(F)
+    rec = Reconstructor(V, F, b, backend="pardiso")
+    assert not rec._upper
+    assert np.abs(rec.solve(curvature_detail(V, F), V[b]) - V).max() < 1e-12
