@@ -260,6 +260,28 @@ def test_pending_factorization_finishes_like_factorize(backend):
 
 
 @pytest.mark.skipif("pardiso" not in available_backends(), reason="PARDISO (pypardiso) not installed")
+def test_cancel_returns_at_once_and_the_analysis_frees_its_memory_when_it_ends(monkeypatch):
+    import threading
+
+    release, freed = threading.Event(), threading.Event()
+
+    class SlowAnalysis:                       # stands in for PARDISO's ordering of a large matrix
+        def __init__(self, M, *, symmetric, analyze_only=False):
+            release.wait(10)
+
+        def free(self):
+            freed.set()
+
+    monkeypatch.setattr(_pardiso, "PardisoFactor", SlowAnalysis)
+    A, _ = _spd_system(10)
+    pending = sparse_solver.PendingFactorization(sp.triu(A, format="csr"), backend="pardiso")
+    pending.cancel()                          # while the analysis still runs
+    assert not freed.is_set()
+    release.set()
+    assert freed.wait(10)
+
+
+@pytest.mark.skipif("pardiso" not in available_backends(), reason="PARDISO (pypardiso) not installed")
 def test_pending_factorization_refuses_an_empty_row():
     pattern = sp.csr_matrix((np.ones(2), [0, 2], [0, 1, 1, 2]), shape=(3, 3))
     with pytest.raises(SolverError, match="row 1 has no stored entries"):

@@ -202,7 +202,8 @@ def _start_factorization(V_ref, F, fixed, backend):
     cores but not fully: 6.6 s of CPU in 3.9 s) while this thread checks the mesh and computes
     the values (~1 s at 1M). Returns ``(layout, PendingFactorization)``; None where that does
     not pay (small systems, another backend) or the input is malformed: the checks in their
-    usual order then report it. (A check that fails after the start waits for the analysis.)"""
+    usual order then report it. (A check that fails after the start raises at once; the
+    analysis frees its memory when it ends.)"""
     try:
         V = as_vertices(V_ref)
         n = V.shape[0]
