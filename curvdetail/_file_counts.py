@@ -2,14 +2,16 @@
 
 pymeshlab's loader silently drops OBJ/OFF/PLY vertices with NaN or infinite coordinates (and the
 faces using them, renumbering the rest), drops OBJ faces whose vertex indices are out of range
-or repeated, and keeps OFF faces whose indices are out of range (its OFF loader then writes out
-of bounds: such a file can crash the process later, before any check of ours can help; this
-module reports the indices when it gets the chance). :func:`check_loaded` compares the
-loaded mesh with the counts the file declares (OFF/PLY headers, a streamed count of OBJ ``v`` and
-``f`` lines; never the whole file in memory) and with its own vertex count.
+or repeated, and keeps OFF faces whose indices are out of range; its OFF loader then writes out
+of bounds, which can crash the process later, so :func:`check_before_loading` looks for such
+faces in an ASCII OFF file before the loader sees it (reading the file once more, vectorized).
+:func:`check_loaded` compares the loaded mesh with the counts the file declares (OFF/PLY
+headers, a streamed count of OBJ ``v`` and ``f`` lines, never the whole file in memory) and
+with its own vertex count.
 """
 
 import os
+import re
 
 import numpy as np
 
@@ -77,6 +79,120 @@ def declared_counts(path):
     """``(vertices, faces)`` the file declares (OBJ, OFF, PLY), None where unknown."""
     counts = _COUNTS.get(os.path.splitext(os.fspath(path))[1].lower())
     return counts(path) if counts is not None else (None, None)
+
+
+def check_before_loading(path, error=ValueError):
+    """Raise ``error`` for an ASCII OFF file whose faces name vertices the file does not have:
+    pymeshlab's OFF loader keeps such faces and writes out of bounds (the process can crash
+    later, even after :func:`check_loaded` has reported them). Other files pass unread."""
+    if os.path.splitext(os.fspath(path))[1].lower() == ".off":
+        problem = _off_face_problem(path)
+        if problem:
+            raise error(f"{path!r}: {problem}; fix or remove those faces in the file and read it again.")
+
+
+def _off_header(data):
+    """``(nv, nf, body offset)`` of an ASCII OFF file's bytes, or None (not that form)."""
+    words, pos = [], 0
+    for _ in range(_HEADER_LINES):
+        end = data.find(b"\n", pos)
+        end = len(data) if end < 0 else end
+        words += data[pos:end].split(b"#", 1)[0].decode("ascii", "replace").split()
+        pos = end + 1
+        if len(words) >= 3 or pos > len(data):
+            break
+    if len(words) < 3 or not words[0].endswith("OFF") or "n" in words[0]:
+        return None
+    try:
+        return int(words[1]), int(words[2]), pos
+    except ValueError:                    # "OFF BINARY"
+        return None
+
+
+def _off_face_problem(path):
+    """What is wrong with the faces of an ASCII OFF file, or None (also where it cannot tell:
+    the loader and :func:`check_loaded` then judge).
+
+    Vectorized over the bytes (~0.5 s for a million vertices): a face line whose tokens are all
+    shorter than the vertex count's digits and unsigned holds no index out of range, so only
+    the other lines (normally none; float colours make them all) are parsed one by one."""
+    with open(path, "rb") as f:
+        data = f.read()
+    header = _off_header(data)
+    if header is None:
+        return None
+    nv, nf, offset = header
+    body = data[offset:]
+    if b"#" in body:
+        body = re.sub(rb"#[^\n]*", b"", body)
+    chars = np.frombuffer(body, dtype=np.uint8)
+    visible = chars > 32
+    newlines = np.flatnonzero(chars == 10)
+    starts = np.concatenate([[0], newlines + 1])
+    ends = np.concatenate([newlines, [chars.size]])
+    filled = np.zeros(starts.size, dtype=bool)
+    some = np.flatnonzero(ends > starts)
+    if some.size:
+        # each segment runs to the next non-empty line: this line's characters and newlines
+        filled[some] = np.logical_or.reduceat(visible, starts[some])
+    lines = np.flatnonzero(filled)
+    if nf == 0 or lines.size < nv + nf:
+        return None                                            # short: the counts check reports it
+    faces = lines[nv:nv + nf]
+    first, last = int(starts[faces[0]]), int(ends[faces[-1]])
+    seg = visible[first:last]
+    token_starts = np.flatnonzero(seg[1:] & ~seg[:-1]) + (first + 1)
+    token_ends = np.flatnonzero(seg[:-1] & ~seg[1:]) + (first + 1)
+    if seg[0]:
+        token_starts = np.concatenate([[first], token_starts])
+    if seg[-1]:
+        token_ends = np.concatenate([token_ends, [last]])
+    line_starts = starts[faces]
+    per_line = np.diff(np.append(np.searchsorted(token_starts, line_starts), token_starts.size))
+    # the vertex count k: a one-digit first token, or parsed below
+    head = np.concatenate([[0], np.cumsum(per_line)[:-1]])
+    one_digit = (token_ends[head] - token_starts[head] == 1) & (chars[token_starts[head]] >= 51) & \
+        (chars[token_starts[head]] <= 57)
+    k = np.where(one_digit, chars[token_starts[head]].astype(np.int64) - 48, 0)
+    suspect = np.zeros(nf, dtype=bool)
+    odd = token_starts[_maybe_out_of_range(chars, token_starts, token_ends, nv)]
+    suspect[np.searchsorted(line_starts, odd, side="right") - 1] = True
+    suspect |= ~one_digit
+    if np.any(~suspect & (per_line < k + 1)):
+        return None                    # not one face a line as expected (OFF is free-form): no verdict
+    bad = []
+    for face in np.flatnonzero(suspect):
+        words = body[starts[faces[face]]:ends[faces[face]]].split()
+        try:
+            count = int(words[0])
+            index = [int(w) for w in words[1:count + 1]]
+        except ValueError:
+            return None
+        if count < 3 or len(index) < count:
+            return None
+        if min(index) < 0 or max(index) >= nv:
+            bad.append((face, index))
+    if not bad:
+        return None
+    return (f"{len(bad)} faces use vertex indices outside the file's {nv} vertices "
+            f"(first: face {bad[0][0]}, {bad[0][1]})")
+
+
+def _maybe_out_of_range(chars, starts, ends, nv):
+    """Tokens that may not be a vertex index below ``nv``: signed ones, ones with more digits
+    than ``nv``, and ones with as many whose value is not below it (or that are not digits)."""
+    length = ends - starts
+    width = len(str(nv))
+    suspect = (chars[starts] == 45) | (length > width)               # 45: "-"
+    same = np.flatnonzero(length == width)
+    value = np.zeros(same.size, dtype=np.int64)
+    digit_only = np.ones(same.size, dtype=bool)
+    for j in range(width):
+        digit = chars[starts[same] + j].astype(np.int64) - 48
+        digit_only &= (digit >= 0) & (digit <= 9)
+        value = value * 10 + digit
+    suspect[same[~digit_only | (value >= nv)]] = True
+    return suspect
 
 
 def check_loaded(path, n_vertices, F, error=ValueError):

@@ -9,7 +9,7 @@ import os
 
 import numpy as np
 
-from ._file_counts import check_loaded
+from ._file_counts import check_before_loading, check_loaded
 from ._output import atomic_output, check_output_path
 from .curvature._validate import as_faces, as_vertices
 from .curvature.errors import MeshError
@@ -44,7 +44,9 @@ def read_mesh(path):
                         face index is out of range, or (OBJ, OFF, PLY) the loader dropped
                         vertices or faces: pymeshlab silently removes vertices with NaN or
                         infinite coordinates (and renumbers the rest) and OBJ faces with
-                        out-of-range or repeated indices
+                        out-of-range or repeated indices; an ASCII OFF file is checked for
+                        out-of-range face indices before pymeshlab reads it (its OFF loader
+                        would write out of bounds)
 
     Examples
     --------
@@ -57,6 +59,7 @@ def read_mesh(path):
     path = os.fspath(path)
     if not os.path.isfile(path):
         raise FileNotFoundError(f"mesh file not found: {path}")
+    check_before_loading(path, error=MeshFileError)
     ms = _meshset()
     try:
         ms.load_new_mesh(path)

@@ -2,6 +2,8 @@
 
 import os
 import stat
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -239,6 +241,24 @@ def test_obj_with_unreferenced_vertices_and_texture_lines_is_read_in_file_order(
     V, F = read_mesh(path)
     assert np.array_equal(V, [[0, 0, 0], [5, 5, 5], [1, 0, 0], [0, 1, 0], [1, 1, 0]])
     assert F.shape == (2, 3) and 1 not in F
+
+
+def test_off_face_out_of_range_is_refused_before_pymeshlab_reads_it(tmp_path):
+    # pymeshlab's OFF loader writes out of bounds for such a face: the process crashed at exit
+    # even after the error was reported, so the file must not reach the loader at all
+    path = tmp_path / "bad.off"
+    path.write_text("OFF\n4 2 0\n" + "".join(f"{x} {y} {z}\n" for x, y, z in _SQUARE) +
+                    "3 0 1 2\n3 1 3 99\n")
+    script = ("from curvdetail.io import read_mesh, MeshFileError\n"
+              "from curvdetail.filters.files import load_meshset\n"
+              f"for read in (read_mesh, load_meshset):\n"
+              f"    try:\n        read({str(path)!r})\n"
+              "    except MeshFileError as exc:\n        print(exc)\n")
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    assert len(lines) == 2 and all("1 faces use vertex indices outside the file's 4 vertices (first: "
+                                   "face 1, [1, 3, 99])" in line for line in lines)
 
 
 def test_off_with_counts_on_the_header_line_and_colours_is_read(tmp_path):

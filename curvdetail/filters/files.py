@@ -15,7 +15,7 @@ import os
 import numpy as np
 
 from .. import _output
-from .._file_counts import check_loaded
+from .._file_counts import check_before_loading, check_loaded
 from ..io import MeshFileError
 from .meshset import WRITTEN_ATTRIBUTES, set_vertex_attribute, vertex_attribute
 from .ply_attributes import read_ply_vertex_attributes
@@ -40,6 +40,7 @@ def load_meshset(path, *more):
             raise FileNotFoundError(f"mesh file not found: {p}")
     ms = pymeshlab.MeshSet()
     for p in paths:
+        check_before_loading(p, error=MeshFileError)
         try:
             ms.load_new_mesh(p)
         except pymeshlab.PyMeshLabException as exc:
