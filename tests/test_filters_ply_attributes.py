@@ -4,6 +4,7 @@ import os
 
 import numpy as np
 import pymeshlab
+import pytest
 
 from curvdetail import curvature_detail, mixed_voronoi_area, read_mesh
 from curvdetail.filters.ply_attributes import read_ply_vertex_attributes
@@ -43,3 +44,28 @@ def test_files_without_custom_attributes_give_nothing(tmp_path):
     ms.load_new_mesh(os.path.join(DATA, "spot.obj"))
     ms.save_current_mesh(str(tmp_path / "s.ply"))
     assert read_ply_vertex_attributes(tmp_path / "s.ply") == {}
+
+
+_ASCII_HEAD = ("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty double mass\n"
+               "property float y\nproperty list uchar double dir\nproperty float z\n"
+               "element face 1\nproperty list uchar int vertex_indices\nend_header\n")
+
+
+def test_ascii_columns_are_mapped_by_the_header_order(tmp_path):
+    path = tmp_path / "a.ply"
+    path.write_text(_ASCII_HEAD + "0 1.5 0 3 1 2 3 0\n1 2.5 0 3 4 5 6 0\n0 -3e2 1 3 7 8 9.5 0\n3 0 1 2\n")
+    attributes = read_ply_vertex_attributes(path)
+    assert np.array_equal(attributes["mass"], [1.5, 2.5, -300.0])
+    assert np.array_equal(attributes["dir"], [[1, 2, 3], [4, 5, 6], [7, 8, 9.5]])
+
+
+@pytest.mark.parametrize("body", [
+    "0 1.5 0 3 1 2 3 0\n1 2.5 0 2 4 5 0 0\n0 3 1 3 7 8 9 0\n",     # list lengths vary
+    "0 1.5 0 3 1 2 3 0\n1 2.5 0 3 4 5 6\n0 3 1 3 7 8 9 0\n",        # a value missing
+    "0 1.5 0 3 1 2 3 0\n",                                          # vertices missing
+    "0 x 0 3 1 2 3 0\n1 2.5 0 3 4 5 6 0\n0 3 1 3 7 8 9 0\n",        # not a number
+])
+def test_ascii_attributes_that_are_not_pymeshlab_s_give_nothing(tmp_path, body):
+    path = tmp_path / "a.ply"
+    path.write_text(_ASCII_HEAD + body)
+    assert read_ply_vertex_attributes(path) == {}

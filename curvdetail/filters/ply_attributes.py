@@ -7,6 +7,7 @@ reads them back so that ``curvdetail apply compute_curvature_detail a.obj b.ply`
 ``curvdetail apply apply_curvature_reconstruction b.ply c.ply`` works.
 """
 
+import itertools
 import os
 
 import numpy as np
@@ -65,8 +66,7 @@ def read_ply_vertex_attributes(path):
         if not custom or n == 0:
             return {}
         if fmt == "ascii":
-            rows = [f.readline().split() for _ in range(n)]
-            return _from_ascii(rows, props, custom)
+            return _from_ascii(list(itertools.islice(f, n)), n, props, custom)
         if fmt not in ("binary_little_endian", "binary_big_endian"):
             return {}
         order = "<" if fmt == "binary_little_endian" else ">"
@@ -99,24 +99,24 @@ def read_ply_vertex_attributes(path):
     return out
 
 
-def _from_ascii(rows, props, custom):
-    out = {name: [] for name in custom}
-    for row in rows:
-        k = 0
-        for name, kind, _, _ in props:
-            if kind == "list":
-                count = int(row[k])
-                values = row[k + 1:k + 1 + count]
-                k += 1 + count
-            else:
-                values = row[k]
-                k += 1
-            if name in out:
-                out[name].append(values)
-    result = {}
-    for name, values in out.items():
-        try:
-            result[name] = np.array(values, dtype=np.float64)
-        except ValueError:
-            return {}
-    return result
+def _from_ascii(lines, n, props, custom):
+    """The custom attributes from the vertex lines of an ASCII PLY file, parsed as one block:
+    every line must hold the same number of values (pymeshlab's lists always have 3 items)."""
+    if len(lines) < n:
+        return {}
+    try:
+        values = np.loadtxt(lines, dtype=np.float64, ndmin=2)
+    except ValueError:                                   # rows of different lengths, not numbers
+        return {}
+    out, k = {}, 0
+    for name, kind, _, _ in props:
+        if kind == "list":
+            if k >= values.shape[1] or np.any(values[:, k] != values[0, k]):
+                return {}
+            count = int(values[0, k])
+            columns, k = slice(k + 1, k + 1 + count), k + 1 + count
+        else:
+            columns, k = k, k + 1
+        if name in custom:
+            out[name] = values[:, columns].copy()
+    return out if k == values.shape[1] else {}
