@@ -10,6 +10,7 @@ headers, a streamed count of OBJ ``v`` and ``f`` lines, never the whole file in 
 with its own vertex count.
 """
 
+import mmap
 import os
 import re
 
@@ -82,13 +83,39 @@ def declared_counts(path):
 
 
 def check_before_loading(path, error=ValueError):
-    """Raise ``error`` for an ASCII OFF file whose faces name vertices the file does not have:
-    pymeshlab's OFF loader keeps such faces and writes out of bounds (the process can crash
-    later, even after :func:`check_loaded` has reported them). Other files pass unread."""
-    if os.path.splitext(os.fspath(path))[1].lower() == ".off":
+    """Raise ``error`` for files that pymeshlab's loader would read into corrupt memory: an ASCII
+    OFF file whose faces name vertices the file does not have (the loader keeps such faces and
+    writes out of bounds; the process can crash later, even after :func:`check_loaded` has
+    reported them), and an OBJ file with indented vertex lines (the loader counts them in one
+    pass and not in the other; reading one aborted the process). Other files pass unread."""
+    extension = os.path.splitext(os.fspath(path))[1].lower()
+    if extension == ".off":
         problem = _off_face_problem(path)
         if problem:
             raise error(f"{path!r}: {problem}; fix or remove those faces in the file and read it again.")
+    elif extension == ".obj":
+        count, line = _obj_indented_vertices(path)
+        if count:
+            raise error(f"{path!r}: {count} vertex lines start with spaces or tabs (first: line {line}), "
+                        "which pymeshlab's OBJ loader miscounts (it crashed reading such a file); remove "
+                        "the leading whitespace and read the file again.")
+
+
+def _obj_indented_vertices(path):
+    """``(number, first 1-based line)`` of ``v`` lines with leading blanks in an OBJ file; the
+    file is scanned through a memory map, never read whole."""
+    with open(path, "rb") as f:
+        try:
+            data = mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ)
+        except ValueError:                 # an empty file
+            return 0, None
+        with data:
+            starts = [m.start() + 1 for m in re.finditer(rb"\n[ \t]+v[ \t]", data)]
+            if re.match(rb"[ \t]+v[ \t]", data):
+                starts.insert(0, 0)
+            if not starts:
+                return 0, None
+            return len(starts), data[:starts[0]].count(b"\n") + 1
 
 
 def _off_header(data):

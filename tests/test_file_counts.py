@@ -84,3 +84,23 @@ def test_off_indices_of_the_vertex_count_s_width_are_compared_by_value(tmp_path)
     path.write_text("OFF\n100 2 0\n" + vertices + "3 97 98 99\n3 98 99 100\n")
     with pytest.raises(ValueError, match=r"1 faces .* 100 vertices \(first: face 1, \[98, 99, 100\]\)"):
         check_before_loading(path)
+
+
+@pytest.mark.parametrize("text, count, line", [
+    (b"v 0 0 0\n  v 1 0 0\nv 0 1 0\n\tv 1 1 0\nf 1 2 3\n", 2, 2),
+    (b" v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", 1, 1),
+    (b"# c\r\nv 0 0 0\r\nv 1 0 0\r\n \t v 0 1 0\r\nf 1 2 3\r\n", 1, 4),
+])
+def test_obj_with_indented_vertex_lines_is_refused_before_loading(tmp_path, text, count, line):
+    # pymeshlab's OBJ loader aborted the process (malloc: invalid size) on such a file
+    path = tmp_path / "m.obj"
+    path.write_bytes(text)
+    with pytest.raises(ValueError, match=rf"{count} vertex lines start with spaces or tabs \(first: line {line}\)"):
+        check_before_loading(path)
+
+
+@pytest.mark.parametrize("text", [b"", b"v 0 0 0\nvt 1 1\n  vt 0 1\n  vn 0 0 1\n\tf 1 1 1\n# v 1 2 3\n"])
+def test_obj_without_indented_vertex_lines_passes(tmp_path, text):
+    path = tmp_path / "m.obj"
+    path.write_bytes(text)
+    check_before_loading(path)

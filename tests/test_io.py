@@ -243,12 +243,18 @@ def test_obj_with_unreferenced_vertices_and_texture_lines_is_read_in_file_order(
     assert F.shape == (2, 3) and 1 not in F
 
 
-def test_off_face_out_of_range_is_refused_before_pymeshlab_reads_it(tmp_path):
-    # pymeshlab's OFF loader writes out of bounds for such a face: the process crashed at exit
-    # even after the error was reported, so the file must not reach the loader at all
-    path = tmp_path / "bad.off"
-    path.write_text("OFF\n4 2 0\n" + "".join(f"{x} {y} {z}\n" for x, y, z in _SQUARE) +
-                    "3 0 1 2\n3 1 3 99\n")
+@pytest.mark.parametrize("name, text, message", [
+    ("bad.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n3 1 3 99\n",
+     "1 faces use vertex indices outside the file's 4 vertices (first: face 1, [1, 3, 99])"),
+    ("bad.obj", "v 0 0 0\n  v 1 0 0\nv 0 1 0\nv 1 1 0\nv 2 2 0\nf 1 2 3\nf 2 4 3\n",
+     "1 vertex lines start with spaces or tabs (first: line 2)"),
+])
+def test_files_that_crash_pymeshlab_are_refused_before_it_reads_them(tmp_path, name, text, message):
+    # pymeshlab's OFF loader writes out of bounds for a face index past the vertices (the process
+    # crashed at exit even after the error was reported), and its OBJ loader aborted the process
+    # on an indented vertex line: the file must not reach the loader at all
+    path = tmp_path / name
+    path.write_text(text)
     script = ("from curvdetail.io import read_mesh, MeshFileError\n"
               "from curvdetail.filters.files import load_meshset\n"
               f"for read in (read_mesh, load_meshset):\n"
@@ -257,8 +263,7 @@ def test_off_face_out_of_range_is_refused_before_pymeshlab_reads_it(tmp_path):
     done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     lines = done.stdout.splitlines()
-    assert len(lines) == 2 and all("1 faces use vertex indices outside the file's 4 vertices (first: "
-                                   "face 1, [1, 3, 99])" in line for line in lines)
+    assert len(lines) == 2 and all(message in line for line in lines)
 
 
 def test_off_with_counts_on_the_header_line_and_colours_is_read(tmp_path):
