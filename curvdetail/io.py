@@ -44,9 +44,9 @@ def read_mesh(path):
                         face index is out of range, or (OBJ, OFF, PLY) the loader dropped
                         vertices or faces: pymeshlab silently removes vertices with NaN or
                         infinite coordinates (and renumbers the rest) and OBJ faces with
-                        out-of-range or repeated indices; an ASCII OFF file is checked for
-                        out-of-range face indices before pymeshlab reads it (its OFF loader
-                        would write out of bounds)
+                        out-of-range or repeated indices. Checked before pymeshlab reads the
+                        file, because its loader would corrupt memory: out-of-range face
+                        indices in an ASCII OFF file, indented vertex lines in an OBJ file
 
     Examples
     --------
