@@ -36,6 +36,15 @@ def test_reconstruct_rebuilds_the_input(tmp_path, capsys, rows):
     assert float(printed.split("max vertex error ")[1].split()[0]) <= 1e-9
 
 
+def test_reconstruct_shows_its_stages_on_a_terminal_only(tmp_path, capsys, monkeypatch):
+    assert main(["reconstruct", NOSE, str(tmp_path / "a.ply")]) == 0
+    assert capsys.readouterr().err == ""                       # not a terminal: quiet
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True, raising=False)
+    assert main(["reconstruct", NOSE, str(tmp_path / "b.ply")]) == 0
+    stages = [line.split(" ...")[0] for line in capsys.readouterr().err.splitlines()]
+    assert stages == ["[1/4] read", "[2/4] factor", "[3/4] solve", "[4/4] write"]
+
+
 def test_reconstruct_closed_mesh_with_fixed_vertices(tmp_path):
     out = tmp_path / "spot.off"
     assert main(["reconstruct", SPOT, str(out), "--fix", "0", "1000", "2000"]) == 0
