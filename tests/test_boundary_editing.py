@@ -87,3 +87,24 @@ def test_stacked_relations_keep_a_large_boundary_sine_free_of_folds(load_mesh):
     assert folded(V) == 0
     assert folded(edit_boundary(V, F, f, relations="one-ring")) > 0
     assert folded(edit_boundary(V, F, f, relations="one+two-ring")) == 0
+
+
+def test_the_mesh_is_checked_and_its_laplacian_assembled_once(monkeypatch):
+    import importlib
+
+    module = importlib.import_module("curvdetail.curvature.cotan_laplacian")
+    calls = []
+    real = module._assemble_upper
+
+    def counting(V, F, cot, check_manifold, edge_counts=None):
+        calls.append(check_manifold)
+        return real(V, F, cot, check_manifold, edge_counts)
+
+    monkeypatch.setattr(module, "_assemble_upper", counting)
+    V, F = grid(10, 10)
+    V[:, 2] = 0.05 * np.sin(4 * V[:, 0])
+    X, info = edit_boundary(V, F, sine_displacement(0.1, axis=2), return_info=True)
+    assert calls.count(True) == 1               # the checked rest-shape L (the editor's)
+    from curvdetail import cotan_laplacian
+    monkeypatch.setattr(module, "_assemble_upper", real)
+    assert (info["editor"].laplacian != cotan_laplacian(V, F)).nnz == 0

@@ -2,8 +2,8 @@
 
 import numpy as np
 
-from ._validate import as_values, boundary_edges
-from .cotan_laplacian import _cotan_laplacian_unchecked, checked_cotan_laplacian
+from ._validate import as_faces, as_values, as_vertices, boundary_edges
+from .cotan_laplacian import _cotan_laplacian_unchecked
 from .curvature_coefficients import DEFAULT_RCOND
 from .curvature_editor import CurvatureEditor
 from .errors import MeshError
@@ -69,9 +69,10 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
     >>> bool(np.allclose(X[b, 2] - V[b, 2], 0.1 * np.sin(2 * np.pi * 2 * info["arc_length"])))
     True
     """
-    V, F, L = checked_cotan_laplacian(V, F)       # every mesh check, and L of the rest shape
     if boundary_detail not in ("deformed", "rest"):
         raise ValueError(f"boundary_detail={boundary_detail!r}; use 'deformed' or 'rest'.")
+    V = as_vertices(V)
+    F = as_faces(F, V.shape[0])        # shapes and indices; the editor below runs every mesh check
     loop = boundary_loop(F)
     P = V[loop]
     seg = np.linalg.norm(np.roll(P, -1, axis=0) - P, axis=1)
@@ -89,6 +90,7 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
         d = as_values(displacement, loop.size, "displacement")
     n = V.shape[0]
     editor = CurvatureEditor(V, F, loop, loop, relations=relations, rcond=rcond, backend=backend)
+    L = editor.laplacian                        # of the rest shape
     if boundary_detail == "rest":
         X = editor.solve(positions=P + d, details=editor.detail[loop])
         if not return_info:

@@ -77,6 +77,7 @@ class CurvatureEditor:
     position_constrained, detail_constrained : int arrays   as given (masks: increasing)
     roi : (r,) int array        the region, increasing
     detail : (n, 3) float array rest detail ``D = L V``
+    laplacian : (n, n) csr_matrix   ``L`` of the rest shape (:func:`cotan_laplacian`)
     coefficients : (n, n) csr_matrix   ``C``
     coefficients_two_ring : (n, n) csr_matrix   ``C2`` (only with ``relations="one+two-ring"``)
     timings : dict              seconds spent in the constructor: ``coefficients`` (L, D and C),
@@ -164,7 +165,7 @@ class CurvatureEditor:
         A, diag = _mixed_voronoi_area_unchecked(V, F), bbox_diagonal(V)
         C, rank, _ = _coefficients(D, A, rows, cols, n, rcond, diag)
         cvals = C.data if C.nnz == rows.size else np.asarray(C[rows, cols]).ravel()  # (rows, cols) order
-        self.detail, self.coefficients = D, C
+        self.detail, self.coefficients, self.laplacian = D, C, L
         self.rank_deficient = int(np.count_nonzero(rank < 3))
         t1 = time.perf_counter()
 
