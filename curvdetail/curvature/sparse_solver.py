@@ -94,9 +94,13 @@ BANDED_MIN_ROW_ENTRIES = 12
 BANDED_MAX_BYTES = 1 << 30
 
 #: Below this many stored entries ``"auto"`` picks SuperLU (used when the matrix is at hand). The
-#: crossover in the measurements above sits near 1e5 entries for both systems: ``L_ff`` has ~7
-#: entries a row (crossover ~15k unknowns), ``L^T L`` ~19 (crossover ~5k unknowns).
-SMALL_SYSTEM_NNZ = 100_000
+#: crossover moves with the host: in the measurements above (2026-11-22) it sat near 1e5 entries
+#: for both systems; on an AMD EPYC host (2026-11-30; grid / cube-sphere, factor + solve, ms)
+#: ``L_ff`` at 4.8k unknowns (33k entries) took 14 / 33 with SuperLU and 14 / 18 with PARDISO, at
+#: 9.6k (66k) 36 / 65 and 35 / 36; ``L^T L`` at 4.8k (88k) 42 / 58 SuperLU, 27 / 35 PARDISO and
+#: 18 / 61 banded. 50k entries splits the difference (``L_ff``: ~7k unknowns, ``L^T L``: ~2.6k);
+#: either way, below it the choice is worth milliseconds.
+SMALL_SYSTEM_NNZ = 50_000
 
 
 def resolve_backend(backend="auto", *, symmetric=True, size=None, nnz=None):
