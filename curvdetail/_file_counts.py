@@ -2,12 +2,12 @@
 
 pymeshlab's loader silently drops OBJ/OFF/PLY vertices with NaN or infinite coordinates (and the
 faces using them, renumbering the rest), drops OBJ faces whose vertex indices are out of range
-or repeated, and keeps OFF faces whose indices are out of range; its OFF loader then writes out
+or repeated and STL triangles with a non-finite or repeated corner, and keeps OFF faces whose indices are out of range; its OFF loader then writes out
 of bounds, which can crash the process later, so :func:`check_before_loading` looks for such
 faces in an ASCII OFF file before the loader sees it (reading the file once more, vectorized).
 :func:`check_loaded` compares the loaded mesh with the counts the file declares (OFF/PLY
-headers, a streamed count of OBJ ``v`` and ``f`` lines, never the whole file in memory) and
-with its own vertex count.
+headers, the binary STL header, a streamed count of OBJ ``v`` and ``f`` lines and of ASCII STL
+facets, never the whole file in memory) and with its own vertex count.
 """
 
 import mmap
@@ -73,11 +73,38 @@ def _ply_counts(path):
     return found.get(b"vertex"), found.get(b"face")
 
 
-_COUNTS = {".obj": _obj_counts, ".off": _off_counts, ".ply": _ply_counts}
+def _stl_counts(path):
+    """``(None, triangles)`` of an STL file: a binary file's header count (when the file size
+    matches it), or an ASCII file's ``endfacet`` lines; ``(None, None)`` if neither."""
+    size = os.path.getsize(path)
+    with open(path, "rb") as f:
+        head = f.read(84)
+        if len(head) == 84:
+            count = int(np.frombuffer(head[80:84], dtype="<u4")[0])
+            if size == 84 + 50 * count:
+                return None, count
+        if not head.lstrip().startswith(b"solid"):
+            return None, None
+        f.seek(0)
+        facets, tail = 0, b""
+        while True:
+            chunk = f.read(_CHUNK)
+            if not chunk:
+                return None, facets
+            text = tail + chunk          # "endfacet" may straddle two chunks, never lie in tail alone
+            facets += text.count(b"endfacet")
+            tail = text[-7:]
+
+
+_COUNTS = {".obj": _obj_counts, ".off": _off_counts, ".ply": _ply_counts, ".stl": _stl_counts}
+
+#: Why pymeshlab drops faces, by format (see :func:`check_loaded`).
+_DROPPED_FACES = {".stl": "non-finite (NaN or inf) coordinates or a repeated corner"}
 
 
 def declared_counts(path):
-    """``(vertices, faces)`` the file declares (OBJ, OFF, PLY), None where unknown."""
+    """``(vertices, faces)`` the file declares (OBJ, OFF, PLY; STL: faces only), None where
+    unknown."""
     counts = _COUNTS.get(os.path.splitext(os.fspath(path))[1].lower())
     return counts(path) if counts is not None else (None, None)
 
@@ -242,7 +269,9 @@ def check_loaded(path, n_vertices, F, error=ValueError):
             "read it again.")
     # polygons are triangulated, so a complete load has at least as many triangles as faces
     if faces is not None and faces > F.shape[0]:
+        cause = _DROPPED_FACES.get(os.path.splitext(os.fspath(path))[1].lower(),
+                                   "vertex indices out of range or repeated within a face")
         raise error(
             f"{path!r} has {faces} faces but pymeshlab loaded {F.shape[0]} triangles: at least "
-            f"{faces - F.shape[0]} were dropped, most likely for vertex indices out of range or "
-            "repeated within a face. Fix or remove those faces in the file and read it again.")
+            f"{faces - F.shape[0]} were dropped, most likely for {cause}. Fix or remove those "
+            "faces in the file and read it again.")

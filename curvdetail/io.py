@@ -43,8 +43,9 @@ def read_mesh(path):
     MeshFileError       the format is unknown, the file is unreadable or holds no triangles, a
                         face index is out of range, or (OBJ, OFF, PLY) the loader dropped
                         vertices or faces: pymeshlab silently removes vertices with NaN or
-                        infinite coordinates (and renumbers the rest) and OBJ faces with
-                        out-of-range or repeated indices. Checked before pymeshlab reads the
+                        infinite coordinates (and renumbers the rest), OBJ faces with
+                        out-of-range or repeated indices, and STL triangles with a non-finite
+                        or repeated corner. Checked before pymeshlab reads the
                         file, because its loader would corrupt memory: out-of-range face
                         indices in an ASCII OFF file, indented vertex lines in an OBJ file
 

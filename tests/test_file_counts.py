@@ -30,7 +30,35 @@ def test_off_and_ply_headers_give_both_counts(tmp_path):
     ply.write_bytes(b"ply\nformat binary_little_endian 1.0\nelement vertex 10\nproperty float x\n"
                     b"element face 16\nproperty list uchar int vertex_indices\nend_header\n\x00\x01")
     assert declared_counts(ply) == (10, 16)
-    assert declared_counts(tmp_path / "m.stl") == (None, None)
+    assert declared_counts(tmp_path / "m.xyz") == (None, None)          # a format without counts
+
+
+def _binary_stl(path, triangles, count=None):
+    triangles = np.asarray(triangles, dtype="<f4")
+    record = np.zeros(len(triangles), dtype=[("normal", "<f4", 3), ("corners", "<f4", (3, 3)), ("attr", "<u2")])
+    record["corners"] = triangles
+    path.write_bytes(b"solid but binary".ljust(80, b" ") + np.uint32(count if count is not None else
+                     len(triangles)).astype("<u4").tobytes() + record.tobytes())
+
+
+_TRIANGLES = [[[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[1, 0, 0], [1, 1, 0], [0, 1, 0]]]
+
+
+@pytest.mark.parametrize("chunk", [3, 7, 64, 1 << 20])
+def test_stl_triangles_are_counted_from_the_binary_header_or_the_ascii_facets(tmp_path, monkeypatch, chunk):
+    monkeypatch.setattr(_file_counts, "_CHUNK", chunk)
+    binary = tmp_path / "b.stl"
+    _binary_stl(binary, _TRIANGLES)                  # its header starts with "solid", too
+    assert declared_counts(binary) == (None, 2)
+    ascii_stl = tmp_path / "a.stl"
+    ascii_stl.write_text("solid t\n" + "".join(
+        " facet normal 0 0 1\n  outer loop\n" + "".join(f"   vertex {x} {y} {z}\n" for x, y, z in t) +
+        "  endloop\n endfacet\n" for t in _TRIANGLES) + "endsolid t\n")
+    assert declared_counts(ascii_stl) == (None, 2)
+    odd = tmp_path / "c.stl"
+    _binary_stl(odd, _TRIANGLES, count=7)            # the size does not match the count
+    odd.write_bytes(b"x" + odd.read_bytes()[1:])     # and it is not ASCII either
+    assert declared_counts(odd) == (None, None)
 
 
 def test_check_loaded_accepts_a_complete_load_and_names_what_is_missing(tmp_path):

@@ -6,6 +6,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pymeshlab
 import pytest
 
 from curvdetail import MeshError, read_mesh, write_mesh
@@ -228,6 +229,33 @@ def test_ply_with_a_nan_vertex_is_refused(tmp_path, fmt):
     path.write_bytes(header.encode() + body)
     with pytest.raises(MeshFileError, match=r"has 5 vertices but pymeshlab loaded 4"):
         read_mesh(path)
+
+
+@pytest.mark.parametrize("bad", ["nan", "inf", "repeated"])
+@pytest.mark.parametrize("binary", [True, False])
+def test_stl_triangles_the_loader_drops_are_reported(tmp_path, bad, binary):
+    # pymeshlab drops STL triangles with a non-finite or a repeated corner without a word
+    third = {"nan": [[1, 0, 0], [np.nan, 1, 0], [2, 1, 0]], "inf": [[1, 0, 0], [np.inf, 1, 0], [2, 1, 0]],
+             "repeated": [[1, 0, 0], [1, 0, 0], [2, 1, 0]]}[bad]
+    triangles = [[[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[1, 0, 0], [1, 1, 0], [0, 1, 0]], third]
+    path = tmp_path / "bad.stl"
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(np.array(triangles[:2], dtype=float).reshape(-1, 3), np.arange(6).reshape(2, 3)))
+    if binary:
+        record = np.zeros(3, dtype=[("normal", "<f4", 3), ("corners", "<f4", (3, 3)), ("attr", "<u2")])
+        record["corners"] = triangles
+        path.write_bytes(b" " * 80 + np.uint32(3).astype("<u4").tobytes() + record.tobytes())
+    else:
+        path.write_text("solid t\n" + "".join(
+            " facet normal 0 0 1\n  outer loop\n" + "".join(f"   vertex {x} {y} {z}\n" for x, y, z in t) +
+            "  endloop\n endfacet\n" for t in triangles) + "endsolid t\n")
+    with pytest.raises(MeshFileError, match=r"has 3 faces but pymeshlab loaded 2 triangles: at least 1 "
+                                            r"were dropped, most likely for non-finite .* repeated corner"):
+        read_mesh(path)
+    good = tmp_path / "good.stl"                                     # the two good ones load
+    ms.save_current_mesh(str(good), binary=binary)
+    V, F = read_mesh(good)
+    assert F.shape == (2, 3)
 
 
 def test_obj_with_unreferenced_vertices_and_texture_lines_is_read_in_file_order(tmp_path):
