@@ -41,7 +41,7 @@ def read_mesh(path):
     ------
     FileNotFoundError   the file does not exist
     MeshFileError       the format is unknown, the file is unreadable or holds no triangles, a
-                        face index is out of range, or (OBJ, OFF, PLY) the loader dropped
+                        face index is out of range, or (OBJ, OFF, PLY, STL) the loader dropped
                         vertices or faces: pymeshlab silently removes vertices with NaN or
                         infinite coordinates (and renumbers the rest), OBJ faces with
                         out-of-range or repeated indices, and STL triangles with a non-finite

@@ -30,7 +30,7 @@ def load_meshset(path, *more):
     them) are added back.
 
     Raises FileNotFoundError if a file does not exist, MeshFileError if pymeshlab cannot read it
-    or dropped vertices or faces of an OBJ, OFF or PLY file, or a face index is out of range
+    or dropped vertices or faces of an OBJ, OFF, PLY or STL file, or a face index is out of range
     (see :func:`curvdetail.read_mesh`)."""
     import pymeshlab
 
