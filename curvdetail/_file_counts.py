@@ -155,7 +155,8 @@ def _off_header(data):
         pos = end + 1
         if len(words) >= 3 or pos > len(data):
             break
-    if len(words) < 3 or not words[0].endswith("OFF") or "n" in words[0]:
+    keyword = "OFF" if words and words[0] == "off" else (words[0] if words else "")
+    if len(words) < 3 or not keyword.endswith("OFF") or "n" in keyword:
         return None
     try:
         return int(words[1]), int(words[2]), pos
@@ -211,9 +212,7 @@ def _off_face_problem(path):
     suspect = np.zeros(nf, dtype=bool)
     odd = token_starts[_maybe_out_of_range(chars, token_starts, token_ends, nv)]
     suspect[np.searchsorted(line_starts, odd, side="right") - 1] = True
-    suspect |= ~one_digit
-    if np.any(~suspect & (per_line < k + 1)):
-        return None                    # not one face a line as expected (OFF is free-form): no verdict
+    suspect |= ~one_digit | (per_line < k + 1)
     bad = []
     for face in np.flatnonzero(suspect):
         words = body[starts[faces[face]]:ends[faces[face]]].split()
@@ -221,9 +220,9 @@ def _off_face_problem(path):
             count = int(words[0])
             index = [int(w) for w in words[1:count + 1]]
         except ValueError:
-            return None
-        if count < 3 or len(index) < count:
-            return None
+            continue                   # not one face a line as expected (OFF is free-form): no verdict
+        if count < 1 or len(index) < count:
+            continue
         if min(index) < 0 or max(index) >= nv:
             bad.append((face, index))
     if not bad:

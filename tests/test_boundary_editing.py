@@ -108,3 +108,22 @@ def test_the_mesh_is_checked_and_its_laplacian_assembled_once(monkeypatch):
     from curvdetail import cotan_laplacian
     monkeypatch.setattr(module, "_assemble_upper", real)
     assert (info["editor"].laplacian != cotan_laplacian(V, F)).nnz == 0
+
+
+@pytest.mark.parametrize("damage, message", [
+    (lambda V, F: (V, np.vstack([F, F[:1]])), "shared by more than two triangles"),         # a doubled triangle
+    (lambda V, F: (np.vstack([V, [0.5, 0.5, 1.0]]), np.vstack([F, [[F[40, 0], F[40, 1], V.shape[0]]]])),
+     "shared by more than two triangles"),                                                  # a fin
+])
+def test_a_malformed_mesh_is_named_before_its_boundary(damage, message):
+    V, F = grid(10, 10)
+    V, F = damage(V, F)
+    with pytest.raises(MeshError, match=message):
+        edit_boundary(V, F, sine_displacement(0.1, axis=2))
+
+
+def test_a_boundary_that_does_not_close_is_a_mesh_error():
+    # a doubled triangle takes its edges off the boundary: the loop breaks off (was a KeyError)
+    V, F = grid(10, 10)
+    with pytest.raises(MeshError, match=r"the boundary does not close: its edge into vertex \d+ has no edge out"):
+        boundary_loop(np.vstack([F, F[:1]]))

@@ -132,3 +132,10 @@ def test_obj_without_indented_vertex_lines_passes(tmp_path, text):
     path = tmp_path / "m.obj"
     path.write_bytes(text)
     check_before_loading(path)
+
+
+def test_a_short_or_odd_face_line_does_not_hide_a_bad_index_after_it(tmp_path):
+    path = tmp_path / "m.off"
+    path.write_text("off\n4 3 0\n" + _OFF_VERTICES + "2 0 1\n3 0 1 2\n3 1 3 7\n")
+    with pytest.raises(ValueError, match=r"1 faces use vertex indices .* \(first: face 2, \[1, 3, 7\]\)"):
+        check_before_loading(path)

@@ -69,3 +69,13 @@ def test_ascii_attributes_that_are_not_pymeshlab_s_give_nothing(tmp_path, body):
     path = tmp_path / "a.ply"
     path.write_text(_ASCII_HEAD + body)
     assert read_ply_vertex_attributes(path) == {}
+
+
+@pytest.mark.parametrize("body", [
+    "0 1.5 0 3 1 2 3 0\n\n1 2.5 0 3 4 5 6 0\n0 3 1 3 7 8 9 0\n",    # a blank line among them
+    "0 1.5 0 3 1 2 3 0 # note\n1 2.5 0 3 4 5 6 0\n0 3 1 3 7 8 9 0\n",  # PLY has no comments here
+])
+def test_ascii_vertex_blocks_with_blank_lines_or_hashes_give_nothing(tmp_path, body):
+    path = tmp_path / "a.ply"
+    path.write_text(_ASCII_HEAD + body)
+    assert read_ply_vertex_attributes(path) == {}

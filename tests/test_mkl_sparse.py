@@ -36,6 +36,15 @@ def test_gram_upper_is_the_upper_triangle_of_the_product():
     assert np.all(C.indices >= rows)
 
 
+def test_gram_upper_sums_duplicate_entries_and_leaves_its_input_alone():
+    from curvdetail.curvature._mkl_sparse import gram_upper
+
+    A = sp.csr_matrix((np.array([1.0, 2.0, 3.0]), np.array([1, 0, 1]), np.array([0, 3])), shape=(1, 2))
+    stored = (A.indices.copy(), A.data.copy())
+    assert gram_upper(A).toarray().tolist() == [[2.0 ** 2 + (1.0 + 3.0) ** 2]]       # the row is (2, 4)
+    assert np.array_equal(A.indices, stored[0]) and np.array_equal(A.data, stored[1])
+
+
 def test_gram_upper_of_an_empty_matrix():
     from curvdetail.curvature._mkl_sparse import gram_upper
 

@@ -155,9 +155,10 @@ def test_auto_falls_back_to_lu_where_the_banded_cholesky_meets_a_non_positive_pi
     A, x = _normal_equations(20)
     smallest = np.linalg.eigvalsh(A.toarray())[:2]
     A = (A - sp.identity(A.shape[0]) * smallest.mean()).tocsr()
-    fac = factorize(A)
-    assert fac.backend == "splu"
-    assert np.abs(fac.solve(A @ x) - x).max() < 1e-6 * np.abs(x).max()    # cond ~ 1e5
+    for given, upper in ((A, False), (sp.triu(A, format="csr"), True)):
+        fac = factorize(given, upper=upper)
+        assert fac.backend == "splu"
+        assert np.abs(fac.solve(A @ x) - x).max() < 1e-6 * np.abs(x).max()    # cond ~ 1e5
     with pytest.raises(SolverError, match="not positive definite"):
         factorize(A, backend="banded")                  # a named backend reports it
     monkeypatch.setenv("CURVDETAIL_SOLVER", "banded")

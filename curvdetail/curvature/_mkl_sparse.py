@@ -76,7 +76,9 @@ def gram_upper(A):
         return sp.csr_matrix((A.shape[0], A.shape[0]))
     if A.nnz > _INT32_MAX or max(A.shape) > _INT32_MAX:
         raise MklSparseError("the matrix needs 64-bit indices")
-    A.sort_indices()                               # syrk takes sorted rows only
+    if not A.has_canonical_format:                 # syrk takes sorted rows without duplicates
+        A = A.copy()                               # (and the caller's matrix stays as it was)
+        A.sum_duplicates()
     indptr = np.ascontiguousarray(A.indptr, dtype=np.int32)
     indices = np.ascontiguousarray(A.indices, dtype=np.int32)
     data = np.ascontiguousarray(A.data)

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ._validate import as_faces, as_values, as_vertices, boundary_edges
+from ._validate import as_faces, as_values, as_vertices, boundary_edges, check_mesh
 from .cotan_laplacian import _cotan_laplacian_unchecked
 from .curvature_coefficients import DEFAULT_RCOND
 from .curvature_editor import CurvatureEditor
@@ -73,7 +73,11 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
         raise ValueError(f"boundary_detail={boundary_detail!r}; use 'deformed' or 'rest'.")
     V = as_vertices(V)
     F = as_faces(F, V.shape[0])        # shapes and indices; the editor below runs every mesh check
-    loop = boundary_loop(F)
+    try:
+        loop = boundary_loop(F)
+    except MeshError:
+        check_mesh(V, F)               # a malformed mesh is named as such, not as a bad boundary
+        raise
     P = V[loop]
     seg = np.linalg.norm(np.roll(P, -1, axis=0) - P, axis=1)
     s = np.concatenate([[0.0], np.cumsum(seg)[:-1]]) / seg.sum()
@@ -172,6 +176,10 @@ def boundary_loop(F):
     cur = nxt[start]
     while cur != start and len(loop) <= E.shape[0]:
         loop.append(cur)
+        if cur not in nxt:
+            raise MeshError(f"the boundary does not close: its edge into vertex {cur} has no edge out of "
+                            "it (triangles oriented inconsistently, or a mesh that is not manifold). "
+                            "Check the mesh with check_mesh and orient it consistently.")
         cur = nxt[cur]
     if len(loop) != E.shape[0]:
         raise MeshError(f"the boundary has {E.shape[0]} edges but the loop through vertex {start} has "

@@ -196,7 +196,7 @@ class Factorization:
             if self.backend != "banded" or not _chosen_automatically(backend):
                 raise
             self.backend = "splu"
-            self._factor_splu(A)
+            self._factor_splu(self._as_backend_wants(A))      # the whole matrix, also from upper=True
 
     def _as_backend_wants(self, A):
         """``A`` (sorted) as the backend takes it: the whole matrix, except PARDISO's triangle."""

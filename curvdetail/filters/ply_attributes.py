@@ -105,8 +105,10 @@ def _from_ascii(lines, n, props, custom):
     if len(lines) < n:
         return {}
     try:
-        values = np.loadtxt(lines, dtype=np.float64, ndmin=2)
-    except ValueError:                                   # rows of different lengths, not numbers
+        values = np.loadtxt(lines, dtype=np.float64, ndmin=2, comments=None)
+    except (ValueError, IndexError):                     # rows of different lengths, not numbers
+        return {}
+    if values.shape[0] != n:                             # blank lines among the vertices
         return {}
     out, k = {}, 0
     for name, kind, _, _ in props:
