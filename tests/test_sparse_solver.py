@@ -159,6 +159,10 @@ def test_auto_falls_back_to_lu_where_the_banded_cholesky_meets_a_non_positive_pi
         fac = factorize(given, upper=upper)
         assert fac.backend == "splu"
         assert np.abs(fac.solve(A @ x) - x).max() < 1e-6 * np.abs(x).max()    # cond ~ 1e5
+    upper = sp.triu(A, format="csr")
+    upper.sort_indices()
+    pending = sparse_solver.PendingFactorization(upper, backend="auto")
+    assert pending.backend == "banded" and pending.finish(upper.data).backend == "splu"
     with pytest.raises(SolverError, match="not positive definite"):
         factorize(A, backend="banded")                  # a named backend reports it
     monkeypatch.setenv("CURVDETAIL_SOLVER", "banded")

@@ -354,6 +354,7 @@ class PendingFactorization:
         self._indptr, self._indices, self.shape = pattern.indptr, pattern.indices, pattern.shape
         n = self.shape[0]
         self.backend = resolve_backend(backend, symmetric=True, size=n, nnz=2 * pattern.nnz - n)
+        self._requested = backend              # "auto" stays "auto" for Factorization's fallback
         self._future = None
         if self.backend == "pardiso" and n > 0:
             from concurrent.futures import ThreadPoolExecutor
@@ -372,7 +373,7 @@ class PendingFactorization:
         A = sp.csr_matrix((np.asarray(data, dtype=np.float64), self._indices, self._indptr), shape=self.shape)
         A.has_sorted_indices = True
         if self._future is None:
-            return Factorization(A, symmetric=True, backend=self.backend, upper=True)
+            return Factorization(A, symmetric=True, backend=self._requested, upper=True)
         from ._pardiso import PardisoError
 
         future, self._future = self._future, None
