@@ -81,3 +81,19 @@ def test_rows_all_falls_back_to_scipys_product_where_mkl_refuses(monkeypatch):
     rec = Reconstructor(V, F, b, backend="pardiso")
     assert not rec._upper
     assert np.abs(rec.solve(curvature_detail(V, F), V[b]) - V).max() < 1e-12
+
+
+def test_a_missing_or_old_mkl_runtime_is_a_mkl_sparse_error(monkeypatch):
+    from curvdetail.curvature import _mkl_sparse
+
+    monkeypatch.setattr(_mkl_sparse, "_library", None)
+    monkeypatch.setattr(_mkl_sparse, "_library_path", lambda: "/nonexistent/libmkl_rt.so")
+    with pytest.raises(_mkl_sparse.MklSparseError, match="MKL's sparse BLAS is not available"):
+        _mkl_sparse.gram_upper(sp.eye(3, format="csr"))
+    # and Reconstructor goes on with SciPy's product
+    monkeypatch.setattr(reconstruct_module, "MKL_GRAM_MIN_FREE", 1)
+    V, F = grid(12, 12)
+    V[:, 2] = V[:, 0] ** 2
+    b = boundary_vertices(F)
+    rec = Reconstructor(V, F, b, backend="pardiso")
+    assert not rec._upper and np.abs(rec.solve(curvature_detail(V, F), V[b]) - V).max() < 1e-12

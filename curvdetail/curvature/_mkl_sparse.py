@@ -32,7 +32,11 @@ class MklSparseError(RuntimeError):
 def _mkl():
     global _library
     if _library is None:
-        lib = ctypes.CDLL(_library_path())
+        try:
+            lib = ctypes.CDLL(_library_path())
+            lib.mkl_sparse_syrk                        # an MKL old enough to lack it (< 2018)
+        except (OSError, AttributeError, RuntimeError) as exc:   # RuntimeError: PardisoError
+            raise MklSparseError(f"MKL's sparse BLAS is not available ({exc})") from None
         lib.mkl_sparse_d_create_csr.argtypes = [ctypes.POINTER(_handle), ctypes.c_int, ctypes.c_int32,
                                                 ctypes.c_int32, _int_p, _int_p, _int_p, _double_p]
         lib.mkl_sparse_syrk.argtypes = [ctypes.c_int, _handle, ctypes.POINTER(_handle)]
