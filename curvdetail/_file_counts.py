@@ -2,9 +2,10 @@
 
 pymeshlab's loader silently drops OBJ/OFF/PLY vertices with NaN or infinite coordinates (and the
 faces using them, renumbering the rest), drops OBJ faces whose vertex indices are out of range
-or repeated and STL triangles with a non-finite or repeated corner, and keeps OFF faces whose indices are out of range; its OFF loader then writes out
-of bounds, which can crash the process later, so :func:`check_before_loading` looks for such
-faces in an ASCII OFF file before the loader sees it (reading the file once more, vectorized).
+or repeated and STL triangles with a non-finite or repeated corner, and keeps OFF faces whose
+indices are out of range; its OFF loader then writes out of bounds, which can crash the process
+later, so :func:`check_before_loading` looks for such faces in an ASCII OFF file before the
+loader sees it (reading the file once more, vectorized).
 :func:`check_loaded` compares the loaded mesh with the counts the file declares (OFF/PLY
 headers, the binary STL header, a streamed count of OBJ ``v`` and ``f`` lines and of ASCII STL
 facets, never the whole file in memory) and with its own vertex count.
@@ -26,17 +27,25 @@ def _obj_counts(path):
     """Numbers of ``v`` and ``f`` lines of an OBJ file, counted in 1 MiB chunks. Like pymeshlab's
     loader, such a line starts at the beginning of a line with ``v`` / ``f`` and a space or tab
     (``vt``, ``vn``, ``vp`` and indented lines do not count)."""
-    vertices = faces = 0
-    tail = b"\n"
+    v, v_tab, f, f_tab = _streamed_counts(path, (b"\nv ", b"\nv\t", b"\nf ", b"\nf\t"), start=b"\n")
+    return v + v_tab, f + f_tab
+
+
+def _streamed_counts(path, needles, start=b""):
+    """Occurrences of each of ``needles`` in the file, read in ``_CHUNK`` pieces (never whole);
+    ``start`` is put before the first byte (a newline makes line-start patterns match there)."""
+    counts = [0] * len(needles)
+    keep = max(len(n) for n in needles) - 1
+    tail = start
     with open(path, "rb") as f:
         while True:
             chunk = f.read(_CHUNK)
             if not chunk:
-                return vertices, faces
+                return counts
             text = tail + chunk          # a match may straddle two chunks, never lie in tail alone
-            vertices += text.count(b"\nv ") + text.count(b"\nv\t")
-            faces += text.count(b"\nf ") + text.count(b"\nf\t")
-            tail = text[-2:]
+            for i, needle in enumerate(needles):
+                counts[i] += text.count(needle)
+            tail = text[max(0, len(text) - keep):]
 
 
 def _off_counts(path):
@@ -91,17 +100,9 @@ def _stl_counts(path):
             count = int(np.frombuffer(head[80:84], dtype="<u4")[0])
             if size == 84 + 50 * count:
                 return None, count
-        if not head.lstrip().startswith(b"solid"):
-            return None, None
-        f.seek(0)
-        facets, tail = 0, b""
-        while True:
-            chunk = f.read(_CHUNK)
-            if not chunk:
-                return None, facets
-            text = tail + chunk          # "endfacet" may straddle two chunks, never lie in tail alone
-            facets += text.count(b"endfacet")
-            tail = text[-7:]
+    if not head.lstrip().startswith(b"solid"):
+        return None, None
+    return None, _streamed_counts(path, (b"endfacet",))[0]
 
 
 _COUNTS = {".obj": _obj_counts, ".off": _off_counts, ".ply": _ply_counts, ".stl": _stl_counts}
