@@ -375,11 +375,13 @@ def write_markdown(path, results, meta):
 
 
 def _write_atomically(path, text):
-    """Write through a temporary file and a rename: an interrupted run leaves the old file."""
-    tmp = path + ".tmp"
-    with open(tmp, "w") as fh:
-        fh.write(text)
-    os.replace(tmp, path)
+    """Write through the package's temporary file and rename: an interrupted run leaves the old
+    file."""
+    from curvdetail._output import atomic_output
+
+    with atomic_output(path, overwrite=True, hint=None, error=FileNotFoundError) as tmp:
+        with open(tmp, "w") as fh:
+            fh.write(text)
 
 
 def main(argv=None):
