@@ -123,9 +123,13 @@ def check_before_loading(path, error=ValueError):
     OFF file whose faces name vertices the file does not have (the loader keeps such faces and
     writes out of bounds; the process can crash later, even after :func:`check_loaded` has
     reported them), and an OBJ file with indented vertex lines (the loader counts them in one
-    pass and not in the other; reading one aborted the process). Other files pass unread."""
+    pass and not in the other; reading one aborted the process). A binary OFF file, which the
+    loader refuses with only "Invalid file", is named as such. Other files pass unread."""
     extension = os.path.splitext(os.fspath(path))[1].lower()
     if extension == ".off":
+        if _off_is_binary(path):
+            raise error(f"{path!r} is a binary OFF file ('OFF BINARY'), which pymeshlab's OFF reader "
+                        "does not read; save it as ASCII OFF, PLY or OBJ and read that.")
         problem = _off_face_problem(path)
         if problem:
             raise error(f"{path!r}: {problem}; fix or remove those faces in the file and read it again.")
@@ -135,6 +139,13 @@ def check_before_loading(path, error=ValueError):
             raise error(f"{path!r}: {count} vertex lines start with spaces or tabs (first: line {line}), "
                         "which pymeshlab's OBJ loader miscounts (it crashed reading such a file); remove "
                         "the leading whitespace and read the file again.")
+
+
+def _off_is_binary(path):
+    """Whether an OFF file's first line is ``[ST][C][N][4][n]OFF BINARY`` (any case)."""
+    with open(path, "rb") as f:
+        words = f.readline(4096).split(b"#", 1)[0].upper().split()
+    return len(words) >= 2 and words[0].endswith(b"OFF") and words[1] == b"BINARY"
 
 
 def _obj_indented_vertices(path):

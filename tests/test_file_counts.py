@@ -98,12 +98,20 @@ def test_off_faces_out_of_range_are_found_before_loading(tmp_path, faces, messag
     "COFF 4 2 0\r\n" + _OFF_VERTICES.replace("\n", " 255 0 0 255\r\n") + "3 0 1 2 0.5 0.5 0.5\r\n  3 1 3 2\r\n",
     "OFF\n4 2 0\n" + _OFF_VERTICES + "3 0 1 2 # 99 in a comment\n\n   \n3 1 3 2 255 128 0\n",
     "OFF\n12 1 0\n" + "0 0 0\n" * 12 + "3 9 10 11\n",                      # two-digit indices < 12
-    "OFF BINARY\n",                                                          # not read
 ])
 def test_off_files_with_indices_in_range_pass(tmp_path, text):
     path = tmp_path / "ok.off"
     path.write_bytes(text.encode())
     check_before_loading(path)
+
+
+@pytest.mark.parametrize("first_line", [b"OFF BINARY\n", b"coff binary # colours\r\n"])
+def test_binary_off_is_named_as_such_before_loading(tmp_path, first_line):
+    # pymeshlab refuses it with "Invalid file" and no word on why
+    path = tmp_path / "b.off"
+    path.write_bytes(first_line + np.array([3, 1, 0], ">i4").tobytes() + np.zeros(9, ">f4").tobytes())
+    with pytest.raises(ValueError, match="binary OFF file .* save it as ASCII OFF, PLY or OBJ"):
+        check_before_loading(path)
 
 
 def test_off_indices_of_the_vertex_count_s_width_are_compared_by_value(tmp_path):

@@ -294,6 +294,14 @@ def test_files_that_crash_pymeshlab_are_refused_before_it_reads_them(tmp_path, n
     assert len(lines) == 2 and all(message in line for line in lines)
 
 
+def test_binary_off_is_refused_with_its_name(tmp_path):
+    path = tmp_path / "b.off"
+    path.write_bytes(b"OFF BINARY\n" + np.array([3, 1, 0], ">i4").tobytes() +
+                     np.eye(3, dtype=">f4").tobytes() + np.array([3, 0, 1, 2, 0], ">i4").tobytes())
+    with pytest.raises(MeshFileError, match="binary OFF file"):
+        read_mesh(path)
+
+
 def test_off_with_counts_on_the_header_line_and_colours_is_read(tmp_path):
     path = tmp_path / "ok.off"
     path.write_text("COFF 4 2 0\n" + "".join(f"{x} {y} {z} 255 0 0 255\n" for x, y, z in _SQUARE) +
