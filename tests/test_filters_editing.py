@@ -65,7 +65,7 @@ def test_filter_is_declared_with_its_parameters():
     (dict(handles=""), FilterParameterError, "empty"),
     (dict(handles="1 2 999999"), FilterParameterError, "outside"),
     (dict(handles="1 2", transform="1 0 0"), FilterParameterError, "16 finite numbers"),
-    (dict(handles="1 2", detail_scale=-1.0), FilterParameterError, "positive"),
+    (dict(handles="1 2", detail_scale=-1.0), FilterParameterError, "greater than 0"),
 ])
 def test_bad_parameters_are_refused(params, error, message):
     ms, V, d, handles = _meshset_with_roi()

@@ -70,6 +70,30 @@ def test_range_is_enforced():
         p.check(0)
 
 
+@pytest.mark.parametrize("value", [0.0, -1e-9, pymeshlab.PercentageValue(0.0)])
+def test_positive_parameters_refuse_zero_and_below(value):
+    p = Parameter("target_edge", "PercentageValue", BBoxLength(1.0, True), "edge", positive=True)
+    with pytest.raises(FilterParameterError, match="'target_edge' is .*; it must be greater than 0"):
+        p.check(value)
+    assert p.check(pymeshlab.PercentageValue(0.5)) == BBoxLength(0.5, True)
+
+
+@pytest.mark.parametrize("name, parameter", [("generate_minimal_surface", "tol"),
+                                             ("generate_curvature_remeshing", "target_edge"),
+                                             ("apply_curvature_editing", "detail_scale")])
+def test_filters_declare_the_strictly_positive_ranges_their_code_demands(name, parameter):
+    # the declared range is what `curvdetail list` shows and what apply checks before running
+    from curvdetail.filters.registry import describe_filter, get_filter
+
+    spec = get_filter(name)
+    p = next(q for q in spec.parameters if q.name == parameter)
+    assert p.positive
+    line = next(text for text in describe_filter(spec).splitlines() if text.strip().startswith(parameter))
+    assert "> 0" in line and ">= 0" not in line
+    with pytest.raises(FilterParameterError, match="greater than 0"):
+        p.parse("0")
+
+
 def test_non_finite_float_is_refused():
     with pytest.raises(FilterParameterError, match="finite"):
         Parameter("tol", "float", 1e-6, "tolerance").parse("nan")

@@ -7,7 +7,7 @@ import numpy as np
 from ..curvature._validate import bbox_diagonal
 from ..curvature.curvature_editor import CurvatureEditor
 from ..curvature.errors import ConstraintError, first_indices
-from .apply_curvature_reconstruction import BACKENDS
+from .apply_curvature_reconstruction import BACKEND_DESCRIPTION, BACKENDS
 from .errors import FilterParameterError
 from .meshset import (get_mesh, layer_id, mesh_arrays, selected_vertices, set_vertex_positions,
                       set_vertex_quality)
@@ -76,7 +76,8 @@ def _matrix(text):
         Parameter("transform", "str", IDENTITY,
                   "4x4 handle transform, 16 numbers row by row, applied to homogeneous positions"),
         Parameter("detail_scale", "float", 1.0,
-                  "factor on the handles' curvature normals after the transform (1 keeps them)"),
+                  "factor on the handles' curvature normals after the transform (1 keeps them)",
+                  positive=True),
         Parameter("move_handles", "bool", True,
                   "constrain the handles' positions to the transformed ones; false constrains "
                   "their curvature normals only and lets them move"),
@@ -87,7 +88,7 @@ def _matrix(text):
                   "curvature stage: the paper's one-ring coefficients (square system) or one- and "
                   "two-ring coefficients together (least squares, steadier for rotated handles)",
                   choices=("one-ring", "one+two-ring")),
-        Parameter("backend", "str", "auto", "sparse solver backend", choices=BACKENDS),
+        Parameter("backend", "str", "auto", BACKEND_DESCRIPTION, choices=BACKENDS),
     ],
 )
 def apply_curvature_editing(ms, *, handles, region_radius, transform, detail_scale, move_handles,
@@ -96,8 +97,6 @@ def apply_curvature_editing(ms, *, handles, region_radius, transform, detail_sca
     V, F = mesh_arrays(ms, mid)
     h = _indices(handles, V.shape[0])
     T = _matrix(transform)
-    if not np.isfinite(detail_scale) or detail_scale <= 0:
-        raise FilterParameterError(f"parameter 'detail_scale' is {detail_scale}; it must be positive.")
     if not move_handles and handle_detail == "free":
         raise FilterParameterError("move_handles=false with handle_detail='free' leaves the handles "
                                    "unconstrained; set one of them.")

@@ -1,7 +1,7 @@
 """Filter ``generate_curvature_remeshing``: the paper's remeshing experiment on the current mesh."""
 
 from ..curvature._validate import bbox_diagonal
-from .apply_curvature_reconstruction import BACKENDS
+from .apply_curvature_reconstruction import BACKEND_DESCRIPTION, BACKENDS
 from .compute_curvature_detail import DETAIL
 from .meshset import add_layer, get_mesh, layer_id, mesh_arrays
 from .parameters import BBoxLength, Parameter
@@ -30,7 +30,7 @@ from .registry import PAPER, filter
                   "'decimate'", choices=("isotropic", "decimate")),
         Parameter("target_edge", "PercentageValue", BBoxLength(1.0, percent=True),
                   "target edge length: a percentage of the bbox diagonal (pymeshlab.PercentageValue, "
-                  "'1%') or an absolute length", min=0.0),
+                  "'1%') or an absolute length", positive=True),
         Parameter("transfer", "str", "conservative",
                   "how detail is carried over: 'conservative' (measure, totals kept) or 'pointwise' "
                   "(the paper: K interpolated, times the target's area)",
@@ -42,7 +42,7 @@ from .registry import PAPER, filter
                   "(shared planar parameterization)", choices=("closest", "uv")),
         Parameter("parameterization", "str", "harmonic", "planar map for location='uv'",
                   choices=("harmonic", "meshlab_harmonic", "lscm")),
-        Parameter("backend", "str", "auto", "sparse solver backend", choices=BACKENDS),
+        Parameter("backend", "str", "auto", BACKEND_DESCRIPTION, choices=BACKENDS),
         Parameter("evaluate", "bool", True,
                   "measure the distances to the source (the costly part on big meshes)"),
         Parameter("add_baseline", "bool", False, "also add the zero-detail baseline as a layer"),

@@ -6,7 +6,7 @@ from ..curvature import minimal_surface
 from ..curvature.minimal_surface import DEFAULT_TOL
 from ..curvature._validate import bbox_diagonal, boundary_vertices, face_double_areas
 from ..curvature.errors import ConstraintError
-from .apply_curvature_reconstruction import BACKENDS
+from .apply_curvature_reconstruction import BACKEND_DESCRIPTION, BACKENDS
 from .meshset import add_layer, get_mesh, layer_id, mesh_arrays
 from .parameters import Parameter
 from .registry import PAPER, filter
@@ -30,8 +30,8 @@ from .registry import PAPER, filter
         Parameter("max_iterations", "int", 200, "Pinkall-Polthier steps at most", min=1),
         Parameter("tol", "float", DEFAULT_TOL,
                   "stop when no vertex moves more than tol x the bbox diagonal normal to the "
-                  "surface in a step (tangential sliding is not counted)", min=0.0),
-        Parameter("backend", "str", "auto", "sparse solver backend", choices=BACKENDS),
+                  "surface in a step (tangential sliding is not counted)", positive=True),
+        Parameter("backend", "str", "auto", BACKEND_DESCRIPTION, choices=BACKENDS),
     ],
 )
 def generate_minimal_surface(ms, *, max_iterations, tol, backend):

@@ -2,7 +2,7 @@
 
 A :class:`Parameter` has a ``name``, a ``type`` (one of :data:`TYPES`), a ``default``, a
 ``description`` and, where they apply, ``choices`` (for ``str``) and ``min`` / ``max`` (for
-``int``, ``float`` and ``PercentageValue``).
+``int``, ``float`` and ``PercentageValue``; ``positive=True`` asks for a value above 0).
 
 Types, as pymeshlab names them:
 
@@ -61,6 +61,7 @@ class Parameter:
     choices: tuple = None
     min: float = None
     max: float = None
+    positive: bool = False
 
     def __post_init__(self):
         if self.type not in TYPES:
@@ -136,6 +137,8 @@ class Parameter:
         return x
 
     def _range(self, x):
+        if self.positive and not x > 0:
+            raise FilterParameterError(f"parameter {self.name!r} is {x}; it must be greater than 0.")
         if self.min is not None and x < self.min:
             raise FilterParameterError(f"parameter {self.name!r} is {x}; it must be at least {self.min}.")
         if self.max is not None and x > self.max:

@@ -175,6 +175,8 @@ def describe_filter(spec, width=96):
         extra = []
         if p.choices:
             extra.append(" | ".join(p.choices))
+        if p.positive:
+            extra.append("> 0")
         if p.min is not None:
             extra.append(f">= {p.min}")
         if p.max is not None:
