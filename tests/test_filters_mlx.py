@@ -94,6 +94,18 @@ def test_enum_given_by_text_is_accepted(tmp_path):
     assert run_script(meshset(), path)[-1]["figures"]["rows"] == "free"
 
 
+@pytest.mark.parametrize("enum_values, index, rows", [
+    ('enum_val0="free" enum_val1="all"', 0, "free"),        # the script's own order wins
+    ('enum_val0="free" enum_val1="all"', 1, "all"),
+    ("", 1, "free"),                                          # no list: our order (all, free)
+])
+def test_enum_index_is_read_through_the_script_s_own_values(tmp_path, enum_values, index, rows):
+    path = write(tmp_path, '<filter name="compute_curvature_detail"/>\n <filter name='
+                           f'"apply_curvature_reconstruction"><Param name="rows" value="{index}" '
+                           f'type="RichEnum" enum_cardinality="2" {enum_values}/></filter>')
+    assert run_script(meshset(), path)[-1]["figures"]["rows"] == rows
+
+
 def test_unknown_parameter_in_script_names_step_and_close_match(tmp_path):
     path = write(tmp_path, '<filter name="generate_minimal_surface"><Param name="max_iteration" '
                            'value="3"/></filter>')

@@ -10,15 +10,16 @@ The format is MeshLab's (and pymeshlab's ``save_filter_script``)::
      </filter>
      <filter name="transfer_curvature_detail">
       <Param name="sourcemesh" value="0" type="RichMesh" .../>
-      <Param name="method" value="1" type="RichEnum" enum_val0="pointwise" enum_val1="conservative" .../>
+      <Param name="method" value="1" type="RichEnum" enum_val0="conservative" enum_val1="pointwise" .../>
      </filter>
     </FilterScript>
 
 A ``<filter>`` whose name is one of ours (the snake_case name of
 :func:`~curvdetail.filters.list_filters`) runs through :func:`~curvdetail.filters.apply` with
 the ``<Param name= value=>`` pairs converted by the parameter types (an enum's value is its index,
-as MeshLab writes it, or its text; a ``PercentageValue`` is absolute, as MeshLab writes it, or
-``"1.5%"`` of the bbox diagonal). Parameters missing from the script take their defaults. Any
+as MeshLab writes it, read through the element's ``enum_val<i>`` where it has them, or its
+text; a ``PercentageValue`` is absolute, as MeshLab writes it, or ``"1.5%"`` of the bbox
+diagonal). Parameters missing from the script take their defaults. Any
 other ``<filter>`` / ``<xmlfilter>`` (MeshLab GUI names) is handed to pymeshlab unchanged, one
 at a time, through a temporary script and ``load_filter_script`` / ``apply_filter_script``.
 """
@@ -66,6 +67,9 @@ def _our_parameters(spec, element, where):
         name, value = child.get("name"), child.get("value")
         if name is None or value is None:
             raise ScriptError(f"{where}: a <{child.tag}> lacks a name or a value.")
+        # an enum index means the script's own enum_val<i> where it lists them (MeshLab writes
+        # both), so a script whose list is in another order still means what it says
+        value = child.get(f"enum_val{value.strip()}", value) if child.get("type") == "RichEnum" else value
         try:
             params[name] = spec.parameter(name).parse(value)
         except KeyError:
