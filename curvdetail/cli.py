@@ -52,9 +52,10 @@ def add_output_arguments(parser):
 
 
 def add_backend_argument(parser):
-    from .curvature.sparse_solver import BACKENDS
+    from .curvature.sparse_solver import AUTO_RULE, BACKENDS
 
-    parser.add_argument("--backend", default="auto", help="sparse solver: " + ", ".join(("auto",) + BACKENDS))
+    parser.add_argument("--backend", default="auto",
+                        help=f"sparse solver: {', '.join(('auto',) + BACKENDS)} ({AUTO_RULE})")
 
 
 def add_input_output_arguments(parser, input_help, output_help):

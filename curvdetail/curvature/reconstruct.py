@@ -36,7 +36,8 @@ class Reconstructor:
     F : (m, 3) int array         triangles
     fixed : (k,) int array or (n,) bool mask   constrained vertices
     rows : {"all", "free"}       which residual rows enter the energy
-    backend : str                sparse solver: "auto", "pardiso", "cholmod" or "splu"
+    backend : str                sparse solver: "auto", "pardiso", "cholmod", "splu" or "banded"
+                                 (see :mod:`.sparse_solver` for what "auto" picks)
     refinement_steps : int, optional   refinement steps of ``rows="all"`` solves (default: the
                                  class attribute, 1). 0 halves the back-substitution time and
                                  gives the plain normal-equation solution (~cond^2 eps).
@@ -299,6 +300,8 @@ def reconstruct(V_ref, F, detail, fixed, fixed_positions, *, rows="all", backend
     ------
     MeshError         malformed mesh
     ConstraintError   bad fixed indices, wrong shapes, or a piece with no fixed vertex
+    ValueError        an unknown ``rows`` mode
+    SolverError       an unknown or uninstalled ``backend``
 
     Examples
     --------

@@ -103,6 +103,11 @@ BANDED_MAX_BYTES = 1 << 30
 SMALL_SYSTEM_NNZ = 50_000
 
 
+#: What ``"auto"`` picks, in a line (for parameter descriptions and help texts).
+AUTO_RULE = (f"auto = SuperLU (or the banded Cholesky for small normal equations) below "
+             f"{SMALL_SYSTEM_NNZ:,} stored entries, else the first installed of PARDISO, CHOLMOD, SuperLU")
+
+
 def resolve_backend(backend="auto", *, symmetric=True, size=None, nnz=None):
     """Turn ``"auto"`` (or the ``CURVDETAIL_SOLVER`` setting) into an installed backend name."""
     if backend in (None, "auto"):

@@ -5,7 +5,7 @@ import numpy as np
 from ..curvature import reconstruct
 from ..curvature._validate import bbox_diagonal, boundary_vertices
 from ..curvature.errors import ConstraintError
-from ..curvature.sparse_solver import BACKENDS as _SOLVERS
+from ..curvature.sparse_solver import AUTO_RULE, BACKENDS as _SOLVERS
 from .compute_curvature_detail import DETAIL
 from .meshset import (get_mesh, layer_id, mesh_arrays, require_vertex_attribute, selected_vertices,
                       set_vertex_positions, set_vertex_quality)
@@ -13,6 +13,7 @@ from .parameters import Parameter
 from .registry import PAPER, filter
 
 BACKENDS = ("auto",) + _SOLVERS
+BACKEND_DESCRIPTION = "sparse solver backend; " + AUTO_RULE
 
 
 @filter(
@@ -35,9 +36,7 @@ BACKENDS = ("auto",) + _SOLVERS
                   choices=("all", "free")),
         Parameter("fix_boundary", "bool", True, "keep the boundary vertices where they are"),
         Parameter("fix_selected", "bool", True, "keep the selected vertices where they are"),
-        Parameter("backend", "str", "auto",
-                  "sparse Cholesky/LU backend: auto (PARDISO, then CHOLMOD, then scipy splu)",
-                  choices=BACKENDS),
+        Parameter("backend", "str", "auto", BACKEND_DESCRIPTION, choices=BACKENDS),
     ],
 )
 def apply_curvature_reconstruction(ms, *, rows, fix_boundary, fix_selected, backend):
