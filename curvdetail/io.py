@@ -127,8 +127,13 @@ def write_mesh(path, V, F, *, quality=None, overwrite=False):
 
 
 def save_mesh(path, mesh, *, overwrite=False, **save_options):
-    """Atomically save a ``pymeshlab.Mesh`` (with its quality, colours and custom attributes where
-    the format holds them). Used by :func:`write_mesh`, the filters and the CLI.
+    """Atomically save a ``pymeshlab.Mesh`` (with its quality and colours where the format holds
+    them). Used by :func:`write_mesh`.
+
+    Custom attributes are not saved: the mesh is copied into a fresh MeshSet, and pymeshlab
+    crashes (segmentation fault) exporting the attributes of such a copy. A MeshSet layer with
+    custom attributes is saved by :func:`curvdetail.filters.files.save_current_mesh` (what the
+    filters and the CLI use), which keeps them in PLY.
 
     The mesh is written to a temporary file in the destination folder (with ``path``'s
     extension) and renamed over ``path`` only when the write succeeded, with the permissions the
@@ -146,7 +151,8 @@ def save_mesh(path, mesh, *, overwrite=False, **save_options):
     Raises
     ------
     FileExistsError   ``path`` exists and ``overwrite`` is False
-    MeshFileError     no extension, missing folder, or pymeshlab failed to write
+    MeshFileError     no extension, missing folder, pymeshlab failed to write, or a save option
+                      that asks for a custom attribute (``__ca_...``)
 
     Examples
     --------
@@ -158,6 +164,11 @@ def save_mesh(path, mesh, *, overwrite=False, **save_options):
     True
     """
     options = dict(save_options)
+    custom = sorted(k for k in options if k.startswith("__ca_"))
+    if custom:
+        raise MeshFileError(f"save_mesh cannot save custom attributes ({', '.join(custom)}): pymeshlab "
+                            "crashes exporting them from a copied mesh. Add the mesh to a MeshSet and "
+                            "save it with curvdetail.filters.files.save_current_mesh.")
     if os.path.splitext(os.fspath(path))[1].lower() == ".ply" and mesh.has_vertex_scalar():
         options.setdefault("save_vertex_quality", True)
     # the temporary file keeps path's extension: pymeshlab picks the format from it

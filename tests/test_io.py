@@ -348,6 +348,17 @@ def test_save_mesh_refuses_to_overwrite(tmp_path):
     assert path.read_text() == "x" and os.listdir(tmp_path) == ["m.ply"]
 
 
+def test_save_mesh_refuses_custom_attribute_options_instead_of_crashing(tmp_path):
+    # pymeshlab segfaults exporting custom attributes of a mesh copied into a fresh MeshSet
+    import pymeshlab
+
+    mesh = pymeshlab.Mesh(vertex_matrix=np.eye(3), face_matrix=np.array([[0, 1, 2]], dtype=np.int32),
+                          v_scalar_array=np.arange(3.0))
+    with pytest.raises(MeshFileError, match=r"cannot save custom attributes \(__ca_vs__foo\).*save_current_mesh"):
+        save_mesh(tmp_path / "m.ply", mesh, __ca_vs__foo=True)
+    assert os.listdir(tmp_path) == []
+
+
 def test_failed_overwrite_keeps_the_old_file(tmp_path, nose, monkeypatch):
     import pymeshlab
 
