@@ -127,3 +127,20 @@ def test_a_boundary_that_does_not_close_is_a_mesh_error():
     V, F = grid(10, 10)
     with pytest.raises(MeshError, match=r"the boundary does not close: its edge into vertex \d+ has no edge out"):
         boundary_loop(np.vstack([F, F[:1]]))
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(amplitude=0.1, axis=3), "axis=3; use 0, 1 or 2"),
+    (dict(amplitude=0.1, axis=True), "axis=True; use 0, 1 or 2"),
+    (dict(amplitude=float("nan")), "amplitude=nan must be a finite number"),
+    (dict(amplitude=0.1, periods=float("inf")), "periods=inf must be a finite number"),
+    (dict(amplitude=0.1, phase="0"), "phase='0' must be a finite number"),
+])
+def test_sine_displacement_refuses_what_would_give_no_displacement(kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        sine_displacement(**kwargs)
+
+
+def test_sine_displacement_takes_numpy_scalars():
+    f = sine_displacement(np.float32(2.0), periods=np.int64(1), axis=np.int64(2))
+    assert np.allclose(f(np.array([0.25]), np.zeros((1, 3))), [[0.0, 0.0, 2.0]])

@@ -1,5 +1,8 @@
 """Shape editing of a patch's boundary (the paper's Fig. 2b)."""
 
+import math
+import numbers
+
 import numpy as np
 
 from ._validate import as_faces, as_values, as_vertices, boundary_edges, check_mesh
@@ -131,14 +134,22 @@ def sine_displacement(amplitude, periods=1, axis=1, phase=0.0):
     -------
     displacement : callable ``(s, P) -> (b, 3)`` for :func:`edit_boundary`
 
+    Raises
+    ------
+    ValueError   ``axis`` not 0, 1 or 2, or ``amplitude``, ``periods`` or ``phase`` not a finite
+                 number
+
     Examples
     --------
     >>> f = sine_displacement(2.0, periods=1, axis=2)
     >>> f(np.array([0.0, 0.25]), np.zeros((2, 3)))[:, 2].round(12).tolist()
     [0.0, 2.0]
     """
-    if axis not in (0, 1, 2):
+    if isinstance(axis, bool) or axis not in (0, 1, 2):
         raise ValueError(f"axis={axis!r}; use 0, 1 or 2 for x, y or z.")
+    for name, value in (("amplitude", amplitude), ("periods", periods), ("phase", phase)):
+        if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
+            raise ValueError(f"{name}={value!r} must be a finite number.")
 
     def displacement(s, P):
         out = np.zeros((np.asarray(s).size, 3))
