@@ -80,6 +80,9 @@ class CurvatureEditor:
     laplacian : (n, n) csr_matrix   ``L`` of the rest shape (:func:`cotan_laplacian`)
     coefficients : (n, n) csr_matrix   ``C``
     coefficients_two_ring : (n, n) csr_matrix   ``C2`` (only with ``relations="one+two-ring"``)
+    relations, rows : str       as given
+    backend : dict              the solver backend of each stage, e.g. ``{"curvature": "splu",
+                                "embedding": "banded"}`` ("none" where a stage has no unknowns)
     timings : dict              seconds spent in the constructor: ``coefficients`` (L, D and C),
                                 ``curvature_setup`` (checks and LU of ``(I - C)_uu``),
                                 ``embedding_setup`` (normal equations and their factorization)

@@ -72,6 +72,8 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, backend
     MeshError         malformed mesh, or triangles collapsed during the iteration (the boundary
                       spans no minimal surface of this topology, e.g. two circles too far apart)
     ConstraintError   bad fixed set or a piece with no fixed vertex
+    ValueError        ``max_iterations`` not a whole number >= 1, ``tol`` not a positive number
+    SolverError       an unknown or uninstalled ``backend``
 
     Examples
     --------

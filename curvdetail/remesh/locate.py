@@ -41,6 +41,7 @@ def locate(points, V, F, *, engine="auto", candidates=8, chunk=20_000):
     ------
     MeshError   mismatched dimensions, empty ``F``, NaN or infinite coordinates, or triangle
                 indices outside ``V``
+    ValueError  an unknown ``engine``
 
     Examples
     --------
