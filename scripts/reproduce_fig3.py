@@ -13,6 +13,7 @@ Writes (paths relative to the repository):
   docs/fig3.png                   the Fig. 3 patches, default configuration
 
 Usage: python scripts/reproduce_fig3.py [--meshes DIR] [--quick]
+(DIR defaults to $CURVDETAIL_MESHES, else ../shared/meshes beside the repository.)
 """
 
 import argparse
@@ -70,10 +71,14 @@ HEADER = ("| patch | source V | target V | retriangulation | transfer | rows | l
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--meshes", default=os.path.join(ROOT, "..", "shared", "meshes"))
+    default_meshes = os.environ.get("CURVDETAIL_MESHES", os.path.join(ROOT, "..", "shared", "meshes"))
+    ap.add_argument("--meshes", default=default_meshes,
+                    help="folder of the public meshes (default: $CURVDETAIL_MESHES, else ../shared/meshes)")
     ap.add_argument("--quick", action="store_true", help="default configuration only, no 100k run")
     args = ap.parse_args()
-    meshes = args.meshes if os.path.isdir(args.meshes) else "/work/shared/meshes"
+    meshes = args.meshes
+    if not os.path.isdir(meshes):
+        ap.error(f"mesh folder {meshes!r} does not exist; pass --meshes DIR or set CURVDETAIL_MESHES")
     os.makedirs(os.path.join(ROOT, "out", "fig3"), exist_ok=True)
     results, lines_main, lines_all = [], [], []
     figure_inputs = {}
