@@ -68,6 +68,19 @@ def test_rest_boundary_detail_keeps_the_inside_detail(load_mesh):
     assert np.array_equal(X2, X)
 
 
+def test_the_sine_runs_along_the_arc_length_of_an_uneven_boundary():
+    # uneven spacing along x: arc length and vertex count along the loop disagree
+    V, F = grid(9, 9)
+    V[:, 0] **= 2
+    X, info = edit_boundary(V, F, sine_displacement(0.1, periods=1, axis=2), return_info=True)
+    loop = info["boundary"]
+    P = V[loop]
+    edges = np.linalg.norm(np.roll(P, -1, axis=0) - P, axis=1)
+    s = np.concatenate([[0.0], np.cumsum(edges)[:-1]]) / edges.sum()
+    assert np.allclose(info["arc_length"], s, atol=1e-15)
+    assert np.allclose(X[loop, 2] - V[loop, 2], 0.1 * np.sin(2 * np.pi * s), atol=1e-12)
+
+
 def test_unknown_boundary_detail_mode_is_refused(load_mesh):
     V, F = load_mesh("terrainA_1k.obj")
     with pytest.raises(ValueError, match="boundary_detail"):

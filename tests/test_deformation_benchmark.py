@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from curvdetail import CurvatureEditor
 from curvdetail.curvature.errors import ConstraintError
 from curvdetail.curvature.testing import grid
 from curvdetail.deformation_benchmark import (DeformationFileError, apply_transform,
@@ -103,6 +104,23 @@ def test_fixed_vertices_stay_and_handles_land_on_their_transformed_positions(mod
     assert np.array_equal(X[fixed], V[fixed])
     assert np.array_equal(X[handles], apply_transform(T, V[handles]))
     assert np.all(np.isfinite(X))
+
+
+@pytest.mark.parametrize("mode", ["transform", "free"])
+def test_free_vertices_are_the_editors_solution_for_the_prescribed_constraints(mode):
+    # the benchmark's status and transform mean: region = status 1 and 2, handles at T V, handle
+    # details T_3x3 D ("transform") or unknown ("free"); the free vertices are the editor's answer
+    V, F, status = _strip()
+    T = _similarity(0.4, 1.0, [0.0, 0.3, 0.5])
+    X = edit_with_selection(V, F, status, T, handle_detail=mode)
+    handles = np.flatnonzero(status == 2)
+    ed = CurvatureEditor(V, F, handles, handles if mode == "transform" else [], roi=np.flatnonzero(status != 0))
+    Y = ed.solve(positions=apply_transform(T, V[handles]),
+                 details=ed.detail[handles] @ T[:3, :3].T if mode == "transform" else None)
+    free = status == 1
+    assert np.abs(X - Y).max() < 1e-12
+    # and they did follow the handles: lifted part of the way, between the fixed end and the handle
+    assert 0.0 < X[free, 2].min() and X[free, 2].max() < 0.5 + 1e-9
 
 
 def test_identity_transform_leaves_the_mesh_in_place(load_mesh):

@@ -12,7 +12,7 @@ from curvdetail.filters.registry import FAMILIES, filter as declare
 
 CORE_FILTERS = {"compute_curvature_detail", "apply_curvature_reconstruction", "generate_minimal_surface",
                 "transfer_curvature_detail", "generate_curvature_remeshing",
-                "get_curvature_reconstruction_error"}
+                "get_curvature_reconstruction_error", "apply_curvature_editing"}
 
 
 def test_issue_filters_are_registered():

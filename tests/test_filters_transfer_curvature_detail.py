@@ -69,10 +69,17 @@ def test_remeshed_nose_rebuilt_from_transferred_detail_is_close():
     assert figures["hausdorff_rms"] < 1e-3 and figures["hausdorff_max"] < 1e-2
 
 
-def test_uv_location_reports_the_parameterization():
-    figures = apply(remeshed_nose(), "transfer_curvature_detail", location="uv")
+def test_uv_location_reports_the_parameterization_and_carries_the_detail():
+    ms = remeshed_nose()
+    figures = apply(ms, "transfer_curvature_detail", location="uv")
     assert figures["parameterization"] == "harmonic"
-    assert figures["flipped_target"] >= 0 and figures["boundary_mismatch"] < 1e-2
+    # our harmonic map of a disk onto a convex domain flips nothing (Tutte / Floater), and both
+    # boundaries are put on the circle by the same arc lengths
+    assert figures["flipped_source"] == 0 and figures["flipped_target"] == 0
+    assert figures["boundary_mismatch"] < 1e-9
+    apply(ms, "apply_curvature_reconstruction", rows="free")
+    error = apply(ms, "get_curvature_reconstruction_error", samplenum=20000)
+    assert error["hausdorff_rms"] < 2e-3        # measured 0.074 % (closest point: 0.034 %)
 
 
 def test_closed_target_is_refused():

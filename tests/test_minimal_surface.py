@@ -117,6 +117,27 @@ def test_result_is_scale_equivariant(load_mesh):
     assert np.abs(X1 - 4.0 * X0).max() < 1e-10 * 4.0 * bbox_diagonal(V)
 
 
+def test_stopping_rule_is_relative_to_the_bbox_diagonal(load_mesh):
+    # the same shape at ten times the size stops after the same steps, with the same relative step
+    V, F = load_mesh("mannequin_nose.obj")
+    b = boundary_vertices(F)
+    X1 = minimal_surface(V, F, b, tol=1e-3)
+    X10 = minimal_surface(10.0 * V, F, b, tol=1e-3)
+    assert X1.converged and X10.converged
+    assert X1.iterations == X10.iterations > 1
+    assert X10.last_step == pytest.approx(X1.last_step, rel=1e-9)
+
+
+def test_order_of_the_fixed_vertices_does_not_matter(load_mesh):
+    V, F = load_mesh("mannequin_nose.obj")
+    b = boundary_vertices(F)
+    shuffled = np.random.default_rng(0).permutation(b)
+    X = minimal_surface(V, F, b, max_iterations=3, tol=1e-12)
+    Y = minimal_surface(V, F, shuffled, max_iterations=3, tol=1e-12)
+    assert np.abs(X - Y).max() < 1e-12 * bbox_diagonal(V)
+    assert np.array_equal(Y[b], V[b])
+
+
 def test_docstring_example_runs():
     assert doctest.testmod(importlib.import_module("curvdetail.curvature.minimal_surface")).failed == 0
 

@@ -31,6 +31,15 @@ def test_obtuse_triangle_gives_half_to_the_obtuse_corner():
     assert np.allclose(A, [0.5, 0.5, 1.0], atol=1e-15)
 
 
+def test_a_barely_obtuse_corner_already_takes_half():
+    # 95 degrees at vertex 0: Meyer et al.'s rule switches at 90, not somewhere beyond it
+    a = np.deg2rad(95.0)
+    V = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [np.cos(a), np.sin(a), 0.0]])
+    area = 0.5 * np.sin(a)
+    assert np.allclose(mixed_voronoi_area(V, np.array([[0, 1, 2]])), [area / 2, area / 4, area / 4],
+                       rtol=1e-12)
+
+
 def test_two_triangles_sum_their_corner_shares():
     # The folded square of test_cotan_laplacian: right triangle A = (0,1,2) gives 1/8, 1/4, 1/8;
     # equilateral B = (0,2,3) of side sqrt 2 (area sqrt(3)/2) gives a third, sqrt(3)/6, to each.

@@ -16,6 +16,21 @@ def test_parallel_planes_are_their_offset_apart(engine):
     # every sample of either plane is exactly 0.05 from the other (same extent)
     assert h["max"] == pytest.approx(0.05, rel=1e-6)
     assert h["rms"] == pytest.approx(0.05, rel=1e-6)
+    assert h["mean"] == pytest.approx(0.05, rel=1e-6)
+
+
+@pytest.mark.parametrize("engine", ["meshlab", "kdtree"])
+def test_one_sided_maxima_are_told_apart(engine):
+    # a small square 0.05 above the middle of a large one: every point of the small one is 0.05
+    # from the large one, while the large one's corners are ~0.4 of a diagonal away
+    V, F = grid(11, 11)
+    W, G = grid(3, 3)
+    W = W * 0.2 + [0.4, 0.4, 0.05]
+    h = hausdorff(W, G, V, F, engine=engine, samples=20000)
+    assert h["a_to_b_max"] == pytest.approx(0.05, rel=1e-6)
+    corner = np.hypot(0.4, 0.4)
+    assert h["b_to_a_max"] == pytest.approx(np.hypot(corner, 0.05), rel=0.02)
+    assert h["max"] == h["b_to_a_max"]
 
 
 def test_kdtree_engine_agrees_with_meshlab_on_far_surfaces(load_mesh):

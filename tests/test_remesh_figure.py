@@ -24,6 +24,13 @@ def test_figure_is_a_png_of_three_panels(tmp_path, result):
     img = mpimg.imread(str(path))
     # three panels side by side: much wider than tall
     assert img.shape[1] > 2 * img.shape[0]
+    rgb = img[..., :3]
+    thirds = np.array_split(np.arange(img.shape[1]), 3)
+    drawn = [(np.abs(rgb[:, cols] - 1.0).sum(-1) > 0.1).mean() for cols in thirds]
+    # vivid pixels: the error colour map; the source and zero-detail panels are shaded grey
+    vivid = [(np.ptp(rgb[:, cols], axis=-1) > 0.25).mean() for cols in thirds]
+    assert min(drawn) > 0.1                      # every panel shows its mesh (~24 % of its area)
+    assert vivid[1] > 0.05 and vivid[0] < 0.005 and vivid[2] < 0.005
 
 
 def test_figure_refuses_to_overwrite(tmp_path, result):

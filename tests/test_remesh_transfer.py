@@ -33,6 +33,13 @@ def test_conservative_transfer_onto_the_same_mesh_is_exact(load_mesh):
     assert np.abs(transfer_curvature(V, F, V, F) - curvature_detail(V, F)).max() < 1e-14
 
 
+def test_pointwise_transfer_onto_the_same_mesh_is_exact(load_mesh):
+    # each target vertex is located on itself (one-hot barycentrics), so D_t = K(x_t) A_t = D
+    V, F = load_mesh("mannequin_nose.obj")
+    D = curvature_detail(V, F)
+    assert np.abs(transfer_curvature(V, F, V, F, method="pointwise") - D).max() < 1e-12 * np.abs(D).max()
+
+
 def test_conservative_transfer_keeps_the_total_detail(load_mesh):
     V, F = load_mesh("mannequin_nose.obj")
     Vt, Ft = retriangulate(V, F, target_edge=0.03)

@@ -1,5 +1,7 @@
 """sparse_solver: every installed backend solves, agrees, factors once; choice and errors."""
 
+import platform
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -20,6 +22,14 @@ def _spd_system(nx=30):
     A = L[inner][:, inner]
     x = np.random.default_rng(3).normal(size=(inner.size, 3))
     return A, x
+
+
+@pytest.mark.skipif(platform.machine() not in ("x86_64", "AMD64"),
+                    reason="pypardiso is a dependency on x86-64 only")
+def test_pardiso_is_available_where_it_is_a_dependency():
+    # a broken MKL runtime would otherwise drop "pardiso" from every backend-parametrized test
+    # without a word (available_backends() leaves out what fails to import)
+    assert "pardiso" in available_backends()
 
 
 @pytest.mark.parametrize("backend", available_backends())

@@ -17,7 +17,6 @@ Every filter lives in its own module named as the filter and is declared with
 """
 
 import importlib
-import importlib.util
 
 from .dispatch import apply
 from .errors import FilterError, FilterParameterError, ScriptError, UnknownFilterError
@@ -26,8 +25,7 @@ from .parameters import BBoxLength, Parameter
 from .registry import (FilterSpec, filter, get_filter, list_filters, print_filter_list,
                        print_filter_parameter_list)
 
-#: Modules that declare filters, imported for their registration (a module not present yet,
-#: e.g. one being written for another issue, is skipped).
+#: Modules that declare filters, imported for their registration.
 FILTER_MODULES = (
     "compute_curvature_detail",
     "apply_curvature_reconstruction",
@@ -39,8 +37,7 @@ FILTER_MODULES = (
 )
 
 for _module in FILTER_MODULES:
-    if importlib.util.find_spec(f"{__name__}.{_module}") is not None:
-        importlib.import_module(f"{__name__}.{_module}")
+    importlib.import_module(f"{__name__}.{_module}")
 del _module
 
 __all__ = [
