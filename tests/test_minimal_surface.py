@@ -101,8 +101,13 @@ def test_fixed_out_of_range_is_refused_with_the_index():
         minimal_surface(V, F, [0, 99])
 
 
-@pytest.mark.parametrize("kwargs, pattern", [({"max_iterations": 0}, "max_iterations=0"),
-                                             ({"tol": 0.0}, "tol=0.0"), ({"tol": np.nan}, "tol=nan")])
+@pytest.mark.parametrize("kwargs, pattern", [
+    ({"max_iterations": 0}, "max_iterations=0"), ({"max_iterations": 2.5}, "max_iterations=2.5 must be a whole"),
+    ({"max_iterations": True}, "max_iterations=True"), ({"max_iterations": "5"}, "max_iterations='5'"),
+    ({"max_iterations": float("inf")}, "max_iterations=inf"), ({"max_iterations": None}, "max_iterations=None"),
+    ({"tol": 0.0}, "tol=0.0"), ({"tol": np.nan}, "tol=nan"), ({"tol": None}, "tol=None"),
+    ({"tol": "5"}, "tol='5'"), ({"tol": 10 ** 400}, "tol=1000"), ({"callback": 3}, "callback=3 is not callable"),
+])
 def test_bad_iteration_settings_are_refused(kwargs, pattern):
     V, F = grid(4, 4)
     with pytest.raises(ValueError, match=pattern):

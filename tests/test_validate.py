@@ -188,6 +188,34 @@ def test_components_are_labelled():
     assert count == 2 and len(set(labels[:9])) == 1 and labels[0] != labels[9]
 
 
+@pytest.mark.parametrize("F, message", [
+    ([[0, 1]], r"shape \(1, 2\)"), (None, r"shape \(\)"), (np.zeros((0, 3), int), "is empty"),
+    ([[0, 1, -2]], "1 triangles have negative vertex indices"), ([[0, 1, 1]], "repeat a vertex index"),
+    ([[0, 1, 2.5]], "non-integer"), (np.ones((1, 3), bool), "dtype bool"),
+])
+def test_boundary_functions_check_their_triangles(F, message):
+    for function in (boundary_edges, boundary_vertices):
+        with pytest.raises(MeshError, match=message):
+            function(F)
+
+
+def test_float_indices_too_large_for_int64_are_named_not_wrapped():
+    with pytest.raises(ConstraintError, match=r"1 indices are outside \[0, 5\) \(first: 1e\+20\)"):
+        as_index_set([1e20], 5, "fixed")
+    with pytest.raises(ConstraintError, match=r"outside \[0, 5\)"):
+        as_index_set(np.array([2 ** 64 - 1], dtype=np.uint64), 5, "fixed")
+    with pytest.raises(MeshError, match=r"entries of 1e\+20"):
+        check_mesh(np.eye(3), [[0, 1, 1e20]])
+
+
+@pytest.mark.parametrize("values", [np.ones((2, 3)) + 1j, np.ones((2, 3), bool), np.full((2, 3), "1")])
+def test_values_must_be_real_numbers(values):
+    # complex would silently lose its imaginary part, bool would mean 0/1
+    with pytest.raises(ConstraintError, match=f"has dtype {values.dtype}; pass a \\(2, 3\\) array of real"):
+        as_values(values, 2, "detail")
+    assert as_values(np.ones((2, 3), np.int32), 2, "detail").dtype == np.float64
+
+
 def test_docstring_examples_run():
     import doctest
     import importlib

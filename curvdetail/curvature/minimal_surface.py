@@ -3,8 +3,8 @@
 import numpy as np
 
 from ._geometry import corner_cotangents
-from ._validate import (as_index_set, bbox_diagonal, check_every_component_fixed, face_double_areas,
-                        ZERO_AREA_RELATIVE)
+from ._validate import (ZERO_AREA_RELATIVE, as_count, as_index_set, as_positive_number, bbox_diagonal,
+                        check_every_component_fixed, face_double_areas)
 from .cotan_laplacian import _assemble_upper, checked_cotan_triangle
 from .errors import ConstraintError, MeshError, first_indices
 from .reconstruct import _FreeSystemLayout
@@ -84,6 +84,10 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, backend
     >>> bool(abs(X[:, 2]).max() < 1e-9)      # the plane spanned by a planar boundary
     True
     """
+    max_iterations = as_count(max_iterations, "max_iterations")
+    tol = as_positive_number(tol, "tol", " (relative to the bbox diagonal)")
+    if callback is not None and not callable(callback):
+        raise ValueError(f"callback={callback!r} is not callable; pass a function (iteration, step) or None.")
     V, F, U, diagonal = checked_cotan_triangle(V, F)     # every mesh check; L of the first step
     n = V.shape[0]
     fixed = as_index_set(fixed, n, "fixed")
@@ -91,10 +95,6 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, backend
         raise ConstraintError("no fixed vertices: a minimal surface needs a fixed boundary; pass e.g. "
                               "boundary_vertices(F).")
     check_every_component_fixed(F, n, fixed, adjacency=U)
-    if int(max_iterations) < 1:
-        raise ValueError(f"max_iterations={max_iterations} must be at least 1.")
-    if not (np.isfinite(tol) and tol > 0):
-        raise ValueError(f"tol={tol} must be a positive number (relative to the bbox diagonal).")
     is_free = np.ones(n, dtype=bool)
     is_free[fixed] = False
     free = np.flatnonzero(is_free)
@@ -105,7 +105,7 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, backend
     converged = free.size == 0
     step = full_step = 0.0 if converged else np.inf
     it = 0
-    while not converged and it < int(max_iterations):
+    while not converged and it < max_iterations:
         if it > 0:                          # weights of the current surface
             cot, _, _ = corner_cotangents(X, F, lengths=False)
             U, diagonal = _assemble_upper(X, F, cot, check_manifold=False)
