@@ -50,6 +50,28 @@ def test_bool_is_not_accepted_as_a_number():
 def test_numpy_scalars_are_accepted():
     assert Parameter("n", "int", 1, "d").check(np.int32(4)) == 4
     assert Parameter("x", "float", 1.0, "d").check(np.float32(0.5)) == 0.5
+    assert Parameter("b", "bool", False, "d").check(np.True_) is True        # numpy 2's bool
+    with pytest.raises(FilterParameterError, match="expects an int"):
+        Parameter("n", "int", 1, "d").check(np.False_)
+
+
+@pytest.mark.parametrize("kind, value, message", [
+    ("mesh", 2 ** 31, "2147483648; it must lie within"), ("int", -(2 ** 40), "must lie within"),
+    ("float", 10 ** 400, "is inf; it must be a finite number"),
+])
+def test_numbers_beyond_what_pymeshlab_takes_are_refused(kind, value, message):
+    # they reached pybind11 (TypeError) or float() (OverflowError) before
+    p = Parameter("p", kind, None if kind == "mesh" else 1, "d")
+    with pytest.raises(FilterParameterError, match=message):
+        p.check(value)
+    with pytest.raises(FilterParameterError, match="must"):
+        p.parse(str(value))
+
+
+def test_an_enum_index_in_other_digits_is_named_not_a_key_error():
+    p = Parameter("rows", "str", "all", "rows", choices=("all", "free"))
+    with pytest.raises(FilterParameterError, match="one of all, free"):
+        p.parse("\u00b2")
 
 
 def test_choice_is_case_insensitive_and_canonical():

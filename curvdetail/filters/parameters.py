@@ -22,7 +22,21 @@ import math
 import numbers
 from dataclasses import dataclass
 
+import numpy as np
+
 from .errors import FilterParameterError
+
+#: Largest magnitude of an int parameter or layer id (pymeshlab passes them as C++ ints).
+INT_MAX = 2 ** 31 - 1
+
+
+def _as_float(value):
+    """``float(value)``, with numbers too large for a float as infinity (then refused as such)."""
+    try:
+        return float(value)
+    except OverflowError:
+        return math.inf
+
 
 #: The parameter types a filter may declare.
 TYPES = ("bool", "int", "float", "str", "PercentageValue", "mesh")
@@ -85,23 +99,24 @@ class Parameter:
         naming the parameter and the expected type (and the choices or range)."""
         t = self.type
         if t == "bool":
-            if isinstance(value, bool) or type(value).__name__ == "bool_":
+            if isinstance(value, (bool, np.bool_)):
                 return bool(value)
             raise self._fail(value, "a bool (True or False)")
         if t in ("int", "mesh"):
             if value is None and t == "mesh":
                 return None
-            if isinstance(value, numbers.Integral) and not isinstance(value, bool) \
-                    and type(value).__name__ != "bool_":
+            if isinstance(value, numbers.Integral) and not isinstance(value, (bool, np.bool_)):
                 if t == "mesh" and value < 0:
                     raise FilterParameterError(f"parameter {self.name!r} is {value}; a layer id is "
                                                "0 or more.")
+                if abs(value) > INT_MAX:              # pymeshlab's C++ ints
+                    raise FilterParameterError(f"parameter {self.name!r} is {value}; it must lie within "
+                                               f"+-{INT_MAX}.")
                 return self._range(int(value))
             raise self._fail(value, "an int" if t == "int" else "a layer id (int) of the MeshSet")
         if t == "float":
-            if isinstance(value, numbers.Real) and not isinstance(value, bool) \
-                    and type(value).__name__ != "bool_":
-                return self._range(self._finite(float(value)))
+            if isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_)):
+                return self._range(self._finite(_as_float(value)))
             raise self._fail(value, "a float")
         if t == "str":
             if not isinstance(value, str):
@@ -122,8 +137,8 @@ class Parameter:
             length = BBoxLength(float(value.value()), True)
         elif type(value).__name__ == "PureValue":
             length = BBoxLength(float(value.value()), False)
-        elif isinstance(value, numbers.Real) and not isinstance(value, bool):
-            length = BBoxLength(float(value), False)
+        elif isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_)):
+            length = BBoxLength(_as_float(value), False)
         else:
             raise self._fail(value, "a PercentageValue: pymeshlab.PercentageValue(percent of the "
                              "bbox diagonal), pymeshlab.PureValue(absolute) or a number (absolute)")
@@ -169,7 +184,7 @@ class Parameter:
             if t == "float":
                 return self.check(float(s))
             if t == "str":
-                if self.choices is not None and s.isdigit() and s not in self.choices \
+                if self.choices is not None and s.isdecimal() and s.isascii() and s not in self.choices \
                         and int(s) < len(self.choices):
                     return self.choices[int(s)]
                 return self.check(s)
@@ -180,7 +195,7 @@ class Parameter:
             raise
         except ValueError:
             expected = {"bool": "true or false", "int": "an integer", "mesh": "a layer id (integer)",
-                        "float": "a number",
+                        "float": "a number", "str": "text",
                         "PercentageValue": "a number (absolute) or a percentage of the bbox "
                                            "diagonal such as 1%"}[t]
             raise FilterParameterError(f"parameter {self.name!r} expects {expected}; got {s!r}.") from None
