@@ -128,6 +128,60 @@ def test_failing_native_step_names_the_step(tmp_path):
         run_script(meshset(), path)
 
 
+@pytest.mark.parametrize("body", [NATIVE_BORDER,
+                                  '<filter name="Delete Current Mesh"/>\n ' + NATIVE_BORDER])
+def test_a_native_step_on_an_empty_meshset_is_refused_in_a_clean_process(tmp_path, body):
+    # pymeshlab's script runner crashed the process (segmentation fault) on such a step
+    import subprocess
+    import sys
+
+    path = write(tmp_path, body)
+    script = ("import pymeshlab\nfrom curvdetail.filters import ScriptError, run_script\n"
+              f"ms = pymeshlab.MeshSet()\nms.load_new_mesh({os.path.join(DATA, 'mannequin_nose.obj')!r})\n"
+              f"if {body.startswith(NATIVE_BORDER)!r}:\n    ms = pymeshlab.MeshSet()\n"
+              f"try:\n    run_script(ms, {str(path)!r})\nexcept ScriptError as exc:\n    print(exc)\n")
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert "the MeshSet holds no mesh, and this filter needs one" in done.stdout
+
+
+def test_a_mesh_creating_native_step_runs_on_an_empty_meshset(tmp_path):
+    path = write(tmp_path, '<filter name="Sphere"><Param name="subdiv" value="2" type="RichInt"/></filter>')
+    ms = pymeshlab.MeshSet()
+    run_script(ms, path)
+    assert ms.current_mesh().vertex_number() == 162
+
+
+def test_a_typo_of_one_of_our_filters_gets_the_close_match(tmp_path):
+    path = write(tmp_path, '<filter name="compute_curvature_detial"/>')
+    with pytest.raises(ScriptError, match="no filter is called 'compute_curvature_detial'; did you mean "
+                                          "compute_curvature_detail"):
+        run_script(meshset(), path)
+
+
+def test_a_parameter_given_twice_is_refused(tmp_path):
+    path = write(tmp_path, '<filter name="compute_curvature_detail"/>\n <filter name='
+                           '"apply_curvature_reconstruction"><Param name="rows" value="all"/>'
+                           '<Param name="rows" value="free"/></filter>')
+    with pytest.raises(ScriptError, match="parameter 'rows' is given twice"):
+        run_script(meshset(), path)
+
+
+@pytest.mark.parametrize("ms, progress, message", [(None, None, "needs a pymeshlab.MeshSet, got NoneType"),
+                                                   ("meshset", 3, "progress=3 is not callable")])
+def test_run_script_checks_its_arguments(tmp_path, ms, progress, message):
+    path = write(tmp_path, '<filter name="compute_curvature_detail"/>')
+    with pytest.raises(ScriptError, match=message):
+        run_script(meshset() if ms == "meshset" else ms, path, progress=progress)
+
+
+def test_an_unknown_encoding_is_a_script_error(tmp_path):
+    path = tmp_path / "enc.mlx"
+    path.write_text('<?xml version="1.0" encoding="foo"?>\n<FilterScript/>\n')
+    with pytest.raises(ScriptError, match="not a MeshLab filter script"):
+        run_script(meshset(), path)
+
+
 def test_malformed_xml_is_refused(tmp_path):
     path = tmp_path / "bad.mlx"
     path.write_text("<FilterScript><filter name='x'>")
@@ -145,6 +199,16 @@ def test_wrong_root_element_is_refused(tmp_path):
 def test_missing_script_is_file_not_found(tmp_path):
     with pytest.raises(FileNotFoundError, match="filter script not found"):
         run_script(meshset(), tmp_path / "none.mlx")
+
+
+@pytest.mark.parametrize("steps, message", [
+    (None, "got NoneType"), ("compute_curvature_detail", "got str"),
+    ([("compute_curvature_detail",)], r"step 1 is \('compute_curvature_detail',\); give a filter name"),
+])
+def test_save_refuses_malformed_steps(tmp_path, steps, message):
+    with pytest.raises(ScriptError, match=message):
+        save_script(tmp_path / "s.mlx", steps)
+    assert not (tmp_path / "s.mlx").exists()
 
 
 def test_save_refuses_to_overwrite_and_unknown_steps(tmp_path):

@@ -26,6 +26,7 @@ at a time, through a temporary script and ``load_filter_script`` / ``apply_filte
 
 import contextlib
 import os
+import re
 import sys
 import tempfile
 import xml.etree.ElementTree as ET
@@ -33,7 +34,7 @@ import xml.etree.ElementTree as ET
 from .._output import atomic_output, check_output_path
 from .dispatch import apply
 from .errors import FilterError, ScriptError
-from .registry import _REGISTRY, get_filter
+from .registry import _REGISTRY, close_matches, get_filter
 
 _RICH_TYPES = {"bool": "RichBool", "int": "RichInt", "float": "RichFloat", "str": "RichString",
                "PercentageValue": "RichAbsPerc", "mesh": "RichMesh"}
@@ -45,7 +46,7 @@ def _steps(path):
         raise FileNotFoundError(f"filter script not found: {path}")
     try:
         root = ET.parse(path).getroot()
-    except ET.ParseError as exc:
+    except (ET.ParseError, LookupError, UnicodeError) as exc:   # LookupError: an unknown encoding
         raise ScriptError(f"{path} is not a MeshLab filter script: {exc}.") from None
     if root.tag != "FilterScript":
         raise ScriptError(f"{path}: the root element is <{root.tag}>; a MeshLab filter script has "
@@ -67,6 +68,8 @@ def _our_parameters(spec, element, where):
         name, value = child.get("name"), child.get("value")
         if name is None or value is None:
             raise ScriptError(f"{where}: a <{child.tag}> lacks a name or a value.")
+        if name in params:
+            raise ScriptError(f"{where}: parameter {name!r} is given twice; keep one <Param name={name!r}>.")
         # an enum index means the script's own enum_val<i> where it lists them (MeshLab writes
         # both), so a script whose list is in another order still means what it says
         value = child.get(f"enum_val{value.strip()}", value) if child.get("type") == "RichEnum" else value
@@ -105,9 +108,38 @@ def _quiet_output():
             os.close(copy)
 
 
+def _refuse_a_near_miss(name, where):
+    """A snake_case step name that is not ours but close to one of ours is a typo, not one of
+    MeshLab's filters (whose script names are words with spaces): pymeshlab would only report
+    'Something really bad happened'."""
+    if re.fullmatch(r"[a-z0-9_]+", name):
+        matches = close_matches(name, _REGISTRY)
+        if matches:
+            raise ScriptError(f"{where}: no filter is called {name!r}; did you mean {', '.join(matches)}?")
+
+
+def _creates_a_mesh(meshlab_name):
+    """Whether a MeshLab filter (by its script name, e.g. "Sphere") makes a mesh from nothing:
+    pymeshlab's ``create_*`` filters, found through the old-to-new name table it ships."""
+    import pymeshlab
+
+    old = re.sub(r"[^a-z0-9]+", "_", meshlab_name.lower()).strip("_")
+    try:
+        with open(os.path.join(os.path.dirname(pymeshlab.__file__), "keys.txt"), encoding="utf-8") as f:
+            names = dict(line.split()[:2] for line in f if len(line.split()) >= 2)
+    except OSError:
+        return False
+    return names.get(old, "").startswith("create_")
+
+
 def _run_native(ms, element, where):
     import pymeshlab
 
+    # pymeshlab's script runner crashes the process (segmentation fault) when a filter that needs
+    # a mesh meets an empty MeshSet
+    if ms.mesh_number() == 0 and not _creates_a_mesh(element.get("name")):
+        raise ScriptError(f"{where}: the MeshSet holds no mesh, and this filter needs one; load a mesh "
+                          "(or create one in an earlier step) first.")
     script = ET.Element("FilterScript")
     script.append(element)
     fd, tmp = tempfile.mkstemp(prefix="curvdetail-step-", suffix=".mlx")
@@ -143,8 +175,10 @@ def run_script(ms, path, *, progress=None):
     Raises
     ------
     FileNotFoundError   the script does not exist
-    ScriptError         malformed XML, or a step failed (the message names the step number and
-                        filter, then the reason)
+    ScriptError         not a MeshSet, malformed XML (or an unknown encoding), a parameter given
+                        twice, a step name that is a typo of one of ours, a MeshLab filter that
+                        needs a mesh on an empty MeshSet, or a step failed (the message names the
+                        step number and filter, then the reason)
 
     Examples
     --------
@@ -158,6 +192,12 @@ def run_script(ms, path, *, progress=None):
     >>> [step["filter"] for step in run_script(ms, script)]
     ['compute_curvature_detail']
     """
+    import pymeshlab
+
+    if not isinstance(ms, pymeshlab.MeshSet):
+        raise ScriptError(f"run_script needs a pymeshlab.MeshSet, got {type(ms).__name__}.")
+    if progress is not None and not callable(progress):
+        raise ScriptError(f"progress={progress!r} is not callable; pass a function (step, total, name) or None.")
     results = []
     path = os.fspath(path)
     steps = _steps(path)
@@ -173,6 +213,7 @@ def run_script(ms, path, *, progress=None):
             except ValueError as exc:
                 raise ScriptError(f"{where}: {exc}") from None
         else:
+            _refuse_a_near_miss(name, where)
             _run_native(ms, element, where)
             figures = {}
         results.append({"filter": name, "figures": figures})
@@ -206,6 +247,7 @@ def save_script(path, steps, *, overwrite=False):
     ------
     FileExistsError        ``path`` exists and ``overwrite`` is False
     FileNotFoundError      the destination folder does not exist
+    ScriptError            ``steps`` is not a list of names or (name, parameters) pairs
     UnknownFilterError, FilterParameterError   as :func:`~curvdetail.filters.apply`
 
     Examples
@@ -220,8 +262,14 @@ def save_script(path, steps, *, overwrite=False):
     from .dispatch import complete_parameters
 
     path = check_output_path(path, overwrite, hint=None, error=FileNotFoundError)
+    if isinstance(steps, str) or not isinstance(steps, (list, tuple)):
+        raise ScriptError(f"steps must be a list of filter names or (name, parameters) pairs; got "
+                          f"{type(steps).__name__}.")
     root = ET.Element("FilterScript")
-    for step in steps:
+    for k, step in enumerate(steps, start=1):
+        if not isinstance(step, str) and not (isinstance(step, (list, tuple)) and len(step) == 2
+                                              and isinstance(step[1], (dict, type(None)))):
+            raise ScriptError(f"step {k} is {step!r}; give a filter name or a (name, {{parameter: value}}) pair.")
         name, params = (step, {}) if isinstance(step, str) else (step[0], dict(step[1] or {}))
         spec = get_filter(name)
         values = complete_parameters(spec, params)
