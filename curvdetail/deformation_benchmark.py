@@ -19,6 +19,7 @@ import os
 import numpy as np
 
 from ._output import atomic_output, check_output_path
+from .curvature._validate import MAX_COORDINATE
 from .curvature.curvature_coefficients import DEFAULT_RCOND
 from .curvature.curvature_editor import CurvatureEditor
 from .curvature.errors import ConstraintError, first_indices
@@ -229,8 +230,14 @@ def edit_with_selection(V, F, status, T, *, handle_detail="transform", relations
     dc = handles if handle_detail == "transform" else np.empty(0, dtype=np.int64)
     editor = CurvatureEditor(V, F, handles, dc, roi=roi, relations=relations, rcond=rcond,
                              backend=backend)
-    details = editor.detail[handles] @ T[:3, :3].T if handle_detail == "transform" else None
-    X = editor.solve(positions=apply_transform(T, editor.V[handles]), details=details)
+    with np.errstate(over="ignore", invalid="ignore"):      # named below instead
+        details = editor.detail[handles] @ T[:3, :3].T if handle_detail == "transform" else None
+        positions = apply_transform(T, editor.V[handles])
+    for values in (positions, details):
+        if values is not None and not np.all(np.abs(values) <= MAX_COORDINATE):
+            raise ConstraintError(f"the handle transform T gives the handles values of {np.abs(values).max():.3g}, "
+                                  f"beyond {MAX_COORDINATE:.0e}, where squares overflow; use a smaller transform.")
+    X = editor.solve(positions=positions, details=details)
     return (X, editor) if return_editor else X
 
 

@@ -123,6 +123,12 @@ def test_free_vertices_are_the_editors_solution_for_the_prescribed_constraints(m
     assert 0.0 < X[free, 2].min() and X[free, 2].max() < 0.5 + 1e-9
 
 
+def test_a_transform_beyond_double_precision_is_named():
+    V, F, status = _strip()
+    with pytest.raises(ConstraintError, match="handle transform T gives the handles values of 3e\\+300"):
+        edit_with_selection(V, F, status, np.diag([1e300, 1.0, 1.0, 1.0]))
+
+
 def test_identity_transform_leaves_the_mesh_in_place(load_mesh):
     V, F = load_mesh("mannequin_ear.obj")
     d = np.linalg.norm(V - V[0], axis=1)

@@ -73,6 +73,18 @@ def test_bad_parameters_are_refused(params, error, message):
         apply(ms, "apply_curvature_editing", **params)
 
 
+@pytest.mark.parametrize("params, message", [
+    (dict(detail_scale=1e300), "transform with detail_scale gives the handles values of"),
+    (dict(transform="1e300 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1"), "the transform gives the handles values of"),
+])
+def test_an_overflowing_edit_is_refused_before_the_mesh_is_touched(params, message):
+    # before, the positions were written and only then the quality's infinities refused
+    ms, V, d, handles = _meshset_with_roi()
+    with pytest.raises(FilterParameterError, match=message):
+        apply(ms, "apply_curvature_editing", handles=" ".join(map(str, handles)), **params)
+    assert np.array_equal(ms.current_mesh().vertex_matrix(), V)
+
+
 def test_region_radius_makes_the_region_without_a_selection():
     ms = pymeshlab.MeshSet()
     ms.load_new_mesh(os.path.join(DATA, "mannequin_ear.obj"))

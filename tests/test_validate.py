@@ -216,6 +216,15 @@ def test_values_must_be_real_numbers(values):
     assert as_values(np.ones((2, 3), np.int32), 2, "detail").dtype == np.float64
 
 
+def test_coordinates_whose_squares_overflow_are_named():
+    # before: "16 triangles have zero area" (the cross products overflowed)
+    V, F = grid(3, 3)
+    with pytest.raises(MeshError, match=r"V: 8 rows reach 1e\+155 .* squares overflow double precision: scale"):
+        check_mesh(V * 1e155, F)
+    with pytest.raises(ConstraintError, match=r"positions: 1 rows reach 1e\+200"):
+        as_values([[1e200, 0, 0]], 1, "positions")
+
+
 def test_docstring_examples_run():
     import doctest
     import importlib

@@ -12,6 +12,10 @@ from scipy.sparse.csgraph import connected_components
 from ._geometry import corner_cotangents
 from .errors import ConstraintError, MeshError, first_indices
 
+#: Largest coordinate magnitude taken: beyond it squared lengths (areas, cotangents, distances)
+#: overflow double precision.
+MAX_COORDINATE = 1e150
+
 # A triangle whose area is below this fraction of the squared bbox diagonal is degenerate:
 # its cotangents overflow. 1e-14 leaves room for meshes of ~1e12 well-shaped triangles.
 ZERO_AREA_RELATIVE = 1e-14
@@ -30,15 +34,22 @@ def as_vertices(V, name="V"):
     if arr.shape[0] == 0:
         raise MeshError(f"{name} is empty (0 vertices); pass a mesh with at least one triangle.")
     arr = np.ascontiguousarray(arr, dtype=np.float64)
-    if np.isfinite(arr).all():      # one flat pass; the per-row search below only on failure
-        return arr
-    bad = np.flatnonzero(~np.isfinite(arr).all(axis=1))
-    if bad.size:
+    if not np.isfinite(arr).all():      # one flat pass; the per-row search below only on failure
+        bad = np.flatnonzero(~np.isfinite(arr).all(axis=1))
         raise MeshError(
             f"{name}: {bad.size} vertices have NaN or infinite coordinates (first: {first_indices(bad)}); "
             "remove or repair them before computing curvature."
         )
+    _check_magnitude(arr, name, MeshError, "scale the mesh down")
     return arr
+
+
+def _check_magnitude(arr, name, error, fix):
+    """Refuse values beyond MAX_COORDINATE, whose squares overflow."""
+    if arr.size and np.abs(arr).max() > MAX_COORDINATE:
+        bad = np.flatnonzero((np.abs(arr) > MAX_COORDINATE).any(axis=1))
+        raise error(f"{name}: {bad.size} rows reach {np.abs(arr).max():.3g} (first: {first_indices(bad)}); "
+                    f"beyond {MAX_COORDINATE:.0e} their squares overflow double precision: {fix}.")
 
 
 def as_faces(F, n_vertices, name="F"):
@@ -309,11 +320,10 @@ def as_values(values, count, name):
     arr = arr.astype(np.float64, copy=False)
     if arr.shape != (count, 3):
         raise ConstraintError(f"{name} has shape {arr.shape}; expected ({count}, 3), one row per vertex.")
-    if np.isfinite(arr).all():      # one flat pass; the per-row search below only on failure
-        return np.ascontiguousarray(arr)
-    bad = np.flatnonzero(~np.isfinite(arr).all(axis=1))
-    if bad.size:
+    if not np.isfinite(arr).all():      # one flat pass; the per-row search below only on failure
+        bad = np.flatnonzero(~np.isfinite(arr).all(axis=1))
         raise ConstraintError(f"{name}: {bad.size} rows are NaN or infinite (first: {first_indices(bad)}).")
+    _check_magnitude(arr, name, ConstraintError, "scale the problem down")
     return np.ascontiguousarray(arr)
 
 

@@ -4,7 +4,7 @@ import time
 
 import numpy as np
 
-from ..curvature._validate import bbox_diagonal
+from ..curvature._validate import MAX_COORDINATE, bbox_diagonal
 from ..curvature.curvature_editor import CurvatureEditor
 from ..curvature.errors import ConstraintError, first_indices
 from .apply_curvature_reconstruction import BACKEND_DESCRIPTION, BACKENDS
@@ -120,11 +120,20 @@ def apply_curvature_editing(ms, *, handles, region_radius, transform, detail_sca
     pc = h if move_handles else np.empty(0, dtype=np.int64)
     dc = h if handle_detail == "transform" else np.empty(0, dtype=np.int64)
     editor = CurvatureEditor(V, F, pc, dc, roi=roi, relations=relations, backend=backend)
-    details = detail_scale * (editor.detail[dc] @ T[:3, :3].T) if dc.size else None
-    positions = V[pc] @ T[:3, :3].T + T[:3, 3] if pc.size else None
+    with np.errstate(over="ignore", invalid="ignore"):      # named below instead
+        details = detail_scale * (editor.detail[dc] @ T[:3, :3].T) if dc.size else None
+        positions = V[pc] @ T[:3, :3].T + T[:3, 3] if pc.size else None
+    for values, what in ((positions, "transform"), (details, "transform with detail_scale")):
+        if values is not None and not np.all(np.abs(values) <= MAX_COORDINATE):
+            raise FilterParameterError(f"the {what} gives the handles values of {np.abs(values).max():.3g}, beyond "
+                                       f"{MAX_COORDINATE:.0e}, where squares overflow; use a smaller transform "
+                                       "or detail_scale.")
     X = editor.solve(positions=positions, details=details)
     seconds = time.perf_counter() - t
     moved = np.linalg.norm(X - V, axis=1)
+    if not np.all(np.isfinite(moved)):      # checked before the MeshSet is touched
+        raise FilterParameterError(f"the edit moved {np.count_nonzero(~np.isfinite(moved))} vertices beyond "
+                                   "double precision; use a smaller transform or detail_scale.")
     set_vertex_positions(ms, mid, X)
     set_vertex_quality(ms, mid, moved)
     return {
