@@ -13,6 +13,8 @@ import contextlib
 import os
 import tempfile
 
+import numpy as np
+
 from .curvature.errors import MeshError
 
 _FORMATS_HINT = "use .ply, .obj, .off, .stl, ..."
@@ -23,13 +25,18 @@ def check_output_path(path, overwrite=False, *, hint=_FORMATS_HINT, error=MeshEr
 
     Raises
     ------
+    ValueError        ``overwrite`` is not a bool
     FileExistsError   ``path`` exists and ``overwrite`` is False
     error             (default :class:`~curvdetail.curvature.errors.MeshError`; the filters
-                      pass their ``MeshFileError``) the folder does not exist, or ``path`` has
-                      no extension to pick the format (``hint`` says which to use;
-                      ``hint=None``: any name will do)
+                      pass their ``MeshFileError``) ``path`` is not a path, the folder does
+                      not exist, or ``path`` has no extension to pick the format (``hint`` says
+                      which to use; ``hint=None``: any name will do)
     """
-    path = os.fspath(path)
+    if not isinstance(path, (str, bytes, os.PathLike)):
+        raise error(f"an output path must be a str or os.PathLike; got {type(path).__name__}.")
+    if not isinstance(overwrite, (bool, np.bool_)):       # "no" would count as True
+        raise ValueError(f"overwrite={overwrite!r} must be True or False.")
+    path = os.fsdecode(path)
     if os.path.exists(path) and not overwrite:
         raise FileExistsError(f"{path} exists; pass --overwrite (overwrite=True) to replace it.")
     folder = os.path.dirname(os.path.abspath(path))
@@ -65,8 +72,11 @@ def atomic_output(path, *, overwrite=False, hint=_FORMATS_HINT, error=MeshError)
     'done'
     """
     path = check_output_path(path, overwrite, hint=hint, error=error)
-    fd, tmp = tempfile.mkstemp(prefix=".curvdetail-", suffix=os.path.splitext(path)[1],
-                               dir=os.path.dirname(os.path.abspath(path)))
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=".curvdetail-", suffix=os.path.splitext(path)[1],
+                                   dir=os.path.dirname(os.path.abspath(path)))
+    except OSError as exc:        # its message would name the temporary file, not the output
+        raise error(f"cannot write {path!r}: {exc.strerror}.") from None
     os.close(fd)
     try:
         yield tmp

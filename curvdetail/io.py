@@ -12,7 +12,7 @@ import numpy as np
 from ._file_counts import check_before_loading, check_loaded
 from ._output import atomic_output, check_output_path
 from .curvature._validate import as_faces, as_vertices
-from .curvature.errors import MeshError
+from .curvature.errors import MeshError, first_indices
 
 
 class MeshFileError(MeshError):
@@ -57,9 +57,7 @@ def read_mesh(path):
     >>> V.shape[1], F.shape[1]
     (3, 3)
     """
-    path = os.fspath(path)
-    if not os.path.isfile(path):
-        raise FileNotFoundError(f"mesh file not found: {path}")
+    path = input_path(path)
     check_before_loading(path, error=MeshFileError)
     ms = _meshset()
     try:
@@ -75,6 +73,19 @@ def read_mesh(path):
         raise MeshFileError(f"{path!r} holds {V.shape[0]} vertices but no triangles; a surface mesh "
                             "is needed.")
     return V, F
+
+
+def input_path(path):
+    """``path`` as a str naming an existing file, or raise: MeshFileError for what is not a path
+    or is a folder, FileNotFoundError for a missing file."""
+    if not isinstance(path, (str, bytes, os.PathLike)):
+        raise MeshFileError(f"a mesh path must be a str or os.PathLike; got {type(path).__name__}.")
+    path = os.fsdecode(path)
+    if os.path.isdir(path):
+        raise MeshFileError(f"{path!r} is a folder; name a mesh file in it.")
+    if not os.path.isfile(path):
+        raise FileNotFoundError(f"mesh file not found: {path}")
+    return path
 
 
 def write_mesh(path, V, F, *, quality=None, overwrite=False):
@@ -118,9 +129,16 @@ def write_mesh(path, V, F, *, quality=None, overwrite=False):
     F = as_faces(F, V.shape[0])
     kwargs = {}
     if quality is not None:
-        q = np.asarray(quality, dtype=np.float64).reshape(-1)
+        q = np.asarray(quality)
+        if q.dtype.kind not in "fiu":
+            raise MeshError(f"quality has dtype {q.dtype}; pass one real number per vertex.")
+        q = q.astype(np.float64).reshape(-1)
         if q.shape[0] != V.shape[0]:
             raise MeshError(f"quality has {q.shape[0]} values for {V.shape[0]} vertices; pass one per vertex.")
+        if not np.isfinite(q).all():
+            bad = np.flatnonzero(~np.isfinite(q))
+            raise MeshError(f"quality: {bad.size} values are NaN or infinite (first: {first_indices(bad)}); "
+                            "pass finite values.")
         kwargs["v_scalar_array"] = q
     mesh = pymeshlab.Mesh(vertex_matrix=V, face_matrix=F.astype(np.int32), **kwargs)
     save_mesh(path, mesh, overwrite=overwrite)
@@ -178,4 +196,5 @@ def save_mesh(path, mesh, *, overwrite=False, **save_options):
         try:
             ms.save_current_mesh(tmp, **options)
         except Exception as exc:
-            raise MeshFileError(f"could not write {os.fspath(path)!r}: {exc}") from None
+            raise MeshFileError(f"could not write {os.fspath(path)!r}: "
+                                f"{str(exc).replace(tmp, os.fspath(path))}") from None

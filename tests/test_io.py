@@ -337,6 +337,36 @@ def test_reads_the_shipped_meshes_in_file_order():
     assert np.allclose(V[0], [float(t) for t in first.split()[:3]])
 
 
+@pytest.mark.parametrize("quality, message", [
+    (np.full(4, np.nan), "quality: 4 values are NaN or infinite"),
+    (np.ones(4) + 1j, "quality has dtype complex128"),
+])
+def test_write_mesh_refuses_quality_it_would_write_wrong(tmp_path, quality, message):
+    with pytest.raises(MeshError, match=message):
+        write_mesh(tmp_path / "q.ply", _SQUARE, _SQUARE_FACES, quality=quality)
+    assert os.listdir(tmp_path) == []
+
+
+@pytest.mark.parametrize("read", ["read_mesh", "load_meshset"])
+def test_paths_that_are_not_mesh_files_are_named(tmp_path, read):
+    from curvdetail.filters.files import load_meshset
+
+    function = {"read_mesh": read_mesh, "load_meshset": load_meshset}[read]
+    with pytest.raises(MeshFileError, match="a mesh path must be a str or os.PathLike; got NoneType"):
+        function(None)
+    with pytest.raises(MeshFileError, match="is a folder; name a mesh file in it"):
+        function(tmp_path)
+    with pytest.raises(FileNotFoundError, match="mesh file not found"):
+        function(tmp_path / "none.obj")
+
+
+def test_bytes_paths_read_and_write(tmp_path):
+    path = os.fsencode(tmp_path / "m.obj")
+    write_mesh(path, _SQUARE, _SQUARE_FACES)
+    V, F = read_mesh(path)
+    assert np.allclose(V, _SQUARE)
+
+
 def test_save_mesh_refuses_to_overwrite(tmp_path):
     import pymeshlab
 

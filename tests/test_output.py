@@ -67,6 +67,39 @@ def test_check_output_path_names_missing_folder_and_extension(tmp_path):
     assert check_output_path(tmp_path / "a", hint=None) == str(tmp_path / "a")
 
 
+@pytest.mark.parametrize("overwrite", ["no", 1, None])
+def test_overwrite_must_be_a_bool(tmp_path, overwrite):
+    # overwrite="no" replaced the file: any truthy value counted as True
+    path = tmp_path / "m.ply"
+    path.write_text("keep")
+    with pytest.raises(ValueError, match=f"overwrite={overwrite!r} must be True or False"):
+        check_output_path(path, overwrite)
+    assert path.read_text() == "keep"
+
+
+def test_output_path_that_is_not_a_path_is_named(tmp_path):
+    with pytest.raises(MeshError, match="an output path must be a str or os.PathLike; got NoneType"):
+        check_output_path(None)
+    with atomic_output(os.fsencode(tmp_path / "b.txt"), hint=None) as tmp:      # bytes work
+        open(tmp, "w").close()
+    assert (tmp_path / "b.txt").exists()
+
+
+def test_a_folder_that_refuses_files_is_named_not_the_temporary_file(tmp_path):
+    folder = tmp_path / "ro"
+    folder.mkdir()
+    os.chmod(folder, 0o500)
+    try:
+        if os.access(folder, os.W_OK):                  # root ignores permissions: use /proc
+            folder = "/proc"
+        with pytest.raises(MeshError, match=r"cannot write '.*m\.ply': ") as info:
+            with atomic_output(os.path.join(folder, "m.ply")):
+                pass
+        assert ".curvdetail-" not in str(info.value)
+    finally:
+        os.chmod(tmp_path / "ro", 0o700)
+
+
 def test_doctests():
     assert doctest.testmod(importlib.import_module("curvdetail._output")).failed == 0
 

@@ -16,7 +16,7 @@ import numpy as np
 
 from .. import _output
 from .._file_counts import check_before_loading, check_loaded
-from ..io import MeshFileError
+from ..io import MeshFileError, input_path
 from .meshset import WRITTEN_ATTRIBUTES, set_vertex_attribute, vertex_attribute
 from .ply_attributes import read_ply_vertex_attributes
 
@@ -34,10 +34,7 @@ def load_meshset(path, *more):
     (see :func:`curvdetail.read_mesh`)."""
     import pymeshlab
 
-    paths = [os.fspath(p) for p in (path, *more)]
-    for p in paths:
-        if not os.path.isfile(p):
-            raise FileNotFoundError(f"mesh file not found: {p}")
+    paths = [input_path(p) for p in (path, *more)]
     ms = pymeshlab.MeshSet()
     for p in paths:
         check_before_loading(p, error=MeshFileError)
@@ -86,4 +83,5 @@ def save_current_mesh(ms, path, *, overwrite=False):
         try:
             ms.save_current_mesh(tmp, **options)
         except pymeshlab.PyMeshLabException as exc:
-            raise MeshFileError(f"could not write {os.fspath(path)!r}: {' '.join(str(exc).split())}") from None
+            detail = " ".join(str(exc).replace(tmp, os.fspath(path)).split())
+            raise MeshFileError(f"could not write {os.fspath(path)!r}: {detail}") from None
