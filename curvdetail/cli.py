@@ -108,7 +108,10 @@ def _reconstruct_command(parser):
         progress = Progress(4, enabled=sys.stderr.isatty())      # 1M vertices take ~20 s
         progress.stage("read")
         V, F = check_mesh(*read_mesh(args.input))
-        fixed = as_index_set(args.fix, V.shape[0], "--fix") if args.fix else boundary_vertices(F)
+        if args.fix == []:                    # "--fix" given without indices
+            raise ConstraintError("--fix needs vertex indices (e.g. --fix 0 17 42); leave it out to fix "
+                                  "the boundary.")
+        fixed = as_index_set(args.fix, V.shape[0], "--fix") if args.fix is not None else boundary_vertices(F)
         if fixed.size == 0:
             raise ConstraintError(f"{args.input} is closed (no boundary); name vertices to fix with --fix.")
         progress.stage("factor")

@@ -110,6 +110,13 @@ def test_fix_out_of_range_names_the_index(tmp_path, capsys):
     assert os.listdir(tmp_path) == []
 
 
+def test_fix_without_indices_is_refused_not_taken_as_the_boundary(tmp_path, capsys):
+    out = tmp_path / "x.ply"
+    assert main(["reconstruct", NOSE, str(out), "--fix"]) == 1
+    assert "--fix needs vertex indices" in _error_line(capsys)
+    assert os.listdir(tmp_path) == []
+
+
 def test_existing_output_is_refused_and_kept(tmp_path, capsys):
     out = tmp_path / "keep.ply"
     out.write_text("precious")

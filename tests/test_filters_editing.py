@@ -64,6 +64,8 @@ def test_filter_is_declared_with_its_parameters():
 @pytest.mark.parametrize("params, error, message", [
     (dict(handles=""), FilterParameterError, "empty"),
     (dict(handles="1 2 999999"), FilterParameterError, "outside"),
+    (dict(handles="1 99999999999999999999999"), FilterParameterError, r"1 indices are outside \[0, \d+\) "
+                                                                        r"\(first: 99999999999999999999999\)"),
     (dict(handles="1 2", transform="1 0 0"), FilterParameterError, "16 finite numbers"),
     (dict(handles="1 2", detail_scale=-1.0), FilterParameterError, "greater than 0"),
 ])

@@ -6,7 +6,7 @@ import numpy as np
 
 from ..curvature._validate import MAX_COORDINATE, bbox_diagonal
 from ..curvature.curvature_editor import CurvatureEditor
-from ..curvature.errors import ConstraintError, first_indices
+from ..curvature.errors import ConstraintError
 from .apply_curvature_reconstruction import BACKEND_DESCRIPTION, BACKENDS
 from .errors import FilterParameterError
 from .meshset import (get_mesh, layer_id, mesh_arrays, selected_vertices, set_vertex_positions,
@@ -23,14 +23,14 @@ def _indices(text, n):
     except ValueError:
         raise FilterParameterError(f"parameter 'handles' must be vertex indices separated by spaces "
                                    f"or commas; got {str(text)[:40]!r}.") from None
+    beyond = [v for v in values if not 0 <= v < n]       # before the int64 cast, which overflows
+    if beyond:
+        raise FilterParameterError(f"parameter 'handles': {len(beyond)} indices are outside [0, {n}) "
+                                   f"(first: {beyond[0]}).")
     idx = np.asarray(values, dtype=np.int64)
     if idx.size == 0:
         raise FilterParameterError("parameter 'handles' is empty; name the handle vertices, e.g. "
                                    "handles='12 40 41'.")
-    bad = idx[(idx < 0) | (idx >= n)]
-    if bad.size:
-        raise FilterParameterError(f"parameter 'handles': {bad.size} indices are outside [0, {n}) "
-                                   f"(first: {first_indices(bad)}).")
     uniq = np.unique(idx)
     if uniq.size != idx.size:
         raise FilterParameterError(f"parameter 'handles': {idx.size - uniq.size} indices are repeated.")
