@@ -64,5 +64,54 @@ def test_vertex_distance_refuses_nan_points_naming_them(far):
     V, F = grid(5, 5)
     P = V[:3].copy()
     P[1, 2] = np.inf
-    with pytest.raises(MeshError, match=r"points: 1 rows are NaN or infinite \(first: 1\)"):
+    with pytest.raises(MeshError, match=r"V: 1 vertices have NaN or infinite coordinates \(first: 1\)"):
         vertex_distance(P, V, F, far=far)
+
+
+@pytest.mark.parametrize("far", [False, True])
+def test_vertex_distance_refuses_a_collapsed_or_overflowing_surface(far):
+    # a surface collapsed to a point hung pymeshlab's grid; coordinates of 1e155 crashed it
+    from curvdetail.curvature.errors import MeshError
+
+    V, F = grid(5, 5)
+    with pytest.raises(MeshError, match="Vs: all 25 vertices are at one point"):
+        vertex_distance(V, np.zeros_like(V), F, far=far)
+    with pytest.raises(MeshError, match=r"Vs: 24 rows reach 1e\+155"):
+        vertex_distance(V, V * 1e155, F, far=far)
+
+
+def test_surfaces_of_fewer_than_eight_triangles_are_measured():
+    # the kd-tree engine asked for 8 neighbours and got missing-neighbour indices (IndexError)
+    V, F = grid(2, 3)                               # 4 triangles
+    assert hausdorff(V, F, V, F, engine="kdtree", samples=1000)["max"] < 1e-12
+    assert np.allclose(vertex_distance(V + [0.0, 0.0, 0.5], V, F, far=True), 0.5)
+    assert np.allclose(vertex_distance(V, V, F, far=True), 0.0)
+
+
+def test_meshes_far_apart_are_measured_with_the_kdtree_engine_not_a_hang():
+    # two unit squares 1e10 apart kept pymeshlab's grid search busy for minutes
+    V, F = grid(5, 5)
+    h = hausdorff(V, F, V + [0.0, 0.0, 1e10], F, samples=1000)
+    assert h["max"] == pytest.approx(1e10, rel=1e-9)
+    assert h["rms"] == pytest.approx(1e10, rel=1e-9)
+
+
+def test_huge_and_tiny_meshes_are_measured_in_a_unit_frame():
+    # at 1e140 pymeshlab's figures overflowed to inf (silently); scale-free now
+    V, F = grid(5, 5)
+    for s in (1e140, 1e-100):
+        h = hausdorff(V * s, F, (V + [0.0, 0.0, 0.1]) * s, F, samples=1000)
+        assert h["rms"] == pytest.approx(0.1 * s, rel=1e-6)
+
+
+@pytest.mark.parametrize("kwargs, words", [
+    ({"samples": True}, "samples=True must be a whole number"),
+    ({"samples": 2 ** 31}, "more than pymeshlab takes"),
+    ({"seed": 2.5}, "seed=2.5 must be a whole number"),
+    ({"seed": -1}, "seed=-1 must be at least 0"),
+])
+def test_bool_huge_or_fractional_counts_are_refused(kwargs, words):
+    # samples=True was taken as 1, 2**31 raised pybind's RuntimeError, seed=2.5 numpy's TypeError
+    V, F = grid(5, 5)
+    with pytest.raises(ValueError, match=words):
+        hausdorff(V, F, V, F, engine="kdtree", **kwargs)

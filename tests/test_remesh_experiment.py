@@ -131,3 +131,37 @@ def test_unknown_backend_is_refused_before_retriangulating(height_field, monkeyp
     monkeypatch.setattr(experiment, "retriangulate", lambda *a, **k: pytest.fail("remeshed first"))
     with pytest.raises(SolverError, match="unknown solver backend 'umfpack'"):
         remesh_experiment(*height_field, backend="umfpack")
+
+
+@pytest.mark.parametrize("kwargs, error, words", [
+    # with a ready target, target_edge is only recorded: it was not checked at all
+    ({"target": "ready", "target_edge": -1}, RemeshError, "target_edge=-1 must be a positive fraction"),
+    ({"target": 5}, ValueError, r"target must be a pair \(Vt, Ft\).*got int"),
+    ({"progress": 5}, ValueError, "progress must be callable.*got int"),
+])
+def test_bad_options_are_refused_before_any_work(height_field, monkeypatch, kwargs, error, words):
+    # a scalar target or a non-callable progress raised a TypeError once the work had started
+    import curvdetail.remesh.experiment as experiment
+
+    monkeypatch.setattr(experiment, "check_disk", lambda *a, **k: pytest.fail("checked the source first"))
+    if kwargs.get("target") == "ready":
+        kwargs = {**kwargs, "target": height_field}
+    with pytest.raises(error, match=words):
+        remesh_experiment(*height_field, **kwargs)
+
+
+def test_overflowing_target_edge_gets_the_admissible_range(height_field):
+    # target_edge ** 2 raised an OverflowError
+    with pytest.raises(RemeshError, match="fewer than 50; choose a target edge between"):
+        remesh_experiment(*height_field, target_edge=1e300)
+
+
+def test_a_two_triangle_square_is_rebuilt_and_measured():
+    # the evaluation's kd-tree asked an 8-nearest query of a 2-triangle surface (IndexError)
+    from curvdetail.curvature.testing import grid
+
+    V, F = grid(2, 2)
+    (X, _), report = remesh_experiment(V, F, target=(V, F))
+    # a flat square rebuilt from its own (zero) detail is itself
+    assert np.abs(X - V).max() < 1e-12
+    assert report["error"]["hausdorff_max"] < 1e-6 and report["baseline_zero_detail"]["hausdorff_max"] < 1e-12

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from curvdetail.curvature.errors import MeshError
+from curvdetail.curvature.testing import grid
 from curvdetail.remesh import interpolate, locate, spread
 
 
@@ -71,7 +72,7 @@ def test_nan_points_are_refused_naming_them_not_a_crash(flat_disk, engine, dim):
     V, F = flat_disk
     P = V[:4, :dim].copy()
     P[2, 0] = np.nan
-    with pytest.raises(MeshError, match=r"points: 1 rows are NaN or infinite \(first: 2\)"):
+    with pytest.raises(MeshError, match=r"points: 1 vertices have NaN or infinite coordinates \(first: 2\)"):
         locate(P, V[:, :dim], F, engine=engine)
 
 
@@ -95,3 +96,89 @@ def test_interpolate_and_spread_refuse_located_points_that_do_not_fit(flat_disk)
         spread(np.ones(4), F, face, bary, V.shape[0])
     with pytest.raises(MeshError, match="vertex indices outside"):
         interpolate(np.ones(3), F, face, bary)
+
+
+def test_a_mesh_collapsed_to_a_point_is_refused_not_a_hang():
+    # pymeshlab's nearest-face grid never returned on a mesh whose vertices all coincide
+    V, F = grid(5, 5)
+    with pytest.raises(MeshError, match="V: all 25 vertices are at one point"):
+        locate(V[:3], np.zeros_like(V), F)
+
+
+def test_coordinates_whose_squares_overflow_are_refused_not_a_segfault():
+    # pymeshlab's grid died with a segmentation fault on coordinates of 1e155
+    V, F = grid(5, 5)
+    with pytest.raises(MeshError, match=r"V: 24 rows reach 1e\+155.*beyond 1e\+150"):
+        locate(V[:3], V * 1e155, F)
+
+
+def test_zero_area_triangles_are_refused_by_name():
+    V, F = grid(5, 5)
+    V[F[7, 0]] = V[F[7, 1]]                        # triangle 7 (and its neighbours) collapse
+    with pytest.raises(MeshError, match=r"F: \d+ triangles have zero area \(first: .*7"):
+        locate(V[:3], V, F)
+
+
+@pytest.mark.parametrize("engine", ["auto", "numpy"])
+def test_points_far_from_the_mesh_get_their_exact_distance_without_a_hang(engine):
+    # points 1e10 mesh sizes away kept pymeshlab's grid search busy for minutes; they go to the
+    # numpy engine. The closest point of (x, y, 1) with x, y in [0, 1] is right below it.
+    V, F = grid(5, 5)
+    P = np.array([[0.5, 0.5, 1.0], [2e10, 0.5, 0.0], [0.25, 0.75, -3e10]])
+    face, bary, dist = locate(P, V, F, engine=engine)
+    # (which point is closest is not resolved in float64 that far away: only the distance is)
+    assert dist == pytest.approx([1.0, 2e10 - 1.0, 3e10], rel=1e-12)
+    assert np.allclose(interpolate(V, F, face[:1], bary[:1]), [[0.5, 0.5, 0.0]], atol=1e-12)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_scale_and_position_of_the_input_do_not_change_the_answer(flat_disk, rng, dim):
+    # locate works in a frame where the mesh has unit size: a mesh of size 1e100 far from the
+    # origin gets the same faces and barycentrics and its distances scaled (to rounding)
+    V, F = flat_disk
+    V = V[:, :dim]
+    P = V[rng.integers(0, V.shape[0], 50)] + rng.normal(scale=0.01, size=(50, dim))
+    face, bary, dist = locate(P, V, F)
+    s, t = 1e100, 3e100
+    face2, bary2, dist2 = locate(P * s + t, V * s + t, F)
+    assert np.array_equal(face, face2)
+    assert np.allclose(bary, bary2, atol=1e-9)
+    assert np.allclose(dist2 / s, dist, atol=1e-12)
+
+
+@pytest.mark.parametrize("what, value, words", [
+    ("F", "fractional", "F has non-integer entries"),
+    ("F", "bool", "F has dtype bool"),
+    ("points", "str", "points has dtype <U"),
+    ("points", "object", "points has dtype object"),
+    ("points", "datetime64", "points has dtype datetime64"),
+    ("V", "complex", "V has dtype complex128"),
+])
+def test_inputs_that_are_not_real_numbers_or_integers_are_refused(what, value, words):
+    # they were coerced: 0.5 face indices truncated, bools read as 0/1, strings parsed
+    V, F = grid(5, 5)
+    args = {"points": V[:3], "V": V, "F": F}
+    x = args[what]
+    args[what] = {"fractional": x + 0.5, "bool": x.astype(bool), "str": x.astype(str),
+                  "object": x.astype(object), "datetime64": x.astype("datetime64[s]"),
+                  "complex": x.astype(complex)}[value]
+    with pytest.raises(MeshError, match=words):
+        locate(args["points"], args["V"], args["F"])
+
+
+@pytest.mark.parametrize("name", ["candidates", "chunk"])
+@pytest.mark.parametrize("value, words", [(0, "at least 1"), (-5, "at least 1"), (True, "whole number"),
+                                          (2.5, "whole number")])
+def test_candidates_and_chunk_must_be_whole_numbers_of_at_least_one(name, value, words):
+    # chunk=-5 returned garbage, candidates=0 / chunk=0 raised numpy errors
+    V, F = grid(5, 5)
+    with pytest.raises(ValueError, match=f"{name}={value!r} must .*{words}"):
+        locate(V[:3], V, F, engine="numpy", **{name: value})
+
+
+def test_interpolate_names_the_offending_face_index_not_its_position():
+    V, F = grid(5, 5)
+    with pytest.raises(MeshError, match=r"1 face indices are outside \[0, 32\) \(first: 99, at positions 1\)"):
+        interpolate(V, F, np.array([3, 99]), np.full((2, 3), 1 / 3))
+    with pytest.raises(MeshError, match="face has dtype float64"):
+        interpolate(V, F, np.array([3.0, 9.5]), np.full((2, 3), 1 / 3))

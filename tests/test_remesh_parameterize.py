@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from curvdetail.curvature.testing import disk
-from curvdetail.remesh import flipped_triangles, parameterize, retriangulate
+from curvdetail.remesh import flipped_triangles, harmonic_map, parameterize, retriangulate
 
 
 def test_harmonic_map_of_a_flat_disk_is_a_rotation_of_it():
@@ -57,3 +57,25 @@ def test_flipped_triangles_refuses_uv_that_does_not_fit_f():
         flipped_triangles(V[:3, :2], F)
     with pytest.raises(MeshError, match=r"UV has shape \(.*, 3\)"):
         flipped_triangles(V, F)
+
+
+def test_harmonic_map_without_pinned_vertices_is_refused_not_zeros():
+    # with nothing pinned every constant solves it: it returned zeros silently
+    from curvdetail.curvature.errors import ConstraintError
+
+    V, F = disk(n_rings=4)
+    with pytest.raises(ConstraintError, match="boundary is empty: with no pinned vertex the harmonic map is "
+                                              "undetermined"):
+        harmonic_map(V, F, [], np.zeros((0, 2)))
+    with pytest.raises(ConstraintError, match=r"boundary_uv has shape \(2, 3\); expected \(2, 2\)"):
+        harmonic_map(V, F, [0, 1], np.zeros((2, 3)))
+    with pytest.raises(ConstraintError, match=r"boundary_uv: 1 rows are NaN or infinite \(first: 1\)"):
+        harmonic_map(V, F, [0, 1], [[0.0, 0.0], [np.nan, 1.0]])
+
+
+def test_a_target_half_given_is_refused_not_ignored():
+    V, F = disk(n_rings=4)
+    with pytest.raises(ValueError, match="Ft was given without Vt: pass both"):
+        parameterize(V, F, None, F)
+    with pytest.raises(ValueError, match="Vt was given without Ft: pass both"):
+        parameterize(V, F, V)

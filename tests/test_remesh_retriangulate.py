@@ -80,16 +80,27 @@ def test_unknown_method_is_refused(load_mesh):
 
 @pytest.mark.parametrize("kwargs, words", [
     ({"iterations": 0}, "at least 1"),
-    ({"iterations": "ten"}, "not a whole number"),
-    ({"iterations": 2.5}, "not a whole number"),
+    ({"iterations": "ten"}, "must be a whole number"),
+    ({"iterations": 2.5}, "must be a whole number"),
     ({"max_surface_distance": -0.01}, "positive fraction"),
     ({"max_surface_distance": float("nan")}, "positive fraction"),
     ({"method": "decimate", "aggressiveness": float("nan")}, "from 0 to 10"),
     ({"method": "decimate", "aggressiveness": 11}, "from 0 to 10"),
+    # bools were taken as 1, huge ints raised a TypeError, strings were parsed
+    ({"iterations": True}, "iterations=True must be a whole number"),
+    ({"max_surface_distance": 10 ** 400}, "positive fraction"),
+    ({"max_surface_distance": True}, "positive fraction"),
+    ({"method": "decimate", "aggressiveness": 10 ** 30}, "from 0 to 10"),
+    ({"method": "decimate", "aggressiveness": True}, "from 0 to 10"),
+    ({"target_edge": True}, "target_edge=True must be a positive fraction"),
+    ({"target_edge": "0.05"}, "target_edge='0.05' must be a positive fraction"),
+    # target_edge ** 2 raised an OverflowError: the admissible range is given instead
+    ({"target_edge": 1e300}, r"fewer than 50; choose a target edge between 0.\d+ % and \d+.\d+ %"),
+    ({"target_edge": 1e-300}, r"about inf target vertices, more than 5,000,000; choose a target edge between"),
 ])
 def test_out_of_range_remesher_options_are_refused_before_remeshing(load_mesh, kwargs, words):
     # they used to be passed on: -1 iterations returned the source unchanged, a negative surface
     # distance and a NaN aggressiveness were handed to the remeshers
     V, F = load_mesh("mannequin_nose.obj")
     with pytest.raises(RemeshError, match=words):
-        retriangulate(V, F, target_edge=0.05, **kwargs)
+        retriangulate(V, F, **{"target_edge": 0.05, **kwargs})

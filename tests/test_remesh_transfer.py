@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from curvdetail.curvature import curvature_detail, mixed_voronoi_area
-from curvdetail.curvature.testing import icosphere
+from curvdetail.curvature.errors import MeshError
+from curvdetail.curvature.testing import grid, icosphere
 from curvdetail.remesh import edge_curvature_measure, retriangulate, transfer_curvature
 from curvdetail.remesh._disk import boundary_loop
 
@@ -82,3 +83,66 @@ def test_bad_options_are_refused(load_mesh):
         transfer_curvature(V, F, V, F, method="nearest")
     with pytest.raises(ValueError, match="needs uv="):
         transfer_curvature(V, F, V, F, location="uv")
+
+
+def _bad_mesh(kind):
+    V, F = grid(5, 5)
+    if kind == "nan vertex":
+        V[3, 0] = np.nan
+    elif kind == "zero area":
+        V[F[7, 0]] = V[F[7, 1]]
+    return {"nan vertex": (V, F), "zero area": (V, F), "(m, 4) F": (V, np.c_[F, F[:, :1]]),
+            "negative index": (V, F - 1), "empty F": (V, F[:0]), "bool V": (V.astype(bool), F),
+            "None V": (None, F), "index out of range": (V, F + 100), "float F": (V, F + 0.5)}[kind]
+
+
+@pytest.mark.parametrize("kind, words", [
+    ("nan vertex", r"V: 1 vertices have NaN or infinite coordinates \(first: 3\)"),
+    ("zero area", r"triangles have zero area \(first: .*7"),
+    ("(m, 4) F", r"F has shape \(32, 4\)"),
+    ("negative index", "vertex indices outside"),
+    ("empty F", "F is empty"),
+    ("bool V", "V has dtype bool"),
+    ("None V", "V has dtype object"),
+    ("index out of range", "vertex indices outside"),
+    ("float F", "F has non-integer entries"),
+])
+def test_edge_measure_refuses_malformed_meshes_by_name(kind, words):
+    # it had no checks: NaN came out silently for a NaN vertex or a zero-area triangle, (m, 4)
+    # and negative indices were taken, other cases raised numpy errors
+    with pytest.raises(MeshError, match=words):
+        edge_curvature_measure(*_bad_mesh(kind))
+
+
+@pytest.mark.parametrize("value, words", [
+    (0, "at least 1"), (-1, "at least 1"), (2.5, "whole number"), ("5", "whole number"),
+    (True, "whole number"), (np.inf, "whole number"),
+    (10 ** 30, r"asks for 5.6e\+31 edge samples, more than 20,000,000"),
+])
+def test_samples_per_edge_must_be_a_sane_whole_number(value, words):
+    # 0 and -1 were clamped to 1, 2.5 truncated, "5" and True accepted, 10**30 an OverflowError
+    V, F = grid(5, 5)
+    with pytest.raises(ValueError, match=words):
+        transfer_curvature(V, F, V, F, samples_per_edge=value)
+
+
+def test_options_that_would_be_ignored_are_refused():
+    V, F = grid(5, 5)
+    uv = (V[:, :2], V[:, :2])
+    with pytest.raises(ValueError, match="uv is only used with location='uv'"):
+        transfer_curvature(V, F, V, F, location="closest", uv=uv)
+    with pytest.raises(ValueError, match="samples_per_edge is used by method='conservative' only"):
+        transfer_curvature(V, F, V, F, method="pointwise", samples_per_edge=3)
+
+
+def test_malformed_uv_is_named_as_uv():
+    # uv=5 raised a TypeError; a NaN in uv was reported as "points: ... rows are NaN"
+    V, F = grid(5, 5)
+    with pytest.raises(ValueError, match=r"needs uv=\(UVs, UVt\), a pair of arrays.*got int"):
+        transfer_curvature(V, F, V, F, location="uv", uv=5)
+    UV = V[:, :2].copy()
+    UV[4, 1] = np.nan
+    with pytest.raises(MeshError, match=r"uv\[0\] \(UVs\): 1 vertices have NaN .*\(first: 4\)"):
+        transfer_curvature(V, F, V, F, location="uv", uv=(UV, V[:, :2]))
+    with pytest.raises(MeshError, match=r"uv\[1\] \(UVt\) has dtype <U"):
+        transfer_curvature(V, F, V, F, location="uv", uv=(V[:, :2], V[:, :2].astype(str)))

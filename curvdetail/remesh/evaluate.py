@@ -1,11 +1,12 @@
 """Two-sided surface distances between meshes (paper Fig. 3, evaluation)."""
 
-import operator
-
 import numpy as np
 
-from ..curvature._validate import bbox_diagonal, check_mesh, face_double_areas
-from .locate import check_points_and_mesh, locate
+from ..curvature._validate import as_count, bbox_diagonal, check_mesh, face_double_areas
+from .locate import FAR_POINTS, _locate, _unit_frame, check_points_and_mesh
+
+#: Largest ``samples``: pymeshlab takes the count as a 32-bit int.
+MAX_SAMPLE_ARG = 2 ** 31 - 1
 
 #: Face samples per direction: ``SAMPLES_PER_FACE`` times the sampled mesh's triangle count,
 #: clamped to [MIN_SAMPLES, MAX_SAMPLES].
@@ -27,15 +28,18 @@ def hausdorff(Va, Fa, Vb, Fb, *, samples=None, engine="meshlab", seed=0):
     with the nearest centroids (a ``cKDTree``, 2 % approximate search) are the candidates and the
     exact closest point on those is taken. For a point at distance ``d`` this overestimates by at
     most about ``r^2 / 2d`` (``r`` a triangle's size): negligible for far surfaces, which is
-    what this engine is for.
+    what this engine is for. Meshes whose bounding boxes are more than one diagonal (of the
+    smaller) apart are always measured with it: pymeshlab's search does not return there.
+    Both engines work in a frame where the two meshes together have unit size.
 
     Parameters
     ----------
     Va, Fa, Vb, Fb : the two meshes ((n, 3) float, (m, 3) int)
-    samples : int or None   face samples per direction; ``None`` = 10 per triangle of the sampled
-                            mesh, at least 100,000 and at most 1,000,000
+    samples : int or None   face samples per direction, 1 to 2**31 - 1 (pymeshlab's int; the
+                            kdtree engine holds ~3 kB per sample); ``None`` = 10 per triangle of
+                            the sampled mesh, at least 100,000 and at most 1,000,000
     engine : {"meshlab", "kdtree"}
-    seed : int              random seed of the ``"kdtree"`` engine's samples
+    seed : int              random seed (>= 0) of the ``"kdtree"`` engine's samples
 
     Returns
     -------
@@ -44,8 +48,9 @@ def hausdorff(Va, Fa, Vb, Fb, *, samples=None, engine="meshlab", seed=0):
 
     Raises
     ------
-    MeshError   malformed meshes
-    ValueError  unknown ``engine``; ``samples`` not a whole number of at least 1
+    MeshError   malformed meshes; coordinates beyond 1e150 (see :func:`locate`)
+    ValueError  unknown ``engine``; ``samples`` not a whole number from 1 to 2**31 - 1 (bools
+                refused); ``seed`` not a whole number >= 0
 
     Examples
     --------
@@ -54,22 +59,51 @@ def hausdorff(Va, Fa, Vb, Fb, *, samples=None, engine="meshlab", seed=0):
     >>> round(hausdorff(V, F, W, F)["rms"], 6)
     0.01
     """
-    import pymeshlab
-
-    Va, Fa = check_mesh(Va, Fa)
-    Vb, Fb = check_mesh(Vb, Fb)
+    # dtypes, scale and distance first; then the meshes in a frame where the two together have
+    # unit size (as pymeshlab sees them too): areas of huge or tiny meshes neither over- nor underflow
+    Va, Vb, _ = check_points_and_mesh(Va, Vb, Fb, names=("Va", "Vb", "Fb"))
+    both = np.vstack([Va, Vb])
+    _, both, scale = _unit_frame(both[:0], both)
+    Va, Fa = check_mesh(both[:Va.shape[0]], Fa)
+    Vb, Fb = check_mesh(both[Va.shape[0]:], Fb)
     if engine not in ("meshlab", "kdtree"):
         raise ValueError(f"engine={engine!r}; use 'meshlab' or 'kdtree'.")
-    if samples is not None:
-        try:
-            count = operator.index(samples)
-        except TypeError:
-            count = 0
-        if count < 1:
-            raise ValueError(f"samples={samples!r} must be a whole number of at least 1, or None for "
-                             "10 per triangle (100,000 to 1,000,000).")
-    if engine == "kdtree":
-        return _hausdorff_kdtree(Va, Fa, Vb, Fb, samples, seed)
+    samples = _check_samples(samples)
+    seed = as_count(seed, "seed", minimum=0)
+    if engine == "kdtree" or _apart(Va, Vb):
+        return _scaled(_hausdorff_kdtree(Va, Fa, Vb, Fb, samples, seed), scale)
+    return _scaled(_hausdorff_meshlab(Va, Fa, Vb, Fb, samples), scale)
+
+
+def _check_samples(samples):
+    if samples is None:
+        return None
+    try:
+        count = as_count(samples, "samples")
+    except ValueError:
+        raise ValueError(f"samples={samples!r} must be a whole number of at least 1, or None for "
+                         "10 per triangle (100,000 to 1,000,000).") from None
+    if count > MAX_SAMPLE_ARG:
+        raise ValueError(f"samples={count:,} is more than pymeshlab takes ({MAX_SAMPLE_ARG:,}, a 32-bit int); "
+                         "1,000,000 is plenty for 1e-3 relative accuracy.")
+    return count
+
+
+def _apart(Va, Vb):
+    """True if the bounding boxes of the meshes are more than ``FAR_POINTS`` diagonals (of the
+    smaller mesh) apart: pymeshlab's grid search slows down with the distance without bound
+    (28 s at 0.1 diagonals for 20,000 samples on a 10k-vertex grid; no answer at 1e10)."""
+    gap = np.linalg.norm(np.maximum(np.maximum(Va.min(0) - Vb.max(0), Vb.min(0) - Va.max(0)), 0.0))
+    return bool(gap > FAR_POINTS * min(bbox_diagonal(Va), bbox_diagonal(Vb)))
+
+
+def _scaled(figures, scale):
+    return {k: v if k == "samples" else v * scale for k, v in figures.items()}
+
+
+def _hausdorff_meshlab(Va, Fa, Vb, Fb, samples):
+    import pymeshlab
+
     ms = pymeshlab.MeshSet()
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=Va, face_matrix=Fa.astype(np.int32)))
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=Vb, face_matrix=Fb.astype(np.int32)))
@@ -95,11 +129,18 @@ def vertex_distance(V, Vs, Fs, *, far=False):
 
     ``far=True`` uses the kd-tree candidates of :func:`hausdorff`'s ``"kdtree"`` engine (fast for
     points far from the surface, overestimating by at most ~``r^2 / 2d``) instead of the exact
-    :func:`locate` (whose grid search slows down with the distance)."""
-    if far:
-        P, Vs, Fs = check_points_and_mesh(V, Vs, Fs)
-        return _one_sided_kdtree(P, Vs, Fs, Vs[Fs].mean(axis=1), np.arange(Fs.shape[0]))
-    return locate(V, Vs, Fs)[2]
+    :func:`locate` (whose grid search slows down with the distance).
+
+    Raises
+    ------
+    MeshError   malformed points or surface, as :func:`locate` refuses them (names ``V``,
+                ``Vs`` and ``Fs``)
+    """
+    P, Vs, Fs = check_points_and_mesh(V, Vs, Fs, names=("V", "Vs", "Fs"))
+    if not far:
+        return _locate(P, Vs, Fs)[2]
+    P, Vs, scale = _unit_frame(P, Vs)
+    return scale * _one_sided_kdtree(P, Vs, Fs, Vs[Fs].mean(axis=1), np.arange(Fs.shape[0]))
 
 
 def _area_samples(V, F, n, rng):
@@ -117,8 +158,10 @@ def _one_sided_kdtree(P, V, F, dense, dense_face, k=8, eps=0.02):
 
     from .locate import _closest_barycentric
 
+    # a surface of fewer than k triangles: cKDTree pads with a missing-neighbour index
+    k = min(k, dense.shape[0])
     _, idx = cKDTree(dense).query(P, k=k, eps=eps)
-    cand = dense_face[idx]
+    cand = dense_face[idx.reshape(P.shape[0], k)]
     _, d = _closest_barycentric(P[:, None, :], V[F[cand]])
     return d.min(axis=1)
 

@@ -13,7 +13,7 @@ from .evaluate import hausdorff, vertex_distance
 from .parameterize import METHODS as PARAMETERIZATIONS
 from .parameterize import parameterize
 from .retriangulate import METHODS as RETRIANGULATIONS
-from .retriangulate import retriangulate
+from .retriangulate import check_target_edge, retriangulate
 from .transfer import LOCATIONS
 from .transfer import METHODS as TRANSFERS
 from .transfer import transfer_curvature
@@ -62,7 +62,8 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="c
     target : tuple (Vt, Ft) or None            a ready retriangulation to use instead of making one
                                                (a disk whose boundary vertices lie on the source's
                                                boundary polyline); ``method`` / ``target_edge`` are then
-                                               only recorded, and ``seconds.retriangulate`` is 0
+                                               only recorded (but still checked), and
+                                               ``seconds.retriangulate`` is 0
 
     Returns
     -------
@@ -79,8 +80,10 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="c
     Raises
     ------
     MeshError, NotADiskError   malformed source or not a disk (says what was found)
-    RemeshError                absurd target edge (with the numbers) or a failed retriangulation
-    ValueError                 unknown option values
+    RemeshError                absurd target edge (with the numbers; not a positive number even
+                               with a ``target``) or a failed retriangulation
+    ValueError                 unknown option values; ``target`` not a pair; ``progress`` not
+                               callable
     SolverError                unknown or uninstalled ``backend`` (before any work)
 
     Examples
@@ -115,6 +118,15 @@ def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="cons
     _check_choice("location", location, LOCATIONS)
     _check_choice("parameterization", parameterization, PARAMETERIZATIONS)
     resolve_backend(backend)               # an unknown or missing backend fails before the work
+    # checked even with a ready target, where it is only recorded: a bad value is a mistake
+    # either way (as pymeshlab checks every parameter of a filter)
+    target_edge = check_target_edge(target_edge)
+    if target is not None and (not isinstance(target, (tuple, list)) or len(target) != 2):
+        raise ValueError(f"target must be a pair (Vt, Ft), a ready retriangulation, or None; got "
+                         f"{type(target).__name__}.")
+    if progress is not None and not callable(progress):
+        raise ValueError(f"progress must be callable (called with each stage name) or None; got "
+                         f"{type(progress).__name__}.")
     V, F, _ = check_disk(V, F, "the source")
     d = bbox_diagonal(V)
     seconds = dict.fromkeys(STAGES, 0.0)

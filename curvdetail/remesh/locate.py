@@ -4,8 +4,18 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
-from ..curvature._validate import bbox_diagonal
+from ..curvature._validate import (ZERO_AREA_RELATIVE, as_count, as_faces, as_vertices, bbox_diagonal,
+                                   face_double_areas)
 from ..curvature.errors import MeshError, first_indices
+
+#: Points further than this (bbox diagonals of the mesh) from its bounding box skip the fast
+#: engines for the numpy one: pymeshlab's grid search slows down with the distance (0.2 s at
+#: 1e4 diagonals on a 40k-vertex grid, no answer after 60 s at 1e10).
+FAR_POINTS = 1.0
+
+#: Points further than this (bbox diagonals) are refused: the closest-point tests multiply
+#: squared lengths, which overflow beyond ~1e77 diagonals.
+MAX_RELATIVE_DISTANCE = 1e50
 
 
 def locate(points, V, F, *, engine="auto", candidates=8, chunk=20_000):
@@ -21,6 +31,10 @@ def locate(points, V, F, *, engine="auto", candidates=8, chunk=20_000):
     trapezoid-map point location (C++) with the numpy engine for the points it finds outside;
     in space pymeshlab's ``transfer_attributes_per_vertex`` (a uniform grid, C++) for the
     nearest face, then the exact barycentric coordinates of the closest point in that face.
+    Points more than ``FAR_POINTS`` bbox diagonals outside the mesh's bounding box always go to
+    the numpy engine (pymeshlab's grid search slows down with the distance, without bound).
+    Everything is computed in a frame where the mesh has unit size, so the scale and position
+    of the input do not matter.
 
     Parameters
     ----------
@@ -39,9 +53,11 @@ def locate(points, V, F, *, engine="auto", candidates=8, chunk=20_000):
 
     Raises
     ------
-    MeshError   mismatched dimensions, empty ``F``, NaN or infinite coordinates, or triangle
-                indices outside ``V``
-    ValueError  an unknown ``engine``
+    MeshError   malformed input (see :func:`check_points_and_mesh`): mismatched dimensions,
+                dtypes that are not real numbers / integers, empty ``F``, NaN or infinite
+                coordinates, triangle indices outside ``V``, zero-area triangles, a mesh of zero
+                extent, coordinates beyond 1e150 or points more than 1e50 bbox diagonals away
+    ValueError  an unknown ``engine``; ``candidates`` or ``chunk`` not a whole number >= 1
 
     Examples
     --------
@@ -54,14 +70,23 @@ def locate(points, V, F, *, engine="auto", candidates=8, chunk=20_000):
     P, V, F = check_points_and_mesh(points, V, F)
     if engine not in ("auto", "numpy"):
         raise ValueError(f"engine={engine!r}; use 'auto' or 'numpy'.")
+    return _locate(P, V, F, engine, as_count(candidates, "candidates"), as_count(chunk, "chunk"))
+
+
+def _locate(P, V, F, engine="auto", candidates=8, chunk=20_000):
+    """:func:`locate` on arrays that passed :func:`check_points_and_mesh`."""
     if P.shape[0] == 0:
         return np.empty(0, dtype=np.int64), np.empty((0, 3)), np.empty(0)
+    # in a frame where the mesh has unit size at the origin: the grid, the trapezoid map and
+    # the closest-point arithmetic then work alike for meshes of any scale and position
+    P, V, scale = _unit_frame(P, V)
     if engine == "numpy":
-        return _locate_kdtree(P, V, F, candidates, chunk)
-    if V.shape[1] == 2:
-        face = _trifinder(P, V, F)
-    else:
-        face = _nearest_face_meshlab(P, V, F)
+        face, bary, dist = _locate_kdtree(P, V, F, candidates, chunk)
+        return face, bary, dist * scale
+    face = np.full(P.shape[0], -1, dtype=np.int64)
+    near = np.flatnonzero(_box_gap(P, V) <= FAR_POINTS)
+    if near.size:
+        face[near] = _trifinder(P[near], V, F) if V.shape[1] == 2 else _nearest_face_meshlab(P[near], V, F)
     bad = face < 0
     face = np.where(bad, 0, face)
     bary, dist = _closest_barycentric(P[:, None, :], V[F[face]][:, None])
@@ -69,30 +94,74 @@ def locate(points, V, F, *, engine="auto", candidates=8, chunk=20_000):
     if bad.any():
         f2, b2, d2 = _locate_kdtree(P[bad], V, F, candidates, chunk)
         face[bad], bary[bad], dist[bad] = f2, b2, d2
-    return face, bary, dist
+    return face, bary, dist * scale
 
 
-def check_points_and_mesh(points, V, F):
-    """``(P, V, F)`` as float64 / float64 / int64 arrays, or MeshError: mismatched dimensions,
-    empty ``F``, NaN or infinite coordinates, triangle indices outside ``V``."""
-    P = np.asarray(points, dtype=np.float64)
-    V = np.asarray(V, dtype=np.float64)
-    F = np.asarray(F, dtype=np.int64)
-    if P.ndim != 2 or V.ndim != 2 or P.shape[1] != V.shape[1] or V.shape[1] not in (2, 3):
-        raise MeshError(f"points {P.shape} and V {V.shape} must both be (k, 2) or both (k, 3).")
-    if F.ndim != 2 or F.shape[1] != 3 or F.shape[0] == 0:
-        raise MeshError(f"F has shape {F.shape}; pass a non-empty (m, 3) triangle array.")
-    # pymeshlab's grid and matplotlib's trapezoid map crash (segmentation fault) on NaN input
-    for name, X in (("points", P), ("V", V)):
-        bad = np.flatnonzero(~np.isfinite(X).all(axis=1))
-        if bad.size:
-            raise MeshError(f"{name}: {bad.size} rows are NaN or infinite (first: {first_indices(bad)}); "
-                            "pass finite coordinates.")
-    bad = np.flatnonzero(((F < 0) | (F >= V.shape[0])).any(axis=1))
-    if bad.size:
-        raise MeshError(f"F: {bad.size} triangles have vertex indices outside [0, {V.shape[0]}) "
-                        f"(first: {first_indices(bad)}); indices are 0-based into V.")
+def check_points_and_mesh(points, V, F, names=("points", "V", "F")):
+    """``(P, V, F)`` as float64 / float64 / int64 arrays, or MeshError: dtypes and shapes as in
+    :func:`~curvdetail.curvature.check_mesh` (``V`` and ``points`` (k, 2) or (k, 3), alike),
+    NaN or infinite coordinates, triangle indices outside ``V`` or repeated in a triangle,
+    zero-area triangles or a mesh of zero extent, coordinates beyond 1e150 (``as_vertices``) and
+    points further than ``MAX_RELATIVE_DISTANCE`` bbox diagonals. ``names``: the three
+    arguments as the caller calls them, for the messages."""
+    P = _as_coordinates(points, names[0], allow_empty=True)
+    V = _as_coordinates(V, names[1])
+    if P.shape[1] != V.shape[1]:
+        raise MeshError(f"{names[0]} {P.shape} and {names[1]} {V.shape} must both be (k, 2) or both (k, 3).")
+    F = as_faces(F, V.shape[0], names[2])
+    _check_areas(V, F, names)
+    far = _box_gap(P, V) / bbox_diagonal(V) if P.shape[0] else np.zeros(0)
+    if far.size and far.max() > MAX_RELATIVE_DISTANCE:
+        raise MeshError(f"{names[0]}: {np.count_nonzero(far > MAX_RELATIVE_DISTANCE)} points lie more than "
+                        f"{MAX_RELATIVE_DISTANCE:.0e} bbox diagonals of {names[1]} from it (first: "
+                        f"{first_indices(np.flatnonzero(far > MAX_RELATIVE_DISTANCE))}; up to {far.max():.3g}); "
+                        "the closest-point arithmetic overflows there: pass points near the mesh.")
     return P, V, F
+
+
+def _as_coordinates(X, name, allow_empty=False):
+    """``X`` as a C-contiguous (k, 2) or (k, 3) float64 array, checked by ``as_vertices``."""
+    try:
+        arr = np.asarray(X)
+    except Exception:
+        return as_vertices(X, name)                  # raises its "could not be read" MeshError
+    if arr.ndim != 2 or arr.shape[1] not in (2, 3):
+        raise MeshError(f"{name} has shape {arr.shape}; pass a (k, 2) or (k, 3) coordinate array.")
+    d = arr.shape[1]
+    if arr.shape[0] == 0 and allow_empty:
+        as_vertices(np.zeros((1, 3), dtype=arr.dtype), name)      # its dtype check alone
+        return np.empty((0, d))
+    # as_vertices takes (n, 3) arrays: planar points go through it with a repeated column
+    return np.ascontiguousarray(as_vertices(arr if d == 3 else arr[:, [0, 1, 1]], name)[:, :d])
+
+
+def _check_areas(V, F, names):
+    """MeshError for a mesh of zero extent or with zero-area triangles (pymeshlab's grid does
+    not return on a mesh collapsed to a point; closest points on a degenerate triangle are
+    ill-defined)."""
+    if bbox_diagonal(V) == 0:
+        raise MeshError(f"{names[1]}: all {V.shape[0]} vertices are at one point (zero extent); pass a mesh "
+                        "with area.")
+    _, U, _ = _unit_frame(V[:0], V)             # areas relative to the unit bbox diagonal: any scale
+    U = U if U.shape[1] == 3 else np.column_stack([U, np.zeros(U.shape[0])])
+    zero = np.flatnonzero(face_double_areas(U, F) <= 2.0 * ZERO_AREA_RELATIVE)
+    if zero.size:
+        raise MeshError(f"{names[2]}: {zero.size} triangles have zero area (first: {first_indices(zero)}); "
+                        "remove them, e.g. with pymeshlab's meshing_remove_null_faces.")
+
+
+def _unit_frame(P, V):
+    """``P`` and ``V`` moved and scaled so that ``V``'s bounding box is centred at the origin
+    with unit diagonal, and that diagonal (distances in the frame times it are true distances)."""
+    centre = 0.5 * (V.max(axis=0) + V.min(axis=0))
+    scale = bbox_diagonal(V)
+    return (P - centre) / scale, (V - centre) / scale, scale
+
+
+def _box_gap(P, V):
+    """Distance of each point from the bounding box of ``V`` (0 inside), shape (k,)."""
+    lo, hi = V.min(axis=0), V.max(axis=0)
+    return np.linalg.norm(np.maximum(np.maximum(lo - P, P - hi), 0.0), axis=1)
 
 
 def _trifinder(P, V, F):
@@ -196,6 +265,13 @@ def _closest_barycentric(P, T):
     """Barycentric coordinates of the closest point of triangles ``T`` (..., 3, d) to points
     ``P`` (..., d), and the distance (Ericson, Real-Time Collision Detection, 5.1.5), vectorized.
     Degenerate (zero-area) triangles fall back to their closest edge point."""
+    # every region's formula is evaluated for every point and only the right one kept: the
+    # others may overflow or divide by ~0 (far points) and are discarded
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        return _closest_barycentric_all(P, T)
+
+
+def _closest_barycentric_all(P, T):
     A, B, C = T[..., 0, :], T[..., 1, :], T[..., 2, :]
     AB, AC, AP = B - A, C - A, P - A
     d1 = (AB * AP).sum(-1)
@@ -248,10 +324,16 @@ def _located(F, face, bary, n, what):
     if F.ndim != 2 or F.shape[1] != 3 or face.ndim != 1 or bary.shape != (face.shape[0], 3):
         raise MeshError(f"{what}: F {F.shape}, face {face.shape} and bary {bary.shape} must be (m, 3), "
                         "(k,) and (k, 3), as locate() returns them.")
+    for name, X in (("F", F), ("face", face)):
+        if X.size and X.dtype.kind not in "iu":       # floats would be truncated, bools mean 0/1
+            raise MeshError(f"{what}: {name} has dtype {X.dtype}; pass integer indices, as locate() uses them.")
+    F = F.astype(np.int64, copy=False)
+    face = face.astype(np.int64, copy=False)
     bad = np.flatnonzero((face < 0) | (face >= F.shape[0]))
     if bad.size:
         raise MeshError(f"{what}: {bad.size} face indices are outside [0, {F.shape[0]}) (first: "
-                        f"{first_indices(bad)}); pass the faces locate() found in this F.")
+                        f"{first_indices(face[bad])}, at positions {first_indices(bad)}); pass the faces "
+                        "locate() found in this F.")
     if F.size and (F.min() < 0 or F.max() >= n):
         raise MeshError(f"{what}: F has vertex indices outside [0, {n}); pass the F the points were "
                         "located in, with one value per vertex.")

@@ -2,8 +2,9 @@
 
 import numpy as np
 
+from ..curvature._validate import as_index_set, as_values, check_every_component_fixed, check_mesh
 from ..curvature.cotan_laplacian import _cotan_laplacian_unchecked
-from ..curvature.errors import MeshError
+from ..curvature.errors import ConstraintError, MeshError
 from ..curvature.sparse_solver import factorize
 from ._disk import Polyline, check_disk
 
@@ -39,7 +40,39 @@ def harmonic_map(V, F, boundary, boundary_uv, *, backend="auto"):
     Returns
     -------
     UV : (n, 2) float array
+
+    Raises
+    ------
+    MeshError         malformed mesh (as :func:`check_mesh` names it)
+    ConstraintError   ``boundary`` empty, out of range or repeated, a piece of the mesh without a
+                      pinned vertex (the map is undetermined there), or ``boundary_uv`` not a
+                      finite (k, 2) array
     """
+    V, F = check_mesh(V, F)
+    boundary = as_index_set(boundary, V.shape[0], "boundary")
+    if boundary.size == 0:
+        raise ConstraintError("boundary is empty: with no pinned vertex the harmonic map is undetermined "
+                              "(any constant solves it); pin the boundary loop, e.g. "
+                              "curvdetail.curvature.boundary_loop(F).")
+    check_every_component_fixed(F, V.shape[0], boundary)
+    return _harmonic_map(V, F, boundary, _as_planar_values(boundary_uv, boundary.size, "boundary_uv"), backend)
+
+
+def _as_planar_values(values, count, name):
+    """``values`` as a finite (count, 2) float array, or ConstraintError (checked by ``as_values``)."""
+    try:
+        arr = np.asarray(values)
+    except Exception:
+        return as_values(values, count, name)          # raises its "could not be read" error
+    if arr.shape != (count, 2):
+        raise ConstraintError(f"{name} has shape {arr.shape}; expected ({count}, 2), one planar position "
+                              "per pinned vertex.")
+    # as_values takes (count, 3) arrays: the planar values go through it with a repeated column
+    return np.ascontiguousarray(as_values(arr[:, [0, 1, 1]], count, name)[:, :2])
+
+
+def _harmonic_map(V, F, boundary, boundary_uv, backend="auto"):
+    """:func:`harmonic_map` on checked input."""
     n = V.shape[0]
     L = _cotan_laplacian_unchecked(V, F).tocsr()
     is_b = np.zeros(n, dtype=bool)
@@ -95,7 +128,7 @@ def parameterize(Vs, Fs, Vt=None, Ft=None, *, method="harmonic", backend="auto")
     Raises
     ------
     MeshError, NotADiskError   either mesh malformed or not a disk
-    ValueError                 unknown method
+    ValueError                 unknown method; only one of ``Vt`` and ``Ft`` given
 
     Examples
     --------
@@ -107,12 +140,16 @@ def parameterize(Vs, Fs, Vt=None, Ft=None, *, method="harmonic", backend="auto")
     """
     if method not in METHODS:
         raise ValueError(f"method={method!r} is not a parameterization; use one of {', '.join(METHODS)}.")
+    if (Vt is None) != (Ft is None):
+        given, missing = ("Ft", "Vt") if Vt is None else ("Vt", "Ft")
+        raise ValueError(f"{given} was given without {missing}: pass both (the target mesh) or neither "
+                         "(the source alone).")
     Vs, Fs, loop_s = check_disk(Vs, Fs, "the source")
     poly = Polyline(Vs[loop_s])
     s_src = poly.s0
     info = {"method": method}
     if method == "harmonic":
-        UVs = harmonic_map(Vs, Fs, loop_s, circle(s_src, poly.total), backend=backend)
+        UVs = _harmonic_map(Vs, Fs, loop_s, circle(s_src, poly.total), backend=backend)
     else:
         UVs = _meshlab_uv(Vs, Fs, method)
     info["flipped_source"] = int(flipped_triangles(UVs, Fs).size)
@@ -121,7 +158,7 @@ def parameterize(Vs, Fs, Vt=None, Ft=None, *, method="harmonic", backend="auto")
     Vt, Ft, loop_t = check_disk(Vt, Ft, "the target")
     _, s_t, _ = poly.project(Vt[loop_t])
     if method == "harmonic":
-        UVt = harmonic_map(Vt, Ft, loop_t, circle(s_t, poly.total), backend=backend)
+        UVt = _harmonic_map(Vt, Ft, loop_t, circle(s_t, poly.total), backend=backend)
         expected = circle(s_t, poly.total)
     else:
         UVt = _meshlab_uv(Vt, Ft, method)

@@ -1,11 +1,8 @@
 """Retriangulate a disk-topology patch, keeping its boundary curve (paper Fig. 3, step 1)."""
 
-import numbers
-import operator
-
 import numpy as np
 
-from ..curvature._validate import bbox_diagonal, face_double_areas
+from ..curvature._validate import as_count, as_positive_number, bbox_diagonal, face_double_areas
 from ._disk import NotADiskError, Polyline, RemeshError, check_disk
 
 METHODS = ("isotropic", "decimate")
@@ -26,7 +23,29 @@ def estimated_vertices(V, F, target_edge):
     V = np.asarray(V, dtype=np.float64)
     F = np.asarray(F, dtype=np.int64)
     area = 0.5 * face_double_areas(V, F).sum()
-    return 2.0 * area / (np.sqrt(3.0) * target_edge ** 2)
+    # divided twice rather than by h**2 (OverflowError beyond 1e154); inf for a tiny h is refused
+    with np.errstate(over="ignore", divide="ignore"):
+        return 2.0 * area / np.sqrt(3.0) / float(target_edge) / float(target_edge)
+
+
+def edge_for_vertices(V, F, count):
+    """The absolute edge length whose equilateral triangulation of the surface has ``count``
+    vertices (the inverse of :func:`estimated_vertices`)."""
+    return float(np.sqrt(2.0 * 0.5 * face_double_areas(V, F).sum() / (np.sqrt(3.0) * count)))
+
+
+def check_target_edge(target_edge):
+    """``target_edge`` as a positive finite float (bools and strings refused), or RemeshError."""
+    return _as(as_positive_number, target_edge, "target_edge",
+               "must be a positive fraction of the bbox diagonal (e.g. 0.01 for 1 %).")
+
+
+def _as(check, value, name, requirement):
+    """``check(value, name)``; its ValueError re-raised as RemeshError: ``name=value requirement``."""
+    try:
+        return check(value, name)
+    except ValueError:
+        raise RemeshError(f"{name}={value!r} {requirement}") from None
 
 
 def retriangulate(V, F, *, method="isotropic", target_edge=0.01, iterations=10, max_surface_distance=None,
@@ -64,8 +83,10 @@ def retriangulate(V, F, *, method="isotropic", target_edge=0.01, iterations=10, 
     Raises
     ------
     MeshError, NotADiskError   the source is malformed or not a disk (says what was found)
-    RemeshError                unknown method, ``iterations`` below 1, a ``max_surface_distance``
-                               that is not positive, ``aggressiveness`` outside [0, 10], a
+    RemeshError                unknown method, ``iterations`` not a whole number >= 1, a
+                               ``target_edge`` or ``max_surface_distance`` that is not a positive
+                               finite number, ``aggressiveness`` outside [0, 10] (bools and
+                               strings are refused for all of them), a
                                target edge length that would give fewer than
                                50 or more than 5,000,000 vertices (the numbers are given), a
                                decimation asked to refine, or a remesher result that is not a disk
@@ -83,52 +104,45 @@ def retriangulate(V, F, *, method="isotropic", target_edge=0.01, iterations=10, 
         raise RemeshError(f"method={method!r} is not a retriangulation method; use 'isotropic' or 'decimate'.")
     V, F, loop = check_disk(V, F, "the source")
     d = bbox_diagonal(V)
-    try:
-        target_edge = float(target_edge)
-    except (TypeError, ValueError):
-        raise RemeshError(f"target_edge={target_edge!r} is not a number; give a fraction of the bbox "
-                          "diagonal, e.g. 0.01 for 1 %.") from None
-    if not np.isfinite(target_edge) or target_edge <= 0:
-        raise RemeshError(f"target_edge={target_edge!r} must be a positive fraction of the bbox diagonal "
-                          "(e.g. 0.01 for 1 %).")
-    try:
-        iterations = operator.index(iterations)
-    except TypeError:
-        raise RemeshError(f"iterations={iterations!r} is not a whole number; give the isotropic remeshing "
-                          "iterations, e.g. 10.") from None
-    if iterations < 1:
-        raise RemeshError(f"iterations={iterations} must be at least 1 (e.g. 10).")
-    if max_surface_distance is not None and not _positive(max_surface_distance):
-        raise RemeshError(f"max_surface_distance={max_surface_distance!r} must be a positive fraction of the "
-                          "bbox diagonal, or None for the target edge.")
-    if not (_positive(aggressiveness) or aggressiveness == 0) or aggressiveness > 10:
-        raise RemeshError(f"aggressiveness={aggressiveness!r} must be a number from 0 to 10 "
-                          "(fast-simplification's agg; default 7).")
+    target_edge = check_target_edge(target_edge)
+    iterations = _as(as_count, iterations, "iterations",
+                     "must be a whole number of at least 1 (isotropic remeshing iterations, e.g. 10).")
+    if max_surface_distance is not None:
+        max_surface_distance = _as(as_positive_number, max_surface_distance, "max_surface_distance",
+                                   "must be a positive fraction of the bbox diagonal, or None for the target edge.")
+    aggressiveness = _check_aggressiveness(aggressiveness)
     h = target_edge * d
     n_est = estimated_vertices(V, F, h)
-    if n_est < MIN_VERTICES or n_est > MAX_VERTICES:
-        side = "fewer than" if n_est < MIN_VERTICES else "more than"
-        limit = MIN_VERTICES if n_est < MIN_VERTICES else MAX_VERTICES
+    if not MIN_VERTICES <= n_est <= MAX_VERTICES:
+        side, limit = ("fewer than", MIN_VERTICES) if n_est < MIN_VERTICES else ("more than", MAX_VERTICES)
         raise RemeshError(
             f"target edge {100 * target_edge:.4g} % of the bbox diagonal ({h:.4g}) would give about "
             f"{n_est:,.0f} target vertices, {side} {limit:,}; choose a target edge between "
-            f"{100 * target_edge * np.sqrt(n_est / MAX_VERTICES):.3g} % and "
-            f"{100 * target_edge * np.sqrt(n_est / MIN_VERTICES):.3g} % for this "
+            f"{100 * edge_for_vertices(V, F, MAX_VERTICES) / d:.3g} % and "
+            f"{100 * edge_for_vertices(V, F, MIN_VERTICES) / d:.3g} % for this "
             f"{V.shape[0]:,}-vertex patch.")
     if method == "isotropic":
-        surf = target_edge if max_surface_distance is None else float(max_surface_distance)
+        surf = target_edge if max_surface_distance is None else max_surface_distance
         Vt, Ft = _isotropic(V, F, h, iterations, surf * d)
         try:
             Vt, Ft, loop_t = check_disk(Vt, Ft, "the isotropic remesher's result")
         except NotADiskError as exc:
             raise RemeshError(f"{exc} Try another target edge.") from None
     else:
-        Vt, Ft, loop_t = _decimate(V, F, h, float(aggressiveness))
+        Vt, Ft, loop_t = _decimate(V, F, h, aggressiveness)
     return _snap_boundary(V, loop, Vt, Ft, loop_t, d, h)
 
 
-def _positive(x):
-    return isinstance(x, numbers.Real) and bool(np.isfinite(x)) and x > 0
+def _check_aggressiveness(value):
+    """``value`` as a float in [0, 10] (bools and strings refused), or RemeshError."""
+    fail = RemeshError(f"aggressiveness={value!r} must be a number from 0 to 10 (fast-simplification's agg; "
+                       "default 7).")
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+        raise fail
+    number = float(value) if abs(value) <= 10 else np.inf      # float(10**400) would raise OverflowError
+    if not 0 <= number <= 10:                                    # NaN fails too
+        raise fail
+    return number
 
 
 def _isotropic(V, F, h, iterations, max_dist):

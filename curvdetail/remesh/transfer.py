@@ -2,13 +2,17 @@
 
 import numpy as np
 
-from ..curvature._validate import check_mesh
+from ..curvature._validate import as_count, check_mesh
 from ..curvature.mean_curvature_normal import mean_curvature_normal
 from ..curvature.mixed_voronoi_area import mixed_voronoi_area
-from .locate import interpolate, locate, spread
+from .locate import _as_coordinates, _locate, check_points_and_mesh, interpolate, spread
 
 METHODS = ("conservative", "pointwise")
 LOCATIONS = ("closest", "uv")
+
+#: Most edge samples the conservative transfer takes: locating them holds ~0.5 kB each, so
+#: this is ~10 GB of memory.
+MAX_EDGE_SAMPLES = 20_000_000
 
 
 def edge_curvature_measure(V, F):
@@ -19,11 +23,25 @@ def edge_curvature_measure(V, F):
     boundary edge. Each vertex's detail is half the measure of its edges:
     ``D_i = (L V)_i = 1/2 sum_{e ni i} c_e`` exactly (the area gradient, edge by edge).
 
+    Parameters
+    ----------
+    V : (n, 3) float array    vertex positions
+    F : (m, 3) int array      triangles (non-manifold edges and unused vertices are allowed)
+
     Returns
     -------
     E : (k, 2) int array      undirected edges (sorted pairs)
     c : (k, 3) float array    their measures
+
+    Raises
+    ------
+    MeshError   malformed ``V`` or ``F`` or a zero-area triangle (as :func:`check_mesh` names them)
     """
+    V, F = check_mesh(V, F, check_manifold=False, check_unreferenced=False)
+    return _edge_curvature_measure(V, F)
+
+
+def _edge_curvature_measure(V, F):
     a, b, c = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
     n = np.cross(b - a, c - a)
     n /= np.linalg.norm(n, axis=1, keepdims=True)
@@ -62,8 +80,10 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     Vt, Ft : (n_t, 3) float, (m_t, 3) int   target mesh (a retriangulation of the source)
     method : {"conservative", "pointwise"}
     location : {"closest", "uv"}
-    uv : tuple (UVs (n_s, 2), UVt (n_t, 2)) or None   required for ``location="uv"``
-    samples_per_edge : int or None   conservative only: samples per source edge; ``None`` =
+    uv : tuple (UVs (n_s, 2), UVt (n_t, 2)) or None   required for ``location="uv"``, refused
+                       with ``"closest"`` (it would not be used)
+    samples_per_edge : int or None   conservative only: samples per source edge, a whole number
+                       >= 1 (the total over all edges at most 20,000,000, ~10 GB); ``None`` =
                        enough that samples are at most half the target's mean edge length apart
 
     Returns
@@ -72,8 +92,10 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
 
     Raises
     ------
-    MeshError    malformed meshes
-    ValueError   unknown method / location, or ``uv`` missing or of the wrong shape
+    MeshError    malformed meshes or ``uv`` (dtypes, NaN, zero-area triangles in the plane)
+    ValueError   unknown method / location; ``uv`` missing, not a pair or of the wrong shape for
+                 ``"uv"``, or given with ``"closest"``; ``samples_per_edge`` not a whole number
+                 >= 1, too many samples, or given with ``"pointwise"``
 
     Examples
     --------
@@ -88,32 +110,58 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
         raise ValueError(f"method={method!r} is not a transfer; use 'conservative' or 'pointwise'.")
     if location not in LOCATIONS:
         raise ValueError(f"location={location!r}; use 'closest' (3D closest point) or 'uv' (shared domain).")
+    if samples_per_edge is not None:
+        if method != "conservative":
+            raise ValueError("samples_per_edge is used by method='conservative' only; drop it for 'pointwise'.")
+        samples_per_edge = as_count(samples_per_edge, "samples_per_edge")
     Vs, Fs = check_mesh(Vs, Fs)
     Vt, Ft = check_mesh(Vt, Ft)
     if location == "uv":
-        if uv is None or len(uv) != 2:
-            raise ValueError("location='uv' needs uv=(UVs, UVt), e.g. from curvdetail.remesh.parameterize.")
-        UVs, UVt = (np.asarray(u, dtype=np.float64) for u in uv)
-        if UVs.shape != (Vs.shape[0], 2) or UVt.shape != (Vt.shape[0], 2):
-            raise ValueError(f"uv shapes {UVs.shape}, {UVt.shape} do not match the meshes "
-                             f"({Vs.shape[0]}, 2), ({Vt.shape[0]}, 2).")
-        src_dom, tgt_dom = UVs, UVt
+        src_dom, tgt_dom = _check_uv(uv, Vs.shape[0], Vt.shape[0])
+        names = ("uv[0] (UVs)", "uv[1] (UVt)")
+    elif uv is not None:
+        raise ValueError("uv is only used with location='uv'; pass location='uv' to locate in the shared "
+                         "domain, or drop uv for the 3D closest point.")
     else:
-        src_dom, tgt_dom = Vs, Vt
+        src_dom, tgt_dom, names = Vs, Vt, ("Vs", "Vt")
     if method == "pointwise":
         K, _ = mean_curvature_normal(Vs, Fs)
-        face, bary, _ = locate(tgt_dom, src_dom, Fs)
+        face, bary, _ = _locate(*check_points_and_mesh(tgt_dom, src_dom, Fs, names=(names[1], names[0], "Fs")))
         return interpolate(K, Fs, face, bary) * mixed_voronoi_area(Vt, Ft)[:, None]
-    E, c = edge_curvature_measure(Vs, Fs)
-    length = np.linalg.norm(Vs[E[:, 1]] - Vs[E[:, 0]], axis=1)
-    if samples_per_edge is None:
-        h_t = np.linalg.norm(Vt[Ft[:, [1, 2, 0]]] - Vt[Ft], axis=2).mean()
-        q = np.maximum(1, np.ceil(2.0 * length / h_t)).astype(np.int64)
-    else:
-        q = np.full(E.shape[0], max(1, int(samples_per_edge)), dtype=np.int64)
+    E, c = _edge_curvature_measure(Vs, Fs)
+    q = _samples_per_edge(Vs, E, Vt, Ft, samples_per_edge)
     edge = np.repeat(np.arange(E.shape[0]), q)
     start = np.concatenate([[0], np.cumsum(q)[:-1]])
     t = (np.arange(edge.size) - start[edge] + 0.5) / q[edge]
     pts = (1 - t)[:, None] * src_dom[E[edge, 0]] + t[:, None] * src_dom[E[edge, 1]]
-    face, bary, _ = locate(pts, tgt_dom, Ft)
+    face, bary, _ = _locate(*check_points_and_mesh(pts, tgt_dom, Ft, names=("edge samples", names[1], "Ft")))
     return spread(c[edge] / q[edge, None], Ft, face, bary, Vt.shape[0])
+
+
+def _check_uv(uv, n_s, n_t):
+    """``uv`` as two float arrays (n_s, 2) and (n_t, 2), or ValueError / MeshError."""
+    if not isinstance(uv, (tuple, list)) or len(uv) != 2:
+        got = "None" if uv is None else type(uv).__name__
+        raise ValueError(f"location='uv' needs uv=(UVs, UVt), a pair of arrays, e.g. from "
+                         f"curvdetail.remesh.parameterize; got {got}.")
+    UVs, UVt = (_as_coordinates(u, name) for u, name in zip(uv, ("uv[0] (UVs)", "uv[1] (UVt)")))
+    if UVs.shape != (n_s, 2) or UVt.shape != (n_t, 2):
+        raise ValueError(f"uv shapes {UVs.shape}, {UVt.shape} do not match the meshes "
+                         f"({n_s}, 2), ({n_t}, 2).")
+    return UVs, UVt
+
+
+def _samples_per_edge(Vs, E, Vt, Ft, count):
+    """Samples on each source edge, shape (k,): ``count`` each, or enough that they are at most
+    half the target's mean edge length apart; ValueError beyond ``MAX_EDGE_SAMPLES`` in all."""
+    if count is None:
+        length = np.linalg.norm(Vs[E[:, 1]] - Vs[E[:, 0]], axis=1)
+        h_t = np.linalg.norm(Vt[Ft[:, [1, 2, 0]]] - Vt[Ft], axis=2).mean()
+        q = np.maximum(1.0, np.ceil(2.0 * length / h_t))
+        total, what = float(q.sum()), "the automatic samples_per_edge (the target is much finer than the source)"
+    else:
+        total, what = count * E.shape[0], f"samples_per_edge={count!r} x {E.shape[0]:,} edges"
+    if total > MAX_EDGE_SAMPLES:
+        raise ValueError(f"{what} asks for {float(total):.3g} edge samples, more than {MAX_EDGE_SAMPLES:,} "
+                         "(~10 GB); pass a smaller samples_per_edge.")
+    return q.astype(np.int64) if count is None else np.full(E.shape[0], count, dtype=np.int64)
