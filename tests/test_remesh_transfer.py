@@ -146,3 +146,13 @@ def test_malformed_uv_is_named_as_uv():
         transfer_curvature(V, F, V, F, location="uv", uv=(UV, V[:, :2]))
     with pytest.raises(MeshError, match=r"uv\[1\] \(UVt\) has dtype <U"):
         transfer_curvature(V, F, V, F, location="uv", uv=(V[:, :2], V[:, :2].astype(str)))
+
+
+@pytest.mark.parametrize("method", ["conservative", "pointwise"])
+def test_a_target_that_is_not_the_same_surface_is_refused(load_mesh, method):
+    # the closest point of a far target would silently give it the wrong detail
+    V, F = load_mesh("mannequin_nose.obj")
+    with pytest.raises(MeshError, match=r"source and target lie up to .* % of the source's bbox diagonal apart"):
+        transfer_curvature(V, F, V + [0.0, 0.0, 1000.0], F, method=method)
+    D = transfer_curvature(V, F, V + [0.0, 0.0, 1e-3], F, method=method)       # a slight offset is fine
+    assert np.all(np.isfinite(D))

@@ -21,16 +21,17 @@ MAX_COORDINATE = 1e150
 ZERO_AREA_RELATIVE = 1e-14
 
 
-def as_vertices(V, name="V"):
-    """Return ``V`` as a C-contiguous (n, 3) float64 array or raise MeshError."""
+def as_vertices(V, name="V", dim=3):
+    """Return ``V`` as a C-contiguous (n, dim) float64 array or raise MeshError (``dim=2``: planar
+    positions, e.g. UVs)."""
     try:
         arr = np.asarray(V)
     except Exception as exc:  # ragged lists and the like
-        raise MeshError(f"{name} could not be read as an array ({exc}); pass an (n, 3) float array.") from None
+        raise MeshError(f"{name} could not be read as an array ({exc}); pass an (n, {dim}) float array.") from None
     if arr.dtype == object or not (np.issubdtype(arr.dtype, np.floating) or np.issubdtype(arr.dtype, np.integer)):
-        raise MeshError(f"{name} has dtype {arr.dtype}; pass an (n, 3) array of real numbers.")
-    if arr.ndim != 2 or arr.shape[1] != 3:
-        raise MeshError(f"{name} has shape {arr.shape}; vertex positions must be an (n, 3) array.")
+        raise MeshError(f"{name} has dtype {arr.dtype}; pass an (n, {dim}) array of real numbers.")
+    if arr.ndim != 2 or arr.shape[1] != dim:
+        raise MeshError(f"{name} has shape {arr.shape}; vertex positions must be an (n, {dim}) array.")
     if arr.shape[0] == 0:
         raise MeshError(f"{name} is empty (0 vertices); pass a mesh with at least one triangle.")
     arr = np.ascontiguousarray(arr, dtype=np.float64)
@@ -309,17 +310,17 @@ def as_positive_number(value, name, hint=""):
     return number
 
 
-def as_values(values, count, name):
-    """Return ``values`` as a (count, 3) float64 array of finite numbers or raise ConstraintError."""
+def as_values(values, count, name, dim=3):
+    """Return ``values`` as a (count, dim) float64 array of finite numbers or raise ConstraintError."""
     try:
         arr = np.asarray(values)
     except Exception as exc:
         raise ConstraintError(f"{name} could not be read as a float array ({exc}).") from None
     if arr.dtype.kind not in "fiu":            # complex would lose its imaginary part, bool mean 0/1
-        raise ConstraintError(f"{name} has dtype {arr.dtype}; pass a ({count}, 3) array of real numbers.")
+        raise ConstraintError(f"{name} has dtype {arr.dtype}; pass a ({count}, {dim}) array of real numbers.")
     arr = arr.astype(np.float64, copy=False)
-    if arr.shape != (count, 3):
-        raise ConstraintError(f"{name} has shape {arr.shape}; expected ({count}, 3), one row per vertex.")
+    if arr.shape != (count, dim):
+        raise ConstraintError(f"{name} has shape {arr.shape}; expected ({count}, {dim}), one row per vertex.")
     if not np.isfinite(arr).all():      # one flat pass; the per-row search below only on failure
         bad = np.flatnonzero(~np.isfinite(arr).all(axis=1))
         raise ConstraintError(f"{name}: {bad.size} rows are NaN or infinite (first: {first_indices(bad)}).")

@@ -127,12 +127,10 @@ def _as_coordinates(X, name, allow_empty=False):
         return as_vertices(X, name)                  # raises its "could not be read" MeshError
     if arr.ndim != 2 or arr.shape[1] not in (2, 3):
         raise MeshError(f"{name} has shape {arr.shape}; pass a (k, 2) or (k, 3) coordinate array.")
-    d = arr.shape[1]
     if arr.shape[0] == 0 and allow_empty:
-        as_vertices(np.zeros((1, 3), dtype=arr.dtype), name)      # its dtype check alone
-        return np.empty((0, d))
-    # as_vertices takes (n, 3) arrays: planar points go through it with a repeated column
-    return np.ascontiguousarray(as_vertices(arr if d == 3 else arr[:, [0, 1, 1]], name)[:, :d])
+        as_vertices(np.zeros((1, arr.shape[1]), dtype=arr.dtype), name, dim=arr.shape[1])   # its dtype check
+        return np.empty((0, arr.shape[1]))
+    return as_vertices(arr, name, dim=arr.shape[1])
 
 
 def _check_areas(V, F, names):

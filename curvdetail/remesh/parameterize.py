@@ -55,20 +55,7 @@ def harmonic_map(V, F, boundary, boundary_uv, *, backend="auto"):
                               "(any constant solves it); pin the boundary loop, e.g. "
                               "curvdetail.curvature.boundary_loop(F).")
     check_every_component_fixed(F, V.shape[0], boundary)
-    return _harmonic_map(V, F, boundary, _as_planar_values(boundary_uv, boundary.size, "boundary_uv"), backend)
-
-
-def _as_planar_values(values, count, name):
-    """``values`` as a finite (count, 2) float array, or ConstraintError (checked by ``as_values``)."""
-    try:
-        arr = np.asarray(values)
-    except Exception:
-        return as_values(values, count, name)          # raises its "could not be read" error
-    if arr.shape != (count, 2):
-        raise ConstraintError(f"{name} has shape {arr.shape}; expected ({count}, 2), one planar position "
-                              "per pinned vertex.")
-    # as_values takes (count, 3) arrays: the planar values go through it with a repeated column
-    return np.ascontiguousarray(as_values(arr[:, [0, 1, 1]], count, name)[:, :2])
+    return _harmonic_map(V, F, boundary, as_values(boundary_uv, boundary.size, "boundary_uv", dim=2), backend)
 
 
 def _harmonic_map(V, F, boundary, boundary_uv, backend="auto"):

@@ -2,7 +2,8 @@
 
 import numpy as np
 
-from ..curvature._validate import as_count, check_mesh
+from ..curvature._validate import as_count, bbox_diagonal, check_mesh
+from ..curvature.errors import MeshError
 from ..curvature.mean_curvature_normal import mean_curvature_normal
 from ..curvature.mixed_voronoi_area import mixed_voronoi_area
 from .locate import _as_coordinates, _locate, check_points_and_mesh, interpolate, spread
@@ -92,7 +93,9 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
 
     Raises
     ------
-    MeshError    malformed meshes or ``uv`` (dtypes, NaN, zero-area triangles in the plane)
+    MeshError    malformed meshes or ``uv`` (dtypes, NaN, zero-area triangles in the plane); with
+                 ``"closest"``, meshes more than ``SAME_SURFACE`` (25 %) of the source's bbox
+                 diagonal apart (not two triangulations of one surface)
     ValueError   unknown method / location; ``uv`` missing, not a pair or of the wrong shape for
                  ``"uv"``, or given with ``"closest"``; ``samples_per_edge`` not a whole number
                  >= 1, too many samples, or given with ``"pointwise"``
@@ -126,7 +129,8 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
         src_dom, tgt_dom, names = Vs, Vt, ("Vs", "Vt")
     if method == "pointwise":
         K, _ = mean_curvature_normal(Vs, Fs)
-        face, bary, _ = _locate(*check_points_and_mesh(tgt_dom, src_dom, Fs, names=(names[1], names[0], "Fs")))
+        face, bary, dist = _locate(*check_points_and_mesh(tgt_dom, src_dom, Fs, names=(names[1], names[0], "Fs")))
+        _check_same_surface(dist, Vs, location)
         return interpolate(K, Fs, face, bary) * mixed_voronoi_area(Vt, Ft)[:, None]
     E, c = _edge_curvature_measure(Vs, Fs)
     q = _samples_per_edge(Vs, E, Vt, Ft, samples_per_edge)
@@ -134,8 +138,27 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     start = np.concatenate([[0], np.cumsum(q)[:-1]])
     t = (np.arange(edge.size) - start[edge] + 0.5) / q[edge]
     pts = (1 - t)[:, None] * src_dom[E[edge, 0]] + t[:, None] * src_dom[E[edge, 1]]
-    face, bary, _ = _locate(*check_points_and_mesh(pts, tgt_dom, Ft, names=("edge samples", names[1], "Ft")))
+    face, bary, dist = _locate(*check_points_and_mesh(pts, tgt_dom, Ft, names=("edge samples", names[1], "Ft")))
+    _check_same_surface(dist, Vs, location)
     return spread(c[edge] / q[edge, None], Ft, face, bary, Vt.shape[0])
+
+
+#: With ``location="closest"``, a target farther than this (fraction of the source's bbox
+#: diagonal) from the source is not a retriangulation of it (measured retriangulations lie within
+#: ~1 %; a coarse decimation of a curved patch within a few %).
+SAME_SURFACE = 0.25
+
+
+def _check_same_surface(dist, Vs, location):
+    """MeshError if the closest-point distances say the meshes are not one surface."""
+    if location != "closest" or dist.size == 0:
+        return
+    worst = float(dist.max()) / bbox_diagonal(Vs)
+    if worst > SAME_SURFACE:
+        raise MeshError(f"source and target lie up to {100 * worst:.3g} % of the source's bbox diagonal "
+                        f"apart (more than {100 * SAME_SURFACE:.0f} %): location='closest' needs two "
+                        "triangulations of the same surface. Align them, or locate in a shared "
+                        "parameterization with location='uv'.")
 
 
 def _check_uv(uv, n_s, n_t):
