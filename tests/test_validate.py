@@ -216,13 +216,35 @@ def test_values_must_be_real_numbers(values):
     assert as_values(np.ones((2, 3), np.int32), 2, "detail").dtype == np.float64
 
 
-def test_coordinates_whose_squares_overflow_are_named():
-    # before: "16 triangles have zero area" (the cross products overflowed)
+@pytest.mark.parametrize("scale", [1e80, 1e155])
+def test_coordinates_whose_products_overflow_are_named(scale):
+    # before: "16 triangles have zero area" at 1e155, and at 1e80 mean_curvature_normal returned
+    # inf / NaN without a word (the areas square the cross products)
     V, F = grid(3, 3)
-    with pytest.raises(MeshError, match=r"V: 8 rows reach 1e\+155 .* squares overflow double precision: scale"):
-        check_mesh(V * 1e155, F)
+    with pytest.raises(MeshError, match=rf"V: 8 rows reach {scale:.0e}".replace("+", r"\+") +
+                       r" .* the geometry overflows double precision: scale the mesh down"):
+        check_mesh(V * scale, F)
+    with pytest.raises(MeshError, match="overflows double precision"):
+        mean_curvature_normal(V * scale, F)
     with pytest.raises(ConstraintError, match=r"positions: 1 rows reach 1e\+200"):
         as_values([[1e200, 0, 0]], 1, "positions")
+
+
+def test_a_mesh_too_small_for_its_areas_is_named_by_its_size():
+    V, F = grid(3, 3)
+    V[:, 2] = V[:, 0] ** 2
+    check_mesh(V * 1e-70, F)                                  # still fine
+    with pytest.raises(MeshError, match=r"the mesh is 1.*e-100 across .* scale it up"):
+        check_mesh(V * 1e-100, F)
+
+
+def test_the_core_is_exact_across_its_range_of_scales():
+    V, F = grid(4, 4)
+    V[:, 2] = V[:, 0] ** 2
+    b = boundary_vertices(F)
+    for scale in (1e-60, 1e70):
+        X = reconstruct(V * scale, F, curvature_detail(V * scale, F), b, V[b] * scale)
+        assert np.abs(X / scale - V).max() < 1e-12
 
 
 def test_docstring_examples_run():

@@ -12,18 +12,22 @@ from scipy.sparse.csgraph import connected_components
 from ._geometry import corner_cotangents
 from .errors import ConstraintError, MeshError, first_indices
 
-#: Largest coordinate magnitude taken: beyond it squared lengths (areas, cotangents, distances)
-#: overflow double precision.
-MAX_COORDINATE = 1e150
+#: Largest coordinate magnitude taken: triangle areas square the cross products of edge vectors
+#: (coordinates squared), which overflow double precision from ~1e77 (mean_curvature_normal then
+#: returned inf / NaN without a word).
+MAX_COORDINATE = 1e75
+
+#: Below this bbox diagonal, squared areas underflow: zero-area reports then name the scale.
+MIN_DIAGONAL = 1e-60
 
 # A triangle whose area is below this fraction of the squared bbox diagonal is degenerate:
 # its cotangents overflow. 1e-14 leaves room for meshes of ~1e12 well-shaped triangles.
 ZERO_AREA_RELATIVE = 1e-14
 
 
-def as_vertices(V, name="V", dim=3):
+def as_vertices(V, name="V", dim=3, max_coordinate=MAX_COORDINATE):
     """Return ``V`` as a C-contiguous (n, dim) float64 array or raise MeshError (``dim=2``: planar
-    positions, e.g. UVs)."""
+    positions, e.g. UVs; ``max_coordinate``: for callers that compute in a unit frame)."""
     try:
         arr = np.asarray(V)
     except Exception as exc:  # ragged lists and the like
@@ -41,16 +45,16 @@ def as_vertices(V, name="V", dim=3):
             f"{name}: {bad.size} vertices have NaN or infinite coordinates (first: {first_indices(bad)}); "
             "remove or repair them before computing curvature."
         )
-    _check_magnitude(arr, name, MeshError, "scale the mesh down")
+    _check_magnitude(arr, name, MeshError, "scale the mesh down", max_coordinate)
     return arr
 
 
-def _check_magnitude(arr, name, error, fix):
-    """Refuse values beyond MAX_COORDINATE, whose squares overflow."""
-    if arr.size and np.abs(arr).max() > MAX_COORDINATE:
-        bad = np.flatnonzero((np.abs(arr) > MAX_COORDINATE).any(axis=1))
+def _check_magnitude(arr, name, error, fix, limit=MAX_COORDINATE):
+    """Refuse values beyond ``limit``, where the geometry's products overflow."""
+    if arr.size and np.abs(arr).max() > limit:
+        bad = np.flatnonzero((np.abs(arr) > limit).any(axis=1))
         raise error(f"{name}: {bad.size} rows reach {np.abs(arr).max():.3g} (first: {first_indices(bad)}); "
-                    f"beyond {MAX_COORDINATE:.0e} their squares overflow double precision: {fix}.")
+                    f"beyond {limit:.0e} the geometry overflows double precision: {fix}.")
 
 
 def as_faces(F, n_vertices, name="F"):
@@ -162,6 +166,9 @@ def _check_mesh(V, F, check_manifold, check_unreferenced, cotangents=False):
     else:
         dbl = face_double_areas(V, F)
     zero = np.flatnonzero(dbl <= 2.0 * ZERO_AREA_RELATIVE * max(diag, np.finfo(float).tiny) ** 2)
+    if zero.size and diag < MIN_DIAGONAL:
+        raise MeshError(f"the mesh is {diag:.3g} across (bbox diagonal): its triangle areas underflow double "
+                        f"precision ({zero.size} come out as zero); scale it up, e.g. to unit size.")
     if zero.size:
         raise MeshError(
             f"{zero.size} triangles have zero area (first: {first_indices(zero)}); remove them, e.g. "

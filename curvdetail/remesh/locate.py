@@ -13,6 +13,10 @@ from ..curvature.errors import MeshError, first_indices
 #: 1e4 diagonals on a 40k-vertex grid, no answer after 60 s at 1e10).
 FAR_POINTS = 1.0
 
+#: Largest coordinate taken here: everything runs in a unit frame, so only the squares of the
+#: input's own differences must not overflow (the core's limit, for areas, is lower).
+MAX_COORDINATE_HERE = 1e150
+
 #: Points further than this (bbox diagonals) are refused: the closest-point tests multiply
 #: squared lengths, which overflow beyond ~1e77 diagonals.
 MAX_RELATIVE_DISTANCE = 1e50
@@ -130,7 +134,7 @@ def _as_coordinates(X, name, allow_empty=False):
     if arr.shape[0] == 0 and allow_empty:
         as_vertices(np.zeros((1, arr.shape[1]), dtype=arr.dtype), name, dim=arr.shape[1])   # its dtype check
         return np.empty((0, arr.shape[1]))
-    return as_vertices(arr, name, dim=arr.shape[1])
+    return as_vertices(arr, name, dim=arr.shape[1], max_coordinate=MAX_COORDINATE_HERE)
 
 
 def _check_areas(V, F, names):
