@@ -25,15 +25,15 @@ def check_output_path(path, overwrite=False, *, hint=_FORMATS_HINT, error=MeshEr
 
     Raises
     ------
-    ValueError        ``overwrite`` is not a bool
+    ValueError        ``path`` is not a path, or ``overwrite`` is not a bool
     FileExistsError   ``path`` exists and ``overwrite`` is False
     error             (default :class:`~curvdetail.curvature.errors.MeshError`; the filters
-                      pass their ``MeshFileError``) ``path`` is not a path, the folder does
-                      not exist, or ``path`` has no extension to pick the format (``hint`` says
-                      which to use; ``hint=None``: any name will do)
+                      pass their ``MeshFileError``) the folder does not exist, or ``path`` has
+                      no extension to pick the format (``hint`` says which to use; ``hint=None``:
+                      any name will do)
     """
     if not isinstance(path, (str, bytes, os.PathLike)):
-        raise error(f"an output path must be a str or os.PathLike; got {type(path).__name__}.")
+        raise ValueError(f"an output path must be a str or os.PathLike; got {type(path).__name__}.")
     if not isinstance(overwrite, (bool, np.bool_)):       # "no" would count as True
         raise ValueError(f"overwrite={overwrite!r} must be True or False.")
     path = os.fsdecode(path)
@@ -76,7 +76,7 @@ def atomic_output(path, *, overwrite=False, hint=_FORMATS_HINT, error=MeshError)
         fd, tmp = tempfile.mkstemp(prefix=".curvdetail-", suffix=os.path.splitext(path)[1],
                                    dir=os.path.dirname(os.path.abspath(path)))
     except OSError as exc:        # its message would name the temporary file, not the output
-        raise error(f"cannot write {path!r}: {exc.strerror}.") from None
+        raise type(exc)(exc.errno, f"cannot write {path!r}: {exc.strerror}") from None
     os.close(fd)
     try:
         yield tmp

@@ -19,7 +19,7 @@ import os
 import numpy as np
 
 from ._output import atomic_output, check_output_path
-from .curvature._validate import MAX_COORDINATE
+from .curvature._validate import check_transformed_values
 from .curvature.curvature_coefficients import DEFAULT_RCOND
 from .curvature.curvature_editor import CurvatureEditor
 from .curvature.errors import ConstraintError, first_indices
@@ -234,9 +234,7 @@ def edit_with_selection(V, F, status, T, *, handle_detail="transform", relations
         details = editor.detail[handles] @ T[:3, :3].T if handle_detail == "transform" else None
         positions = apply_transform(T, editor.V[handles])
     for values in (positions, details):
-        if values is not None and not np.all(np.abs(values) <= MAX_COORDINATE):
-            raise ConstraintError(f"the handle transform T gives the handles values of {np.abs(values).max():.3g}, "
-                                  f"beyond {MAX_COORDINATE:.0e}, where squares overflow; use a smaller transform.")
+        check_transformed_values(values, "the handle transform T", "use a smaller transform")
     X = editor.solve(positions=positions, details=details)
     return (X, editor) if return_editor else X
 

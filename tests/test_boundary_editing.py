@@ -145,6 +145,7 @@ def test_a_boundary_that_does_not_close_is_a_mesh_error():
 @pytest.mark.parametrize("kwargs, message", [
     (dict(amplitude=0.1, axis=3), "axis=3; use 0, 1 or 2"),
     (dict(amplitude=0.1, axis=True), "axis=True; use 0, 1 or 2"),
+    (dict(amplitude=0.1, axis=np.True_), "use 0, 1 or 2"),
     (dict(amplitude=float("nan")), "amplitude=nan must be a finite number"),
     (dict(amplitude=0.1, periods=float("inf")), "periods=inf must be a finite number"),
     (dict(amplitude=0.1, phase="0"), "phase='0' must be a finite number"),

@@ -13,6 +13,7 @@ def test_parallel_planes_are_their_offset_apart(engine):
     W = V.copy()
     W[:, 2] += 0.05
     h = hausdorff(V, F, W, F, engine=engine, samples=20000)
+    assert h["engine"] == engine
     # every sample of either plane is exactly 0.05 from the other (same extent)
     assert h["max"] == pytest.approx(0.05, rel=1e-6)
     assert h["rms"] == pytest.approx(0.05, rel=1e-6)
@@ -94,6 +95,7 @@ def test_meshes_far_apart_are_measured_with_the_kdtree_engine_not_a_hang():
     h = hausdorff(V, F, V + [0.0, 0.0, 1e10], F, samples=1000)
     assert h["max"] == pytest.approx(1e10, rel=1e-9)
     assert h["rms"] == pytest.approx(1e10, rel=1e-9)
+    assert h["engine"] == "kdtree"                   # said, though "meshlab" was asked for
 
 
 def test_huge_and_tiny_meshes_are_measured_in_a_unit_frame():
@@ -115,3 +117,11 @@ def test_bool_huge_or_fractional_counts_are_refused(kwargs, words):
     V, F = grid(5, 5)
     with pytest.raises(ValueError, match=words):
         hausdorff(V, F, V, F, engine="kdtree", **kwargs)
+
+
+def test_kdtree_seed_none_draws_fresh_samples():
+    V, F = grid(11, 11)
+    W = V.copy()
+    W[:, 2] += 0.05
+    h = hausdorff(V, F, W, F, engine="kdtree", samples=2000, seed=None)
+    assert h["rms"] == pytest.approx(0.05, rel=1e-6)

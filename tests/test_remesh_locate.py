@@ -182,3 +182,13 @@ def test_interpolate_names_the_offending_face_index_not_its_position():
         interpolate(V, F, np.array([3, 99]), np.full((2, 3), 1 / 3))
     with pytest.raises(MeshError, match="face has dtype float64"):
         interpolate(V, F, np.array([3.0, 9.5]), np.full((2, 3), 1 / 3))
+
+
+def test_a_mesh_too_small_to_square_its_extent_is_located_not_called_a_point():
+    # its bbox diagonal underflows when squared: it was reported as "all vertices at one point"
+    V, F = grid(6, 6)
+    V[:, 2] = 0.1 * V[:, 0] ** 2
+    P = V[[3, 17]] + [0.01, 0.02, 0.05]
+    _, _, d = locate(P, V, F)
+    _, _, d_tiny = locate(P * 1e-170, V * 1e-170, F)
+    assert np.allclose(d_tiny / 1e-170, d, rtol=1e-12)

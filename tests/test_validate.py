@@ -247,6 +247,25 @@ def test_the_core_is_exact_across_its_range_of_scales():
         assert np.abs(X / scale - V).max() < 1e-12
 
 
+def test_counts_and_positive_numbers_take_what_numpy_hands_out():
+    # float32 scalars (no overflow warning in the range check), 0-d arrays, whole floats
+    import warnings
+
+    from curvdetail.curvature._validate import as_count, as_positive_number
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert as_positive_number(np.float32(0.25), "tol") == 0.25
+        assert as_positive_number(np.array(0.05), "tol") == 0.05
+        assert as_count(3.0, "n") == 3 and as_count(np.array(2000), "n") == 2000
+        assert as_count(np.uint8(7), "n") == 7 and as_count(2 ** 70, "n") == 2 ** 70
+    for bad in (True, np.True_, 2.5, "5", None, float("nan"), np.array([1, 2])):
+        with pytest.raises(ValueError, match="must be a whole number >= 1"):
+            as_count(bad, "n")
+    with pytest.raises(ValueError, match="must be a positive number"):       # inf, not an OverflowError
+        as_positive_number(10 ** 400, "tol")
+
+
 def test_docstring_examples_run():
     import doctest
     import importlib

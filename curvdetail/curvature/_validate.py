@@ -5,6 +5,9 @@ They run at the boundary of each public function, before any sparse algebra, and
 and the first offending indices.
 """
 
+import math
+import numbers
+
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
@@ -120,9 +123,11 @@ def bbox_diagonal(V):
 def check_mesh(V, F, *, check_manifold=True, check_unreferenced=True):
     """Validate a triangle mesh and return ``(V, F)`` as float64 / int64 arrays.
 
-    Checks, in order: shapes and dtypes, emptiness, NaN/inf, index range, repeated indices in
-    a face, zero-area faces (below ``ZERO_AREA_RELATIVE`` times the squared bbox diagonal),
-    non-manifold edges (an edge in more than two triangles) and unreferenced vertices.
+    Checks, in order: shapes and dtypes, emptiness, NaN/inf, coordinates beyond
+    ``MAX_COORDINATE`` (1e75: the areas would overflow), index range, repeated indices in a face,
+    zero-area faces (below ``ZERO_AREA_RELATIVE`` times the squared bbox diagonal; a mesh under
+    ``MIN_DIAGONAL`` across is told its areas underflow), non-manifold edges (an edge in more
+    than two triangles) and unreferenced vertices.
 
     Parameters
     ----------
@@ -297,28 +302,42 @@ def as_index_set(indices, n, name):
     return arr
 
 
+def as_float(value):
+    """``value`` as a float if it is a real number (numpy scalars and 0-d arrays included; a
+    number too large for a double becomes inf), else None (bools and strings included)."""
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value.item()
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        return None
+    try:
+        return float(value)
+    except OverflowError:              # a Python int beyond a double
+        return math.inf
+
+
 def as_count(value, name, minimum=1):
-    """Return ``value`` as an int >= ``minimum`` (Python or numpy integers; not a bool, a float or
-    a string), or raise ValueError naming the argument."""
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+    """Return ``value`` as an int >= ``minimum`` (a whole number: ints, whole floats, numpy
+    scalars, 0-d arrays; not a bool or a string), or raise ValueError naming the argument."""
+    number = as_float(value)
+    if number is None or not math.isfinite(number) or number != round(number):
         raise ValueError(f"{name}={value!r} must be a whole number >= {minimum}.")
-    if value < minimum:
-        raise ValueError(f"{name}={value} must be at least {minimum}.")
-    return int(value)
+    if number < minimum:
+        raise ValueError(f"{name}={value!r} must be at least {minimum}.")
+    value = value.item() if isinstance(value, np.ndarray) else value
+    return int(value) if isinstance(value, numbers.Integral) else int(number)
 
 
 def as_positive_number(value, name, hint=""):
-    """Return ``value`` as a finite float > 0 (not a bool or a string), or raise ValueError."""
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise ValueError(f"{name}={value!r} must be a positive number{hint}.")
-    number = float(value) if abs(value) < 1e308 else float("inf")
-    if not (np.isfinite(number) and number > 0):
+    """Return ``value`` as a finite float > 0 (see :func:`as_float`), or raise ValueError."""
+    number = as_float(value)
+    if number is None or not (math.isfinite(number) and number > 0):
         raise ValueError(f"{name}={value!r} must be a positive number{hint}.")
     return number
 
 
 def as_values(values, count, name, dim=3):
-    """Return ``values`` as a (count, dim) float64 array of finite numbers or raise ConstraintError."""
+    """Return ``values`` as a (count, dim) float64 array of finite numbers within
+    ``MAX_COORDINATE`` or raise ConstraintError."""
     try:
         arr = np.asarray(values)
     except Exception as exc:
@@ -333,6 +352,14 @@ def as_values(values, count, name, dim=3):
         raise ConstraintError(f"{name}: {bad.size} rows are NaN or infinite (first: {first_indices(bad)}).")
     _check_magnitude(arr, name, ConstraintError, "scale the problem down")
     return np.ascontiguousarray(arr)
+
+
+def check_transformed_values(values, what, fix, error=ConstraintError):
+    """Raise ``error`` if constraint values made by a user's transform (None: none) are not
+    finite or beyond MAX_COORDINATE, naming ``what`` made them and ``fix``."""
+    if values is not None and not np.all(np.abs(values) <= MAX_COORDINATE):
+        raise error(f"{what} gives the handles values of {np.abs(values).max():.3g}, beyond {MAX_COORDINATE:.0e}, "
+                    f"where the geometry overflows double precision; {fix}.")
 
 
 def vertex_components(F, n, adjacency=None):

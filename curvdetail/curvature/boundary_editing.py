@@ -145,7 +145,7 @@ def sine_displacement(amplitude, periods=1, axis=1, phase=0.0):
     >>> f(np.array([0.0, 0.25]), np.zeros((2, 3)))[:, 2].round(12).tolist()
     [0.0, 2.0]
     """
-    if isinstance(axis, bool) or axis not in (0, 1, 2):
+    if isinstance(axis, (bool, np.bool_)) or axis not in (0, 1, 2):
         raise ValueError(f"axis={axis!r}; use 0, 1 or 2 for x, y or z.")
     for name, value in (("amplitude", amplitude), ("periods", periods), ("phase", phase)):
         if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):

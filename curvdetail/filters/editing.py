@@ -4,7 +4,7 @@ import time
 
 import numpy as np
 
-from ..curvature._validate import MAX_COORDINATE, bbox_diagonal
+from ..curvature._validate import bbox_diagonal, check_transformed_values
 from ..curvature.curvature_editor import CurvatureEditor
 from ..curvature.errors import ConstraintError
 from .apply_curvature_reconstruction import BACKEND_DESCRIPTION, BACKENDS
@@ -123,11 +123,8 @@ def apply_curvature_editing(ms, *, handles, region_radius, transform, detail_sca
     with np.errstate(over="ignore", invalid="ignore"):      # named below instead
         details = detail_scale * (editor.detail[dc] @ T[:3, :3].T) if dc.size else None
         positions = V[pc] @ T[:3, :3].T + T[:3, 3] if pc.size else None
-    for values, what in ((positions, "transform"), (details, "transform with detail_scale")):
-        if values is not None and not np.all(np.abs(values) <= MAX_COORDINATE):
-            raise FilterParameterError(f"the {what} gives the handles values of {np.abs(values).max():.3g}, beyond "
-                                       f"{MAX_COORDINATE:.0e}, where squares overflow; use a smaller transform "
-                                       "or detail_scale.")
+    for values, what in ((positions, "the transform"), (details, "the transform with detail_scale")):
+        check_transformed_values(values, what, "use a smaller transform or detail_scale", FilterParameterError)
     X = editor.solve(positions=positions, details=details)
     seconds = time.perf_counter() - t
     moved = np.linalg.norm(X - V, axis=1)

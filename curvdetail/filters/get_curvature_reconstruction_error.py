@@ -15,7 +15,9 @@ from .registry import PAPER, filter
         between the sampled layer (by default the current one, e.g. the retriangulation rebuilt
         from transferred curvature detail) and the target layer (by default layer 0, the source as
         loaded), with pymeshlab's get_hausdorff_distance sampling the faces in both directions
-        (curvdetail.remesh.hausdorff, the same figures as the remeshing report). Returns the
+        (curvdetail.remesh.hausdorff, the same figures as the remeshing report; layers more than
+        one bounding-box diagonal apart are measured with its kd-tree engine instead, and the
+        figures say which engine ran). Returns the
         maximum and RMS distances as fractions of the target's bounding-box diagonal (the
         evaluation of the paper's remeshing experiment, Fig. 3), and the one-sided figures. With
         set_quality the sampled layer's vertex quality becomes its distance to the target, so
@@ -56,6 +58,7 @@ def get_curvature_reconstruction_error(ms, *, sampledmesh, targetmesh, samplenum
         "mean": h["mean"],
         "diagonal": diag,
         "samples": h["samples"],
+        "engine": h["engine"],
         "sampledmesh": sampled,
         "targetmesh": target,
     }

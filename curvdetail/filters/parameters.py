@@ -24,18 +24,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..curvature._validate import as_float
 from .errors import FilterParameterError
 
 #: Largest magnitude of an int parameter or layer id (pymeshlab passes them as C++ ints).
 INT_MAX = 2 ** 31 - 1
-
-
-def _as_float(value):
-    """``float(value)``, with numbers too large for a float as infinity (then refused as such)."""
-    try:
-        return float(value)
-    except OverflowError:
-        return math.inf
 
 
 #: The parameter types a filter may declare.
@@ -116,7 +109,7 @@ class Parameter:
             raise self._fail(value, "an int" if t == "int" else "a layer id (int) of the MeshSet")
         if t == "float":
             if isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_)):
-                return self._range(self._finite(_as_float(value)))
+                return self._range(self._finite(as_float(value)))
             raise self._fail(value, "a float")
         if t == "str":
             if not isinstance(value, str):
@@ -138,7 +131,7 @@ class Parameter:
         elif type(value).__name__ == "PureValue":
             length = BBoxLength(float(value.value()), False)
         elif isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_)):
-            length = BBoxLength(_as_float(value), False)
+            length = BBoxLength(as_float(value), False)
         else:
             raise self._fail(value, "a PercentageValue: pymeshlab.PercentageValue(percent of the "
                              "bbox diagonal), pymeshlab.PureValue(absolute) or a number (absolute)")

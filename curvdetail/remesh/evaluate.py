@@ -39,12 +39,13 @@ def hausdorff(Va, Fa, Vb, Fb, *, samples=None, engine="meshlab", seed=0):
                             kdtree engine holds ~3 kB per sample); ``None`` = 10 per triangle of
                             the sampled mesh, at least 100,000 and at most 1,000,000
     engine : {"meshlab", "kdtree"}
-    seed : int              random seed (>= 0) of the ``"kdtree"`` engine's samples
+    seed : int or None      random seed (>= 0) of the ``"kdtree"`` engine's samples (None: fresh
+                            entropy, as numpy's ``default_rng``)
 
     Returns
     -------
     dict with ``max``, ``rms``, ``mean`` (absolute lengths), ``a_to_b_max``, ``b_to_a_max``,
-    ``samples`` (total)
+    ``samples`` (total), ``engine`` (the one that ran: "kdtree" also for meshes far apart)
 
     Raises
     ------
@@ -69,10 +70,11 @@ def hausdorff(Va, Fa, Vb, Fb, *, samples=None, engine="meshlab", seed=0):
     if engine not in ("meshlab", "kdtree"):
         raise ValueError(f"engine={engine!r}; use 'meshlab' or 'kdtree'.")
     samples = _check_samples(samples)
-    seed = as_count(seed, "seed", minimum=0)
-    if engine == "kdtree" or _apart(Va, Vb):
-        return _scaled(_hausdorff_kdtree(Va, Fa, Vb, Fb, samples, seed), scale)
-    return _scaled(_hausdorff_meshlab(Va, Fa, Vb, Fb, samples), scale)
+    seed = None if seed is None else as_count(seed, "seed", minimum=0)
+    engine = "kdtree" if engine == "kdtree" or _apart(Va, Vb) else "meshlab"
+    figures = _hausdorff_kdtree(Va, Fa, Vb, Fb, samples, seed) if engine == "kdtree" else \
+        _hausdorff_meshlab(Va, Fa, Vb, Fb, samples)
+    return dict(_scaled(figures, scale), engine=engine)
 
 
 def _check_samples(samples):

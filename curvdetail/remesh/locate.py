@@ -114,7 +114,7 @@ def check_points_and_mesh(points, V, F, names=("points", "V", "F")):
         raise MeshError(f"{names[0]} {P.shape} and {names[1]} {V.shape} must both be (k, 2) or both (k, 3).")
     F = as_faces(F, V.shape[0], names[2])
     _check_areas(V, F, names)
-    far = _box_gap(P, V) / bbox_diagonal(V) if P.shape[0] else np.zeros(0)
+    far = _box_gap(P, V) / _diagonal(V) if P.shape[0] else np.zeros(0)
     if far.size and far.max() > MAX_RELATIVE_DISTANCE:
         raise MeshError(f"{names[0]}: {np.count_nonzero(far > MAX_RELATIVE_DISTANCE)} points lie more than "
                         f"{MAX_RELATIVE_DISTANCE:.0e} bbox diagonals of {names[1]} from it (first: "
@@ -141,7 +141,7 @@ def _check_areas(V, F, names):
     """MeshError for a mesh of zero extent or with zero-area triangles (pymeshlab's grid does
     not return on a mesh collapsed to a point; closest points on a degenerate triangle are
     ill-defined)."""
-    if bbox_diagonal(V) == 0:
+    if np.ptp(V, axis=0).max() == 0:
         raise MeshError(f"{names[1]}: all {V.shape[0]} vertices are at one point (zero extent); pass a mesh "
                         "with area.")
     _, U, _ = _unit_frame(V[:0], V)             # areas relative to the unit bbox diagonal: any scale
@@ -156,8 +156,16 @@ def _unit_frame(P, V):
     """``P`` and ``V`` moved and scaled so that ``V``'s bounding box is centred at the origin
     with unit diagonal, and that diagonal (distances in the frame times it are true distances)."""
     centre = 0.5 * (V.max(axis=0) + V.min(axis=0))
-    scale = bbox_diagonal(V)
+    scale = _diagonal(V)
     return (P - centre) / scale, (V - centre) / scale, scale
+
+
+def _diagonal(V):
+    """The bounding-box diagonal of a mesh of non-zero extent, without squaring its extents
+    (which underflow below ~1e-154)."""
+    extent = np.ptp(V, axis=0)
+    largest = extent.max()
+    return float(largest * np.linalg.norm(extent / largest))
 
 
 def _box_gap(P, V):

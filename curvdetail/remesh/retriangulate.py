@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ..curvature._validate import as_count, as_positive_number, bbox_diagonal, face_double_areas
+from ..curvature._validate import as_count, as_float, as_positive_number, bbox_diagonal, face_double_areas
 from ._disk import NotADiskError, Polyline, RemeshError, check_disk
 
 METHODS = ("isotropic", "decimate")
@@ -135,13 +135,10 @@ def retriangulate(V, F, *, method="isotropic", target_edge=0.01, iterations=10, 
 
 def _check_aggressiveness(value):
     """``value`` as a float in [0, 10] (bools and strings refused), or RemeshError."""
-    fail = RemeshError(f"aggressiveness={value!r} must be a number from 0 to 10 (fast-simplification's agg; "
-                       "default 7).")
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise fail
-    number = float(value) if abs(value) <= 10 else np.inf      # float(10**400) would raise OverflowError
-    if not 0 <= number <= 10:                                    # NaN fails too
-        raise fail
+    number = as_float(value)
+    if number is None or not 0 <= number <= 10:              # NaN fails too
+        raise RemeshError(f"aggressiveness={value!r} must be a number from 0 to 10 (fast-simplification's "
+                          "agg; default 7).")
     return number
 
 
