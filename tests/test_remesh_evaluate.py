@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from curvdetail.curvature.errors import MeshError
 from curvdetail.curvature.testing import grid
 from curvdetail.remesh import hausdorff, vertex_distance
 
@@ -125,3 +126,15 @@ def test_kdtree_seed_none_draws_fresh_samples():
     W[:, 2] += 0.05
     h = hausdorff(V, F, W, F, engine="kdtree", samples=2000, seed=None)
     assert h["rms"] == pytest.approx(0.05, rel=1e-6)
+
+
+@pytest.mark.parametrize("which, message", [("Fa", r"Fa: 2 triangles have vertex indices outside"),
+                                            ("Va", r"Va has shape \(16, 2\); hausdorff measures surfaces in space")])
+def test_hausdorff_names_each_argument_as_the_caller_does(which, message):
+    V, F = grid(4, 4)
+    args = {"Va": V, "Fa": F, "Vb": V, "Fb": F}
+    args[which] = F - 1 if which == "Fa" else V[:, :2]
+    if which == "Va":
+        args["Vb"] = V[:, :2]
+    with pytest.raises(MeshError, match=message):
+        hausdorff(args["Va"], args["Fa"], args["Vb"], args["Fb"])

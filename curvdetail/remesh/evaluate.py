@@ -2,7 +2,8 @@
 
 import numpy as np
 
-from ..curvature._validate import as_count, bbox_diagonal, check_mesh, face_double_areas
+from ..curvature._validate import as_count, as_faces, bbox_diagonal, check_mesh, face_double_areas
+from ..curvature.errors import MeshError
 from .locate import FAR_POINTS, _locate, _unit_frame, check_points_and_mesh
 
 #: Largest ``samples``: pymeshlab takes the count as a 32-bit int.
@@ -63,6 +64,9 @@ def hausdorff(Va, Fa, Vb, Fb, *, samples=None, engine="meshlab", seed=0):
     # dtypes, scale and distance first; then the meshes in a frame where the two together have
     # unit size (as pymeshlab sees them too): areas of huge or tiny meshes neither over- nor underflow
     Va, Vb, _ = check_points_and_mesh(Va, Vb, Fb, names=("Va", "Vb", "Fb"))
+    if Va.shape[1] != 3:
+        raise MeshError(f"Va has shape {Va.shape}; hausdorff measures surfaces in space, (n, 3).")
+    Fa = as_faces(Fa, Va.shape[0], "Fa")              # named as the caller names it
     both = np.vstack([Va, Vb])
     _, both, scale = _unit_frame(both[:0], both)
     Va, Fa = check_mesh(both[:Va.shape[0]], Fa)
