@@ -40,7 +40,8 @@ def read_mesh(path):
     Raises
     ------
     FileNotFoundError   the file does not exist
-    MeshFileError       the format is unknown, the file is unreadable or holds no triangles, a
+    MeshFileError       ``path`` is not a path or names a folder, the format is unknown (binary
+                        OFF included), the file is unreadable or holds no triangles, a
                         face index is out of range, or (OBJ, OFF, PLY, STL) the loader dropped
                         vertices or faces: pymeshlab silently removes vertices with NaN or
                         infinite coordinates (and renumbers the rest), OBJ faces with
