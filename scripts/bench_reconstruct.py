@@ -298,6 +298,8 @@ def markdown_table(results):
                          f"skipped: {r['skipped'].split(';')[0]} | | | | |")
             continue
         name = r["method"] if r["method"] != "reconstruct" else f"**reconstruct** ({r['backend']})"
+        if "measured" in r:                     # a row kept from an earlier run (see the meta)
+            name += f" (run of {r['measured']})"
         factor = "-" if r["method"] == "spsolve" else _fmt(r["factor_s"])
         lines.append(f"| {r['surface']} | {r['n']:,} | {r['rows']} | {name} | {factor} | "
                      f"{_fmt(r['solve_s'])} | {_fmt(r['resolve_s'])} | {_fmt(r['peak_rss_gb'])} | "
