@@ -32,10 +32,42 @@ def test_isotropic_edges_are_near_the_target_length(load_mesh):
     assert np.median(E) / (0.03 * bbox_diagonal(V)) == pytest.approx(1.0, abs=0.2)
 
 
-def test_decimation_reaches_about_the_triangle_count_of_the_target_edge(load_mesh):
+@pytest.mark.parametrize("target_edge", [0.03, 0.06])
+def test_decimation_reaches_the_triangle_count_of_the_target_edge(load_mesh, target_edge):
+    from curvdetail.curvature._validate import face_double_areas
+
     V, F = load_mesh("terrainA_1k.obj")
+    Vt, Ft = retriangulate(V, F, method="decimate", target_edge=target_edge)
+    h = target_edge * bbox_diagonal(V)
+    equilateral = 0.5 * face_double_areas(V, F).sum() / (np.sqrt(3.0) / 4.0 * h * h)   # 1283 / 321
+    assert Ft.shape[0] == pytest.approx(equilateral, rel=0.05)
+
+
+@pytest.mark.parametrize("scale, shift", [(1e-9, 0.0), (1e9, 0.0), (1.0, 1e3)])
+def test_decimation_does_not_depend_on_units_or_position(load_mesh, scale, shift):
+    # fast-simplification's collapse threshold is absolute: fed the patch in metres x 1e9 it
+    # collapsed nothing and the source came back as its own "decimation"
+    V, F = load_mesh("terrainA_1k.obj")
+    offset = shift * bbox_diagonal(V)
     Vt, Ft = retriangulate(V, F, method="decimate", target_edge=0.06)
-    assert Ft.shape[0] < 0.5 * F.shape[0]
+    Vs, Fs = retriangulate(V * scale + offset, F, method="decimate", target_edge=0.06)
+    np.testing.assert_array_equal(Fs, Ft)
+    assert np.abs((Vs - offset) / scale - Vt).max() <= 1e-9 * bbox_diagonal(V)
+
+
+@pytest.mark.parametrize("scale", [1e-30, 1e30])
+def test_isotropic_remeshing_at_extreme_units_matches_unit_scale(load_mesh, scale):
+    # the isotropic remesher flips discrete choices on last-bit differences, so the
+    # triangulations are compared by their size and edge lengths, not triangle by triangle
+    V, F = load_mesh("mannequin_nose.obj")
+    Vt, Ft = retriangulate(V, F, method="isotropic", target_edge=0.05)
+    Vs, Fs = retriangulate(V * scale, F, method="isotropic", target_edge=0.05)
+    assert Vs.shape[0] == pytest.approx(Vt.shape[0], rel=0.02)
+
+    def median_edge(X, T):
+        return np.median(np.linalg.norm(X[T[:, [1, 2, 0]]] - X[T], axis=2)) / bbox_diagonal(X)
+
+    assert median_edge(Vs, Fs) == pytest.approx(median_edge(Vt, Ft), rel=0.02)
 
 
 @pytest.mark.parametrize("pct,words", [(1e-5, "more than 5,000,000"), (0.9, "fewer than 50")])

@@ -121,16 +121,22 @@ def retriangulate(V, F, *, method="isotropic", target_edge=0.01, iterations=10, 
             f"{100 * edge_for_vertices(V, F, MAX_VERTICES) / d:.3g} % and "
             f"{100 * edge_for_vertices(V, F, MIN_VERTICES) / d:.3g} % for this "
             f"{V.shape[0]:,}-vertex patch.")
+    # Both remeshers work in a unit frame (bbox centre at the origin, diagonal 1): their
+    # tolerances are absolute (fast-simplification's collapse threshold starts at 1e-9, so a
+    # patch 1e12 across came back undecimated), and the result must not depend on where the
+    # patch sits or on its units.
+    center = 0.5 * (V.min(axis=0) + V.max(axis=0))
+    unit = (V - center) / d
     if method == "isotropic":
         surf = target_edge if max_surface_distance is None else max_surface_distance
-        Vt, Ft = _isotropic(V, F, h, iterations, surf * d)
+        Ut, Ft = _isotropic(unit, F, target_edge, iterations, surf)
         try:
-            Vt, Ft, loop_t = check_disk(Vt, Ft, "the isotropic remesher's result")
+            Ut, Ft, loop_t = check_disk(Ut, Ft, "the isotropic remesher's result")
         except NotADiskError as exc:
             raise RemeshError(f"{exc} Try another target edge.") from None
     else:
-        Vt, Ft, loop_t = _decimate(V, F, h, aggressiveness)
-    return _snap_boundary(V, loop, Vt, Ft, loop_t, d, h)
+        Ut, Ft, loop_t = _decimate(unit, F, target_edge, aggressiveness)
+    return _snap_boundary(V, loop, Ut * d + center, Ft, loop_t, d, h)
 
 
 def _check_aggressiveness(value):
