@@ -55,6 +55,13 @@ def test_refinement_steps_must_be_a_whole_number(load_mesh, steps):
         Reconstructor(V, F, fixed, refinement_steps=steps)
 
 
+@pytest.mark.parametrize("steps", [2, 2.0, np.int64(2), np.array(2)])
+def test_refinement_steps_take_whole_numbers_as_every_other_count_does(load_mesh, steps):
+    V, F, fixed = _problem(load_mesh, "spot.obj")
+    rec = Reconstructor(V, F, fixed, refinement_steps=steps)
+    assert rec.refinement_steps == 2 and type(rec.refinement_steps) is int
+
+
 @pytest.mark.parametrize("rows", ROWS)
 def test_fixed_vertices_are_kept_bit_for_bit(load_mesh, rows, rng):
     V, F, fixed = _problem(load_mesh, "mannequin_nose.obj")

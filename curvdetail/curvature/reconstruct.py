@@ -3,7 +3,7 @@
 import numpy as np
 import scipy.sparse as sp
 
-from ._validate import as_faces, as_index_set, as_values, as_vertices, check_every_component_fixed
+from ._validate import as_count, as_faces, as_index_set, as_values, as_vertices, check_every_component_fixed
 from .cotan_laplacian import _edge_pattern, _symmetric_from_upper, checked_cotan_triangle
 from .errors import ConstraintError
 from .sparse_solver import SMALL_SYSTEM_NNZ, PendingFactorization, factorize, resolve_backend
@@ -76,11 +76,11 @@ class Reconstructor:
         if rows not in ROW_MODES:
             raise ValueError(f"rows={rows!r} is not a row mode; use 'all' (the paper's E_Q) or 'free'.")
         if refinement_steps is not None:
-            if isinstance(refinement_steps, bool) or not isinstance(refinement_steps, (int, np.integer)) \
-                    or refinement_steps < 0:
-                raise ValueError(f"refinement_steps={refinement_steps!r} must be a whole number >= 0 "
-                                 "(1, the default, gives solver precision; 0 skips the refinement).")
-            self.refinement_steps = int(refinement_steps)
+            try:
+                self.refinement_steps = as_count(refinement_steps, "refinement_steps", minimum=0)
+            except ValueError as exc:
+                raise ValueError(f"{exc} (1, the default, gives solver precision; 0 skips the "
+                                 "refinement).") from None
         self.rows = rows
         # rows="free" only: for rows="all" the pattern of L_f: L_f:^T costs a sparse product as
         # long as the values' one, and starting early saved nothing (measured at 1M)
