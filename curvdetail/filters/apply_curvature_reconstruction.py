@@ -6,9 +6,8 @@ from ..curvature import reconstruct
 from ..curvature._validate import bbox_diagonal, boundary_vertices
 from ..curvature.errors import ConstraintError
 from ..curvature.sparse_solver import AUTO_RULE, BACKENDS as _SOLVERS
-from .compute_curvature_detail import DETAIL
-from .meshset import (get_mesh, layer_id, mesh_arrays, require_vertex_attribute, selected_vertices,
-                      set_vertex_positions, set_vertex_quality)
+from .detail_attributes import load_detail
+from .meshset import get_mesh, layer_id, mesh_arrays, selected_vertices, set_vertex_positions, set_vertex_quality
 from .parameters import Parameter
 from .registry import PAPER, filter
 
@@ -42,8 +41,7 @@ BACKEND_DESCRIPTION = "sparse solver backend; " + AUTO_RULE
 def apply_curvature_reconstruction(ms, *, rows, fix_boundary, fix_selected, backend):
     mid = layer_id(ms)
     V, F = mesh_arrays(ms, mid)
-    D = require_vertex_attribute(ms, mid, DETAIL, "point",
-                                 "run compute_curvature_detail or transfer_curvature_detail first.")
+    D = load_detail(ms, mid)
     parts = []
     if fix_boundary:
         parts.append(boundary_vertices(F))

@@ -5,11 +5,9 @@ import numpy as np
 from ..curvature._validate import boundary_vertices
 from ..curvature.cotan_laplacian import checked_cotan_laplacian
 from ..curvature.mixed_voronoi_area import _mixed_voronoi_area_unchecked
-from .meshset import layer_id, mesh_arrays, set_vertex_attribute, set_vertex_quality, vertex_normals
+from .detail_attributes import AREA, DETAIL, NORMAL, store_detail  # noqa: F401  (names re-exported)
+from .meshset import layer_id, mesh_arrays, set_vertex_quality, vertex_normals
 from .registry import PAPER, filter
-
-#: Custom attribute names written by this filter and read by the others.
-NORMAL, DETAIL, AREA = "curvature_normal", "curvature_detail", "curvature_area"
 
 
 def signed_mean_curvature(V, F, K):
@@ -46,9 +44,7 @@ def compute_curvature_detail(ms):
     A = _mixed_voronoi_area_unchecked(V, F)        # = mixed_voronoi_area(V, F)
     K = D / A[:, None]                             # = mean_curvature_normal(V, F)[0], bit for bit
     H = signed_mean_curvature(V, F, K)
-    set_vertex_attribute(ms, mid, NORMAL, K)
-    set_vertex_attribute(ms, mid, DETAIL, D)
-    set_vertex_attribute(ms, mid, AREA, A)
+    store_detail(ms, mid, D, K, A)
     set_vertex_quality(ms, mid, H)
     boundary = boundary_vertices(F)
     interior = np.ones(V.shape[0], dtype=bool)

@@ -3,9 +3,10 @@
 import numpy as np
 
 from ..curvature import curvature_detail, mixed_voronoi_area
-from .compute_curvature_detail import AREA, DETAIL, NORMAL, signed_mean_curvature
+from .compute_curvature_detail import signed_mean_curvature
+from .detail_attributes import store_detail
 from .errors import FilterError
-from .meshset import layer_id, mesh_arrays, set_vertex_attribute, set_vertex_quality
+from .meshset import layer_id, mesh_arrays, set_vertex_quality
 from .parameters import Parameter
 from .registry import PAPER, filter
 
@@ -63,9 +64,7 @@ def transfer_curvature_detail(ms, *, sourcemesh, targetmesh, method, location, p
     Dt = transfer_curvature(Vs, Fs, Vt, Ft, method=method, location=location, uv=uv)
     At = mixed_voronoi_area(Vt, Ft)
     Kt = Dt / At[:, None]
-    set_vertex_attribute(ms, target, DETAIL, Dt)
-    set_vertex_attribute(ms, target, NORMAL, Kt)
-    set_vertex_attribute(ms, target, AREA, At)
+    store_detail(ms, target, Dt, Kt, At)
     set_vertex_quality(ms, target, signed_mean_curvature(Vt, Ft, Kt))
     Ds = curvature_detail(Vs, Fs)
     scale = max(np.abs(Ds).sum(), np.finfo(float).tiny)

@@ -1,0 +1,69 @@
+"""detail_attributes: stored curvature detail carries the vertex numbering it belongs to, and
+detail of another triangulation is refused instead of rebuilt from."""
+
+import os
+
+import numpy as np
+import pymeshlab
+import pytest
+
+from curvdetail import boundary_vertices
+from curvdetail.filters import FilterError, apply
+
+DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
+
+
+def meshset(name):
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(os.path.join(DATA, name))
+    return ms
+
+
+def _remeshed(ms):
+    # every parameter passed: pymeshlab keeps earlier calls' values in one process
+    ms.meshing_isotropic_explicit_remeshing(
+        iterations=3, adaptive=False, selectedonly=False, targetlen=pymeshlab.PercentageValue(1.5),
+        featuredeg=30.0, checksurfdist=True, maxsurfdist=pymeshlab.PercentageValue(1.5), splitflag=True,
+        collapseflag=True, swapflag=True, smoothflag=True, reprojectflag=True)
+
+
+@pytest.mark.parametrize("step", ["remesh", "subdivide", "remove_vertex"])
+def test_detail_of_another_triangulation_is_refused_not_rebuilt(step):
+    # MeshLab keeps custom attributes through these steps without interpolating them: new
+    # vertices read 0 and the remeshed nose, rebuilt from that, moved by 10 % of its diagonal
+    ms = meshset("mannequin_nose.obj")
+    apply(ms, "compute_curvature_detail")
+    if step == "remesh":
+        _remeshed(ms)
+    elif step == "subdivide":
+        ms.meshing_surface_subdivision_midpoint(iterations=1, threshold=pymeshlab.PercentageValue(0.0),
+                                                selected=False)
+    else:
+        ms.compute_selection_by_condition_per_vertex(condselect="(vi == 100)")
+        ms.meshing_remove_selected_vertices()
+    n = ms.current_mesh().vertex_number()
+    with pytest.raises(FilterError, match=rf"'curvature_detail' belongs to another triangulation: [\d,]+ of "
+                                          rf"{n:,} vertices were added, removed or renumbered.*"
+                                          "compute_curvature_detail again"):
+        apply(ms, "apply_curvature_reconstruction")
+
+
+def test_detail_survives_moved_vertices_and_a_ply_round_trip(tmp_path):
+    # the stamp follows the numbering, not the geometry; and it is saved with the detail
+    from curvdetail.filters.files import load_meshset, save_current_mesh
+
+    ms = meshset("mannequin_nose.obj")
+    V = ms.current_mesh().vertex_matrix().copy()
+    apply(ms, "compute_curvature_detail")
+    ms.compute_coord_by_function(x="x", y="y", z="z + 0.01 * x", onselected=False)
+    save_current_mesh(ms, str(tmp_path / "d.ply"))
+    ms2 = load_meshset(str(tmp_path / "d.ply"))
+    apply(ms2, "apply_curvature_reconstruction")
+    # the boundary was moved with the rest; the interior follows its detail
+    b = boundary_vertices(ms2.current_mesh().face_matrix())
+    moved = V[b].copy()
+    moved[:, 2] += 0.01 * V[b, 0]
+    assert np.allclose(ms2.current_mesh().vertex_matrix()[b], moved, rtol=0, atol=1e-12)
+    with pytest.raises(FilterError, match="another triangulation"):
+        _remeshed(ms2)
+        apply(ms2, "apply_curvature_reconstruction")
