@@ -6,6 +6,7 @@ file behind (outputs are written atomically, last).
 """
 
 import argparse
+import os
 import sys
 import time
 
@@ -485,6 +486,11 @@ def main(argv=None):
     except KeyboardInterrupt:
         print("curvdetail: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:
+        # the reader went away (`curvdetail list | head`): not an error of ours, as for cat(1);
+        # stdout is pointed at /dev/null so that Python's final flush does not fail again
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
     except (ValueError, OSError, RuntimeError) as exc:
         message = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         print(f"curvdetail: error: {message}", file=sys.stderr)

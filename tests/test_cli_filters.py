@@ -233,3 +233,19 @@ def test_installed_command_exits_non_zero_with_one_line(tmp_path):
                            str(tmp_path / "o.ply")], capture_output=True, text=True)
     assert proc.returncode == 1 and proc.stderr.count("\n") == 1
     assert proc.stderr.startswith("curvdetail: error: unknown filter 'nope'")
+
+
+def test_list_into_a_closed_pipe_exits_quietly():
+    # `curvdetail list | head -1`: the reader is gone before the listing is written
+    import subprocess
+    import sys
+
+    read_end, write_end = os.pipe()
+    os.close(read_end)
+    try:
+        done = subprocess.run([sys.executable, "-m", "curvdetail", "list"], stdout=write_end,
+                              stderr=subprocess.PIPE, timeout=120)
+    finally:
+        os.close(write_end)
+    assert done.returncode == 0
+    assert done.stderr == b""
