@@ -301,3 +301,22 @@ def test_pending_factorization_refuses_an_empty_row():
     pattern = sp.csr_matrix((np.ones(2), [0, 2], [0, 1, 1, 2]), shape=(3, 3))
     with pytest.raises(SolverError, match="row 1 has no stored entries"):
         sparse_solver.PendingFactorization(pattern, backend="pardiso")
+
+
+def test_unknown_backend_from_the_environment_names_the_variable(monkeypatch):
+    # the user passed no backend: the message must say where the name came from
+    monkeypatch.setenv("CURVDETAIL_SOLVER", "foo")
+    with pytest.raises(SolverError, match=r"unknown solver backend 'foo' \(from the environment variable "
+                                          r"CURVDETAIL_SOLVER\)"):
+        resolve_backend("auto", size=10)
+    monkeypatch.delenv("CURVDETAIL_SOLVER")
+    with pytest.raises(SolverError, match=r"unknown solver backend 'foo'; choose one of"):
+        resolve_backend("foo", size=10)
+
+
+@pytest.mark.parametrize("name", ["SPLU", " splu", "Banded"])
+def test_backend_names_are_case_insensitive(monkeypatch, name):
+    monkeypatch.delenv("CURVDETAIL_SOLVER", raising=False)
+    assert resolve_backend(name, size=10) == name.strip().lower()
+    monkeypatch.setenv("CURVDETAIL_SOLVER", name)
+    assert resolve_backend("AUTO", size=10) == name.strip().lower()

@@ -110,8 +110,12 @@ AUTO_RULE = (f"auto = SuperLU (or the banded Cholesky for small normal equations
 
 def resolve_backend(backend="auto", *, symmetric=True, size=None, nnz=None):
     """Turn ``"auto"`` (or the ``CURVDETAIL_SOLVER`` setting) into an installed backend name."""
+    if isinstance(backend, str):
+        backend = backend.strip().lower()         # "PARDISO" too, as the filters' choices are taken
+    source = ""
     if backend in (None, "auto"):
-        backend = os.environ.get("CURVDETAIL_SOLVER", "auto") or "auto"
+        backend = (os.environ.get("CURVDETAIL_SOLVER", "auto") or "auto").strip().lower()
+        source = " (from the environment variable CURVDETAIL_SOLVER)" if backend != "auto" else ""
     if backend == "auto":
         small = nnz < SMALL_SYSTEM_NNZ if nnz is not None else (size is not None and size < SMALL_SYSTEM)
         if small:
@@ -123,11 +127,13 @@ def resolve_backend(backend="auto", *, symmetric=True, size=None, nnz=None):
                 continue
             return name
     if backend not in BACKENDS:
-        raise SolverError(f"unknown solver backend {backend!r}; choose one of {', '.join(BACKENDS)} or 'auto'.")
+        raise SolverError(f"unknown solver backend {backend!r}{source}; choose one of {', '.join(BACKENDS)} "
+                          "or 'auto'.")
     if backend not in available_backends():
         hint = {"pardiso": "pip install pypardiso (x86-64 only)",
                 "cholmod": "install SuiteSparse (apt install libsuitesparse-dev) and pip install scikit-sparse"}
-        raise SolverError(f"solver backend {backend!r} is not installed; {hint[backend]}, or use backend='auto'.")
+        raise SolverError(f"solver backend {backend!r}{source} is not installed; {hint[backend]}, or use "
+                          "backend='auto'.")
     if backend in ("cholmod", "banded") and not symmetric:
         name = {"cholmod": "CHOLMOD", "banded": "The banded Cholesky"}[backend]
         raise SolverError(f"{name} factors symmetric positive definite matrices only; use 'pardiso' or 'splu'.")
@@ -136,7 +142,10 @@ def resolve_backend(backend="auto", *, symmetric=True, size=None, nnz=None):
 
 def _chosen_automatically(backend):
     """True if ``backend`` leaves the choice to :func:`resolve_backend` (no name, no setting)."""
-    return backend in (None, "auto") and (os.environ.get("CURVDETAIL_SOLVER", "auto") or "auto") == "auto"
+    if isinstance(backend, str):
+        backend = backend.strip().lower()
+    return backend in (None, "auto") and \
+        (os.environ.get("CURVDETAIL_SOLVER", "auto") or "auto").strip().lower() == "auto"
 
 
 def _refuse_empty_rows(indptr):
