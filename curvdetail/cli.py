@@ -174,6 +174,14 @@ def _minimal_command(parser):
 
 # --- remesh (remeshing issue) ---------------------------------------------------------------
 
+def _percentage(text):
+    """``--target-edge`` value: a number of percent, with or without a trailing ``%``."""
+    try:
+        return float(text.strip().removesuffix("%"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a percentage (e.g. 1 or 1%)") from None
+
+
 @command("remesh", help="retriangulate a disk patch, rebuild it from its curvature detail, and "
                         "measure the error (the paper's Fig. 3)")
 def _remesh_command(parser):
@@ -182,8 +190,9 @@ def _remesh_command(parser):
     parser.add_argument("--method", choices=("isotropic", "decimate"), default="isotropic",
                         help="retriangulation: pymeshlab isotropic remeshing or fast-simplification "
                              "decimation (default: isotropic)")
-    parser.add_argument("--target-edge", type=float, default=1.0, metavar="PCT",
-                        help="target edge length in %% of the source's bbox diagonal (default: 1)")
+    parser.add_argument("--target-edge", type=_percentage, default=1.0, metavar="PCT",
+                        help="target edge length in %% of the source's bbox diagonal, e.g. 1 or 1%% "
+                             "(default: 1)")
     parser.add_argument("--transfer", choices=("conservative", "pointwise"), default="conservative",
                         help="detail transfer: conservative (edge curvature measure, default) or "
                              "pointwise (the paper: K interpolated times target area)")
@@ -192,7 +201,7 @@ def _remesh_command(parser):
     parser.add_argument("--location", choices=("closest", "uv"), default="closest",
                         help="locate points by 3D closest point (default) or in a shared planar domain")
     parser.add_argument("--parameterization", choices=("harmonic", "meshlab_harmonic", "lscm"),
-                        default="harmonic", help="planar domain for --location uv (default: harmonic)")
+                        default=None, help="planar domain for --location uv (default: harmonic)")
     add_backend_argument(parser)
     parser.add_argument("--report", metavar="R.json", default=None, help="write the JSON report here")
     parser.add_argument("--image", metavar="FIG.png", default=None,
@@ -210,6 +219,10 @@ def _remesh_command(parser):
         from .remesh.experiment import run_experiment
 
         resolve_input_output(args)      # checks OUTPUT
+        if args.parameterization is not None and args.location != "uv":
+            raise ValueError(f"--parameterization {args.parameterization} applies to --location uv only "
+                             f"(locating by {args.location} point uses no planar map); add --location uv "
+                             "or leave it out.")
         if not (args.target_edge > 0 and args.target_edge < float("inf")):
             raise ValueError(f"--target-edge {args.target_edge:g}: give a positive percentage of the bbox "
                              "diagonal, e.g. 1 for 1 %.")
@@ -223,7 +236,7 @@ def _remesh_command(parser):
         try:
             result = run_experiment(V, F, method=args.method, target_edge=args.target_edge / 100.0,
                                     transfer=args.transfer, rows=args.rows, location=args.location,
-                                    parameterization=args.parameterization, backend=args.backend,
+                                    parameterization=args.parameterization or "harmonic", backend=args.backend,
                                     source_path=os.path.abspath(args.input), progress=progress.stage)
             report = result["report"]
             # all outputs appear together, only once every one of them is written

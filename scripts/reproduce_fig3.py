@@ -45,16 +45,17 @@ def pct(x, digits=3):
     return f"{100 * x:.{digits}f}"
 
 
-def row(name, rep, t_retri=None):
+def row(name, rep, t_retri=None, method=None):
     """One table line; ``t_retri`` = the time of a retriangulation made outside the experiment
-    (shared by several configurations), added to its stage times."""
+    (shared by several configurations), added to its stage times; ``method`` = how that
+    retriangulation was made (the report says "given")."""
     e, b, f, s, o = (rep["error"], rep["baseline_zero_detail"], rep["floor_retriangulated"], rep["seconds"],
                      rep["options"])
     ok = e["hausdorff_rms"] <= 1e-3 and e["hausdorff_max"] <= 1e-2 and rep["improvement_over_zero_detail"] >= 50
     loc = o["location"] + (f" ({o['parameterization']})" if o["location"] == "uv" else "")
     total = s["total"] + (t_retri or 0.0)
     t_retri = s["retriangulate"] if t_retri is None else t_retri
-    return (f"| {name} | {rep['source']['vertices']:,} | {rep['target']['vertices']:,} | {o['method']} | "
+    return (f"| {name} | {rep['source']['vertices']:,} | {rep['target']['vertices']:,} | {method or o['method']} | "
             f"{o['transfer']} | {o['rows']} | {loc} | **{pct(e['hausdorff_rms'], 4)}** / {pct(e['hausdorff_max'])} | "
             f"{pct(b['hausdorff_rms'], 2)} / {pct(b['hausdorff_max'], 1)} | "
             f"{pct(f['hausdorff_rms'], 4)} / {pct(f['hausdorff_max'])} | {rep['improvement_over_zero_detail']:,.0f}x | "
@@ -99,7 +100,7 @@ def main():
                 continue
             rep = out["report"]
             results.append(dict(rep, seconds_retriangulate_shared=round(t_retri, 4)))
-            line = row(name.rsplit(".", 1)[0], rep, t_retri)
+            line = row(name.rsplit(".", 1)[0], rep, t_retri, method="isotropic")
             lines_all.append(line)
             if (transfer, rows, location) == CONFIGS[0]:
                 lines_main.append(line)
@@ -122,7 +123,7 @@ def main():
                     continue
                 rep = out["report"]
                 results.append(rep)
-                line = row(name.rsplit(".", 1)[0], rep)
+                line = row(name.rsplit(".", 1)[0], rep, method="isotropic")
                 pi = rep["parameterization"]
                 params.append(line + f" {pi['flipped_source']} / {pi['flipped_target']} |")
                 print(params[-1], flush=True)

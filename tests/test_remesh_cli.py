@@ -80,3 +80,27 @@ def test_decimation_that_would_refine_names_the_command_line_option(tmp_path, ca
     err = capsys.readouterr().err
     assert "decimation can only coarsen" in err and "--method isotropic" in err and "method='" not in err
     assert os.listdir(tmp_path) == []
+
+
+@pytest.mark.parametrize("given", ["6%", " 6 %"])
+def test_target_edge_takes_a_percent_sign(tmp_path, capsys, given):
+    rep = tmp_path / "r.json"
+    rc = main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "o.ply"), "--target-edge", given,
+               "--method", "decimate", "--report", str(rep), "--quiet"])
+    assert rc == 0
+    assert json.loads(rep.read_text())["options"]["target_edge"] == pytest.approx(0.06)
+
+
+def test_target_edge_that_is_no_number_is_an_argument_error(tmp_path, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "o.ply"), "--target-edge", "1x"])
+    assert exc.value.code == 2
+    assert "'1x' is not a percentage (e.g. 1 or 1%)" in capsys.readouterr().err
+
+
+def test_parameterization_without_uv_location_is_refused_not_ignored(tmp_path, capsys):
+    rc = main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "o.ply"),
+               "--parameterization", "lscm", "--quiet"])
+    assert rc == 1
+    assert "--parameterization lscm applies to --location uv only" in capsys.readouterr().err
+    assert os.listdir(tmp_path) == []

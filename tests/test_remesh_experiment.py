@@ -165,3 +165,14 @@ def test_a_two_triangle_square_is_rebuilt_and_measured():
     # a flat square rebuilt from its own (zero) detail is itself
     assert np.abs(X - V).max() < 1e-12
     assert report["error"]["hausdorff_max"] < 1e-6 and report["baseline_zero_detail"]["hausdorff_max"] < 1e-12
+
+
+def test_report_says_a_given_target_was_not_made_by_the_experiment(height_field):
+    V, F = height_field
+    target = retriangulate(V, F, method="decimate", target_edge=0.06)
+    _, given = remesh_experiment(V, F, target=target, evaluate=False)
+    assert given["options"]["method"] == "given" and given["options"]["target_edge"] is None
+    assert given["seconds"]["retriangulate"] == 0.0
+    _, made = remesh_experiment(V, F, method="decimate", target_edge=0.06, evaluate=False)
+    assert made["options"]["method"] == "decimate" and made["options"]["target_edge"] == 0.06
+    assert made["target"]["vertices"] == given["target"]["vertices"]      # the same decimation

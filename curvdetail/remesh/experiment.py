@@ -62,7 +62,9 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="c
     target : tuple (Vt, Ft) or None            a ready retriangulation to use instead of making one
                                                (a disk whose boundary vertices lie on the source's
                                                boundary polyline); ``method`` / ``target_edge`` are then
-                                               only recorded (but still checked), and
+                                               unused (but still checked), the report's
+                                               ``options.method`` is ``"given"`` and its
+                                               ``options.target_edge`` None, and
                                                ``seconds.retriangulate`` is 0
 
     Returns
@@ -167,7 +169,8 @@ def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="cons
                    "faces": int(F.shape[0]), "bbox_diagonal": d},
         "target": {"vertices": int(Vt.shape[0]), "faces": int(Ft.shape[0]),
                    "boundary_vertices": int(loop_t.size)},
-        "options": {"method": method, "target_edge": float(target_edge), "transfer": transfer, "rows": rows,
+        "options": {"method": "given" if target is not None else method,
+                    "target_edge": float(target_edge) if target is None else None, "transfer": transfer, "rows": rows,
                     "location": location, "parameterization": parameterization if location == "uv" else None,
                     "backend": rec.backend},
     }
