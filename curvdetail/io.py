@@ -6,6 +6,7 @@ unless ``overwrite=True``.
 """
 
 import os
+import re
 
 import numpy as np
 
@@ -142,10 +143,17 @@ def write_mesh(path, V, F, *, quality=None, overwrite=False):
                             "pass finite values.")
         kwargs["v_scalar_array"] = q
     mesh = pymeshlab.Mesh(vertex_matrix=V, face_matrix=F.astype(np.int32), **kwargs)
-    save_mesh(path, mesh, overwrite=overwrite)
+    # geometry (and quality) only: pymeshlab would add its default white colours and computed
+    # normals, and its OFF writer then says NCOFF, a header libigl's readOFF refuses
+    save_mesh(path, mesh, overwrite=overwrite, _plain=True)
 
 
-def save_mesh(path, mesh, *, overwrite=False, **save_options):
+#: What :func:`write_mesh` turns off where the format has the option (pymeshlab refuses an
+#: option the format lacks, e.g. ``save_vertex_normal`` for VRML).
+_PLAIN_OPTIONS = {"save_vertex_color": False, "save_vertex_normal": False, "save_face_color": False}
+
+
+def save_mesh(path, mesh, *, overwrite=False, _plain=False, **save_options):
     """Atomically save a ``pymeshlab.Mesh`` (with its quality and colours where the format holds
     them). Used by :func:`write_mesh`.
 
@@ -195,7 +203,21 @@ def save_mesh(path, mesh, *, overwrite=False, **save_options):
         ms = _meshset()
         ms.add_mesh(mesh)
         try:
-            ms.save_current_mesh(tmp, **options)
+            _save(ms, tmp, options, _PLAIN_OPTIONS if _plain else {})
         except Exception as exc:
             raise MeshFileError(f"could not write {os.fspath(path)!r}: "
                                 f"{str(exc).replace(tmp, os.fspath(path))}") from None
+
+
+def _save(ms, path, options, optional):
+    """``ms.save_current_mesh(path, **options, **optional)``, leaving out each ``optional``
+    option the format does not have."""
+    optional = {k: v for k, v in optional.items() if k not in options}
+    while True:
+        try:
+            return ms.save_current_mesh(path, **options, **optional)
+        except Exception as exc:
+            missing = re.search(r"Parameter (\w+) not found", str(exc))
+            if missing is None or missing.group(1) not in optional:
+                raise
+            del optional[missing.group(1)]

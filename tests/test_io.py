@@ -10,6 +10,7 @@ import pymeshlab
 import pytest
 
 from curvdetail import MeshError, read_mesh, write_mesh
+from curvdetail.curvature.testing import icosphere
 from curvdetail.io import MeshFileError, save_mesh
 
 from conftest import data_path
@@ -408,3 +409,25 @@ def test_docstring_examples_run():
     import importlib
 
     assert doctest.testmod(importlib.import_module("curvdetail.io"), optionflags=doctest.ELLIPSIS).failed == 0
+
+
+def test_written_off_is_plain_geometry_that_other_readers_take(tmp_path):
+    # pymeshlab's defaults wrote "NCOFF" with RGBA colours and normals on every vertex line,
+    # a header libigl's readOFF refuses
+    V, F = icosphere(subdivisions=1)
+    write_mesh(tmp_path / "s.off", V, F)
+    lines = (tmp_path / "s.off").read_text().splitlines()
+    assert lines[0] == "OFF"
+    assert lines[1].split() == [str(V.shape[0]), str(F.shape[0]), "0"]
+    vertex_lines = lines[2:2 + V.shape[0]]
+    assert all(len(line.split()) == 3 for line in vertex_lines)
+    np.testing.assert_allclose(np.array([line.split() for line in vertex_lines], dtype=float), V, rtol=0, atol=1e-15)
+
+
+def test_written_ply_holds_positions_faces_and_quality_only(tmp_path):
+    V, F = icosphere(subdivisions=1)
+    write_mesh(tmp_path / "s.ply", V, F, quality=V[:, 0])
+    raw = (tmp_path / "s.ply").read_bytes()
+    header = raw[:raw.index(b"end_header")].decode()
+    properties = [line.split()[-1] for line in header.splitlines() if line.startswith("property")]
+    assert properties == ["x", "y", "z", "quality", "vertex_indices"]
