@@ -87,32 +87,62 @@ def resolve_input_output(args):
 
 # --- reconstruct / minimal (core issue) -----------------------------------------------------
 
+def _vertex_indices(text):
+    """One ``--fix`` value: an index, or several separated by commas ("0,17,42")."""
+    try:
+        return [int(part) for part in text.split(",") if part.strip()]
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not a vertex index (put --fix after INPUT OUTPUT, or end its list with --)") from None
+
+
+def add_fix_arguments(parser):
+    parser.add_argument("--fix", type=_vertex_indices, nargs="*", default=None, metavar="I",
+                        help="vertex indices to keep fixed, e.g. --fix 0 17 42 or --fix 0,17,42 "
+                             "(default: the boundary; a closed piece needs some)")
+    parser.add_argument("--fix-boundary", action="store_true",
+                        help="with --fix: keep the boundary fixed as well")
+
+
+def fixed_vertices(args, F, n):
+    """The vertices ``--fix`` / ``--fix-boundary`` name (the boundary when neither is given)."""
+    import numpy as np
+
+    from .curvature._validate import as_index_set, boundary_vertices
+    from .curvature.errors import ConstraintError
+
+    if args.fix is None:
+        return boundary_vertices(F)
+    indices = [i for part in args.fix for i in part]
+    if not indices:                         # "--fix" given without indices
+        raise ConstraintError("--fix needs vertex indices (e.g. --fix 0 17 42); leave it out to fix "
+                              "the boundary.")
+    fixed = as_index_set(indices, n, "--fix")
+    return np.union1d(fixed, boundary_vertices(F)) if args.fix_boundary else fixed
+
+
 @command("reconstruct", help="rebuild a mesh from its own curvature detail with the boundary fixed")
 def _reconstruct_command(parser):
     add_input_output_arguments(parser, "mesh file (any format MeshLab reads)",
                                "rebuilt mesh; quality = distance to INPUT")
     parser.add_argument("--rows", choices=("all", "free"), default="all",
                         help="residual rows in E_Q: all vertices (the paper) or free ones only")
-    parser.add_argument("--fix", type=int, nargs="*", default=None, metavar="I",
-                        help="vertex indices to fix (default: the boundary; a closed mesh needs some)")
+    add_fix_arguments(parser)
     add_backend_argument(parser)
     add_output_arguments(parser)
 
     def run(args):
         import numpy as np
 
-        from . import Reconstructor, boundary_vertices, curvature_detail, read_mesh, write_mesh
-        from .curvature._validate import as_index_set, bbox_diagonal, check_mesh
+        from . import Reconstructor, curvature_detail, read_mesh, write_mesh
+        from .curvature._validate import bbox_diagonal, check_mesh
         from .curvature.errors import ConstraintError
 
         resolve_input_output(args)
         progress = Progress(4, enabled=sys.stderr.isatty())      # 1M vertices take ~20 s
         progress.stage("read")
         V, F = check_mesh(*read_mesh(args.input))
-        if args.fix == []:                    # "--fix" given without indices
-            raise ConstraintError("--fix needs vertex indices (e.g. --fix 0 17 42); leave it out to fix "
-                                  "the boundary.")
-        fixed = as_index_set(args.fix, V.shape[0], "--fix") if args.fix is not None else boundary_vertices(F)
+        fixed = fixed_vertices(args, F, V.shape[0])
         if fixed.size == 0:
             raise ConstraintError(f"{args.input} is closed (no boundary); name vertices to fix with --fix.")
         progress.stage("factor")
@@ -144,21 +174,23 @@ def _minimal_command(parser):
     parser.add_argument("--tol", type=float, default=DEFAULT_TOL,
                         help="stop when no vertex moves more than TOL x bbox diagonal normal to the "
                              f"surface in a step (tangential sliding is not counted; default {DEFAULT_TOL:g})")
+    add_fix_arguments(parser)
     add_backend_argument(parser)
     add_output_arguments(parser)
 
     def run(args):
         import numpy as np
 
-        from . import boundary_vertices, minimal_surface, read_mesh, write_mesh
+        from . import minimal_surface, read_mesh, write_mesh
         from .curvature._validate import check_mesh
         from .curvature.errors import ConstraintError
 
         resolve_input_output(args)
         V, F = check_mesh(*read_mesh(args.input))
-        fixed = boundary_vertices(F)
+        fixed = fixed_vertices(args, F, V.shape[0])
         if fixed.size == 0:
-            raise ConstraintError(f"{args.input} is closed: a minimal surface needs a boundary to span.")
+            raise ConstraintError(f"{args.input} is closed: a minimal surface needs a boundary to span "
+                                  "(or vertices named with --fix).")
         progress = Progress(args.max_iterations, enabled=sys.stderr.isatty())
         X = minimal_surface(V, F, fixed, max_iterations=args.max_iterations, tol=args.tol,
                             backend=args.backend, callback=lambda i, s: progress.stage(f"step {i}"))
