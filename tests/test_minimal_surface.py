@@ -133,6 +133,21 @@ def test_stopping_rule_is_relative_to_the_bbox_diagonal(load_mesh):
     assert X10.last_step == pytest.approx(X1.last_step, rel=1e-9)
 
 
+def test_each_piece_settles_against_its_own_size(load_mesh):
+    # nose and ear in one mesh, the ear 10 units away: against the whole mesh's diagonal the
+    # nose counted as settled after 4 of its 44 steps; now the pair stops when the slower piece
+    # does, and the nose part is the nose's own minimal surface
+    Vn, Fn = load_mesh("mannequin_nose.obj")
+    Ve, Fe = load_mesh("mannequin_ear.obj")
+    V = np.vstack([Vn, Ve + [10.0, 0.0, 0.0]])
+    F = np.vstack([Fn, Fe + Vn.shape[0]])
+    both = minimal_surface(V, F, boundary_vertices(F))
+    nose = minimal_surface(Vn, Fn, boundary_vertices(Fn))
+    ear = minimal_surface(Ve, Fe, boundary_vertices(Fe))
+    assert both.converged and both.iterations == max(nose.iterations, ear.iterations)
+    assert np.abs(both[:Vn.shape[0]] - nose).max() < 1e-4 * bbox_diagonal(Vn)
+
+
 def test_order_of_the_fixed_vertices_does_not_matter(load_mesh):
     V, F = load_mesh("mannequin_nose.obj")
     b = boundary_vertices(F)
