@@ -124,8 +124,26 @@ def test_bad_value_in_script_names_step_and_parameter(tmp_path):
 
 def test_failing_native_step_names_the_step(tmp_path):
     path = write(tmp_path, '<filter name="No Such MeshLab Filter"/>')
-    with pytest.raises(ScriptError, match=r"step 1 \(No Such MeshLab Filter\): pymeshlab failed"):
+    with pytest.raises(ScriptError, match=r"step 1 \(No Such MeshLab Filter\): pymeshlab failed without a "
+                                          r"reason .*usual cause is a filter name MeshLab does not know"):
         run_script(meshset(), path)
+
+
+@pytest.mark.parametrize("name, words", [
+    # pymeshlab answers each with "Something really bad happened. Please report this issue"
+    ("meshing_remove_duplicate_vertices",
+     r"'meshing_remove_duplicate_vertices' is pymeshlab's Python name, not MeshLab's \('remove duplicate vertices'"),
+    ("remove duplicate vertices",
+     r"MeshLab spells this filter differently \('remove duplicate vertices' in lower case; pymeshlab's "
+     r"meshing_remove_duplicate_vertices\)"),
+    ("Remove Duplicated Vertex", r"no filter called 'Remove Duplicated Vertex'; did you mean 'remove duplicate vertices'"),
+])
+def test_misnamed_meshlab_step_says_what_meshlab_calls_it(tmp_path, name, words):
+    path = write(tmp_path, f'<filter name="{name}"/>')
+    with pytest.raises(ScriptError, match=words + r".*as MeshLab writes it \(Filters > Show current filter script\)"):
+        run_script(meshset(), path)
+    # the name MeshLab writes runs
+    run_script(meshset(), write(tmp_path, '<filter name="Remove Duplicate Vertices"/>'))
 
 
 @pytest.mark.parametrize("body", [NATIVE_BORDER,

@@ -25,6 +25,7 @@ at a time, through a temporary script and ``load_filter_script`` / ``apply_filte
 """
 
 import contextlib
+import functools
 import os
 import re
 import sys
@@ -118,18 +119,61 @@ def _refuse_a_near_miss(name, where):
             raise ScriptError(f"{where}: no filter is called {name!r}; did you mean {', '.join(matches)}?")
 
 
+@functools.lru_cache(maxsize=1)
+def _pymeshlab_renames():
+    """pymeshlab's table of its old Python names (MeshLab's script names in snake case, e.g.
+    ``remove_duplicate_vertices``) to its current ones (``meshing_remove_duplicate_vertices``);
+    empty if it is not there."""
+    import pymeshlab
+
+    try:
+        with open(os.path.join(os.path.dirname(pymeshlab.__file__), "keys.txt"), encoding="utf-8") as f:
+            return dict(line.split()[:2] for line in f if len(line.split()) >= 2)
+    except OSError:
+        return {}
+
+
+def _snake(meshlab_name):
+    return re.sub(r"[^a-z0-9]+", "_", meshlab_name.lower()).strip("_")
+
+
 def _creates_a_mesh(meshlab_name):
     """Whether a MeshLab filter (by its script name, e.g. "Sphere") makes a mesh from nothing:
     pymeshlab's ``create_*`` filters, found through the old-to-new name table it ships."""
+    return _pymeshlab_renames().get(_snake(meshlab_name), "").startswith("create_")
+
+
+#: MeshLab's own words for "I know no filter of this name" (its script runner says no more).
+_UNKNOWN_STEP = "Something really bad happened"
+
+_HOW_NAMES_ARE_WRITTEN = ("A step names MeshLab's filter with its capitals and spaces, as MeshLab writes "
+                          "it (Filters > Show current filter script) or pymeshlab's "
+                          "MeshSet.save_filter_script does.")
+
+
+def _unknown_native_step(name):
+    """Why MeshLab failed on a step called ``name`` without a reason: pymeshlab's Python name used in a script,
+    MeshLab's name spelled with other capitals or spaces, or a close match (MeshLab's names
+    in the words of pymeshlab's rename table, which holds the filters renamed since 2022)."""
+    import difflib
+
     import pymeshlab
 
-    old = re.sub(r"[^a-z0-9]+", "_", meshlab_name.lower()).strip("_")
-    try:
-        with open(os.path.join(os.path.dirname(pymeshlab.__file__), "keys.txt"), encoding="utf-8") as f:
-            names = dict(line.split()[:2] for line in f if len(line.split()) >= 2)
-    except OSError:
-        return False
-    return names.get(old, "").startswith("create_")
+    renames = _pymeshlab_renames()
+    if re.fullmatch(r"[a-z0-9_]+", name) and (name in renames.values() or hasattr(pymeshlab.MeshSet, name)):
+        old = next((o for o, new in renames.items() if new == name), None)
+        words = f" ({old.replace('_', ' ')!r} in lower case)" if old else ""
+        return f"{name!r} is pymeshlab's Python name, not MeshLab's{words}. {_HOW_NAMES_ARE_WRITTEN}"
+    key = _snake(name)
+    if key in renames:
+        return (f"MeshLab spells this filter differently ({key.replace('_', ' ')!r} in lower case; "
+                f"pymeshlab's {renames[key]}). {_HOW_NAMES_ARE_WRITTEN}")
+    matches = difflib.get_close_matches(key, list(renames), n=3, cutoff=0.75)
+    if matches:
+        return (f"MeshLab has no filter called {name!r}; did you mean "
+                f"{', '.join(repr(m.replace('_', ' ')) for m in matches)} (in lower case)? {_HOW_NAMES_ARE_WRITTEN}")
+    return (f"pymeshlab failed without a reason ({_UNKNOWN_STEP!r}); the usual cause is a filter name "
+            f"MeshLab does not know. {_HOW_NAMES_ARE_WRITTEN}")
 
 
 def _run_native(ms, element, where):
@@ -153,7 +197,9 @@ def _run_native(ms, element, where):
                 ms.apply_filter_script()
         except pymeshlab.PyMeshLabException as exc:
             detail = " ".join(str(exc).split())
-            raise ScriptError(f"{where}: pymeshlab failed: {detail}") from None
+            reason = _unknown_native_step(element.get("name", "")) if _UNKNOWN_STEP in detail else \
+                f"pymeshlab failed: {detail}"
+            raise ScriptError(f"{where}: {reason}") from None
     finally:
         os.remove(tmp)
 
