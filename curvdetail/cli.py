@@ -206,6 +206,30 @@ def _minimal_command(parser):
 
 # --- remesh (remeshing issue) ---------------------------------------------------------------
 
+#: From this many estimated target vertices ``curvdetail remesh`` says beforehand that it will
+#: take a while (measured: 88k vertices 65 s, 547k ~10 min, most of it the evaluation).
+BIG_TARGET = 200_000
+
+
+def _note_a_big_target(V, F, args):
+    """A line on stderr when the target edge asks for more than ``BIG_TARGET`` vertices (an
+    estimate only: on a mesh the checks will refuse, nothing is said)."""
+    import numpy as np
+
+    from .curvature._validate import bbox_diagonal
+    from .remesh.retriangulate import estimated_vertices
+
+    try:
+        with np.errstate(all="ignore"):
+            count = float(estimated_vertices(V, F, args.target_edge / 100.0 * bbox_diagonal(V)))
+    except (ValueError, IndexError, ArithmeticError):
+        return
+    if BIG_TARGET < count < float("inf"):
+        skip = "" if args.no_evaluate else " (the measurements most of it; --no-evaluate skips them)"
+        sys.stderr.write(f"note: a {args.target_edge:g} % target edge gives about {count:,.0f} target vertices; "
+                         f"this takes minutes{skip}.\n")
+
+
 def _percentage(text):
     """``--target-edge`` value: a number of percent, with or without a trailing ``%``."""
     try:
@@ -238,6 +262,9 @@ def _remesh_command(parser):
     parser.add_argument("--report", metavar="R.json", default=None, help="write the JSON report here")
     parser.add_argument("--image", metavar="FIG.png", default=None,
                         help="write a picture: source, rebuilt coloured by error, zero-detail baseline")
+    parser.add_argument("--no-evaluate", action="store_true",
+                        help="skip the distance measurements (most of the time on big meshes); OUTPUT "
+                             "gets no quality, and --image is not available")
     parser.add_argument("--quiet", action="store_true", help="no stage progress on stderr")
     add_output_arguments(parser)
 
@@ -261,15 +288,20 @@ def _remesh_command(parser):
         for extra in (args.report, args.image):
             if extra is not None:
                 check_output_path(extra, args.overwrite, hint=None, error=FileNotFoundError)
+        if args.no_evaluate and args.image is not None:
+            raise ValueError("--image shows the measured distances; leave out --no-evaluate or --image.")
         _check_image_and_distinct(args.image, args.output, args.report)
         V, F = read_mesh(args.input)
-        stages = 4 + (args.location == "uv") + (args.image is not None)
+        if not args.quiet:
+            _note_a_big_target(V, F, args)
+        stages = 3 + (not args.no_evaluate) + (args.location == "uv") + (args.image is not None)
         progress = Progress(stages, enabled=not args.quiet)
         try:
             result = run_experiment(V, F, method=args.method, target_edge=args.target_edge / 100.0,
                                     transfer=args.transfer, rows=args.rows, location=args.location,
                                     parameterization=args.parameterization or "harmonic", backend=args.backend,
-                                    source_path=os.path.abspath(args.input), progress=progress.stage)
+                                    evaluate=not args.no_evaluate, source_path=os.path.abspath(args.input),
+                                    progress=progress.stage)
             report = result["report"]
             # all outputs appear together, only once every one of them is written
             with contextlib.ExitStack() as outputs:
@@ -292,6 +324,10 @@ def _remesh_command(parser):
                 write_mesh(tmp, result["X"], result["Ft"], quality=result["distance"], overwrite=True)
         finally:
             progress.close()
+        if args.no_evaluate:
+            print(f"{report['source']['vertices']:,} -> {report['target']['vertices']:,} vertices; not "
+                  f"measured (--no-evaluate); {report['seconds']['total']:.2f} s")
+            return 0
         e, b, fl = report["error"], report["baseline_zero_detail"], report["floor_retriangulated"]
         print(f"{report['source']['vertices']:,} -> {report['target']['vertices']:,} vertices; "
               f"RMS {100 * e['hausdorff_rms']:.4f} %, max {100 * e['hausdorff_max']:.3f} % of the bbox "

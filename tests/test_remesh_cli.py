@@ -104,3 +104,39 @@ def test_parameterization_without_uv_location_is_refused_not_ignored(tmp_path, c
     assert rc == 1
     assert "--parameterization lscm applies to --location uv only" in capsys.readouterr().err
     assert os.listdir(tmp_path) == []
+
+
+def test_no_evaluate_skips_the_measurements(tmp_path, capsys):
+    out, rep = tmp_path / "o.ply", tmp_path / "r.json"
+    rc = main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(out), "--target-edge", "3",
+               "--no-evaluate", "--report", str(rep), "--quiet"])
+    assert rc == 0
+    report = json.loads(rep.read_text())
+    assert "error" not in report and report["seconds"]["evaluate"] == 0.0
+    assert report["target"]["vertices"] == read_mesh(str(out))[0].shape[0]
+    assert "vertices; not measured (--no-evaluate)" in capsys.readouterr().out
+
+
+def test_no_evaluate_with_an_image_is_refused_before_the_work(tmp_path, capsys):
+    rc = main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "o.ply"),
+               "--no-evaluate", "--image", str(tmp_path / "f.png"), "--quiet"])
+    assert rc == 1
+    assert "--image shows the measured distances" in capsys.readouterr().err
+    assert os.listdir(tmp_path) == []
+
+
+def test_a_target_edge_asking_for_a_big_mesh_is_announced(tmp_path, capsys, monkeypatch):
+    # the nose at 0.1 % took ~10 minutes without a word; the note comes before the work
+    import curvdetail.cli as cli
+
+    monkeypatch.setattr(cli, "BIG_TARGET", 1_000)
+    rc = main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "o.ply"), "--target-edge", "2",
+               "--no-evaluate"])
+    err = capsys.readouterr().err
+    assert rc == 0
+    assert "note: a 2 % target edge gives about " in err and "target vertices; this takes minutes." in err
+    assert err.index("note:") < err.index("[1/3] retriangulate")
+    monkeypatch.setattr(cli, "BIG_TARGET", 1_000_000)
+    main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "p.ply"), "--target-edge", "2",
+          "--no-evaluate"])
+    assert "note:" not in capsys.readouterr().err
