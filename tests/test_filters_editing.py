@@ -47,6 +47,24 @@ def test_handles_follow_the_transform_and_unselected_vertices_stay():
     assert figures["amplification"] == pytest.approx(1.0, abs=0.05)   # nothing outruns a translation
 
 
+def test_python_callers_may_pass_handles_and_transform_as_arrays():
+    # as pymeshlab takes a matrix parameter: the same edit as from the texts, digit for digit
+    T = np.eye(4)
+    T[:3, :3] = [[np.cos(0.3), -np.sin(0.3), 0.0], [np.sin(0.3), np.cos(0.3), 0.0], [0.0, 0.0, 1.0]]
+    T[:3, 3] = [0.01, 0.0, 0.02 / 3.0]
+    ms_text, V, d, handles = _meshset_with_roi()
+    apply(ms_text, "apply_curvature_editing", handles=" ".join(map(str, handles)),
+          transform=" ".join(map(repr, T.ravel().tolist())))
+    ms_array, *_ = _meshset_with_roi()
+    apply(ms_array, "apply_curvature_editing", handles=handles, transform=T)
+    ms_list, *_ = _meshset_with_roi()
+    apply(ms_list, "apply_curvature_editing", handles=handles.tolist(), transform=T.tolist())
+    X = ms_text.current_mesh().vertex_matrix()
+    assert np.abs(X - V).max() > 1e-3                    # it did move
+    assert np.array_equal(ms_array.current_mesh().vertex_matrix(), X)
+    assert np.array_equal(ms_list.current_mesh().vertex_matrix(), X)
+
+
 def test_identity_edit_leaves_the_mesh_in_place():
     ms, V, d, handles = _meshset_with_roi()
     apply(ms, "apply_curvature_editing", handles=",".join(map(str, handles)))

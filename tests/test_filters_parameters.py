@@ -141,3 +141,21 @@ def test_declaration_needs_known_type_and_description():
         Parameter("x", "double", 1.0, "d")
     with pytest.raises(TypeError, match="description"):
         Parameter("x", "float", 1.0, " ")
+
+
+def test_enum_takes_its_index_from_python_as_pymeshlab_does():
+    p = Parameter("rows", "str", "all", "rows", choices=("all", "free"))
+    assert p.check(1) == "free" and p.check(np.int64(0)) == "all"
+    for bad in (2, -1, True):
+        with pytest.raises(FilterParameterError, match=r"'rows'.*one of all, free, or its index"):
+            p.check(bad)
+
+
+def test_text_parameter_takes_a_sequence_of_numbers_digit_for_digit():
+    p = Parameter("transform", "str", "", "numbers")
+    assert p.check([1, 2, 3]) == "1 2 3"
+    assert p.check(np.array([[0.1, 1 / 3], [2.0, 5.0]])) == "0.1 0.3333333333333333 2.0 5.0"
+    assert [float(t) for t in p.check(np.array([np.pi])).split()] == [np.pi]
+    for bad in ([True, 2], [[1, 2], [3]], ["1", 2], object()):
+        with pytest.raises(FilterParameterError, match="'transform' expects a str"):
+            p.check(bad)

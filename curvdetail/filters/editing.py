@@ -68,13 +68,15 @@ def _matrix(text):
         editing".
     """,
     parameters=[
-        Parameter("handles", "str", "", "handle vertex indices, separated by spaces or commas"),
+        Parameter("handles", "str", "", "handle vertex indices, separated by spaces or commas "
+                  "(from Python also a list or array)"),
         Parameter("region_radius", "PercentageValue", BBoxLength(0.0, percent=True),
                   "also put every vertex within this distance of a handle into the region of "
                   "interest (0: the selection alone); a percentage of the bbox diagonal or absolute",
                   min=0.0),
         Parameter("transform", "str", IDENTITY,
-                  "4x4 handle transform, 16 numbers row by row, applied to homogeneous positions"),
+                  "4x4 handle transform, 16 numbers row by row, applied to homogeneous positions "
+                  "(from Python also a 4x4 array)"),
         Parameter("detail_scale", "float", 1.0,
                   "factor on the handles' curvature normals after the transform (1 keeps them)",
                   positive=True),

@@ -50,6 +50,17 @@ class BBoxLength:
         return f"{self.value!r}%" if self.percent else repr(self.value)
 
 
+def _numbers_as_text(value):
+    """A list, tuple or array of real numbers (``handles=[1, 2, 3]``, ``transform=np.eye(4)``)
+    as the space-separated text the str parameters take (row by row, every digit kept);
+    anything else unchanged."""
+    if isinstance(value, (list, tuple, np.ndarray)):
+        arr = np.asarray(value, dtype=object).ravel() if not isinstance(value, np.ndarray) else value.ravel()
+        if arr.size and all(isinstance(x, numbers.Real) and not isinstance(x, (bool, np.bool_)) for x in arr.tolist()):
+            return " ".join(repr(x) if isinstance(x, float) else str(x) for x in arr.tolist())
+    return value
+
+
 @dataclass(frozen=True)
 class Parameter:
     """One typed filter parameter (see the module docstring for the types).
@@ -112,8 +123,13 @@ class Parameter:
                 return self._range(self._finite(as_float(value)))
             raise self._fail(value, "a float")
         if t == "str":
+            if self.choices is not None and isinstance(value, numbers.Integral) \
+                    and not isinstance(value, (bool, np.bool_)) and 0 <= value < len(self.choices):
+                return self.choices[int(value)]           # an enum index, as pymeshlab takes it
+            if self.choices is None:
+                value = _numbers_as_text(value)
             if not isinstance(value, str):
-                raise self._fail(value, "a str" + (f" (one of {', '.join(self.choices)})"
+                raise self._fail(value, "a str" + (f" (one of {', '.join(self.choices)}, or its index)"
                                                    if self.choices else ""))
             if self.choices is not None:
                 for c in self.choices:
