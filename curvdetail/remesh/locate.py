@@ -221,7 +221,7 @@ def _locate_kdtree(P, V, F, candidates, chunk):
     for lo in range(0, k, chunk):
         hi = min(k, lo + chunk)
         Q = P[lo:hi]
-        _, near_v = tree_v.query(Q, k=1)
+        _, near_v = tree_v.query(Q, k=1, workers=-1)
         todo = np.arange(Q.shape[0])
         best_d = np.full(Q.shape[0], np.inf)
         # A second round with more centroids where the first is not certain: a triangle whose
@@ -230,7 +230,7 @@ def _locate_kdtree(P, V, F, candidates, chunk):
         # heuristic, exact on meshes of bounded triangle size variation).
         for c in (int(candidates), 4 * int(candidates)):
             c = min(c, F.shape[0])
-            dc, near_f = tree_c.query(Q[todo], k=c)
+            dc, near_f = tree_c.query(Q[todo], k=c, workers=-1)
             near_f = near_f.reshape(todo.size, c)
             dc = dc.reshape(todo.size, c)
             if c > candidates:   # second round: add the nearest vertex's triangles as well
@@ -281,48 +281,44 @@ def _closest_barycentric(P, T):
         return _closest_barycentric_all(P, T)
 
 
+def _dot(a, b):
+    """Row-wise dot product over the last axis (einsum: ~5x a product and a sum over 3 terms)."""
+    return np.einsum("...i,...i->...", a, b)
+
+
 def _closest_barycentric_all(P, T):
     A, B, C = T[..., 0, :], T[..., 1, :], T[..., 2, :]
     AB, AC, AP = B - A, C - A, P - A
-    d1 = (AB * AP).sum(-1)
-    d2 = (AC * AP).sum(-1)
+    d1 = _dot(AB, AP)
+    d2 = _dot(AC, AP)
     BP = P - B
-    d3 = (AB * BP).sum(-1)
-    d4 = (AC * BP).sum(-1)
+    d3 = _dot(AB, BP)
+    d4 = _dot(AC, BP)
     CP = P - C
-    d5 = (AB * CP).sum(-1)
-    d6 = (AC * CP).sum(-1)
+    d5 = _dot(AB, CP)
+    d6 = _dot(AC, CP)
     va = d3 * d6 - d5 * d4
     vb = d5 * d2 - d1 * d6
     vc = d1 * d4 - d3 * d2
     tiny = np.finfo(float).tiny
-    shape = d1.shape
-    u = np.empty(shape)
-    v = np.empty(shape)
-    w = np.empty(shape)
-    done = np.zeros(shape, dtype=bool)
-
-    def put(mask, uu, vv, ww):
-        m = mask & ~done
-        u[m], v[m], w[m] = uu[m], vv[m], ww[m]
-        done[m] = True
-
-    zeros, ones = np.zeros(shape), np.ones(shape)
-    put((d1 <= 0) & (d2 <= 0), ones, zeros, zeros)                       # vertex A
-    put((d3 >= 0) & (d4 <= d3), zeros, ones, zeros)                      # vertex B
-    put((d6 >= 0) & (d5 <= d6), zeros, zeros, ones)                      # vertex C
-    t = d1 / np.where(np.abs(d1 - d3) > tiny, d1 - d3, tiny)
-    put((vc <= 0) & (d1 >= 0) & (d3 <= 0), 1 - t, t, zeros)              # edge AB
-    t = d2 / np.where(np.abs(d2 - d6) > tiny, d2 - d6, tiny)
-    put((vb <= 0) & (d2 >= 0) & (d6 <= 0), 1 - t, zeros, t)              # edge AC
-    t = (d4 - d3) / np.where(np.abs((d4 - d3) + (d5 - d6)) > tiny, (d4 - d3) + (d5 - d6), tiny)
-    put((va <= 0) & ((d4 - d3) >= 0) & ((d5 - d6) >= 0), zeros, 1 - t, t)  # edge BC
+    # the Voronoi regions in Ericson's order; np.select takes the first that holds
+    t_ab = d1 / np.where(np.abs(d1 - d3) > tiny, d1 - d3, tiny)
+    t_ac = d2 / np.where(np.abs(d2 - d6) > tiny, d2 - d6, tiny)
+    t_bc = (d4 - d3) / np.where(np.abs((d4 - d3) + (d5 - d6)) > tiny, (d4 - d3) + (d5 - d6), tiny)
     s = va + vb + vc
     s = np.where(np.abs(s) > tiny, s, tiny)
-    put(np.ones(shape, dtype=bool), va / s, vb / s, vc / s)              # interior
+    regions = [(d1 <= 0) & (d2 <= 0),                                   # vertex A
+               (d3 >= 0) & (d4 <= d3),                                  # vertex B
+               (d6 >= 0) & (d5 <= d6),                                  # vertex C
+               (vc <= 0) & (d1 >= 0) & (d3 <= 0),                       # edge AB
+               (vb <= 0) & (d2 >= 0) & (d6 <= 0),                       # edge AC
+               (va <= 0) & ((d4 - d3) >= 0) & ((d5 - d6) >= 0)]         # edge BC
+    u = np.select(regions, [1.0, 0.0, 0.0, 1 - t_ab, 1 - t_ac, 0.0], default=va / s)   # else: interior
+    v = np.select(regions, [0.0, 1.0, 0.0, t_ab, 0.0, 1 - t_bc], default=vb / s)
+    w = np.select(regions, [0.0, 0.0, 1.0, 0.0, t_ac, t_bc], default=vc / s)
     bary = np.clip(np.stack([u, v, w], axis=-1), 0.0, 1.0)
     bary /= np.maximum(bary.sum(-1, keepdims=True), tiny)
-    X = (bary[..., :, None] * T).sum(-2)
+    X = np.einsum("...k,...kd->...d", bary, T)
     return bary, np.linalg.norm(X - P, axis=-1)
 
 
