@@ -450,7 +450,13 @@ def _run_command(parser):
 
 # --- edit (editing issue) -------------------------------------------------------------------
 
-@command("edit", help="deform a mesh with curvature-detail editing, given a benchmark .sel/.def pair")
+#: Exit status of ``curvdetail edit`` when OUTPUT is written but vertices moved more than three
+#: times as far as the handles (the warning says so; scripts can tell it from a clean edit).
+AMPLIFIED = 4
+
+
+@command("edit", help="deform a mesh with curvature-detail editing, given a benchmark .sel/.def pair "
+                      "(exit status 4: written, but the edit amplified the handles' motion)")
 def _edit_command(parser):
     parser.add_argument("mesh", metavar="MESH", help="mesh file (vertex order must match SEL)")
     parser.add_argument("output", metavar="OUTPUT", help="edited mesh; quality = distance moved")
@@ -522,6 +528,7 @@ def _edit_command(parser):
                   "(ill-conditioned coefficients, see docs/editing.md); try --relations one+two-ring "
                   "or --handle-detail free.",
                   file=sys.stderr)
+            return AMPLIFIED
         return 0
 
     return run

@@ -69,3 +69,25 @@ def test_malformed_selection_fails_cleanly_and_leaves_no_output(tmp_path, capsys
     err = capsys.readouterr().err
     assert rc == 1 and err.startswith("curvdetail: error:") and "line 4" in err
     assert not out.exists()
+
+
+def test_an_amplified_edit_is_written_with_exit_status_4(tmp_path, capsys, monkeypatch):
+    # the cactus benchmark with its default options moved vertices by 19x the bbox diagonal and
+    # exited 0: a script could not tell; the same result is now written with status 4
+    import curvdetail.deformation_benchmark as benchmark
+
+    V, F, status, T, p = _case(tmp_path)
+    real = benchmark.edit_with_selection
+
+    def blown_up(*args, **kwargs):
+        X, editor = real(*args, **kwargs)
+        X = X.copy()
+        X[status == 1] += [0.0, 0.0, 50.0]          # free vertices far beyond the handle motion
+        return X, editor
+
+    monkeypatch.setattr(benchmark, "edit_with_selection", blown_up)
+    out = tmp_path / "out.ply"
+    rc = main(["edit", str(p["off"]), "--sel", str(p["sel"]), "--def", str(p["def"]), str(out)])
+    assert rc == 4
+    assert "warning: vertices moved up to" in capsys.readouterr().err
+    assert read_mesh(str(out))[0].shape == V.shape
