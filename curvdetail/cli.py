@@ -384,13 +384,18 @@ def _run_on_file(args, work):
     as JSON, save the current mesh (quality and curvature attributes kept in PLY)."""
     import json
 
-    from .filters.files import check_output_path, load_meshset, save_current_mesh
+    from .filters.files import attributes_lost_in, check_output_path, load_meshset, save_current_mesh
 
     check_output_path(args.output, args.overwrite)
     ms = load_meshset(args.input, *args.add)
     figures = work(ms)
     save_current_mesh(ms, args.output, overwrite=args.overwrite)
     print(json.dumps(figures, indent=2, default=str))
+    lost = attributes_lost_in(ms, args.output)
+    if lost:
+        # documented, but the next step ("no attribute 'curvature_detail'") is confusing without it
+        print(f"curvdetail: note: {os.path.basename(args.output)} holds the geometry only; the attributes "
+              f"{', '.join(lost)} are kept by PLY output.", file=sys.stderr)
     return 0
 
 

@@ -66,6 +66,15 @@ def test_apply_writes_ply_with_attributes_and_prints_figures(capsys, tmp_path):
     assert ms.current_mesh().has_vertex_scalar()
 
 
+def test_apply_to_a_format_without_attributes_says_what_is_left_out(capsys, tmp_path):
+    rc, _, err = run_cli(capsys, "apply", "compute_curvature_detail", NOSE, tmp_path / "d.obj")
+    assert rc == 0
+    assert ("note: d.obj holds the geometry only; the attributes curvature_area, curvature_detail, "
+            "curvature_normal, curvature_vertex_id are kept by PLY output.") in err
+    rc, _, err = run_cli(capsys, "apply", "compute_curvature_detail", NOSE, tmp_path / "d.ply")
+    assert rc == 0 and "note:" not in err
+
+
 def vertices(path):
     ms = load_meshset(path)          # keep the MeshSet alive while its mesh is read
     return ms.current_mesh().vertex_matrix().copy()

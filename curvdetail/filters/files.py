@@ -72,6 +72,16 @@ def save_options(ms, path):
     return options
 
 
+def attributes_lost_in(ms, path):
+    """Names of the filters' custom attributes on the current mesh that ``path``'s format does
+    not hold (all of them but for PLY), sorted."""
+    if os.path.splitext(os.fspath(path))[1].lower() == ".ply":
+        return []
+    mid = ms.current_mesh_id()
+    return [name for name, kind in sorted(WRITTEN_ATTRIBUTES.items())
+            if vertex_attribute(ms, mid, name, kind) is not None]
+
+
 def save_current_mesh(ms, path, *, overwrite=False):
     """Atomically save the current mesh of ``ms`` (see the module docstring for what is kept).
 
