@@ -171,7 +171,12 @@ def boundary_loop(F):
     MeshError   the mesh has no boundary, several loops, or a vertex where the boundary
                 touches itself
     """
-    E = boundary_edges(np.asarray(F))
+    return loop_of_boundary_edges(boundary_edges(np.asarray(F)))
+
+
+def loop_of_boundary_edges(E):
+    """:func:`boundary_loop` from the boundary edges ``E`` (k, 2) of :func:`boundary_edges`
+    (for callers that have them: finding them sorts every half-edge of the mesh)."""
     if E.shape[0] == 0:
         raise MeshError("the mesh is closed (no boundary loop); shape editing of a boundary needs "
                         "a patch with one boundary loop.")

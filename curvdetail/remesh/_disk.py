@@ -11,7 +11,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from ..curvature._validate import boundary_edges, check_mesh, non_manifold_edges, vertex_components
-from ..curvature.boundary_editing import boundary_loop
+from ..curvature.boundary_editing import loop_of_boundary_edges
 from ..curvature.errors import MeshError, first_indices
 
 
@@ -80,7 +80,7 @@ def check_disk(V, F, what="the source"):
     if chi != 1:
         raise NotADiskError(f"{what} has one boundary loop but Euler characteristic {chi} "
                             f"({(1 - chi) // 2} handles); {need}.")
-    return V, F, boundary_loop(F)
+    return V, F, loop_of_boundary_edges(B)
 
 
 class Polyline:
