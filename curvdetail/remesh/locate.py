@@ -31,10 +31,10 @@ def locate(points, V, F, *, engine="auto", candidates=8, chunk=20_000):
 
     Engines: ``"numpy"``: candidate triangles from a ``cKDTree`` of centroids (plus the nearest
     vertex's triangles in a second round where the first is not certain), exact closest point on
-    each (Ericson's region tests, all in numpy). ``"auto"``: in the plane the numpy engine
-    (matplotlib's trapezoid-map point location took 4.7 s at 100k points and 74 s at 1M, against
-    1.1 and 13 s); in space pymeshlab's ``transfer_attributes_per_vertex`` (a uniform grid, C++)
-    for the nearest face, then the exact barycentric coordinates of the closest point in that face.
+    each (Ericson's region tests, all in numpy). ``"auto"``: in the plane matplotlib's
+    trapezoid-map point location (C++) with the numpy engine for the points it finds outside;
+    in space pymeshlab's ``transfer_attributes_per_vertex`` (a uniform grid, C++) for the
+    nearest face, then the exact barycentric coordinates of the closest point in that face.
     Points more than ``FAR_POINTS`` bbox diagonals outside the mesh's bounding box always go to
     the numpy engine (pymeshlab's grid search slows down with the distance, without bound).
     Everything is computed in a frame where the mesh has unit size, so the scale and position
@@ -81,16 +81,16 @@ def _locate(P, V, F, engine="auto", candidates=8, chunk=20_000):
     """:func:`locate` on arrays that passed :func:`check_points_and_mesh`."""
     if P.shape[0] == 0:
         return np.empty(0, dtype=np.int64), np.empty((0, 3)), np.empty(0)
-    # in a frame where the mesh has unit size at the origin: the grid and the closest-point
-    # arithmetic then work alike for meshes of any scale and position
+    # in a frame where the mesh has unit size at the origin: the grid, the trapezoid map and
+    # the closest-point arithmetic then work alike for meshes of any scale and position
     P, V, scale = _unit_frame(P, V)
-    if engine == "numpy" or V.shape[1] == 2:
+    if engine == "numpy":
         face, bary, dist = _locate_kdtree(P, V, F, candidates, chunk)
         return face, bary, dist * scale
     face = np.full(P.shape[0], -1, dtype=np.int64)
     near = np.flatnonzero(_box_gap(P, V) <= FAR_POINTS)
     if near.size:
-        face[near] = _nearest_face_meshlab(P[near], V, F)
+        face[near] = _trifinder(P[near], V, F) if V.shape[1] == 2 else _nearest_face_meshlab(P[near], V, F)
     bad = face < 0
     face = np.where(bad, 0, face)
     bary, dist = _closest_barycentric(P[:, None, :], V[F[face]][:, None])
@@ -172,6 +172,18 @@ def _box_gap(P, V):
     """Distance of each point from the bounding box of ``V`` (0 inside), shape (k,)."""
     lo, hi = V.min(axis=0), V.max(axis=0)
     return np.linalg.norm(np.maximum(np.maximum(lo - P, P - hi), 0.0), axis=1)
+
+
+def _trifinder(P, V, F):
+    """Containing triangle per planar point (-1 outside or where matplotlib cannot build its
+    trapezoid map, e.g. over flipped triangles)."""
+    from matplotlib.tri import Triangulation, TrapezoidMapTriFinder
+
+    try:
+        finder = TrapezoidMapTriFinder(Triangulation(V[:, 0], V[:, 1], F))
+        return np.asarray(finder(P[:, 0], P[:, 1]), dtype=np.int64)
+    except (RuntimeError, ValueError):
+        return np.full(P.shape[0], -1, dtype=np.int64)
 
 
 def _nearest_face_meshlab(P, V, F):
