@@ -239,6 +239,8 @@ def test_unknown_backend_is_refused_before_computing_coefficients(plane_grid, mo
         CurvatureEditor(V, F, b, b, backend="umfpack")
 
 
+@pytest.mark.skipif("pardiso" not in sparse_solver.available_backends(),
+                    reason="without PARDISO both sides of the size rule are SuperLU")
 def test_auto_curvature_backend_follows_the_size_rule(monkeypatch):
     # SuperLU below CURVATURE_SPLU_MAX unknowns (faster back-substitution), the general choice
     # from it on (SuperLU's factorization grew 24 s at 1M against PARDISO's 8.5 s); same result
@@ -255,3 +257,8 @@ def test_auto_curvature_backend_follows_the_size_rule(monkeypatch):
     assert small.backend["curvature"] == "splu"
     assert large.backend["curvature"] == resolve_backend("auto", symmetric=False, size=10**6, nnz=10**7)
     assert np.abs(small.solve() - large.solve()).max() < 1e-9 * _diag(V)
+    # "AUTO" and CURVDETAIL_SOLVER=auto leave the choice to the rule as "auto" does
+    monkeypatch.setattr(editor_module, "CURVATURE_SPLU_MAX", 300_000)
+    assert CurvatureEditor(V, F, b, b, backend="AUTO").backend["curvature"] == "splu"
+    monkeypatch.setenv("CURVDETAIL_SOLVER", "auto")
+    assert CurvatureEditor(V, F, b, b).backend["curvature"] == "splu"

@@ -156,6 +156,9 @@ def test_text_parameter_takes_a_sequence_of_numbers_digit_for_digit():
     assert p.check([1, 2, 3]) == "1 2 3"
     assert p.check(np.array([[0.1, 1 / 3], [2.0, 5.0]])) == "0.1 0.3333333333333333 2.0 5.0"
     assert [float(t) for t in p.check(np.array([np.pi])).split()] == [np.pi]
+    # a list of numpy scalars (numpy 2 writes np.float64(1.0) as "np.float64(1.0)")
+    assert p.check(list(np.eye(2).ravel())) == "1.0 0.0 0.0 1.0"
+    assert p.check([np.int64(3), np.int32(4), np.float32(0.5)]) == "3 4 0.5"
     for bad in ([True, 2], [[1, 2], [3]], ["1", 2], object()):
         with pytest.raises(FilterParameterError, match="'transform' expects a str"):
             p.check(bad)

@@ -1,6 +1,5 @@
 """Two-stage mesh editing with curvature coefficients (the paper's Sections 3.1-3.2)."""
 
-import os
 import time
 
 import numpy as np
@@ -12,7 +11,7 @@ from .cotan_laplacian import checked_cotan_laplacian
 from .curvature_coefficients import DEFAULT_RCOND, _coefficients, _one_ring_pairs, check_rcond
 from .errors import ConstraintError, first_indices
 from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
-from .sparse_solver import factorize, resolve_backend
+from .sparse_solver import _chosen_automatically, factorize, resolve_backend
 
 
 RELATIONS = ("one-ring", "one+two-ring")
@@ -75,9 +74,10 @@ class CurvatureEditor:
                                 denser factorization
     rcond : float               singular-value threshold of :func:`curvature_coefficients`
     backend : str               sparse solver backend ("auto", "pardiso", "cholmod", "splu", "banded");
-                                with "auto" the curvature stage uses SuperLU (fastest
-                                back-substitution for ``(I - C)`` here), the embedding the core's
-                                automatic choice
+                                with "auto" the curvature stage uses SuperLU below
+                                :data:`CURVATURE_SPLU_MAX` unknowns (fastest back-substitution
+                                for ``(I - C)`` there) and the core's automatic choice from there,
+                                the embedding the core's automatic choice
 
     Attributes
     ----------
@@ -200,8 +200,7 @@ class CurvatureEditor:
         self._fd, self._dc = fd, dc
         at_fd = _positions_in(fd, n)
         at_dc = _positions_in(dc, n)
-        curv_backend = "splu" if backend == "auto" and not os.environ.get("CURVDETAIL_SOLVER") \
-            and fd.size < CURVATURE_SPLU_MAX else backend
+        curv_backend = "splu" if _chosen_automatically(backend) and fd.size < CURVATURE_SPLU_MAX else backend
         if relations == "one+two-ring":
             self._stacked_system(D, in_roi, fd, dc, at_fd, at_dc, (rows, cols, cvals),
                                  (rows2, cols2, cvals2), backend)

@@ -57,7 +57,9 @@ def _numbers_as_text(value):
     if isinstance(value, (list, tuple, np.ndarray)):
         arr = np.asarray(value, dtype=object).ravel() if not isinstance(value, np.ndarray) else value.ravel()
         if arr.size and all(isinstance(x, numbers.Real) and not isinstance(x, (bool, np.bool_)) for x in arr.tolist()):
-            return " ".join(repr(x) if isinstance(x, float) else str(x) for x in arr.tolist())
+            # numbers as Python writes them: numpy 2's repr of np.float64(1.0) is "np.float64(1.0)"
+            return " ".join(str(int(x)) if isinstance(x, numbers.Integral) else repr(float(x))
+                            for x in arr.tolist())
     return value
 
 
