@@ -22,6 +22,19 @@ def command(name, help):
     return register
 
 
+def _say(text, stream=None, end="\n"):
+    """Write a progress line, note or warning to stderr; False (and nothing raised) when the
+    reader has gone away: such lines must not end a run whose outputs are still to be written
+    (`curvdetail remesh ... 2>&1 | head` would otherwise stop half-way with status 0)."""
+    stream = stream or sys.stderr
+    try:
+        stream.write(text + end)
+        stream.flush()
+        return True
+    except (BrokenPipeError, ValueError):       # ValueError: the stream was closed
+        return False
+
+
 class Progress:
     """Stage-by-stage progress on stderr: ``[2/5] parameterize ... 0.41 s``."""
 
@@ -35,13 +48,11 @@ class Progress:
         self.done += 1
         self._t = time.perf_counter()
         if self.enabled:
-            self.stream.write(f"[{self.done}/{self.total}] {name} ...")
-            self.stream.flush()
+            self.enabled = _say(f"[{self.done}/{self.total}] {name} ...", self.stream, end="")
 
     def _finish(self):
         if self._t is not None and self.enabled:
-            self.stream.write(f" {time.perf_counter() - self._t:.2f} s\n")
-            self.stream.flush()
+            self.enabled = _say(f" {time.perf_counter() - self._t:.2f} s", self.stream)
         self._t = None
 
     def close(self):
@@ -97,7 +108,7 @@ def _vertex_indices(text):
 
 
 def add_fix_arguments(parser):
-    parser.add_argument("--fix", type=_vertex_indices, nargs="*", default=None, metavar="I",
+    parser.add_argument("--fix", type=_vertex_indices, nargs="*", action="extend", default=None, metavar="I",
                         help="vertex indices to keep fixed, e.g. --fix 0 17 42 or --fix 0,17,42 "
                              "(default: the boundary; a closed piece needs some)")
     parser.add_argument("--fix-boundary", action="store_true",
@@ -217,17 +228,17 @@ def _note_a_big_target(V, F, args):
     import numpy as np
 
     from .curvature._validate import bbox_diagonal
-    from .remesh.retriangulate import estimated_vertices
+    from .remesh.retriangulate import MAX_VERTICES, estimated_vertices
 
     try:
         with np.errstate(all="ignore"):
             count = float(estimated_vertices(V, F, args.target_edge / 100.0 * bbox_diagonal(V)))
     except (ValueError, IndexError, ArithmeticError):
         return
-    if BIG_TARGET < count < float("inf"):
+    if BIG_TARGET < count <= MAX_VERTICES:           # beyond, retriangulate refuses it at once
         skip = "" if args.no_evaluate else " (the measurements most of it; --no-evaluate skips them)"
-        sys.stderr.write(f"note: a {args.target_edge:g} % target edge gives about {count:,.0f} target vertices; "
-                         f"this takes minutes{skip}.\n")
+        _say(f"note: a {args.target_edge:g} % target edge gives about {count:,.0f} target vertices; "
+             f"this takes minutes{skip}.")
 
 
 def _percentage(text):
@@ -394,8 +405,8 @@ def _run_on_file(args, work):
     lost = attributes_lost_in(ms, args.output)
     if lost:
         # documented, but the next step ("no attribute 'curvature_detail'") is confusing without it
-        print(f"curvdetail: note: {os.path.basename(args.output)} holds the geometry only; the attributes "
-              f"{', '.join(lost)} are kept by PLY output.", file=sys.stderr)
+        _say(f"curvdetail: note: {os.path.basename(args.output)} holds the geometry only; the attributes "
+             f"{', '.join(lost)} are kept by PLY output.")
     return 0
 
 
@@ -528,11 +539,10 @@ def _edit_command(parser):
               f"vertices; {seconds:.3f} s")
         handle_move = moved[status == 2].max()
         if moved.max() > 3.0 * handle_move + 1e-12 * bbox_diagonal(V):
-            print(f"curvdetail: warning: vertices moved up to {moved.max() / max(handle_move, 1e-300):.1f} "
-                  "times as far as the handles: the curvature stage amplified the handle details "
-                  "(ill-conditioned coefficients, see docs/editing.md); try --relations one+two-ring "
-                  "or --handle-detail free.",
-                  file=sys.stderr)
+            _say(f"curvdetail: warning: vertices moved up to {moved.max() / max(handle_move, 1e-300):.1f} "
+                 "times as far as the handles: the curvature stage amplified the handle details "
+                 "(ill-conditioned coefficients, see docs/editing.md); try --relations one+two-ring "
+                 "or --handle-detail free.")
             return AMPLIFIED
         return 0
 
@@ -577,16 +587,18 @@ def main(argv=None):
     try:
         return int(args._run(args) or 0)
     except KeyboardInterrupt:
-        print("curvdetail: interrupted", file=sys.stderr)
+        _say("curvdetail: interrupted")
         return 130
     except BrokenPipeError:
-        # the reader went away (`curvdetail list | head`): not an error of ours, as for cat(1);
-        # stdout is pointed at /dev/null so that Python's final flush does not fail again
+        # the reader of stdout went away (`curvdetail list | head`): not an error of ours, as for
+        # cat(1); stdout carries only the final figures, written after every output file (stderr
+        # lines go through _say, which never raises); stdout is pointed at /dev/null so that
+        # Python's final flush does not fail again
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
     except (ValueError, OSError, RuntimeError) as exc:
         message = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        print(f"curvdetail: error: {message}", file=sys.stderr)
+        _say(f"curvdetail: error: {message}")
         return 1
 
 

@@ -206,6 +206,8 @@ def test_fix_takes_commas_and_adds_the_boundary_when_asked(tmp_path, capsys):
     nb = boundary_vertices(F).size
     assert main(["reconstruct", NOSE, str(tmp_path / "a.ply"), "--fix", "0,5", "9"]) == 0
     assert "3 fixed" in capsys.readouterr().out
+    assert main(["reconstruct", NOSE, str(tmp_path / "r.ply"), "--fix", "0", "--fix", "5,9"]) == 0
+    assert "3 fixed" in capsys.readouterr().out            # a repeated --fix adds, not replaces
     assert main(["reconstruct", NOSE, str(tmp_path / "b.ply"), "--fix", "300", "--fix-boundary"]) == 0
     assert f"{nb + 1} fixed" in capsys.readouterr().out      # vertex 300 is inside
 

@@ -258,3 +258,22 @@ def test_list_into_a_closed_pipe_exits_quietly():
         os.close(write_end)
     assert done.returncode == 0
     assert done.stderr == b""
+
+
+def test_a_closed_stderr_does_not_stop_the_work(tmp_path):
+    # `curvdetail remesh ... 2>&1 | head -c 10`: the progress line met the closed pipe and the
+    # run ended with status 0 and no output file; progress and notes now give up quietly
+    import subprocess
+    import sys
+
+    read_end, write_end = os.pipe()
+    os.close(read_end)
+    out = tmp_path / "o.ply"
+    try:
+        done = subprocess.run([sys.executable, "-m", "curvdetail", "remesh", NOSE, str(out), "--target-edge", "6",
+                               "--method", "decimate", "--no-evaluate"],
+                              stdout=subprocess.PIPE, stderr=write_end, timeout=300)
+    finally:
+        os.close(write_end)
+    assert done.returncode == 0 and out.exists()
+    assert b"vertices; not measured" in done.stdout
