@@ -70,7 +70,7 @@ def test_apply_to_a_format_without_attributes_says_what_is_left_out(capsys, tmp_
     rc, _, err = run_cli(capsys, "apply", "compute_curvature_detail", NOSE, tmp_path / "d.obj")
     assert rc == 0
     assert ("note: d.obj holds the geometry only; the attributes curvature_area, curvature_detail, "
-            "curvature_normal, curvature_vertex_id are kept by PLY output.") in err
+            "curvature_normal, curvature_vertex_id, curvature_vertex_ring are kept by PLY output.") in err
     rc, _, err = run_cli(capsys, "apply", "compute_curvature_detail", NOSE, tmp_path / "d.ply")
     assert rc == 0 and "note:" not in err
 

@@ -41,7 +41,7 @@ BACKEND_DESCRIPTION = "sparse solver backend; " + AUTO_RULE
 def apply_curvature_reconstruction(ms, *, rows, fix_boundary, fix_selected, backend):
     mid = layer_id(ms)
     V, F = mesh_arrays(ms, mid)
-    D = load_detail(ms, mid)
+    D = load_detail(ms, mid, F)
     parts = []
     if fix_boundary:
         parts.append(boundary_vertices(F))

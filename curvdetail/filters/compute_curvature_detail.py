@@ -44,7 +44,7 @@ def compute_curvature_detail(ms):
     A = _mixed_voronoi_area_unchecked(V, F)        # = mixed_voronoi_area(V, F)
     K = D / A[:, None]                             # = mean_curvature_normal(V, F)[0], bit for bit
     H = signed_mean_curvature(V, F, K)
-    store_detail(ms, mid, D, K, A)
+    store_detail(ms, mid, F, D, K, A)
     set_vertex_quality(ms, mid, H)
     boundary = boundary_vertices(F)
     interior = np.ones(V.shape[0], dtype=bool)

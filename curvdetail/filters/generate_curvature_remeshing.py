@@ -2,7 +2,7 @@
 
 from ..curvature._validate import bbox_diagonal
 from .apply_curvature_reconstruction import BACKEND_DESCRIPTION, BACKENDS
-from .detail_attributes import DETAIL, VERTEX_ID, stamp
+from .detail_attributes import DETAIL, stamp
 from .meshset import add_layer, get_mesh, layer_id, mesh_arrays
 from .parameters import BBoxLength, Parameter
 from .registry import PAPER, filter
@@ -66,7 +66,7 @@ def generate_curvature_remeshing(ms, *, method, target_edge, transfer, rows, loc
         layers["zero_detail"] = add_layer(ms, result["Z"], Ft, f"{label} zero detail",
                                           quality=result["zero_distance"])
     layers["rebuilt"] = add_layer(ms, result["X"], Ft, f"{label} rebuilt", quality=result["distance"],
-                                  attributes={DETAIL: result["Dt"], VERTEX_ID: stamp(result["X"].shape[0])})
+                                  attributes={DETAIL: result["Dt"], **stamp(Ft, result["X"].shape[0])})
     report = dict(result["report"])
     report["layers"] = layers
     return report

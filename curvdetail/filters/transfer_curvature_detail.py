@@ -64,7 +64,7 @@ def transfer_curvature_detail(ms, *, sourcemesh, targetmesh, method, location, p
     Dt = transfer_curvature(Vs, Fs, Vt, Ft, method=method, location=location, uv=uv)
     At = mixed_voronoi_area(Vt, Ft)
     Kt = Dt / At[:, None]
-    store_detail(ms, target, Dt, Kt, At)
+    store_detail(ms, target, Ft, Dt, Kt, At)
     set_vertex_quality(ms, target, signed_mean_curvature(Vt, Ft, Kt))
     Ds = curvature_detail(Vs, Fs)
     scale = max(np.abs(Ds).sum(), np.finfo(float).tiny)
