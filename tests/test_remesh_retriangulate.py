@@ -148,3 +148,12 @@ def test_out_of_range_remesher_options_are_refused_before_remeshing(load_mesh, k
     V, F = load_mesh("mannequin_nose.obj")
     with pytest.raises(RemeshError, match=words):
         retriangulate(V, F, **{"target_edge": 0.05, **kwargs})
+
+
+def test_decimation_keeps_the_source_boundary_vertices_bit_for_bit(load_mesh):
+    # preserve_border keeps them; the decimation frame's round trip must not move them by rounding
+    V, F = load_mesh("mannequin_ear.obj")
+    Vt, Ft = retriangulate(V, F, method="decimate", target_edge=0.03)
+    _, _, loop = check_disk(V, F)
+    _, _, loop_t = check_disk(Vt, Ft)
+    assert sorted(map(tuple, Vt[loop_t])) == sorted(map(tuple, V[loop]))

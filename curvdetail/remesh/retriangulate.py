@@ -140,7 +140,22 @@ def retriangulate(V, F, *, method="isotropic", target_edge=0.01, iterations=10, 
             raise RemeshError(f"{exc} Try another target edge.") from None
     else:
         Ut, Ft, loop_t = _decimate(unit, F, target_edge, aggressiveness)
-    return _snap_boundary(V, loop, Ut * d + center, Ft, loop_t, d, h)
+    Vt = Ut * d + center
+    if method == "decimate":
+        Vt = _restore_kept_vertices(V, Vt, d)
+    return _snap_boundary(V, loop, Vt, Ft, loop_t, d, h)
+
+
+def _restore_kept_vertices(V, Vt, d):
+    """``Vt`` with every vertex the decimation left in place (within rounding of the frame's
+    round trip, 1e-12 of the diagonal) set back to its source coordinates exactly."""
+    from scipy.spatial import cKDTree
+
+    dist, nearest = cKDTree(V).query(Vt, k=1, workers=-1)
+    kept = dist <= 1e-12 * d
+    Vt = Vt.copy()
+    Vt[kept] = V[nearest[kept]]
+    return Vt
 
 
 def _check_aggressiveness(value):
