@@ -183,7 +183,7 @@ def _minimal_command(parser):
     from .curvature.minimal_surface import DEFAULT_TOL
 
     parser.add_argument("--tol", type=float, default=DEFAULT_TOL,
-                        help="stop when no vertex moves more than TOL x bbox diagonal normal to the "
+                        help="stop when no vertex moves more than TOL x the bbox diagonal of its piece normal to the "
                              f"surface in a step (tangential sliding is not counted; default {DEFAULT_TOL:g})")
     add_fix_arguments(parser)
     add_backend_argument(parser)

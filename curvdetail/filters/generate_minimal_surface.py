@@ -19,7 +19,7 @@ from .registry import PAPER, filter
         Generate the minimal surface spanned by the current mesh's boundary: zero curvature
         detail (D = 0) with the boundary vertices fixed, found by cotangent-harmonic steps with the
         weights recomputed from the current surface (Pinkall and Polthier 1993) until no vertex
-        moves more than tol times the bounding-box diagonal normal to the surface in a step
+        moves more than tol times the bounding-box diagonal of its piece normal to the surface in a step
         (vertices keep sliding within the surface on irregular meshes; that is not counted, and
         last_step is this normal step). It is the paper's validity check
         and the zero-detail baseline of the remeshing experiment. The result is added as a new
@@ -29,7 +29,7 @@ from .registry import PAPER, filter
     parameters=[
         Parameter("max_iterations", "int", 200, "Pinkall-Polthier steps at most", min=1),
         Parameter("tol", "float", DEFAULT_TOL,
-                  "stop when no vertex moves more than tol x the bbox diagonal normal to the "
+                  "stop when no vertex moves more than tol x its piece's bbox diagonal normal to the "
                   "surface in a step (tangential sliding is not counted)", positive=True),
         Parameter("backend", "str", "auto", BACKEND_DESCRIPTION, choices=BACKENDS),
     ],
