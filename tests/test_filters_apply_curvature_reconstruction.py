@@ -73,4 +73,3 @@ def test_missing_detail_attribute_says_what_to_run():
     with pytest.raises(FilterError, match="no per-vertex point attribute 'curvature_detail'; run "
                                           "compute_curvature_detail"):
         apply(meshset("mannequin_nose.obj"), "apply_curvature_reconstruction")
-

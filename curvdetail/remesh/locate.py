@@ -274,7 +274,8 @@ def _padded_rings(F, n):
 def _closest_barycentric(P, T):
     """Barycentric coordinates of the closest point of triangles ``T`` (..., 3, d) to points
     ``P`` (..., d), and the distance (Ericson, Real-Time Collision Detection, 5.1.5), vectorized.
-    Degenerate (zero-area) triangles fall back to their closest edge point."""
+    Zero-area triangles are not measured exactly (a collinear one can come out farther than it
+    is); every caller passes meshes whose triangles were checked to have area."""
     # every region's formula is evaluated for every point and only the right one kept: the
     # others may overflow or divide by ~0 (far points) and are discarded
     with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
