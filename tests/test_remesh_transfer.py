@@ -7,7 +7,7 @@ from curvdetail.curvature import curvature_detail, mixed_voronoi_area
 from curvdetail.curvature.errors import MeshError
 from curvdetail.curvature.testing import grid, icosphere
 from curvdetail.remesh import edge_curvature_measure, retriangulate, transfer_curvature
-from curvdetail.remesh._disk import boundary_loop
+from curvdetail.curvature import boundary_loop
 
 
 def _cap(radius=2.0):
