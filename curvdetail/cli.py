@@ -183,8 +183,9 @@ def _minimal_command(parser):
     from .curvature.minimal_surface import DEFAULT_TOL
 
     parser.add_argument("--tol", type=float, default=DEFAULT_TOL,
-                        help="stop when no vertex moves more than TOL x the bbox diagonal of its piece normal to the "
-                             f"surface in a step (tangential sliding is not counted; default {DEFAULT_TOL:g})")
+                        help="stop when no vertex moves more than TOL x the bbox diagonal of its piece "
+                             "normal to the surface in a step (tangential sliding is not counted; "
+                             f"default {DEFAULT_TOL:g})")
     add_fix_arguments(parser)
     add_backend_argument(parser)
     add_output_arguments(parser)
@@ -282,7 +283,6 @@ def _remesh_command(parser):
     def run(args):
         import contextlib
         import json
-        import os
 
         from ._output import atomic_output, check_output_path
         from .io import MeshFileError, read_mesh, write_mesh
@@ -441,7 +441,6 @@ def _run_command(parser):
     add_output_arguments(parser)
 
     def run(args):
-        import os
 
         from .filters import run_script
 
