@@ -1,0 +1,160 @@
+"""Speed and memory of the operations around the solver, each against its peer in the same run.
+
+The reconstruction solve has its own benchmark (bench_reconstruct.py). This one times, on a
+height-field grid of the given sizes (a second grid of half the vertices is the "target"
+mesh), each case in its own subprocess so that its peak RSS is its own:
+
+* ``edge_curvature_measure`` (the conservative transfer's measure) against the same sums
+  keyed by a row-wise ``np.unique(axis=0)``, the implementation it replaced;
+* the editor's curvature stage ``(I - C)``: SuperLU against PARDISO (``CurvatureEditor``'s
+  ``timings["curvature_setup"]`` and a three-column back-substitution), the two sides of the
+  size rule ``CURVATURE_SPLU_MAX``;
+* ``hausdorff`` with pymeshlab's engine against the kd-tree engine (1M samples each way);
+* ``locate`` of the target's vertices on the source: pymeshlab's grid ("auto") against the
+  numpy engine in space, matplotlib's trapezoid map ("auto") against the numpy engine in the
+  plane.
+
+Usage::
+
+    python scripts/bench_operations.py --sizes 100k --out out/bench_operations.json
+    python scripts/bench_operations.py --sizes 100k,1M --out out/bench_operations.json --force
+
+The machine's load average is recorded beside the times (the machine is shared).
+"""
+
+import argparse
+import json
+import os
+import platform
+import resource
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+SIDES = {"10k": 100, "100k": 316, "1M": 1000}
+CASES = {
+    "edge_measure": ("int64 keys", "np.unique(axis=0)"),
+    "curvature_stage": ("splu", "pardiso"),
+    "hausdorff": ("meshlab", "kdtree"),
+    "locate_3d": ("auto", "numpy"),
+    "locate_2d": ("auto", "numpy"),
+}
+
+
+def grid_surface(side):
+    from curvdetail.curvature.testing import grid
+
+    V, F = grid(side, side)
+    x, y = V[:, 0], V[:, 1]
+    V[:, 2] = 0.05 * np.sin(6 * np.pi * x) * np.cos(4 * np.pi * y) + 0.02 * np.sin(2 * np.pi * (7 * x + 5 * y))
+    return V, F
+
+
+def _edge_measure_by_rows(V, F):
+    """The row-wise unique that ``edge_curvature_measure`` used before (the peer)."""
+    a, b, c = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
+    n = np.cross(b - a, c - a)
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    ends = np.stack([F[:, [1, 2]], F[:, [2, 0]], F[:, [0, 1]]], axis=1).reshape(-1, 2)
+    g = np.cross(V[ends[:, 1]] - V[ends[:, 0]], np.repeat(n, 3, axis=0))
+    E, inverse = np.unique(np.sort(ends, axis=1), axis=0, return_inverse=True)
+    meas = np.zeros((E.shape[0], 3))
+    np.add.at(meas, inverse.reshape(-1), g)
+    return E, meas
+
+
+def run_case(case, variant, size):
+    """Time one variant of one case in this process; a dict of figures."""
+    from curvdetail import CurvatureEditor, boundary_vertices
+    from curvdetail.remesh import hausdorff, locate
+    from curvdetail.remesh.transfer import _edge_curvature_measure
+
+    V, F = grid_surface(SIDES[size])
+    out = {"vertices": int(V.shape[0])}
+    t = time.perf_counter()
+    if case == "edge_measure":
+        E, _ = _edge_curvature_measure(V, F) if variant == "int64 keys" else _edge_measure_by_rows(V, F)
+        out["edges"] = int(E.shape[0])
+    elif case == "curvature_stage":
+        b = boundary_vertices(F)
+        centre = int(np.argmin(np.linalg.norm(V[:, :2] - 0.5, axis=1)))
+        handles = np.union1d(b, np.unique(F[(F == centre).any(axis=1)]))
+        editor = CurvatureEditor(V, F, handles, handles, rows="free", backend=variant)
+        out["setup_s"] = editor.timings["curvature_setup"]
+        rhs = np.random.default_rng(0).normal(size=(editor._fd.size, 3))
+        solves = []
+        for _ in range(3):
+            s = time.perf_counter()
+            editor._curv.solve(rhs)
+            solves.append(time.perf_counter() - s)
+        out.update(unknowns=int(editor._fd.size), solve_s=float(np.median(solves)))
+    else:
+        Vt, Ft = grid_surface(SIDES[size] * 7 // 10)
+        if case == "hausdorff":
+            h = hausdorff(Vt, Ft, V, F, engine=variant, samples=1_000_000)
+            out.update(max=h["max"], rms=h["rms"], samples=h["samples"])
+        else:
+            dim = 3 if case == "locate_3d" else 2
+            _, _, dist = locate(Vt[:, :dim], V[:, :dim], F, engine=variant)
+            out.update(points=int(Vt.shape[0]), max_distance=float(dist.max()))
+    out["seconds"] = time.perf_counter() - t
+    out["peak_rss_gb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0 ** 2
+    return out
+
+
+def in_subprocess(case, variant, size, timeout):
+    cmd = [sys.executable, os.path.abspath(__file__), "--child", case, variant, size]
+    try:
+        done = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return {"error": f"over {timeout} s"}
+    lines = [line for line in done.stdout.splitlines() if line.startswith("RESULT ")]
+    if done.returncode != 0 or not lines:
+        return {"error": (done.stderr.strip().splitlines() or ["no output"])[-1]}
+    return json.loads(lines[-1][len("RESULT "):])
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--sizes", default="100k", help="comma-separated: 10k, 100k, 1M")
+    ap.add_argument("--cases", default=",".join(CASES), help="comma-separated: " + ", ".join(CASES))
+    ap.add_argument("--out", default="out/bench_operations.json")
+    ap.add_argument("--force", action="store_true", help="replace OUT if it exists")
+    ap.add_argument("--timeout", type=int, default=900, help="seconds per case")
+    ap.add_argument("--child", nargs=3, help=argparse.SUPPRESS)
+    args = ap.parse_args(argv)
+    if args.child:
+        print("RESULT " + json.dumps(run_case(*args.child)), flush=True)
+        return 0
+    sizes = [s for s in args.sizes.split(",") if s]
+    cases = [c for c in args.cases.split(",") if c]
+    unknown = [s for s in sizes if s not in SIDES] + [c for c in cases if c not in CASES]
+    if unknown:
+        ap.error(f"unknown size or case: {', '.join(unknown)}")
+    if os.path.exists(args.out) and not args.force:
+        ap.error(f"{args.out} exists; pass --force to replace it")
+    results = []
+    for size in sizes:
+        for case in cases:
+            for variant in CASES[case]:
+                r = in_subprocess(case, variant, size, args.timeout)
+                r.update(case=case, variant=variant, size=size, load_average=os.getloadavg()[0])
+                results.append(r)
+                shown = ", ".join(f"{k} {v:.3g}" if isinstance(v, float) else f"{k} {v}"
+                                  for k, v in r.items() if k not in ("case", "variant", "size"))
+                print(f"{size} {case} [{variant}]: {shown}", flush=True)
+    report = {"machine": {"cpu": platform.processor() or platform.machine(), "cores": os.cpu_count()},
+              "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "results": results}
+    os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
+    tmp = args.out + ".tmp"
+    with open(tmp, "w", encoding="utf-8") as fh:
+        json.dump(report, fh, indent=2)
+        fh.write("\n")
+    os.replace(tmp, args.out)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
