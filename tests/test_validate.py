@@ -182,6 +182,15 @@ def test_closed_surface_has_no_boundary():
     assert boundary_edges(F).shape == (0, 2) and boundary_vertices(F).size == 0
 
 
+def test_boundary_vertices_are_the_ends_of_the_boundary_edges(load_mesh):
+    # counted by a sparse pass, not derived from boundary_edges: the two must agree, also on a
+    # mesh with a non-manifold edge (three triangles on (0, 1): not a boundary) and one unused index
+    fan = np.array([[0, 1, 2], [1, 0, 3], [0, 1, 5], [2, 1, 6]])
+    for F in (load_mesh("mannequin_nose.obj")[1], load_mesh("terrainA_1k.obj")[1], fan,
+              np.vstack([grid(4, 4)[1], grid(3, 3)[1] + 16])):
+        assert np.array_equal(boundary_vertices(F), np.unique(boundary_edges(F)))
+
+
 def test_components_are_labelled():
     V, F = _square()
     labels, count = vertex_components(np.vstack([F, F + 9]), 18)
