@@ -54,6 +54,22 @@ def test_rebuilt_layer_equals_reconstruction_filter_on_the_retriangulation(terra
     assert np.abs(check.mesh(1).vertex_matrix() - X).max() < 1e-9 * bbox_diagonal(X)
 
 
+def test_rebuilt_layers_stored_detail_rebuilds_that_layer(terrain_run, tmp_path):
+    # the layer's detail is stamped with its own triangles: saved and loaded, moved back to the
+    # retriangulated positions (same triangles) and rebuilt over the free rows, it gives the
+    # rebuilt layer again (no "another triangulation")
+    from curvdetail.filters.files import load_meshset, save_current_mesh
+    from curvdetail.filters.meshset import set_vertex_positions
+
+    ms, _ = terrain_run
+    save_current_mesh(ms, str(tmp_path / "rebuilt.ply"))
+    again = load_meshset(str(tmp_path / "rebuilt.ply"))
+    set_vertex_positions(again, 0, ms.mesh(1).vertex_matrix())
+    apply(again, "apply_curvature_reconstruction", rows="free")
+    X = ms.mesh(2).vertex_matrix()
+    assert np.abs(again.current_mesh().vertex_matrix() - X).max() < 1e-9 * bbox_diagonal(X)
+
+
 def test_rebuilt_quality_is_the_distance_to_the_source(terrain_run):
     ms, _ = terrain_run
     d = vertex_distance(ms.mesh(2).vertex_matrix(), ms.mesh(0).vertex_matrix(), ms.mesh(0).face_matrix())
