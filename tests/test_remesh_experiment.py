@@ -175,4 +175,7 @@ def test_report_says_a_given_target_was_not_made_by_the_experiment(height_field)
     assert given["seconds"]["retriangulate"] == 0.0
     _, made = remesh_experiment(V, F, method="decimate", target_edge=0.06, evaluate=False)
     assert made["options"]["method"] == "decimate" and made["options"]["target_edge"] == 0.06
+    # the fraction of the diagonal and the length it stands for, both named
+    assert made["options"]["target_edge_length"] == pytest.approx(0.06 * made["source"]["bbox_diagonal"])
+    assert given["options"]["target_edge_length"] is None
     assert made["target"]["vertices"] == given["target"]["vertices"]      # the same decimation

@@ -64,7 +64,9 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="c
                                                boundary polyline); ``method`` / ``target_edge`` are then
                                                unused (but still checked), the report's
                                                ``options.method`` is ``"given"`` and its
-                                               ``options.target_edge`` None, and
+                                               ``options.target_edge`` (fraction of the
+                                               diagonal) and ``target_edge_length``
+                                               (absolute) None, and
                                                ``seconds.retriangulate`` is 0
 
     Returns
@@ -170,7 +172,9 @@ def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="cons
         "target": {"vertices": int(Vt.shape[0]), "faces": int(Ft.shape[0]),
                    "boundary_vertices": int(loop_t.size)},
         "options": {"method": "given" if target is not None else method,
-                    "target_edge": float(target_edge) if target is None else None, "transfer": transfer, "rows": rows,
+                    "target_edge": float(target_edge) if target is None else None,
+                    "target_edge_length": float(target_edge * d) if target is None else None,
+                    "transfer": transfer, "rows": rows,
                     "location": location, "parameterization": parameterization if location == "uv" else None,
                     "backend": rec.backend},
     }
