@@ -65,11 +65,16 @@ def save_options(ms, path):
     options = {"binary": True}
     if mesh.has_vertex_scalar():
         options["save_vertex_quality"] = True
-    mid = ms.current_mesh_id()
-    for name, kind in sorted(WRITTEN_ATTRIBUTES.items()):
-        if vertex_attribute(ms, mid, name, kind) is not None:
-            options[("__ca_vp__" if kind == "point" else "__ca_vs__") + name.lower()] = True
+    for name, kind in _attributes_on_current_mesh(ms):
+        options[("__ca_vp__" if kind == "point" else "__ca_vs__") + name.lower()] = True
     return options
+
+
+def _attributes_on_current_mesh(ms):
+    """``(name, kind)`` of every custom attribute a filter wrote that the current mesh holds, sorted."""
+    mid = ms.current_mesh_id()
+    return [(name, kind) for name, kind in sorted(WRITTEN_ATTRIBUTES.items())
+            if vertex_attribute(ms, mid, name, kind) is not None]
 
 
 def attributes_lost_in(ms, path):
@@ -77,9 +82,7 @@ def attributes_lost_in(ms, path):
     not hold (all of them but for PLY), sorted."""
     if os.path.splitext(os.fspath(path))[1].lower() == ".ply":
         return []
-    mid = ms.current_mesh_id()
-    return [name for name, kind in sorted(WRITTEN_ATTRIBUTES.items())
-            if vertex_attribute(ms, mid, name, kind) is not None]
+    return [name for name, _ in _attributes_on_current_mesh(ms)]
 
 
 def save_current_mesh(ms, path, *, overwrite=False):

@@ -155,8 +155,6 @@ def _unknown_native_step(name):
     """Why MeshLab failed on a step called ``name`` without a reason: pymeshlab's Python name used in a script,
     MeshLab's name spelled with other capitals or spaces, or a close match (MeshLab's names
     in the words of pymeshlab's rename table, which holds the filters renamed since 2022)."""
-    import difflib
-
     import pymeshlab
 
     renames = _pymeshlab_renames()
@@ -168,7 +166,7 @@ def _unknown_native_step(name):
     if key in renames:
         return (f"MeshLab spells this filter differently ({key.replace('_', ' ')!r} in lower case; "
                 f"pymeshlab's {renames[key]}). {_HOW_NAMES_ARE_WRITTEN}")
-    matches = difflib.get_close_matches(key, list(renames), n=3, cutoff=0.75)
+    matches = close_matches(key, renames, cutoff=0.75)
     if matches:
         return (f"MeshLab has no filter called {name!r}; did you mean "
                 f"{', '.join(repr(m.replace('_', ' ')) for m in matches)} (in lower case)? {_HOW_NAMES_ARE_WRITTEN}")

@@ -55,7 +55,7 @@ def _numbers_as_text(value):
     as the space-separated text the str parameters take (row by row, every digit kept);
     anything else unchanged."""
     if isinstance(value, (list, tuple, np.ndarray)):
-        arr = np.asarray(value, dtype=object).ravel() if not isinstance(value, np.ndarray) else value.ravel()
+        arr = np.asarray(value, dtype=object).ravel()
         if arr.size and all(isinstance(x, numbers.Real) and not isinstance(x, (bool, np.bool_)) for x in arr.tolist()):
             # numbers as Python writes them: numpy 2's repr of np.float64(1.0) is "np.float64(1.0)"
             return " ".join(str(int(x)) if isinstance(x, numbers.Integral) else repr(float(x))

@@ -129,9 +129,10 @@ def list_filters():
     return [_REGISTRY[k] for k in sorted(_REGISTRY)]
 
 
-def close_matches(word, candidates):
-    """Up to three candidates that look like ``word`` (difflib), for error messages."""
-    return difflib.get_close_matches(word, list(candidates), n=3, cutoff=0.5)
+def close_matches(word, candidates, cutoff=0.5):
+    """Up to three candidates that look like ``word`` (difflib, similarity >= ``cutoff``), for
+    error messages."""
+    return difflib.get_close_matches(word, list(candidates), n=3, cutoff=cutoff)
 
 
 def get_filter(name):
