@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ..curvature._validate import as_count, bbox_diagonal, check_mesh
+from ..curvature._validate import _edge_keys, as_count, bbox_diagonal, check_mesh
 from ..curvature.errors import MeshError
 from ..curvature.mean_curvature_normal import mean_curvature_normal
 from ..curvature.mixed_voronoi_area import mixed_voronoi_area
@@ -49,12 +49,11 @@ def _edge_curvature_measure(V, F):
     ends = np.stack([F[:, [1, 2]], F[:, [2, 0]], F[:, [0, 1]]], axis=1).reshape(-1, 2)   # edge k opposite corner k
     vec = V[ends[:, 1]] - V[ends[:, 0]]
     g = np.cross(vec, np.repeat(n, 3, axis=0))                                           # |e| x outward conormal
-    ends = np.sort(ends, axis=1)
-    # one int64 key per undirected edge, in the (low, high) lexicographic order a row-wise
-    # unique gives: at 1M vertices 0.4 s against 18 s for np.unique(axis=0)
-    n = np.int64(V.shape[0])
-    keys, first, inverse = np.unique(ends[:, 0] * n + ends[:, 1], return_index=True, return_inverse=True)
-    E = ends[first]
+    # one int64 key per undirected edge (the same half-edge order as ends), in the (low, high)
+    # lexicographic order a row-wise unique gives: at 1M vertices 0.4 s against 18 s for
+    # np.unique(axis=0)
+    keys, first, inverse = np.unique(_edge_keys(F)[0], return_index=True, return_inverse=True)
+    E = np.sort(ends[first], axis=1)
     inverse = inverse.reshape(-1)
     meas = np.column_stack([np.bincount(inverse, weights=g[:, j], minlength=keys.size) for j in range(3)])
     return E, meas
