@@ -4,7 +4,7 @@ import numpy as np
 
 from ._geometry import corner_cotangents
 from ._validate import (ZERO_AREA_RELATIVE, as_count, as_index_set, as_positive_number, bbox_diagonal,
-                        check_every_component_fixed, face_double_areas, vertex_components)
+                        check_every_component_fixed, vertex_components)
 from .cotan_laplacian import _assemble_upper, checked_cotan_triangle
 from .errors import ConstraintError, MeshError, first_indices
 from .reconstruct import _FreeSystemLayout
@@ -23,9 +23,10 @@ class MinimalSurfaceResult(np.ndarray):
 DEFAULT_TOL = 1e-4
 
 
-def _vertex_normals(X, F):
-    """Area-weighted unit vertex normals, shape (n, 3)."""
-    fn = np.cross(X[F[:, 1]] - X[F[:, 0]], X[F[:, 2]] - X[F[:, 0]])
+def _vertex_normals(X, F, face_cross=None):
+    """Area-weighted unit vertex normals, shape (n, 3); ``face_cross`` (m, 3), the triangles'
+    ``(x1 - x0) x (x2 - x0)``, where the caller has it."""
+    fn = np.cross(X[F[:, 1]] - X[F[:, 0]], X[F[:, 2]] - X[F[:, 0]]) if face_cross is None else face_cross
     n = X.shape[0]
     N = np.column_stack([np.bincount(F.ravel(), weights=np.repeat(fn[:, k], 3), minlength=n)
                          for k in range(3)])
@@ -139,7 +140,9 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, backend
             factor.refactor(system)
         X_new = X.copy()
         X_new[free] = factor.solve(-(L_fc @ X[fixed]))
-        dbl = face_double_areas(X_new, F)
+        # one cross product per triangle serves the collapse check and the normals
+        cross = np.cross(X_new[F[:, 1]] - X_new[F[:, 0]], X_new[F[:, 2]] - X_new[F[:, 0]])
+        dbl = np.sqrt(np.einsum("ij,ij->i", cross, cross))
         collapsed = np.flatnonzero(dbl <= 2.0 * ZERO_AREA_RELATIVE * diag ** 2)
         if collapsed.size:
             raise MeshError(
@@ -149,7 +152,7 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, backend
             )
         move = X_new - X
         full_step = float((np.abs(move).max(axis=1) / scale).max())
-        step = float((np.abs(np.einsum("ij,ij->i", move, _vertex_normals(X_new, F))) / scale).max())
+        step = float((np.abs(np.einsum("ij,ij->i", move, _vertex_normals(X_new, F, cross))) / scale).max())
         X = X_new
         it += 1
         converged = step < tol
