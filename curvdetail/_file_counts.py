@@ -122,7 +122,9 @@ def check_before_loading(path, error=ValueError):
     """Raise ``error`` for files that pymeshlab's loader would read into corrupt memory: an ASCII
     OFF file whose faces name vertices the file does not have (the loader keeps such faces and
     writes out of bounds; the process can crash later, even after :func:`check_loaded` has
-    reported them), and an OBJ file with indented vertex lines (the loader counts them in one
+    reported them) or whose rows the loader would misread without a word (it takes OFF as one
+    stream of numbers, so a vertex row with a value too many or too few, or a short face row,
+    shifts everything after it), and an OBJ file with indented vertex lines (the loader counts them in one
     pass and not in the other; reading one aborted the process). A binary OFF file, which the
     loader refuses with only "Invalid file", is named as such. Other files pass unread."""
     extension = os.path.splitext(os.fspath(path))[1].lower()
@@ -130,9 +132,9 @@ def check_before_loading(path, error=ValueError):
         if _off_is_binary(path):
             raise error(f"{path!r} is a binary OFF file ('OFF BINARY'), which pymeshlab's OFF reader "
                         "does not read; save it as ASCII OFF, PLY or OBJ and read that.")
-        problem = _off_face_problem(path)
+        problem = _off_rows_problem(path)
         if problem:
-            raise error(f"{path!r}: {problem}; fix or remove those faces in the file and read it again.")
+            raise error(f"{path!r}: {problem}; fix those rows in the file and read it again.")
     elif extension == ".obj":
         count, line = _obj_indented_vertices(path)
         if count:
@@ -165,9 +167,11 @@ def _obj_indented_vertices(path):
             return len(starts), data[:starts[0]].count(b"\n") + 1
 
 
-def _off_face_problem(path):
-    """What is wrong with the faces of an ASCII OFF file, or None (also where it cannot tell:
-    the loader and :func:`check_loaded` then judge).
+def _off_rows_problem(path):
+    """What is wrong with the rows of an ASCII OFF file, or None (also where it cannot tell:
+    the loader and :func:`check_loaded` then judge): vertex rows with an unusual number of
+    values (:func:`_off_vertex_rows_problem`), face rows that are not a count and that many
+    integer indices, faces with indices out of range.
 
     Vectorized over the bytes (~1 s for a million vertices, against ~4.5 s for pymeshlab's own
     read): a face line whose tokens are all unsigned and shorter than the vertex count's digits
@@ -195,8 +199,9 @@ def _off_face_problem(path):
     lines = np.flatnonzero(filled)
     if nf == 0 or lines.size < nv + nf:
         return None                                            # short: the counts check reports it
-    faces = lines[nv:nv + nf]
-    first, last = int(starts[faces[0]]), int(ends[faces[-1]])
+    rows = lines[:nv + nf]
+    faces = rows[nv:]
+    first, last = int(starts[rows[0]]), int(ends[rows[-1]])
     seg = visible[first:last]
     token_starts = np.flatnonzero(seg[1:] & ~seg[:-1]) + (first + 1)
     token_ends = np.flatnonzero(seg[:-1] & ~seg[1:]) + (first + 1)
@@ -204,8 +209,13 @@ def _off_face_problem(path):
         token_starts = np.concatenate([[first], token_starts])
     if seg[-1]:
         token_ends = np.concatenate([token_ends, [last]])
+    per_row = np.diff(np.append(np.searchsorted(token_starts, starts[rows]), token_starts.size))
+    problem = _off_vertex_rows_problem(per_row[:nv])
+    if problem:
+        return problem
+    token_starts, token_ends = token_starts[per_row[:nv].sum():], token_ends[per_row[:nv].sum():]
     line_starts = starts[faces]
-    per_line = np.diff(np.append(np.searchsorted(token_starts, line_starts), token_starts.size))
+    per_line = per_row[nv:]
     # the vertex count k: a one-digit first token, or parsed below
     head = np.concatenate([[0], np.cumsum(per_line)[:-1]])
     one_digit = (token_ends[head] - token_starts[head] == 1) & (chars[token_starts[head]] >= 51) & \
@@ -222,15 +232,35 @@ def _off_face_problem(path):
             count = int(words[0])
             index = [int(w) for w in words[1:count + 1]]
         except ValueError:
-            continue                   # not one face a line as expected (OFF is free-form): no verdict
-        if count < 1 or len(index) < count:
-            continue
+            index = None
+        if index is None or count < 1 or len(index) < count:
+            # pymeshlab reads OFF as one stream of numbers: a short or unreadable face row
+            # shifts every later face (a two-value row came back as a duplicated triangle)
+            text = body[starts[faces[face]]:ends[faces[face]]].decode("ascii", "replace").strip()
+            return (f"face {face} is the row {text!r}, which is not a vertex count followed by that "
+                    "many integer vertex indices")
         if min(index) < 0 or max(index) >= nv:
             bad.append((face, index))
     if not bad:
         return None
     return (f"{len(bad)} faces use vertex indices outside the file's {nv} vertices "
             f"(first: face {bad[0][0]}, {bad[0][1]})")
+
+
+def _off_vertex_rows_problem(values_per_row):
+    """What is wrong with an OFF file's vertex rows, given the number of values on each, or
+    None. Every row holds the same number of values (3 coordinates, and the colour, normal or
+    texture values the keyword announces): pymeshlab reads OFF as one stream of numbers, so a
+    row with a value too many or too few shifts every later coordinate without a word."""
+    if not values_per_row.size:
+        return None
+    usual = int(np.bincount(values_per_row).argmax())
+    odd = np.flatnonzero((values_per_row != usual) | (values_per_row < 3))
+    if not odd.size:
+        return None
+    return (f"{odd.size} vertex rows hold a number of values other than {usual}, that of the other "
+            f"rows (first: vertex {odd[0]}, {values_per_row[odd[0]]} values), which would shift "
+            "every later coordinate")
 
 
 def _maybe_out_of_range(chars, starts, ends, nv):

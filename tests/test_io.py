@@ -1,5 +1,6 @@
 """read_mesh / write_mesh / save_mesh: round trips per format, overwrite refusal, atomic writes."""
 
+import re
 import os
 import stat
 import subprocess
@@ -431,3 +432,29 @@ def test_written_ply_holds_positions_faces_and_quality_only(tmp_path):
     header = raw[:raw.index(b"end_header")].decode()
     properties = [line.split()[-1] for line in header.splitlines() if line.startswith("property")]
     assert properties == ["x", "y", "z", "quality", "vertex_indices"]
+
+
+@pytest.mark.parametrize("rows, message", [
+    ("0 0 0\n1 0 0 7\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n",
+     "1 vertex rows hold a number of values other than 3, that of the other rows (first: vertex 1, 4 values)"),
+    ("0 0 0\n1 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n",
+     "1 vertex rows hold a number of values other than 3, that of the other rows (first: vertex 1, 2 values)"),
+    ("0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2\n3 0 2 3\n",
+     "face 0 is the row '4 0 1 2', which is not a vertex count followed by that many integer"),
+    ("0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2.5 3\n",
+     "face 1 is the row '3 0 2.5 3', which is not a vertex count"),
+])
+def test_off_rows_the_loader_would_misread_are_refused(tmp_path, rows, message):
+    # pymeshlab reads OFF as one stream of numbers: a vertex row with a value too many came back
+    # as vertex (7, 1, 1), a two-value row as a duplicated triangle, both without a word
+    path = tmp_path / "rows.off"
+    path.write_text("OFF\n4 2 0\n" + rows)
+    with pytest.raises(MeshFileError, match=re.escape(message)):
+        read_mesh(path)
+
+
+def test_off_face_rows_with_colours_and_polygons_are_read(tmp_path):
+    path = tmp_path / "ok.off"
+    path.write_text("OFF\n4 1 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3 255 0 0\n")
+    V, F = read_mesh(path)
+    assert np.array_equal(V, [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]) and F.shape == (2, 3)
