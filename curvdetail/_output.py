@@ -27,16 +27,20 @@ def check_output_path(path, overwrite=False, *, hint=_FORMATS_HINT, error=MeshEr
     ------
     ValueError        ``path`` is not a path, or ``overwrite`` is not a bool
     FileExistsError   ``path`` exists and ``overwrite`` is False
+    IsADirectoryError ``path`` is a folder, where ``error`` is an ``OSError`` (else ``error``)
     error             (default :class:`~curvdetail.curvature.errors.MeshError`; the filters
-                      pass their ``MeshFileError``) the folder does not exist, or ``path`` has
-                      no extension to pick the format (``hint`` says which to use; ``hint=None``:
-                      any name will do)
+                      pass their ``MeshFileError``) ``path`` is a folder, its folder does not
+                      exist, or ``path`` has no extension to pick the format (``hint`` says
+                      which to use; ``hint=None``: any name will do)
     """
     if not isinstance(path, (str, bytes, os.PathLike)):
         raise ValueError(f"an output path must be a str or os.PathLike; got {type(path).__name__}.")
     if not isinstance(overwrite, (bool, np.bool_)):       # "no" would count as True
         raise ValueError(f"overwrite={overwrite!r} must be True or False.")
     path = os.fsdecode(path)
+    if os.path.isdir(path):       # --overwrite cannot help: a folder is never replaced
+        kind = IsADirectoryError if issubclass(error, OSError) else error
+        raise kind(f"cannot write {path!r}: it is a folder; name a file (in it, or elsewhere).")
     if os.path.exists(path) and not overwrite:
         raise FileExistsError(f"{path} exists; pass --overwrite (overwrite=True) to replace it.")
     folder = os.path.dirname(os.path.abspath(path))

@@ -60,13 +60,15 @@ def read_mesh(path):
     (3, 3)
     """
     path = input_path(path)
-    check_before_loading(path, error=MeshFileError)
+    try:
+        check_before_loading(path, error=MeshFileError)
+    except OSError as exc:          # unreadable: named as the file's problem, as pymeshlab's are
+        raise MeshFileError(f"could not read {path!r}: {exc.strerror or exc}.") from None
     ms = _meshset()
     try:
         ms.load_new_mesh(path)
     except Exception as exc:
-        raise MeshFileError(f"could not read {path!r}: {exc}. Use a format MeshLab reads "
-                            "(.obj, .off, .ply, .stl, ...).") from None
+        raise MeshFileError(load_failure(path, exc)) from None
     mesh = ms.current_mesh()
     V = np.ascontiguousarray(mesh.vertex_matrix(), dtype=np.float64)
     F = np.ascontiguousarray(mesh.face_matrix(), dtype=np.int64)
@@ -75,6 +77,21 @@ def read_mesh(path):
         raise MeshFileError(f"{path!r} holds {V.shape[0]} vertices but no triangles; a surface mesh "
                             "is needed.")
     return V, F
+
+
+#: Extensions whose files pymeshlab reads (and that most meshes come in): a failed read of one
+#: of these means a damaged file, not the wrong format.
+COMMON_FORMATS = (".ply", ".obj", ".off", ".stl")
+
+
+def load_failure(path, exc):
+    """The message for pymeshlab's failure to load ``path``: its whole text on one line (its
+    first line alone says "Unable to open file", which reads like a missing file), and the fix
+    that fits: a damaged file for the common formats, another format otherwise."""
+    reason = " ".join(str(exc).split()) or type(exc).__name__
+    if os.path.splitext(path)[1].lower() in COMMON_FORMATS:
+        return f"could not read {path!r}: {reason}. The file is damaged or incomplete; export it again."
+    return f"could not read {path!r}: {reason}. Use a format MeshLab reads (.obj, .off, .ply, .stl, ...)."
 
 
 def input_path(path):
@@ -88,6 +105,54 @@ def input_path(path):
     if not os.path.isfile(path):
         raise FileNotFoundError(f"mesh file not found: {path}")
     return path
+
+
+#: Formats pymeshlab writes as points only: a mesh saved there loses its triangles.
+POINT_FORMATS = (".xyz", ".e57", ".pts", ".ptx", ".apts", ".asc")
+
+_MESH_HINT = "use .ply, .obj, .off, .stl, ..."
+_WRITES = {}            # extension -> None (pymeshlab writes it) or why it does not
+
+
+def check_mesh_output(path, overwrite=False, *, hint=_MESH_HINT):
+    """Return ``path`` as a str, or raise before any work if a mesh cannot be written there:
+    :func:`curvdetail._output.check_output_path` (existing file, folder, no extension), a format
+    that keeps the points only (:data:`POINT_FORMATS`), or one pymeshlab does not write (found by
+    writing one triangle to a temporary file, once per extension and process).
+
+    Raises
+    ------
+    FileExistsError   ``path`` exists and ``overwrite`` is False
+    MeshFileError     ``path`` is a folder, its folder is missing, or the format is not a mesh
+                      format pymeshlab writes
+    """
+    path = check_output_path(path, overwrite, hint=hint, error=MeshFileError)
+    extension = os.path.splitext(path)[1].lower()
+    if extension in POINT_FORMATS:
+        raise MeshFileError(f"cannot write {path!r}: {extension} files hold points only, so the "
+                            f"triangles would be lost; {hint}")
+    if extension not in _WRITES:
+        _WRITES[extension] = _why_not_written(extension)
+    if _WRITES[extension] is not None:
+        raise MeshFileError(f"cannot write {path!r}: pymeshlab does not write {extension} meshes "
+                            f"({_WRITES[extension]}); {hint}")
+    return path
+
+
+def _why_not_written(extension):
+    """None if pymeshlab writes a triangle to a ``extension`` file, else its message."""
+    import tempfile
+
+    import pymeshlab
+
+    with tempfile.TemporaryDirectory(prefix="curvdetail-format-") as folder:
+        ms = _meshset()
+        ms.add_mesh(pymeshlab.Mesh(vertex_matrix=np.eye(3), face_matrix=np.array([[0, 1, 2]], dtype=np.int32)))
+        try:
+            ms.save_current_mesh(os.path.join(folder, "probe" + extension))
+        except Exception as exc:
+            return " ".join(str(exc).replace(folder + os.sep, "").split()) or type(exc).__name__
+    return None
 
 
 def write_mesh(path, V, F, *, quality=None, overwrite=False):
@@ -106,7 +171,8 @@ def write_mesh(path, V, F, *, quality=None, overwrite=False):
     ------
     FileExistsError   ``path`` exists and ``overwrite`` is False
     MeshError         malformed ``V``, ``F`` or ``quality``
-    MeshFileError     the format is unknown or the folder is not writable
+    MeshFileError     ``path`` is a folder, its folder is missing or not writable, or the format
+                      is unknown or keeps points only (.xyz, ...; see :func:`check_mesh_output`)
 
     Examples
     --------
@@ -126,7 +192,7 @@ def write_mesh(path, V, F, *, quality=None, overwrite=False):
     """
     import pymeshlab
 
-    check_output_path(path, overwrite, error=MeshFileError)
+    check_mesh_output(path, overwrite)
     V = as_vertices(V)
     F = as_faces(F, V.shape[0])
     kwargs = {}
@@ -144,8 +210,11 @@ def write_mesh(path, V, F, *, quality=None, overwrite=False):
         kwargs["v_scalar_array"] = q
     mesh = pymeshlab.Mesh(vertex_matrix=V, face_matrix=F.astype(np.int32), **kwargs)
     # geometry (and quality) only: pymeshlab would add its default white colours and computed
-    # normals, and its OFF writer then says NCOFF, a header libigl's readOFF refuses
-    save_mesh(path, mesh, overwrite=overwrite, _plain=True)
+    # normals, and its OFF writer then says NCOFF, a header libigl's readOFF refuses; and its
+    # meshes always carry a quality, which without ours would be written as zeros (in MeshLab:
+    # zero error everywhere)
+    plain = dict(_PLAIN_OPTIONS, **({} if quality is not None else {"save_vertex_quality": False}))
+    save_mesh(path, mesh, overwrite=overwrite, _plain=plain)
 
 
 #: What :func:`write_mesh` turns off where the format has the option (pymeshlab refuses an
@@ -153,7 +222,7 @@ def write_mesh(path, V, F, *, quality=None, overwrite=False):
 _PLAIN_OPTIONS = {"save_vertex_color": False, "save_vertex_normal": False, "save_face_color": False}
 
 
-def save_mesh(path, mesh, *, overwrite=False, _plain=False, **save_options):
+def save_mesh(path, mesh, *, overwrite=False, _plain=None, **save_options):
     """Atomically save a ``pymeshlab.Mesh`` (with its quality and colours where the format holds
     them). Used by :func:`write_mesh`.
 
@@ -178,8 +247,9 @@ def save_mesh(path, mesh, *, overwrite=False, _plain=False, **save_options):
     Raises
     ------
     FileExistsError   ``path`` exists and ``overwrite`` is False
-    MeshFileError     no extension, missing folder, pymeshlab failed to write, or a save option
-                      that asks for a custom attribute (``__ca_...``)
+    MeshFileError     no extension, a folder, missing folder, a format pymeshlab does not write
+                      as a mesh, pymeshlab failed to write, or a save option that asks for a
+                      custom attribute (``__ca_...``)
 
     Examples
     --------
@@ -196,14 +266,17 @@ def save_mesh(path, mesh, *, overwrite=False, _plain=False, **save_options):
         raise MeshFileError(f"save_mesh cannot save custom attributes ({', '.join(custom)}): pymeshlab "
                             "crashes exporting them from a copied mesh. Add the mesh to a MeshSet and "
                             "save it with curvdetail.filters.files.save_current_mesh.")
-    if os.path.splitext(os.fspath(path))[1].lower() == ".ply" and mesh.has_vertex_scalar():
+    check_mesh_output(path, overwrite)
+    plain = _plain or {}         # options to set where the format has them (write_mesh's)
+    if os.path.splitext(os.fspath(path))[1].lower() == ".ply" and mesh.has_vertex_scalar() and \
+            "save_vertex_quality" not in plain:
         options.setdefault("save_vertex_quality", True)
     # the temporary file keeps path's extension: pymeshlab picks the format from it
     with atomic_output(path, overwrite=overwrite, error=MeshFileError) as tmp:
         ms = _meshset()
         ms.add_mesh(mesh)
         try:
-            _save(ms, tmp, options, _PLAIN_OPTIONS if _plain else {})
+            _save(ms, tmp, options, plain)
         except Exception as exc:
             raise MeshFileError(f"could not write {os.fspath(path)!r}: "
                                 f"{str(exc).replace(tmp, os.fspath(path))}") from None

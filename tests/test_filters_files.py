@@ -5,7 +5,7 @@ import os
 import numpy as np
 import pytest
 
-from curvdetail.filters import apply
+from curvdetail.filters import apply, files
 from curvdetail.filters.files import check_output_path, load_meshset, save_current_mesh
 from curvdetail.filters.meshset import vertex_attribute
 from curvdetail.io import MeshFileError
@@ -53,10 +53,21 @@ def test_existing_output_is_kept_unless_overwrite(tmp_path):
     assert out.read_bytes().startswith(b"ply")
 
 
-def test_failed_save_leaves_no_file(tmp_path):
+def test_failed_save_leaves_no_file(tmp_path, monkeypatch):
     ms = load_meshset(NOSE)
-    with pytest.raises(MeshFileError, match="could not write"):
+    # pymeshlab refuses the write (here: an option it does not have) after the checks passed
+    monkeypatch.setattr(files, "save_options", lambda ms, path: {"no_such_option": True})
+    with pytest.raises(MeshFileError, match=r"could not write .*d\.ply': .*no_such_option"):
+        save_current_mesh(ms, tmp_path / "d.ply")
+    assert os.listdir(tmp_path) == []
+
+
+def test_unknown_and_point_formats_are_refused_before_saving(tmp_path):
+    ms = load_meshset(NOSE)
+    with pytest.raises(MeshFileError, match="pymeshlab does not write .unknownformat meshes"):
         save_current_mesh(ms, tmp_path / "d.unknownformat")
+    with pytest.raises(MeshFileError, match=".xyz files hold points only"):
+        check_output_path(tmp_path / "d.xyz")
     assert os.listdir(tmp_path) == []
 
 

@@ -16,7 +16,7 @@ import numpy as np
 
 from .. import _output
 from .._file_counts import check_before_loading, check_loaded
-from ..io import MeshFileError, input_path
+from ..io import MeshFileError, check_mesh_output, input_path, load_failure
 from .meshset import WRITTEN_ATTRIBUTES, set_vertex_attribute, vertex_attribute
 from .ply_attributes import read_ply_vertex_attributes
 
@@ -41,8 +41,7 @@ def load_meshset(path, *more):
         try:
             ms.load_new_mesh(p)
         except pymeshlab.PyMeshLabException as exc:
-            raise MeshFileError(f"could not read {p!r}: {' '.join(str(exc).split())}. Use a format "
-                                "MeshLab reads (.obj, .off, .ply, .stl, ...).") from None
+            raise MeshFileError(load_failure(p, exc)) from None
         n = ms.current_mesh().vertex_number()
         check_loaded(p, n, ms.current_mesh().face_matrix(), error=MeshFileError)   # what pymeshlab dropped
         for name, values in read_ply_vertex_attributes(p).items():
@@ -53,8 +52,9 @@ def load_meshset(path, *more):
 
 def check_output_path(path, overwrite=False):
     """Raise before any work if ``path`` cannot be written: it exists (and not ``overwrite``),
-    its folder does not exist, or it has no extension to pick the format."""
-    return _output.check_output_path(path, overwrite, hint=_HINT, error=MeshFileError)
+    it is a folder, its folder does not exist, or its extension names no mesh format pymeshlab
+    writes (:func:`curvdetail.io.check_mesh_output`)."""
+    return check_mesh_output(path, overwrite, hint=_HINT)
 
 
 def save_options(ms, path):
@@ -88,9 +88,11 @@ def attributes_lost_in(ms, path):
 def save_current_mesh(ms, path, *, overwrite=False):
     """Atomically save the current mesh of ``ms`` (see the module docstring for what is kept).
 
-    Raises FileExistsError, MeshFileError (unknown format, missing folder, pymeshlab failed)."""
+    Raises FileExistsError, MeshFileError (unknown or points-only format, a folder, missing
+    folder, pymeshlab failed)."""
     import pymeshlab
 
+    check_output_path(path, overwrite)
     options = save_options(ms, path)
     with _output.atomic_output(path, overwrite=overwrite, hint=_HINT, error=MeshFileError) as tmp:
         try:
