@@ -1,13 +1,16 @@
 """The ``curvdetail`` command.
 
 Every subcommand is declared with :func:`command` next to the code that runs it. A failure
-anywhere exits non-zero with one ``curvdetail: error: ...`` line on stderr and leaves no output
-file behind (outputs are written atomically, last).
+anywhere exits non-zero with a ``curvdetail: error: ...`` message on stderr and leaves no output
+file behind (outputs are written atomically, last; Ctrl-C and SIGTERM remove the temporary
+files too).
 """
 
 import argparse
 import os
+import signal
 import sys
+import threading
 import time
 
 _COMMANDS = {}
@@ -80,8 +83,8 @@ def add_input_output_arguments(parser, input_help, output_help):
 
 def resolve_input_output(args):
     """Fill ``args.input`` / ``args.output`` from ``--example``, check both are given and that
-    OUTPUT can be written (:func:`curvdetail._output.check_output_path`: existing file, folder,
-    extension), before any work."""
+    OUTPUT can be written (:func:`curvdetail.io.check_mesh_output`: existing file, folder,
+    a mesh format pymeshlab writes), before any work."""
     if args.example:
         if args.output is not None:
             raise ValueError("with --example give only OUTPUT, not INPUT and OUTPUT.")
@@ -90,10 +93,9 @@ def resolve_input_output(args):
         args.input, args.output = example_path(), args.input
     if args.input is None or args.output is None:
         raise ValueError("missing INPUT or OUTPUT (or use --example OUTPUT).")
-    from ._output import check_output_path
-    from .io import MeshFileError
+    from .io import check_mesh_output
 
-    check_output_path(args.output, args.overwrite, error=MeshFileError)
+    check_mesh_output(args.output, args.overwrite)
 
 
 # --- reconstruct / minimal (core issue) -----------------------------------------------------
@@ -301,7 +303,7 @@ def _remesh_command(parser):
                 check_output_path(extra, args.overwrite, hint=None, error=FileNotFoundError)
         if args.no_evaluate and args.image is not None:
             raise ValueError("--image shows the measured distances; leave out --no-evaluate or --image.")
-        _check_image_and_distinct(args.image, args.output, args.report)
+        _check_image_and_distinct(args.image, args.output, args.report, inputs=[args.input])
         V, F = read_mesh(args.input)
         if not args.quiet:
             _note_a_big_target(V, F, args)
@@ -417,7 +419,7 @@ def _apply_command(parser):
     parser.add_argument("output", metavar="OUTPUT",
                         help="the current mesh afterwards (.ply keeps quality and attributes)")
     parser.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
-                        help="a filter parameter (repeatable); lengths as 0.01 or 1%% of the bbox diagonal")
+                        help="a filter parameter (repeatable); a length as an absolute value in model units (0.01) or as a percentage of the bbox diagonal (1%%)")
     _add_layers_argument(parser)
     add_output_arguments(parser)
 
@@ -500,12 +502,13 @@ def _edit_command(parser):
         from .curvature._validate import bbox_diagonal, check_mesh
         from .deformation_benchmark import (edit_with_selection, read_selection, read_transform,
                                             render_panels)
-        from .io import MeshFileError
+        from .io import MeshFileError, check_mesh_output
 
-        check_output_path(args.output, args.overwrite, error=MeshFileError)
+        check_mesh_output(args.output, args.overwrite)
         if args.image:
             check_output_path(args.image, args.overwrite, hint=None, error=FileNotFoundError)
-        _check_image_and_distinct(args.image, args.output)
+        _check_image_and_distinct(args.image, args.output, inputs=[args.mesh],
+                                  other_inputs=[args.sel, args.transform])
         progress = Progress(3, enabled=sys.stderr.isatty())
         progress.stage("read")
         V, F = check_mesh(*read_mesh(args.mesh))
@@ -551,17 +554,26 @@ def _edit_command(parser):
 
 # --- entry point ----------------------------------------------------------------------------
 
-def _check_image_and_distinct(image, *others):
-    """``--image`` must end in .png (only PNG is written), and no two outputs may be one file."""
-    import os
-
+def _check_image_and_distinct(image, output, *extras, inputs=(), other_inputs=()):
+    """``--image`` must end in .png (only PNG is written), no two outputs may be one file, and
+    no output may replace an input file, with one exception: OUTPUT, the mesh, may replace the
+    input mesh (``inputs``) when --overwrite asks for it (checked with the output's other
+    conditions). The picture or report over the input mesh, or anything over the other input
+    files (``other_inputs``: selections, transforms), is refused even with --overwrite."""
     if image is not None and not image.lower().endswith(".png"):
         raise ValueError(f"--image {image}: only PNG pictures are written; end the name in .png.")
-    paths = [p for p in (image, *others) if p is not None]
-    real = [os.path.realpath(p) for p in paths]
+    # (path, may it replace the input mesh)
+    outputs = [(p, p == output) for p in (image, output, *extras) if p is not None]
+    real = [os.path.realpath(p) for p, _ in outputs]
     for k, r in enumerate(real):
         if r in real[:k]:
-            raise ValueError(f"{paths[k]} is given for two outputs; name a separate file for each.")
+            raise ValueError(f"{outputs[k][0]} is given for two outputs; name a separate file for each.")
+    mesh_inputs = {os.path.realpath(p) for p in inputs if p is not None}
+    for (path, is_mesh), r in zip(outputs, real):
+        for given in (*inputs, *other_inputs):
+            if given is not None and r == os.path.realpath(given) and not (is_mesh and r in mesh_inputs):
+                raise ValueError(f"{path} is an input of this run ({given}); writing there would "
+                                 "destroy it even with --overwrite. Name another file.")
 
 
 def build_parser():
@@ -580,14 +592,29 @@ def build_parser():
     return parser
 
 
+class _Terminated(BaseException):
+    """SIGTERM (``timeout``, ``kill``), raised in the main thread so that the output files' ``with``
+    blocks remove their temporary files, as for Ctrl-C."""
+
+
+def _raise_terminated(signum, frame):
+    raise _Terminated()
+
+
 def main(argv=None):
     parser = build_parser()
     args = parser.parse_args(argv)
+    in_main_thread = threading.current_thread() is threading.main_thread()
+    if in_main_thread:
+        previous = signal.signal(signal.SIGTERM, _raise_terminated)
     try:
         return int(args._run(args) or 0)
     except KeyboardInterrupt:
         _say("curvdetail: interrupted")
         return 130
+    except _Terminated:
+        _say("curvdetail: terminated")
+        return 128 + signal.SIGTERM
     except BrokenPipeError:
         # the reader of stdout went away (`curvdetail list | head`): not an error of ours, as for
         # cat(1); stdout carries only the final figures, written after every output file (stderr
@@ -596,9 +623,13 @@ def main(argv=None):
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
     except (ValueError, OSError, RuntimeError) as exc:
-        message = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        # the whole message: pymeshlab's first line alone ("Unable to open file") hid the reason
+        message = str(exc).strip() or type(exc).__name__
         _say(f"curvdetail: error: {message}")
         return 1
+    finally:
+        if in_main_thread:
+            signal.signal(signal.SIGTERM, previous if previous is not None else signal.SIG_DFL)
 
 
 if __name__ == "__main__":

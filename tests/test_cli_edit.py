@@ -1,5 +1,7 @@
 """`curvdetail edit MESH --sel SEL --def DEF OUTPUT`: exact constraints, images, clean failures."""
 
+import os
+
 import numpy as np
 
 from curvdetail import read_mesh, write_mesh
@@ -91,3 +93,20 @@ def test_an_amplified_edit_is_written_with_exit_status_4(tmp_path, capsys, monke
     assert rc == 4
     assert "warning: vertices moved up to" in capsys.readouterr().err
     assert read_mesh(str(out))[0].shape == V.shape
+
+
+def test_output_over_an_input_file_is_refused_even_with_overwrite(tmp_path, capsys):
+    V, F, status, T, paths = _case(tmp_path)
+    # a selection file whose name a mesh writer would take
+    sel = tmp_path / "selection.ply"
+    os.rename(paths["sel"], sel)
+    before = sel.read_bytes()
+    rc = main(["edit", str(paths["off"]), str(sel), "--sel", str(sel), "--def", str(paths["def"]),
+               "--overwrite"])
+    assert rc == 1
+    assert "selection.ply is an input of this run" in capsys.readouterr().err
+    assert sel.read_bytes() == before
+    paths["sel"] = sel
+    # the mesh over the input mesh is what --overwrite asks for
+    assert main(["edit", str(paths["off"]), str(paths["off"]), "--sel", str(paths["sel"]),
+                 "--def", str(paths["def"]), "--overwrite"]) == 0

@@ -143,3 +143,55 @@ def test_a_target_edge_asking_for_a_big_mesh_is_announced(tmp_path, capsys, monk
     main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "p.ply"), "--target-edge", "2",
           "--no-evaluate"])
     assert "note:" not in capsys.readouterr().err
+
+
+def test_a_report_over_the_input_is_refused_even_with_overwrite(tmp_path, capsys):
+    # --overwrite replaces outputs; the input mesh replaced by a JSON report was data lost
+    src = tmp_path / "src.obj"
+    src.write_bytes(open(os.path.join(DATA, "mannequin_nose.obj"), "rb").read())
+    before = src.read_bytes()
+    rc = main(["remesh", str(src), str(tmp_path / "o.ply"), "--report", str(src), "--overwrite", "--quiet"])
+    assert rc == 1
+    assert "src.obj is an input of this run" in capsys.readouterr().err
+    assert src.read_bytes() == before and sorted(os.listdir(tmp_path)) == ["src.obj"]
+
+
+def test_an_output_that_is_a_folder_is_refused_before_the_work(tmp_path, capsys):
+    (tmp_path / "rep.json").mkdir()
+    rc = main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "o.ply"),
+               "--report", str(tmp_path / "rep.json"), "--overwrite", "--quiet"])
+    assert rc == 1
+    assert "rep.json': it is a folder; name a file" in capsys.readouterr().err
+    assert sorted(os.listdir(tmp_path)) == ["rep.json"]
+
+
+@pytest.mark.parametrize("name, message", [("o.xyzzy", "pymeshlab does not write .xyzzy meshes"),
+                                           ("o.xyz", ".xyz files hold points only")])
+def test_an_output_format_that_cannot_hold_the_mesh_is_refused_before_the_work(tmp_path, capsys, name,
+                                                                              message):
+    rc = main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / name),
+               "--report", str(tmp_path / "r.json"), "--quiet"])
+    err = capsys.readouterr().err
+    assert rc == 1 and message in err and ".curvdetail-" not in err
+    assert os.listdir(tmp_path) == []
+
+
+def test_sigterm_removes_the_temporary_files_like_ctrl_c(tmp_path, capsys, monkeypatch):
+    # `timeout` and `kill` send SIGTERM; it used to leave .curvdetail-*.png/.ply behind
+    import signal
+
+    import curvdetail.io
+
+    real = curvdetail.io.write_mesh
+
+    def write_then_terminated(path, *args, **kwargs):
+        real(path, *args, **kwargs)                  # the temporary file is written ...
+        os.kill(os.getpid(), signal.SIGTERM)         # ... and the run is killed before the rename
+
+    monkeypatch.setattr(curvdetail.io, "write_mesh", write_then_terminated)
+    rc = main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "o.ply"),
+               "--report", str(tmp_path / "r.json"), "--quiet"])
+    assert rc == 128 + signal.SIGTERM
+    assert "curvdetail: terminated" in capsys.readouterr().err
+    assert os.listdir(tmp_path) == []
+    assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL      # put back after the run
