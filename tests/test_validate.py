@@ -280,3 +280,15 @@ def test_docstring_examples_run():
     import importlib
 
     assert doctest.testmod(importlib.import_module("curvdetail.curvature._validate"), optionflags=doctest.ELLIPSIS).failed == 0
+
+
+def test_boundary_functions_take_sparse_huge_indices_without_allocating_or_overflowing():
+    # 2**32 - 1 is a common "no vertex" sentinel: boundary_vertices allocated 32 GiB for it, and
+    # boundary_edges' key min * n + max overflowed for indices near 2**33, losing two edges
+    X = 2 ** 33 - 1
+    F = np.array([[0, X, 5], [2 ** 31, X, 7]])
+    expected = {(5, 0), (0, X), (X, 5), (7, 2 ** 31), (X, 7), (2 ** 31, X)}
+    assert set(map(tuple, boundary_edges(F).tolist())) == expected
+    G = np.array([[0, 1, 2], [0, 2, 0xFFFFFFFF]], dtype=np.uint32)
+    assert boundary_vertices(G).tolist() == [0, 1, 2, 0xFFFFFFFF]
+    assert set(map(tuple, boundary_edges(G).tolist())) == {(0, 1), (1, 2), (2, 0xFFFFFFFF), (0xFFFFFFFF, 0)}

@@ -245,10 +245,23 @@ def boundary_edges(F):
            [2, 3]])
     """
     F = as_faces(F, None)
+    ids, F = _compact_ids(F)
     D = np.stack([F[:, [1, 2]], F[:, [2, 0]], F[:, [0, 1]]], axis=1).reshape(-1, 2)
     keys, _ = _edge_keys(F)
     uniq, first, counts = np.unique(keys, return_index=True, return_counts=True)
-    return D[first[counts == 1]]
+    E = D[first[counts == 1]]
+    return E if ids is None else ids[E]
+
+
+def _compact_ids(F):
+    """``(ids, F')`` with ``F = ids[F']`` and ``F'`` numbered ``0 .. len(ids) - 1``, where ``F``'s
+    largest index is far above its number of corners (unchecked triangles, e.g. 2**32 - 1 as
+    "no vertex": per-vertex arrays would take gigabytes and the edge keys ``min * n + max``
+    overflow); ``(None, F)`` otherwise."""
+    if F.size == 0 or int(F.max()) < 2 * F.size + 1024:
+        return None, F
+    ids, inverse = np.unique(F, return_inverse=True)
+    return ids, inverse.reshape(F.shape)
 
 
 def boundary_vertices(F):
@@ -263,6 +276,7 @@ def boundary_vertices(F):
     0
     """
     F = as_faces(F, None)
+    ids, F = _compact_ids(F)
     # triangles per undirected edge by a sparse COO -> CSR pass (no sort of all half-edges:
     # 1M vertices 0.35 s against 1.0 s for np.unique of boundary_edges); cotan_laplacian's
     # _edge_pattern counts the same way, but the reconstruction tests check that its checks do
@@ -275,7 +289,7 @@ def boundary_vertices(F):
     on_boundary = np.zeros(n, dtype=bool)
     on_boundary[np.repeat(np.arange(n), np.diff(counts.indptr))[once]] = True
     on_boundary[counts.indices[once]] = True
-    return np.flatnonzero(on_boundary)
+    return np.flatnonzero(on_boundary) if ids is None else ids[on_boundary]
 
 
 def as_index_set(indices, n, name):
