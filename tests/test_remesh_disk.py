@@ -69,3 +69,18 @@ def test_patch_with_a_handle_is_refused_with_the_handle_count():
     F = np.concatenate([np.column_stack([a, b, d]), np.column_stack([a, d, c])])[1:]
     with pytest.raises(NotADiskError, match="Euler characteristic -1 .1 handles"):
         check_disk(V, F)
+
+
+def test_a_reversed_boundary_triangle_is_named_as_an_orientation_problem(flat_disk):
+    # it looked like a pinched boundary ("cut one out"); the fix is to orient the triangles
+    from curvdetail.curvature._validate import boundary_edges
+
+    V, F = flat_disk
+    F = F.copy()
+    B = boundary_edges(F)
+    on_boundary = np.isin(F, B).sum(axis=1)
+    k = int(np.flatnonzero(on_boundary == 2)[0])
+    F[k] = F[k, ::-1]
+    with pytest.raises(NotADiskError, match=r"not consistently oriented: 2 interior edges run the same way "
+                                            r"in both their triangles .*meshing_re_orient_faces_coherently"):
+        check_disk(V, F)

@@ -292,3 +292,17 @@ def test_boundary_functions_take_sparse_huge_indices_without_allocating_or_overf
     G = np.array([[0, 1, 2], [0, 2, 0xFFFFFFFF]], dtype=np.uint32)
     assert boundary_vertices(G).tolist() == [0, 1, 2, 0xFFFFFFFF]
     assert set(map(tuple, boundary_edges(G).tolist())) == {(0, 1), (1, 2), (2, 0xFFFFFFFF), (0xFFFFFFFF, 0)}
+
+
+def test_misoriented_edges_finds_the_three_edges_of_a_reversed_interior_triangle():
+    from curvdetail.curvature._validate import misoriented_edges
+
+    V, F = grid(6, 6)
+    assert misoriented_edges(F).shape == (0, 2)
+    F = F.copy()
+    interior = np.flatnonzero(~np.isin(F, boundary_vertices(F)).any(axis=1))[0]
+    F[interior] = F[interior, ::-1]
+    E = misoriented_edges(F)
+    # each of its edges now runs as in the neighbour across it, i.e. as in the reversed triangle
+    reversed_edges = {(F[interior, k], F[interior, (k + 1) % 3]) for k in range(3)}
+    assert set(map(tuple, E.tolist())) == reversed_edges

@@ -253,6 +253,30 @@ def boundary_edges(F):
     return E if ids is None else ids[E]
 
 
+def misoriented_edges(F):
+    """Interior edges that run the same way in both their triangles, shape (k, 2) as (from, to),
+    sorted: where the triangles are not consistently oriented. Empty for an oriented mesh.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> misoriented_edges(np.array([[0, 1, 2], [0, 2, 3]])).tolist()    # (0, 2) against (2, 0)
+    []
+    >>> misoriented_edges(np.array([[0, 1, 2], [0, 3, 2]])).tolist()    # both run 2 -> 0
+    [[2, 0]]
+    """
+    F = as_faces(F, None)
+    ids, F = _compact_ids(F)
+    keys, n = _edge_keys(F)
+    directed = F[:, [1, 2, 0]].ravel() * n + F[:, [2, 0, 1]].ravel()
+    order = np.argsort(keys, kind="stable")
+    keys, directed = keys[order], directed[order]
+    same = (keys[1:] == keys[:-1]) & (directed[1:] == directed[:-1])
+    bad = np.unique(directed[1:][same])
+    E = np.column_stack([bad // n, bad % n]).astype(F.dtype, copy=False)
+    return E if ids is None else ids[E]
+
+
 def _compact_ids(F):
     """``(ids, F')`` with ``F = ids[F']`` and ``F'`` numbered ``0 .. len(ids) - 1``, where ``F``'s
     largest index is far above its number of corners (unchecked triangles, e.g. 2**32 - 1 as
