@@ -73,6 +73,9 @@ def read_mesh(path):
     V = np.ascontiguousarray(mesh.vertex_matrix(), dtype=np.float64)
     F = np.ascontiguousarray(mesh.face_matrix(), dtype=np.int64)
     check_loaded(path, V.shape[0], F, error=MeshFileError)
+    if F.shape[0] == 0 and V.shape[0] == 0:       # pymeshlab "reads" some other files as nothing
+        raise MeshFileError(f"pymeshlab read nothing from {path!r} (no vertices, no triangles); is it a "
+                            "mesh file? Use a format MeshLab reads (.obj, .off, .ply, .stl, ...).")
     if F.shape[0] == 0:
         raise MeshFileError(f"{path!r} holds {V.shape[0]} vertices but no triangles; a surface mesh "
                             "is needed.")

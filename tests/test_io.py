@@ -500,3 +500,11 @@ def test_written_ply_without_quality_holds_no_quality_field(tmp_path):
     assert properties == ["x", "y", "z", "vertex_indices"]
     W, G = read_mesh(tmp_path / "s.ply")
     assert np.array_equal(W, V) and np.array_equal(G, F)
+
+
+def test_a_file_pymeshlab_reads_as_nothing_is_not_called_a_mesh_without_triangles(tmp_path):
+    path = tmp_path / "notes.txt"
+    path.write_text("hello world\n")
+    with pytest.raises(MeshFileError, match=r"pymeshlab read nothing from .*notes.txt' \(no vertices, no "
+                                            r"triangles\); is it a mesh file\?"):
+        read_mesh(path)

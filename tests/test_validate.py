@@ -306,3 +306,13 @@ def test_misoriented_edges_finds_the_three_edges_of_a_reversed_interior_triangle
     # each of its edges now runs as in the neighbour across it, i.e. as in the reversed triangle
     reversed_edges = {(F[interior, k], F[interior, (k + 1) % 3]) for k in range(3)}
     assert set(map(tuple, E.tolist())) == reversed_edges
+
+
+def test_an_integer_0_1_mask_is_named_as_such_with_both_fixes():
+    mask = np.zeros(25, dtype=int)
+    mask[:5] = 1
+    with pytest.raises(ConstraintError, match=r"fixed: 23 indices are repeated .* It looks like a 0/1 mask of "
+                                              r"all 25 vertices: pass it as booleans \(fixed=mask.astype\(bool\)\)"):
+        as_index_set(mask, 25, "fixed")
+    with pytest.raises(ConstraintError, match=r"repeated \(first: 3\); list each vertex once\.$"):
+        as_index_set([3, 3], 25, "fixed")                  # a plain repeat gets no mask hint

@@ -346,9 +346,13 @@ def as_index_set(indices, n, name):
         )
     uniq, counts = np.unique(arr, return_counts=True)
     if uniq.size != arr.size:
+        # a 0/1 mask of integers (mask.astype(int), a MeshLab selection) is the likely mistake
+        mask = arr.size == n and uniq.size <= 2 and set(uniq.tolist()) <= {0, 1}
+        hint = (f" It looks like a 0/1 mask of all {n} vertices: pass it as booleans "
+                f"({name}=mask.astype(bool)) or as indices (np.flatnonzero(mask)).") if mask else ""
         raise ConstraintError(
             f"{name}: {arr.size - uniq.size} indices are repeated (first: {first_indices(uniq[counts > 1])}); "
-            "list each vertex once."
+            f"list each vertex once.{hint}"
         )
     return arr
 
