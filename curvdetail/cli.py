@@ -419,7 +419,8 @@ def _apply_command(parser):
     parser.add_argument("output", metavar="OUTPUT",
                         help="the current mesh afterwards (.ply keeps quality and attributes)")
     parser.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
-                        help="a filter parameter (repeatable); a length as an absolute value in model units (0.01) or as a percentage of the bbox diagonal (1%%)")
+                        help="a filter parameter (repeatable); a length as an absolute value in model "
+                             "units (0.01) or as a percentage of the bbox diagonal (1%%)")
     _add_layers_argument(parser)
     add_output_arguments(parser)
 
