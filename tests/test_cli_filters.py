@@ -277,3 +277,27 @@ def test_a_closed_stderr_does_not_stop_the_work(tmp_path):
         os.close(write_end)
     assert done.returncode == 0 and out.exists()
     assert b"vertices; not measured" in done.stdout
+
+
+def test_apply_remeshing_with_a_big_target_is_announced_with_the_value_given(capsys, tmp_path, monkeypatch):
+    # `--param target_edge=0.01` is 0.01 model units: on the 15 km terrain 1.3M vertices and 7
+    # minutes without a word; the note names the value as written and comes before the work
+    import curvdetail.cli as cli
+    from curvdetail import read_mesh
+    from curvdetail.curvature._validate import bbox_diagonal
+
+    diagonal = bbox_diagonal(read_mesh(NOSE)[0])
+    monkeypatch.setattr(cli, "BIG_TARGET", 500)
+    length = round(0.03 * diagonal, 6)
+    rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "o.ply",
+                           "--param", f"target_edge={length}", "--param", "evaluate=false")
+    assert rc == 0
+    assert f"note: target_edge={length} gives about " in err and "target vertices; this takes minutes." in err
+    assert "skips them" not in err                             # evaluate=false: nothing to skip
+    rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "q.ply",
+                           "--param", f"target_edge={length}")
+    assert rc == 0 and "(the measurements most of it; --param evaluate=false skips them)" in err
+    monkeypatch.setattr(cli, "BIG_TARGET", 1_000_000)
+    rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "p.ply",
+                           "--param", f"target_edge={length}", "--param", "evaluate=false")
+    assert rc == 0 and "note:" not in err
