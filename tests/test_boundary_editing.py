@@ -146,6 +146,7 @@ def test_a_boundary_that_does_not_close_is_a_mesh_error():
     (dict(amplitude=0.1, axis=3), "axis=3; use 0, 1 or 2"),
     (dict(amplitude=0.1, axis=True), "axis=True; use 0, 1 or 2"),
     (dict(amplitude=0.1, axis=np.True_), "use 0, 1 or 2"),
+    (dict(amplitude=0.1, axis=2.0), r"axis=2\.0; use 0, 1 or 2"),     # would index columns with a float
     (dict(amplitude=float("nan")), "amplitude=nan must be a finite number"),
     (dict(amplitude=0.1, periods=float("inf")), "periods=inf must be a finite number"),
     (dict(amplitude=0.1, phase="0"), "phase='0' must be a finite number"),
@@ -158,3 +159,16 @@ def test_sine_displacement_refuses_what_would_give_no_displacement(kwargs, messa
 def test_sine_displacement_takes_numpy_scalars():
     f = sine_displacement(np.float32(2.0), periods=np.int64(1), axis=np.int64(2))
     assert np.allclose(f(np.array([0.25]), np.zeros((1, 3))), [[0.0, 0.0, 2.0]])
+
+
+@pytest.mark.parametrize("flag", ["no", 0, None])
+def test_return_info_must_be_a_bool(flag):
+    V, F = grid(6, 6)
+    with pytest.raises(ValueError, match=r"return_info=.* must be True or False"):
+        edit_boundary(V, F, sine_displacement(0.05, axis=2), return_info=flag)
+
+
+def test_return_info_takes_a_numpy_bool():
+    V, F = grid(6, 6)
+    X, info = edit_boundary(V, F, sine_displacement(0.05, axis=2), return_info=np.True_)
+    assert info["boundary"].size == 20

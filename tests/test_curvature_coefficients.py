@@ -102,6 +102,19 @@ def test_bad_rcond_is_refused(plane_grid, rcond):
         curvature_coefficients(*plane_grid, rcond=rcond)
 
 
+@pytest.mark.parametrize("rcond", ["1e-6", True, np.True_, None])
+def test_rcond_that_is_not_a_number_is_refused_even_if_float_takes_it(plane_grid, rcond):
+    # "1e-6" and True went through float() (the other numeric parameters refuse them)
+    with pytest.raises(ValueError, match=r"rcond=.* is not a number; pass a threshold in \(0, 1\)"):
+        curvature_coefficients(*plane_grid, rcond=rcond)
+
+
+def test_rcond_takes_numpy_scalars(plane_grid):
+    from curvdetail.curvature.curvature_coefficients import check_rcond
+
+    assert check_rcond(np.float32(1e-3)) == pytest.approx(1e-3) and check_rcond(np.array(1e-6)) == 1e-6
+
+
 def test_malformed_mesh_is_refused_before_any_algebra(plane_grid):
     V, F = plane_grid
     bad = F.copy()

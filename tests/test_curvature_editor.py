@@ -149,6 +149,14 @@ def test_rcond_outside_zero_one_is_refused_like_curvature_coefficients(plane_gri
         CurvatureEditor(V, F, b, b, rcond=rcond)
 
 
+def test_rcond_as_a_string_is_refused_by_the_editor(plane_grid):
+    # "1e-6" was converted by float() and taken
+    V, F = plane_grid
+    b = boundary_vertices(F)
+    with pytest.raises(ValueError, match=r"rcond='1e-6' is not a number"):
+        CurvatureEditor(V, F, b, b, rcond="1e-6")
+
+
 def test_stacked_relations_solve_the_least_squares_problem_of_both_coefficient_sets(load_mesh, rng):
     V, F = load_mesh("mannequin_nose.obj")
     b = boundary_vertices(F)

@@ -60,7 +60,8 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
     ------
     MeshError         malformed mesh, or not exactly one boundary loop
     ConstraintError   displacement array of the wrong shape or with NaN / inf
-    ValueError        the displacement callable returned the wrong shape or non-finite values
+    ValueError        the displacement callable returned the wrong shape or non-finite values,
+                      or ``return_info`` is not a bool
 
     Examples
     --------
@@ -74,6 +75,8 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
     """
     if boundary_detail not in ("deformed", "rest"):
         raise ValueError(f"boundary_detail={boundary_detail!r}; use 'deformed' or 'rest'.")
+    if not isinstance(return_info, (bool, np.bool_)):      # "no" would count as True
+        raise ValueError(f"return_info={return_info!r} must be True or False.")
     V = as_vertices(V)
     F = as_faces(F, V.shape[0])        # shapes and indices; the editor below runs every mesh check
     try:
@@ -136,8 +139,8 @@ def sine_displacement(amplitude, periods=1, axis=1, phase=0.0):
 
     Raises
     ------
-    ValueError   ``axis`` not 0, 1 or 2, or ``amplitude``, ``periods`` or ``phase`` not a finite
-                 number
+    ValueError   ``axis`` not the integer 0, 1 or 2, or ``amplitude``, ``periods`` or ``phase``
+                 not a finite number
 
     Examples
     --------
@@ -145,8 +148,10 @@ def sine_displacement(amplitude, periods=1, axis=1, phase=0.0):
     >>> f(np.array([0.0, 0.25]), np.zeros((2, 3)))[:, 2].round(12).tolist()
     [0.0, 2.0]
     """
-    if isinstance(axis, (bool, np.bool_)) or axis not in (0, 1, 2):
+    # an integer only: 2.0 passes `in (0, 1, 2)` but cannot index the output's columns
+    if isinstance(axis, (bool, np.bool_)) or not isinstance(axis, numbers.Integral) or axis not in (0, 1, 2):
         raise ValueError(f"axis={axis!r}; use 0, 1 or 2 for x, y or z.")
+    axis = int(axis)
     for name, value in (("amplitude", amplitude), ("periods", periods), ("phase", phase)):
         if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
             raise ValueError(f"{name}={value!r} must be a finite number.")

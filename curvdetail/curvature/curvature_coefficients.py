@@ -5,7 +5,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ._validate import bbox_diagonal
+from ._validate import as_float, bbox_diagonal
 from .cotan_laplacian import checked_cotan_laplacian
 from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
 
@@ -139,13 +139,12 @@ WELL_CONDITIONED = 1e-6
 
 def check_rcond(rcond):
     """``rcond`` as a float in (0, 1), or ValueError naming the value and the fix."""
-    try:
-        rcond = float(rcond)
-    except (TypeError, ValueError):
-        raise ValueError(f"rcond={rcond!r} is not a number; pass a threshold in (0, 1), e.g. 1e-6.") from None
-    if not 0.0 < rcond < 1.0:
+    number = as_float(rcond)           # a real number only: float("1e-6") and float(True) would pass
+    if number is None:
+        raise ValueError(f"rcond={rcond!r} is not a number; pass a threshold in (0, 1), e.g. 1e-6.")
+    if not 0.0 < number < 1.0:
         raise ValueError(f"rcond={rcond!r} is outside (0, 1); pass a relative threshold such as 1e-6.")
-    return rcond
+    return number
 
 
 def _coefficients(D, A, rows, cols, n, rcond, diag, *, want_scale=False):
