@@ -59,6 +59,24 @@ def test_flipped_triangles_refuses_uv_that_does_not_fit_f():
         flipped_triangles(V, F)
 
 
+def test_flipped_triangles_refuses_nan_uv_instead_of_reporting_none_flipped():
+    from curvdetail.curvature.errors import MeshError
+
+    V, F = disk(n_rings=4)
+    UV = V[:, :2].copy()
+    UV[5] = np.nan                       # NaN <= 0 is False: every triangle passed as unflipped
+    with pytest.raises(MeshError, match=r"UV: 1 vertices have NaN or infinite coordinates \(first: 5\)"):
+        flipped_triangles(UV, F)
+
+
+def test_flipped_triangles_refuses_non_integer_faces():
+    from curvdetail.curvature.errors import MeshError
+
+    V, F = disk(n_rings=4)
+    with pytest.raises(MeshError, match="F has non-integer entries; triangle indices must be integers"):
+        flipped_triangles(V[:, :2], F + 0.5)
+
+
 def test_harmonic_map_without_pinned_vertices_is_refused_not_zeros():
     # with nothing pinned every constant solves it: it returned zeros silently
     from curvdetail.curvature.errors import ConstraintError

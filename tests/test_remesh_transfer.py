@@ -156,3 +156,73 @@ def test_a_target_that_is_not_the_same_surface_is_refused(load_mesh, method):
         transfer_curvature(V, F, V + [0.0, 0.0, 1000.0], F, method=method)
     D = transfer_curvature(V, F, V + [0.0, 0.0, 1e-3], F, method=method)       # a slight offset is fine
     assert np.all(np.isfinite(D))
+
+
+def _located_on_grid():
+    from curvdetail.remesh import locate
+
+    V, F = grid(5, 5)
+    face, bary, _ = locate(V[:6] + [0.01, 0.02, 0.0], V, F)
+    return V, F, face, bary
+
+
+@pytest.mark.parametrize("n, words", [
+    (127.7, r"n=127\.7 must be a whole number >= 1"),           # was a TypeError from scipy
+    (None, "n=None must be a whole number >= 1"),
+    ("x", "n='x' must be a whole number >= 1"),
+    (-1, "n=-1 must be at least 1"),
+    (10 ** 12, r"n=1000000000000 asks for a dense .* more than 100,000,000 rows"),   # was a MemoryError
+    (3, r"F has vertex indices outside \[0, n=3\) \(up to 24\); pass n >= 25"),
+])
+def test_spread_refuses_a_vertex_count_that_is_not_a_sane_count_for_f(n, words):
+    from curvdetail.remesh import spread
+
+    V, F, face, bary = _located_on_grid()
+    with pytest.raises(ValueError, match=words):
+        spread(np.ones(face.size), F, face, bary, n)
+
+
+def test_spread_takes_numpy_and_whole_float_counts():
+    from curvdetail.remesh import spread
+
+    V, F, face, bary = _located_on_grid()
+    assert spread(np.ones(face.size), F, face, bary, np.int64(25)).sum() == pytest.approx(face.size, abs=1e-12)
+    assert spread(np.ones(face.size), F, face, bary, 30.0).shape == (30, 1)
+
+
+@pytest.mark.parametrize("values, words", [
+    (np.array(["a"] * 25), r"values has dtype <U1; pass a \(25,\) or \(25, c\) array of real numbers"),
+    (None, "values has dtype object"),
+    (np.ones(3), r"values has 3 rows but F references vertex 24; .*\(at least 25\)"),   # F was blamed
+    (np.r_[np.ones(24), np.nan], r"values has 1 NaN or infinite rows \(first: 24\)"),
+])
+def test_interpolate_names_values_that_do_not_fit_the_mesh(values, words):
+    from curvdetail.remesh import interpolate
+
+    V, F, face, bary = _located_on_grid()
+    with pytest.raises(MeshError, match=words):
+        interpolate(values, F, face, bary)
+
+
+@pytest.mark.parametrize("scale, words", [
+    (100.0, "6 rows of bary are not barycentric coordinates"),      # far outside [0, 1]
+    (0.5, "6 rows of bary are not barycentric coordinates"),        # rows sum to 0.5
+    (np.nan, r"6 rows of bary are not barycentric .*finite, in \[0, 1\] and sum to 1"),
+])
+def test_interpolate_and_spread_refuse_coordinates_that_are_not_barycentric(scale, words):
+    # they were taken silently: extrapolated values, and spread lost its conservation
+    from curvdetail.remesh import interpolate, spread
+
+    V, F, face, bary = _located_on_grid()
+    with pytest.raises(MeshError, match="interpolate: " + words):
+        interpolate(V, F, face, bary * scale)
+    with pytest.raises(MeshError, match="spread: " + words):
+        spread(np.ones(face.size), F, face, bary * scale, V.shape[0])
+
+
+def test_coordinates_off_by_rounding_are_taken():
+    from curvdetail.remesh import interpolate
+
+    V, F, face, bary = _located_on_grid()
+    nudged = bary + np.array([1e-9, -1e-9, 0.0])
+    assert np.abs(interpolate(V, F, face, nudged) - interpolate(V, F, face, bary)).max() < 1e-8

@@ -21,6 +21,13 @@ MAX_COORDINATE_HERE = 1e150
 #: squared lengths, which overflow beyond ~1e77 diagonals.
 MAX_RELATIVE_DISTANCE = 1e50
 
+#: Barycentric coordinates taken by interpolate / spread: entries in [-tol, 1 + tol], rows summing
+#: to 1 within tol. locate() clips and normalizes its coordinates, so they are off by rounding only.
+BARY_TOLERANCE = 1e-6
+
+#: Most vertices spread() returns rows for: its (n, c) result is dense (0.8 GB per column here).
+MAX_SPREAD_VERTICES = 100_000_000
+
 
 def locate(points, V, F, *, engine="auto", candidates=8, chunk=20_000):
     """Nearest triangle and barycentric coordinates of each point, vectorized.
@@ -323,34 +330,79 @@ def _closest_barycentric_all(P, T):
     return bary, np.linalg.norm(X - P, axis=-1)
 
 
-def _located(F, face, bary, n, what):
-    """``(F, face, bary)`` as arrays, or MeshError if they do not fit each other and ``n`` vertices."""
+def _located(F, face, bary, what):
+    """``(F, face, bary)`` as arrays, or MeshError if they do not fit each other (the callers
+    check ``F`` against their vertex count)."""
     F = np.asarray(F)
     face = np.asarray(face)
-    bary = np.asarray(bary, dtype=np.float64)
+    bary = np.asarray(bary)
     if F.ndim != 2 or F.shape[1] != 3 or face.ndim != 1 or bary.shape != (face.shape[0], 3):
         raise MeshError(f"{what}: F {F.shape}, face {face.shape} and bary {bary.shape} must be (m, 3), "
                         "(k,) and (k, 3), as locate() returns them.")
     for name, X in (("F", F), ("face", face)):
         if X.size and X.dtype.kind not in "iu":       # floats would be truncated, bools mean 0/1
             raise MeshError(f"{what}: {name} has dtype {X.dtype}; pass integer indices, as locate() uses them.")
+    if bary.dtype.kind not in "fiu":
+        raise MeshError(f"{what}: bary has dtype {bary.dtype}; pass the (k, 3) float barycentric coordinates "
+                        "locate() returns.")
     F = F.astype(np.int64, copy=False)
     face = face.astype(np.int64, copy=False)
+    bary = bary.astype(np.float64, copy=False)
     bad = np.flatnonzero((face < 0) | (face >= F.shape[0]))
     if bad.size:
         raise MeshError(f"{what}: {bad.size} face indices are outside [0, {F.shape[0]}) (first: "
                         f"{first_indices(face[bad])}, at positions {first_indices(bad)}); pass the faces "
                         "locate() found in this F.")
-    if F.size and (F.min() < 0 or F.max() >= n):
-        raise MeshError(f"{what}: F has vertex indices outside [0, {n}); pass the F the points were "
-                        "located in, with one value per vertex.")
+    if F.size and F.min() < 0:
+        raise MeshError(f"{what}: F has negative vertex indices; indices are 0-based.")
+    # weights far outside [0, 1] or not summing to 1 would extrapolate (and break spread's
+    # conservation) silently; locate()'s own are exact to rounding
+    tol = BARY_TOLERANCE
+    with np.errstate(invalid="ignore"):
+        off = ~(np.isfinite(bary).all(axis=1) & (bary >= -tol).all(axis=1) & (bary <= 1 + tol).all(axis=1)
+                & (np.abs(bary.sum(axis=1) - 1.0) <= tol))
+    if off.any():
+        bad = np.flatnonzero(off)
+        raise MeshError(f"{what}: {bad.size} rows of bary are not barycentric coordinates (first: "
+                        f"{first_indices(bad)}): each must be finite, in [0, 1] and sum to 1 (within {tol:g}); "
+                        "pass the coordinates locate() returns.")
     return F, face, bary
 
 
+def _as_point_values(values, count, what, per):
+    """``values`` as a float array of shape (count,) or (count, c), finite, or MeshError naming
+    ``values``, the expected leading length ``count`` and ``per`` (what one row stands for)."""
+    try:
+        vals = np.asarray(values)
+    except Exception as exc:               # ragged lists and the like
+        raise MeshError(f"{what}: values could not be read as an array ({exc}); pass a ({count},) or "
+                        f"({count}, c) float array, one value (or row) per {per}.") from None
+    if vals.dtype.kind not in "fiu":       # strings, None (object), complex; bools would mean 0/1
+        raise MeshError(f"{what}: values has dtype {vals.dtype}; pass a ({count},) or ({count}, c) array of "
+                        f"real numbers, one value (or row) per {per}.")
+    if vals.ndim not in (1, 2):
+        raise MeshError(f"{what}: values has shape {vals.shape}; pass a ({count},) or ({count}, c) array, one "
+                        f"value (or row) per {per}.")
+    vals = vals.astype(np.float64, copy=False)
+    if not np.isfinite(vals).all():
+        bad = np.flatnonzero(~np.isfinite(vals.reshape(vals.shape[0], -1)).all(axis=1))
+        raise MeshError(f"{what}: values has {bad.size} NaN or infinite rows (first: {first_indices(bad)}); "
+                        "repair them first.")
+    return vals
+
+
 def interpolate(values, F, face, bary):
-    """Values at located points: ``sum_k bary_k values[F[face, k]]`` (values (n,) or (n, c))."""
-    vals = np.asarray(values)
-    F, face, bary = _located(F, face, bary, vals.shape[0] if vals.ndim else 0, "interpolate")
+    """Values at located points: ``sum_k bary_k values[F[face, k]]`` (values (n,) or (n, c)).
+
+    ``values`` must be finite with one row per vertex of the mesh ``F`` indexes, ``face`` and
+    ``bary`` as :func:`locate` returns them (rows in [0, 1] summing to 1, within
+    ``BARY_TOLERANCE``); MeshError otherwise."""
+    F, face, bary = _located(F, face, bary, "interpolate")
+    need = int(F.max()) + 1 if F.size else 0
+    vals = _as_point_values(values, need, "interpolate", "vertex of the mesh F indexes")
+    if vals.shape[0] < need:          # the values, not F, are what does not fit
+        raise MeshError(f"interpolate: values has {vals.shape[0]} rows but F references vertex {need - 1}; "
+                        f"pass one value (or row) per vertex of the mesh F indexes (at least {need}).")
     corner = vals[F[face]]                                   # (k, 3) or (k, 3, c)
     if corner.ndim == 2:
         return (bary * corner).sum(1)
@@ -360,11 +412,22 @@ def interpolate(values, F, face, bary):
 def spread(values, F, face, bary, n):
     """Adjoint of :func:`interpolate`: each point's value split over the 3 corners of its
     triangle by barycentric weights and summed per vertex, shape (n, c). The sum is conserved
-    exactly (up to rounding), since the weights of a point sum to 1."""
-    F, face, bary = _located(F, face, bary, int(n), "spread")
-    vals = np.asarray(values, dtype=np.float64)
-    if vals.shape[:1] != face.shape:
-        raise MeshError(f"spread: {vals.shape[0] if vals.ndim else 0} values for {face.shape[0]} located "
+    exactly (up to rounding), since the weights of a point sum to 1.
+
+    ``n`` is a whole number, at least the number of vertices ``F`` references and at most
+    ``MAX_SPREAD_VERTICES``; ``values`` finite with one value (or row) per located point;
+    ValueError / MeshError otherwise."""
+    n = as_count(n, "n")
+    if n > MAX_SPREAD_VERTICES:
+        raise ValueError(f"n={n} asks for a dense ({n}, c) result, more than {MAX_SPREAD_VERTICES:,} rows; "
+                         "pass the vertex count of the mesh F indexes.")
+    F, face, bary = _located(F, face, bary, "spread")
+    if F.size and F.max() >= n:
+        raise MeshError(f"spread: F has vertex indices outside [0, n={n}) (up to {F.max()}); pass n >= "
+                        f"{F.max() + 1}, the vertex count of the mesh F indexes.")
+    vals = _as_point_values(values, face.shape[0], "spread", "located point")
+    if vals.shape[0] != face.shape[0]:
+        raise MeshError(f"spread: values has {vals.shape[0]} rows for {face.shape[0]} located "
                         "points; give one value (or row) per point.")
     vals = vals.reshape(face.shape[0], -1)
     rows = F[face].ravel()

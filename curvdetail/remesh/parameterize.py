@@ -2,7 +2,8 @@
 
 import numpy as np
 
-from ..curvature._validate import as_index_set, as_values, check_every_component_fixed, check_mesh
+from ..curvature._validate import (as_faces, as_index_set, as_values, as_vertices, check_every_component_fixed,
+                                  check_mesh)
 from ..curvature.cotan_laplacian import _cotan_laplacian_unchecked
 from ..curvature.errors import ConstraintError, MeshError
 from ..curvature.sparse_solver import factorize
@@ -13,12 +14,13 @@ METHODS = ("harmonic", "meshlab_harmonic", "lscm")
 
 def flipped_triangles(UV, F):
     """Indices of triangles whose orientation in the plane is reversed or degenerate (signed area
-    <= 0 relative to the orientation of the majority, by area), shape (k,)."""
-    UV = np.asarray(UV, dtype=np.float64)
-    F = np.asarray(F)
-    if UV.ndim != 2 or UV.shape[1] != 2 or F.ndim != 2 or F.shape[1] != 3:
-        raise MeshError(f"UV has shape {UV.shape} and F {F.shape}; pass (n, 2) and (m, 3) arrays.")
-    if F.size and (F.min() < 0 or F.max() >= UV.shape[0]):
+    <= 0 relative to the orientation of the majority, by area), shape (k,).
+
+    ``UV``: finite (n, 2) floats; ``F``: (m, 3) integers in [0, n). MeshError otherwise."""
+    # NaN UVs would compare as "not flipped" and float faces fail to index: refuse both here
+    UV = as_vertices(UV, "UV", dim=2)
+    F = as_faces(F, None)
+    if F.max() >= UV.shape[0]:
         raise MeshError(f"F has vertex indices outside [0, {UV.shape[0]}); pass one UV row per vertex.")
     a, b, c = UV[F[:, 0]], UV[F[:, 1]], UV[F[:, 2]]
     signed = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
