@@ -89,3 +89,25 @@ def test_missing_layer_is_refused():
     ms.load_new_mesh(os.path.join(DATA, "mannequin_nose.obj"))
     with pytest.raises(FilterError, match="targetmesh layer id 3 does not exist"):
         apply(ms, "get_curvature_reconstruction_error", targetmesh=3)
+
+
+def test_a_sample_count_beyond_the_limit_is_refused_before_the_layers_are_read(monkeypatch):
+    # samplenum=2000000000 was taken and effectively hung the command
+    from curvdetail.filters import FilterParameterError
+    import curvdetail.remesh
+
+    monkeypatch.setattr(curvdetail.remesh, "hausdorff", lambda *a, **k: pytest.fail("sampled"))
+    V, F = grid(5, 5)
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(V, F.astype(np.int32)))
+    ms.add_mesh(pymeshlab.Mesh(V, F.astype(np.int32)))
+    with pytest.raises(FilterParameterError, match="parameter 'samplenum' is 2000000000; it must be at most 10000000"):
+        apply(ms, "get_curvature_reconstruction_error", samplenum=2_000_000_000)
+
+
+def test_the_sample_limit_is_the_one_hausdorff_takes():
+    from curvdetail.filters.registry import get_filter
+    from curvdetail.remesh.evaluate import MAX_SAMPLE_COUNT
+
+    (p,) = [p for p in get_filter("get_curvature_reconstruction_error").parameters if p.name == "samplenum"]
+    assert p.max == MAX_SAMPLE_COUNT

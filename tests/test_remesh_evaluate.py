@@ -109,7 +109,7 @@ def test_huge_and_tiny_meshes_are_measured_in_a_unit_frame():
 
 @pytest.mark.parametrize("kwargs, words", [
     ({"samples": True}, "samples=True must be a whole number"),
-    ({"samples": 2 ** 31}, "more than pymeshlab takes"),
+    ({"samples": 2 ** 31}, "more than the limit of 10,000,000"),
     ({"seed": 2.5}, "seed=2.5 must be a whole number"),
     ({"seed": -1}, "seed=-1 must be at least 0"),
 ])
@@ -138,3 +138,26 @@ def test_hausdorff_names_each_argument_as_the_caller_does(which, message):
         args["Vb"] = V[:, :2]
     with pytest.raises(MeshError, match=message):
         hausdorff(args["Va"], args["Fa"], args["Vb"], args["Fb"])
+
+
+@pytest.mark.parametrize("engine", ["meshlab", "kdtree"])
+def test_sample_counts_beyond_the_limit_are_refused_before_sampling(monkeypatch, engine):
+    # samples=2e9 was taken and sampled for hours (pymeshlab takes up to 2**31 - 1)
+    import curvdetail.remesh.evaluate as evaluate
+
+    for name in ("_hausdorff_meshlab", "_hausdorff_kdtree"):
+        monkeypatch.setattr(evaluate, name, lambda *a, **k: pytest.fail("sampled"))
+    V, F = grid(5, 5)
+    with pytest.raises(ValueError, match=r"samples=2,000,000,000 is more than the limit of 10,000,000 per "
+                                         r"direction .*~1,000,000 is plenty"):
+        hausdorff(V, F, V, F, samples=2_000_000_000, engine=engine)
+    with pytest.raises(ValueError, match="more than the limit"):
+        hausdorff(V, F, V, F, samples=evaluate.MAX_SAMPLE_COUNT + 1, engine=engine)
+
+
+@pytest.mark.parametrize("far", ["no", 0, None])
+def test_vertex_distance_far_must_be_a_bool(far):
+    # far="no" was taken as True (the approximate engine)
+    V, F = grid(5, 5)
+    with pytest.raises(ValueError, match=r"far=.* must be True or False"):
+        vertex_distance(V, V, F, far=far)

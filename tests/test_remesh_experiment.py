@@ -138,6 +138,7 @@ def test_unknown_backend_is_refused_before_retriangulating(height_field, monkeyp
     ({"target": "ready", "target_edge": -1}, RemeshError, "target_edge=-1 must be a positive fraction"),
     ({"target": 5}, ValueError, r"target must be a pair \(Vt, Ft\).*got int"),
     ({"progress": 5}, ValueError, "progress must be callable.*got int"),
+    ({"evaluate": "no"}, ValueError, "evaluate='no' must be True or False"),   # "no" counted as True
 ])
 def test_bad_options_are_refused_before_any_work(height_field, monkeypatch, kwargs, error, words):
     # a scalar target or a non-callable progress raised a TypeError once the work had started
@@ -179,3 +180,37 @@ def test_report_says_a_given_target_was_not_made_by_the_experiment(height_field)
     assert made["options"]["target_edge_length"] == pytest.approx(0.06 * made["source"]["bbox_diagonal"])
     assert given["options"]["target_edge_length"] is None
     assert made["target"]["vertices"] == given["target"]["vertices"]      # the same decimation
+
+
+@pytest.mark.parametrize("shift, words", [
+    (lambda V: 2.0 * V, r"\(up to 0\.354 of the source's bbox diagonal; allowed 1e-06\)"),
+    (lambda V: V + [0.0, 0.0, 0.5], r"\(up to 0\.177 of the source's bbox diagonal; allowed 1e-06\)"),
+])
+def test_a_target_whose_boundary_is_off_the_source_boundary_is_refused(monkeypatch, shift, words):
+    # it was rebuilt with its boundary pinned where it was and reported a 35 % error, no warning
+    import curvdetail.remesh.experiment as experiment
+
+    monkeypatch.setattr(experiment, "transfer_curvature", lambda *a, **k: pytest.fail("transferred"))
+    V, F = disk(n_rings=10)
+    words = r"60 of 60 target boundary vertices are off the source's boundary polyline " + words
+    with pytest.raises(RemeshError, match=words + r".*Pass one made by curvdetail\.remesh\.retriangulate"):
+        remesh_experiment(V, F, target=(shift(V), F))
+
+
+def test_a_target_with_one_boundary_vertex_slightly_off_names_it():
+    from curvdetail.curvature.boundary_editing import boundary_loop
+    from curvdetail.remesh.experiment import _polyline_distance
+
+    V, F = disk(n_rings=6)
+    Vt = V.copy()
+    Vt[boundary_loop(F)[3], 2] += 1e-4              # 3.5e-5 of the diagonal: beyond 1e-6
+    with pytest.raises(RemeshError, match=r"^1 of \d+ target boundary vertices are off .*up to 3\.5\de-05"):
+        remesh_experiment(V, F, target=(Vt, F), evaluate=False)
+    Vt[boundary_loop(F)[3], 2] = V[boundary_loop(F)[3], 2] + 1e-8     # rounding-sized: taken
+    remesh_experiment(V, F, target=(Vt, F), evaluate=False)
+    # the exact search, in chunks smaller than one row of segments, agrees with a direct one
+    P, X = V[boundary_loop(F)], np.random.default_rng(1).normal(size=(7, 3))
+    A, B = P, np.roll(P, -1, axis=0)
+    t = np.clip(((X[:, None] - A) * (B - A)).sum(-1) / ((B - A) ** 2).sum(-1), 0, 1)
+    direct = np.linalg.norm(X[:, None] - (A + t[..., None] * (B - A)), axis=-1).min(1)
+    assert np.allclose(_polyline_distance(P, X, max_entries=5), direct, rtol=1e-12, atol=0)

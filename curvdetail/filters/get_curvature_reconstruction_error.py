@@ -26,9 +26,11 @@ from .registry import PAPER, filter
     parameters=[
         Parameter("sampledmesh", "mesh", None, "layer whose error is measured (default: current)"),
         Parameter("targetmesh", "mesh", 0, "reference layer the distances are measured to"),
+        # max: remesh.evaluate.MAX_SAMPLE_COUNT (a literal: importing curvdetail.remesh here would
+        # load it with every filter), refused before the layers are read
         Parameter("samplenum", "int", 0,
-                  "face samples per direction; 0 picks 10 per triangle of the sampled mesh, "
-                  "between 100000 and 1000000", min=0),
+                  "face samples per direction, at most 10000000 (~1000000 is plenty); 0 picks 10 per "
+                  "triangle of the sampled mesh, between 100000 and 1000000", min=0, max=10_000_000),
         Parameter("set_quality", "bool", True,
                   "set the sampled layer's vertex quality to its distance to the target"),
     ],

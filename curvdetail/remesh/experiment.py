@@ -8,7 +8,7 @@ from ..curvature._validate import bbox_diagonal
 from ..curvature.boundary_editing import boundary_loop
 from ..curvature.reconstruct import ROW_MODES, Reconstructor
 from ..curvature.sparse_solver import resolve_backend
-from ._disk import check_disk
+from ._disk import Polyline, RemeshError, check_disk
 from .evaluate import hausdorff, vertex_distance
 from .parameterize import METHODS as PARAMETERIZATIONS
 from .parameterize import parameterize
@@ -27,6 +27,12 @@ BASELINE_SAMPLES = 20000
 #: A rebuilt surface with a vertex further than this (x bbox diagonal) from the source is measured
 #: with the kd-tree engine as well (see :func:`hausdorff`).
 FAR_SURFACE = 0.02
+
+#: A given target's boundary vertex further than this (x the source's bbox diagonal) from the
+#: source's boundary polyline is refused: the reconstruction pins the target's boundary where it
+#: is, so a target off the source gives a large error that measures the target, not the method.
+#: retriangulate() puts them within 1e-12.
+TARGET_BOUNDARY_TOLERANCE = 1e-6
 
 STAGES = ("retriangulate", "parameterize", "transfer", "reconstruct", "evaluate")
 
@@ -85,9 +91,11 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="c
     ------
     MeshError, NotADiskError   malformed source or not a disk (says what was found)
     RemeshError                absurd target edge (with the numbers; not a positive number even
-                               with a ``target``) or a failed retriangulation
+                               with a ``target``), a failed retriangulation, or a ``target`` with
+                               boundary vertices off the source's boundary polyline (by more than
+                               ``TARGET_BOUNDARY_TOLERANCE`` = 1e-6 of the bbox diagonal)
     ValueError                 unknown option values; ``target`` not a pair; ``progress`` not
-                               callable
+                               callable; ``evaluate`` not a bool
     SolverError                unknown or uninstalled ``backend`` (before any work)
 
     Examples
@@ -102,6 +110,38 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="c
                             location=location, parameterization=parameterization, backend=backend,
                             evaluate=evaluate, source_path=source_path, progress=progress, target=target)
     return (result["X"], result["Ft"]), result["report"]
+
+
+def _polyline_distance(P, X, max_entries=2_000_000):
+    """Exact distance of each point ``X`` (m, 3) to the closed polyline through ``P`` (k, 3),
+    in chunks of points so that no (points x segments) array exceeds ``max_entries``."""
+    AB = np.roll(P, -1, axis=0) - P
+    length2 = np.maximum((AB * AB).sum(1), np.finfo(float).tiny)
+    out = np.empty(X.shape[0])
+    step = max(1, max_entries // P.shape[0])
+    for lo in range(0, X.shape[0], step):
+        AX = X[lo:lo + step, None, :] - P                                    # (c, k, 3)
+        t = np.clip(np.einsum("ckd,kd->ck", AX, AB) / length2, 0.0, 1.0)
+        out[lo:lo + step] = np.sqrt(((AX - t[..., None] * AB) ** 2).sum(-1).min(1))
+    return out
+
+
+def _check_target_boundary(P, X, d):
+    """RemeshError unless every target boundary vertex ``X`` lies on the source boundary
+    polyline ``P`` within ``TARGET_BOUNDARY_TOLERANCE * d``."""
+    # nearest-candidate projection first: its distances are upper bounds, so only the points it
+    # does not clear need the exact (points x segments) search
+    _, _, dist = Polyline(P).project(X)
+    dist = dist / d
+    suspect = np.flatnonzero(dist > TARGET_BOUNDARY_TOLERANCE)
+    dist[suspect] = _polyline_distance(P, X[suspect]) / d
+    off = np.flatnonzero(dist > TARGET_BOUNDARY_TOLERANCE)
+    if off.size:
+        raise RemeshError(
+            f"{off.size} of {X.shape[0]} target boundary vertices are off the source's boundary polyline "
+            f"(up to {dist.max():.3g} of the source's bbox diagonal; allowed {TARGET_BOUNDARY_TOLERANCE:g}): "
+            "the target must be a retriangulation of the source with its boundary vertices on the source's "
+            "boundary. Pass one made by curvdetail.remesh.retriangulate, or target=None to make it here.")
 
 
 def _check_choice(name, value, choices):
@@ -128,10 +168,12 @@ def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="cons
     if target is not None and (not isinstance(target, (tuple, list)) or len(target) != 2):
         raise ValueError(f"target must be a pair (Vt, Ft), a ready retriangulation, or None; got "
                          f"{type(target).__name__}.")
+    if not isinstance(evaluate, (bool, np.bool_)):       # "no" would count as True
+        raise ValueError(f"evaluate={evaluate!r} must be True or False.")
     if progress is not None and not callable(progress):
         raise ValueError(f"progress must be callable (called with each stage name) or None; got "
                          f"{type(progress).__name__}.")
-    V, F, _ = check_disk(V, F, "the source")
+    V, F, loop_s = check_disk(V, F, "the source")
     d = bbox_diagonal(V)
     seconds = dict.fromkeys(STAGES, 0.0)
     t_all = time.perf_counter()
@@ -146,7 +188,8 @@ def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="cons
         Vt, Ft = retriangulate(V, F, method=method, target_edge=target_edge)
         seconds["retriangulate"] = time.perf_counter() - t
     else:
-        Vt, Ft, _ = check_disk(*target, "the target")
+        Vt, Ft, loop_given = check_disk(*target, "the target")
+        _check_target_boundary(V[loop_s], Vt[loop_given], d)
 
     uv, param_info = None, None
     if location == "uv":
