@@ -219,6 +219,19 @@ def test_missing_script_is_file_not_found(tmp_path):
         run_script(meshset(), tmp_path / "none.mlx")
 
 
+@pytest.mark.parametrize("path, kind", [(None, "NoneType"), (3, "int")])
+def test_a_script_path_that_is_not_a_path_is_a_script_error(path, kind):
+    # os.fspath raised a TypeError
+    with pytest.raises(ScriptError, match=f"a filter script path is needed .*; got {kind}"):
+        run_script(meshset(), path)
+
+
+def test_a_folder_is_named_as_a_folder_not_as_missing(tmp_path):
+    # it was "filter script not found" for a folder that exists
+    with pytest.raises(ScriptError, match=r"is a folder; pass the path of a \.mlx filter script"):
+        run_script(meshset(), tmp_path)
+
+
 @pytest.mark.parametrize("steps, message", [
     (None, "got NoneType"), ("compute_curvature_detail", "got str"),
     ([("compute_curvature_detail",)], r"step 1 is \('compute_curvature_detail',\); give a filter name"),

@@ -41,8 +41,18 @@ _RICH_TYPES = {"bool": "RichBool", "int": "RichInt", "float": "RichFloat", "str"
                "PercentageValue": "RichAbsPerc", "mesh": "RichMesh"}
 
 
+def _script_path(path):
+    """``path`` as a str, or ScriptError if it is not a path (os.fspath raised a TypeError)."""
+    if not isinstance(path, (str, bytes, os.PathLike)):
+        raise ScriptError(f"a filter script path is needed (a str or os.PathLike of a .mlx file); got "
+                          f"{type(path).__name__}.")
+    return os.fsdecode(path)
+
+
 def _steps(path):
-    path = os.fspath(path)
+    path = _script_path(path)
+    if os.path.isdir(path):       # not "not found": it exists, but is no script
+        raise ScriptError(f"{path} is a folder; pass the path of a .mlx filter script (a file).")
     if not os.path.isfile(path):
         raise FileNotFoundError(f"filter script not found: {path}")
     try:
@@ -219,10 +229,10 @@ def run_script(ms, path, *, progress=None):
     Raises
     ------
     FileNotFoundError   the script does not exist
-    ScriptError         not a MeshSet, malformed XML (or an unknown encoding), a parameter given
-                        twice, a step name that is a typo of one of ours, a MeshLab filter that
-                        needs a mesh on an empty MeshSet, or a step failed (the message names the
-                        step number and filter, then the reason)
+    ScriptError         not a MeshSet, ``path`` not a path or a folder, malformed XML (or an
+                        unknown encoding), a parameter given twice, a step name that is a typo of
+                        one of ours, a MeshLab filter that needs a mesh on an empty MeshSet, or a
+                        step failed (the message names the step number and filter, then the reason)
 
     Examples
     --------
@@ -243,7 +253,7 @@ def run_script(ms, path, *, progress=None):
     if progress is not None and not callable(progress):
         raise ScriptError(f"progress={progress!r} is not callable; pass a function (step, total, name) or None.")
     results = []
-    path = os.fspath(path)
+    path = _script_path(path)
     steps = _steps(path)
     for k, element in enumerate(steps, start=1):
         name = element.get("name")
