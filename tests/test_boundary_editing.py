@@ -135,11 +135,20 @@ def test_a_malformed_mesh_is_named_before_its_boundary(damage, message):
         edit_boundary(V, F, sine_displacement(0.1, axis=2))
 
 
-def test_a_boundary_that_does_not_close_is_a_mesh_error():
-    # a doubled triangle takes its edges off the boundary: the loop breaks off (was a KeyError)
+def test_a_doubled_triangle_is_named_not_the_broken_boundary_it_makes():
+    # a doubled triangle takes its edges off the boundary: the loop breaks off (was a KeyError,
+    # then "the boundary does not close")
     V, F = grid(10, 10)
-    with pytest.raises(MeshError, match=r"the boundary does not close: its edge into vertex \d+ has no edge out"):
-        boundary_loop(np.vstack([F, F[:1]]))
+    with pytest.raises(MeshError, match=r"1 triangles appear more than once \(first: 0\), which takes their "
+                                        r"edges off the boundary; remove the copies"):
+        boundary_loop(np.vstack([F, F[:1, ::-1]]))
+
+
+def test_a_boundary_that_does_not_close_is_a_mesh_error():
+    from curvdetail.curvature.boundary_editing import loop_of_boundary_edges
+
+    with pytest.raises(MeshError, match=r"the boundary does not close: its edge into vertex 2 has no edge out"):
+        loop_of_boundary_edges(np.array([[0, 1], [1, 2], [3, 0]]))
 
 
 @pytest.mark.parametrize("kwargs, message", [
@@ -172,3 +181,21 @@ def test_return_info_takes_a_numpy_bool():
     V, F = grid(6, 6)
     X, info = edit_boundary(V, F, sine_displacement(0.05, axis=2), return_info=np.True_)
     assert info["boundary"].size == 20
+
+
+def test_two_separate_disks_are_named_as_two_pieces_not_as_holes():
+    V, F = grid(6, 6)
+    V2 = np.vstack([V, V + [3.0, 0.0, 0.0]])
+    F2 = np.vstack([F, F + V.shape[0]])
+    with pytest.raises(MeshError, match="the mesh has 2 separate pieces, each with its own boundary"):
+        boundary_loop(F2)
+    with pytest.raises(MeshError, match="2 separate pieces"):
+        edit_boundary(V2, F2, sine_displacement(0.1))
+
+
+def test_a_reversed_boundary_triangle_is_named_as_an_orientation_problem():
+    V, F = grid(6, 6)
+    F = F.copy()
+    F[0] = F[0, ::-1]                                   # a corner triangle
+    with pytest.raises(MeshError, match="not consistently oriented: .*meshing_re_orient_faces_coherently"):
+        edit_boundary(V, F, sine_displacement(0.1))

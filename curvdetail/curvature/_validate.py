@@ -277,6 +277,19 @@ def misoriented_edges(F):
     return E if ids is None else ids[E]
 
 
+def check_oriented(F, what="the mesh", error=MeshError):
+    """Raise ``error`` if triangles of ``F`` are wound against their neighbours (see
+    :func:`misoriented_edges`). A reversed triangle at the boundary makes the boundary look
+    pinched or split, and the fix is to orient the triangles, not to cut the mesh; the boundary
+    checks call this on their error paths only (it sorts every half-edge)."""
+    E = misoriented_edges(F)
+    if E.shape[0]:
+        pairs = ", ".join(f"({a}, {b})" for a, b in E[:3])
+        raise error(f"{what} is not consistently oriented: {E.shape[0]} interior edges run the same way "
+                    f"in both their triangles (first: {pairs}); orient the triangles consistently (e.g. "
+                    "pymeshlab's meshing_re_orient_faces_coherently) and try again.")
+
+
 def _compact_ids(F):
     """``(ids, F')`` with ``F = ids[F']`` and ``F'`` numbered ``0 .. len(ids) - 1``, where ``F``'s
     largest index is far above its number of corners (unchecked triangles, e.g. 2**32 - 1 as

@@ -5,7 +5,8 @@ import numbers
 
 import numpy as np
 
-from ._validate import as_faces, as_values, as_vertices, boundary_edges, check_mesh
+from ._validate import (_compact_ids, as_faces, as_values, as_vertices, boundary_edges, check_mesh,
+                        check_oriented, vertex_components)
 from .cotan_laplacian import _cotan_laplacian_unchecked
 from .curvature_coefficients import DEFAULT_RCOND
 from .curvature_editor import CurvatureEditor
@@ -174,9 +175,33 @@ def boundary_loop(F):
     Raises
     ------
     MeshError   the mesh has no boundary, several loops, or a vertex where the boundary
-                touches itself
+                touches itself; triangles wound against their neighbours and several pieces are
+                named as such
     """
-    return loop_of_boundary_edges(boundary_edges(np.asarray(F)))
+    E = boundary_edges(F)
+    try:
+        return loop_of_boundary_edges(E)
+    except MeshError as exc:
+        problem = exc
+    # name the cause where it is not the boundary itself: repeated or reversed triangles,
+    # several pieces
+    _, F = _compact_ids(as_faces(F, None))
+    corners = np.sort(F, axis=1)
+    _, first, counts = np.unique(corners, axis=0, return_index=True, return_counts=True)
+    if np.any(counts > 1):
+        twice = np.sort(first[counts > 1])
+        raise MeshError(f"{twice.size} triangles appear more than once (first: {', '.join(map(str, twice[:3]))}), "
+                        "which takes their edges off the boundary; remove the copies (e.g. pymeshlab's "
+                        "meshing_remove_duplicate_faces).")
+    check_oriented(F)
+    labels, _ = vertex_components(F, int(F.max()) + 1)
+    pieces = np.unique(labels[F.ravel()]).size          # unreferenced vertices are no pieces
+    if pieces > 1:
+        raise MeshError(f"the mesh has {pieces} separate pieces, each with its own boundary; shape "
+                        "editing of a boundary needs one disk-topology patch: edit each piece on its "
+                        "own (e.g. keep one with pymeshlab's meshing_remove_connected_component_by_"
+                        "face_number).")
+    raise problem
 
 
 def loop_of_boundary_edges(E):
