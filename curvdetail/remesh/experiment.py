@@ -85,7 +85,10 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="c
         distance of a rebuilt vertex to the source),
         ``improvement_over_zero_detail`` (RMS ratio), ``ratio_to_floor`` (RMS ratio),
         ``parameterization`` (flip counts, for ``location="uv"``) and
-        ``seconds.{retriangulate, parameterize, transfer, reconstruct, evaluate, total}``
+        ``seconds.{retriangulate, parameterize, transfer, reconstruct, evaluate, total}``.
+        With ``evaluate=False`` the measured keys (``error``, ``baseline_zero_detail``,
+        ``floor_retriangulated``, ``improvement_over_zero_detail``, ``ratio_to_floor``) are
+        absent, not None
 
     Raises
     ------
