@@ -508,3 +508,23 @@ def test_a_file_pymeshlab_reads_as_nothing_is_not_called_a_mesh_without_triangle
     with pytest.raises(MeshFileError, match=r"pymeshlab read nothing from .*notes.txt' \(no vertices, no "
                                             r"triangles\); is it a mesh file\?"):
         read_mesh(path)
+
+
+@pytest.mark.parametrize("faces, message", [
+    ("f 1 2 3\nf 2.5 4 3\n", "the face on line 8 has a fractional vertex index"),
+    ("f 1 2 3\n# a comment line. fine\nf 2 4 3 # second\n", "the face on line 9 ends in a comment"),
+])
+def test_obj_faces_the_loader_would_misread_are_refused_before_loading(tmp_path, faces, message):
+    # 2.5 became 2 without a word; "f 1/1 2/1 3/1 # face no. 1" came back as two triangles, one
+    # with a vertex index past the file's vertices (the test process crashed at exit)
+    path = tmp_path / "f.obj"
+    path.write_text("v 0.5 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0.5 0.5\n# faces.\n" + faces)
+    with pytest.raises(MeshFileError, match=message):
+        read_mesh(path)
+
+
+def test_obj_decimals_and_comments_outside_faces_are_read(tmp_path):
+    path = tmp_path / "f.obj"
+    path.write_text("# made by hand. v 1\nv 0.5 0 0\nv 1 0 0\nv 0 1 0\nvt 0.5 0.5\nf 1/1 2/1 3/1\n"
+                    "# the end.\n")
+    assert read_mesh(path)[1].tolist() == [[0, 1, 2]]
