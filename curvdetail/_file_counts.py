@@ -182,7 +182,7 @@ def _obj_odd_face(path):
     """``(1-based line, character)`` of the first ``f`` line of an OBJ file that holds a ``.``
     (a fractional index, which pymeshlab's loader truncates) or a ``#`` (a trailing comment,
     whose words it reads as further corners: a triangle came back with a vertex index past the
-    file's vertices), or None. Vectorized over the bytes from the first face line on (~0.2 s for
+    file's vertices), or None. Vectorized over the bytes from the first face line on (~0.4 s for
     a million vertices); only lines holding one of the two characters are looked at."""
     with open(path, "rb") as f:
         try:
