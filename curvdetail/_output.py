@@ -13,8 +13,7 @@ import contextlib
 import os
 import tempfile
 
-import numpy as np
-
+from .curvature._validate import check_bool
 from .curvature.errors import MeshError
 
 _FORMATS_HINT = "use .ply, .obj, .off, .stl, ..."
@@ -35,8 +34,7 @@ def check_output_path(path, overwrite=False, *, hint=_FORMATS_HINT, error=MeshEr
     """
     if not isinstance(path, (str, bytes, os.PathLike)):
         raise ValueError(f"an output path must be a str or os.PathLike; got {type(path).__name__}.")
-    if not isinstance(overwrite, (bool, np.bool_)):       # "no" would count as True
-        raise ValueError(f"overwrite={overwrite!r} must be True or False.")
+    check_bool(overwrite, "overwrite")
     path = os.fsdecode(path)
     if os.path.isdir(path):       # --overwrite cannot help: a folder is never replaced
         kind = IsADirectoryError if issubclass(error, OSError) else error

@@ -300,12 +300,14 @@ def _remesh_command(parser):
         if not (args.target_edge > 0 and args.target_edge < float("inf")):
             raise ValueError(f"--target-edge {args.target_edge:g}: give a positive percentage of the bbox "
                              "diagonal, e.g. 1 for 1 %.")
+        # first: an output over an input is refused even with --overwrite, which the existing-
+        # file check below would suggest
+        _check_image_and_distinct(args.image, args.output, args.report, inputs=[args.input])
         for extra in (args.report, args.image):
             if extra is not None:
                 check_output_path(extra, args.overwrite, hint=None, error=FileNotFoundError)
         if args.no_evaluate and args.image is not None:
             raise ValueError("--image shows the measured distances; leave out --no-evaluate or --image.")
-        _check_image_and_distinct(args.image, args.output, args.report, inputs=[args.input])
         V, F = read_mesh(args.input)
         if not args.quiet:
             _note_a_big_target(V, F, args.target_edge / 100.0, evaluate=not args.no_evaluate)
@@ -401,6 +403,7 @@ def _run_on_file(args, work):
 
     from .filters.files import attributes_lost_in, check_output_path, load_meshset, save_current_mesh
 
+    _check_image_and_distinct(None, args.output, inputs=[args.input], other_inputs=args.add)
     check_output_path(args.output, args.overwrite)
     ms = load_meshset(args.input, *args.add)
     figures = work(ms)
@@ -525,11 +528,11 @@ def _edit_command(parser):
                                             render_panels)
         from .io import MeshFileError, check_mesh_output
 
+        _check_image_and_distinct(args.image, args.output, inputs=[args.mesh],
+                                  other_inputs=[args.sel, args.transform])
         check_mesh_output(args.output, args.overwrite)
         if args.image:
             check_output_path(args.image, args.overwrite, hint=None, error=FileNotFoundError)
-        _check_image_and_distinct(args.image, args.output, inputs=[args.mesh],
-                                  other_inputs=[args.sel, args.transform])
         progress = Progress(3, enabled=sys.stderr.isatty())
         progress.stage("read")
         V, F = check_mesh(*read_mesh(args.mesh))

@@ -199,3 +199,11 @@ def test_a_reversed_boundary_triangle_is_named_as_an_orientation_problem():
     F[0] = F[0, ::-1]                                   # a corner triangle
     with pytest.raises(MeshError, match="not consistently oriented: .*meshing_re_orient_faces_coherently"):
         edit_boundary(V, F, sine_displacement(0.1))
+
+
+def test_two_closed_pieces_are_named_as_closed_not_as_pieces_with_boundaries():
+    from curvdetail.curvature.testing import icosphere
+
+    V, F = icosphere(subdivisions=1)
+    with pytest.raises(MeshError, match=r"the mesh is closed \(no boundary loop\)"):
+        boundary_loop(np.vstack([F, F + V.shape[0]]))

@@ -301,3 +301,12 @@ def test_apply_remeshing_with_a_big_target_is_announced_with_the_value_given(cap
     rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "p.ply",
                            "--param", f"target_edge={length}", "--param", "evaluate=false")
     assert rc == 0 and "note:" not in err
+
+
+def test_apply_refuses_to_write_over_an_added_layer_even_with_overwrite(capsys, tmp_path):
+    added = tmp_path / "b.obj"
+    added.write_bytes(open(NOSE, "rb").read())
+    before = added.read_bytes()
+    rc, out, err = run_cli(capsys, "apply", "compute_curvature_detail", NOSE, added, "--add", added, "--overwrite")
+    assert rc == 1 and "b.obj is an input of this run" in err
+    assert added.read_bytes() == before

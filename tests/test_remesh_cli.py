@@ -150,9 +150,10 @@ def test_a_report_over_the_input_is_refused_even_with_overwrite(tmp_path, capsys
     src = tmp_path / "src.obj"
     src.write_bytes(open(os.path.join(DATA, "mannequin_nose.obj"), "rb").read())
     before = src.read_bytes()
-    rc = main(["remesh", str(src), str(tmp_path / "o.ply"), "--report", str(src), "--overwrite", "--quiet"])
-    assert rc == 1
-    assert "src.obj is an input of this run" in capsys.readouterr().err
+    for extra in (["--overwrite"], []):      # without it, not "exists; pass --overwrite" either
+        rc = main(["remesh", str(src), str(tmp_path / "o.ply"), "--report", str(src), "--quiet", *extra])
+        assert rc == 1
+        assert "src.obj is an input of this run" in capsys.readouterr().err
     assert src.read_bytes() == before and sorted(os.listdir(tmp_path)) == ["src.obj"]
 
 

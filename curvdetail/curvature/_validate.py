@@ -370,6 +370,14 @@ def as_index_set(indices, n, name):
     return arr
 
 
+def check_bool(value, name):
+    """``bool(value)`` for True / False (numpy's too), else ValueError: ``"no"`` or ``0`` would
+    otherwise count as an answer."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name}={value!r} must be True or False.")
+    return bool(value)
+
+
 def as_float(value):
     """``value`` as a float if it is a real number (numpy scalars and 0-d arrays included; a
     number too large for a double becomes inf), else None (bools and strings included)."""

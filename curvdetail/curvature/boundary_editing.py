@@ -5,8 +5,8 @@ import numbers
 
 import numpy as np
 
-from ._validate import (_compact_ids, as_faces, as_values, as_vertices, boundary_edges, check_mesh,
-                        check_oriented, vertex_components)
+from ._validate import (_compact_ids, as_faces, as_values, as_vertices, boundary_edges, check_bool,
+                        check_mesh, check_oriented, vertex_components)
 from .cotan_laplacian import _cotan_laplacian_unchecked
 from .curvature_coefficients import DEFAULT_RCOND
 from .curvature_editor import CurvatureEditor
@@ -76,8 +76,7 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
     """
     if boundary_detail not in ("deformed", "rest"):
         raise ValueError(f"boundary_detail={boundary_detail!r}; use 'deformed' or 'rest'.")
-    if not isinstance(return_info, (bool, np.bool_)):      # "no" would count as True
-        raise ValueError(f"return_info={return_info!r} must be True or False.")
+    check_bool(return_info, "return_info")
     V = as_vertices(V)
     F = as_faces(F, V.shape[0])        # shapes and indices; the editor below runs every mesh check
     try:
@@ -183,6 +182,8 @@ def boundary_loop(F):
         return loop_of_boundary_edges(E)
     except MeshError as exc:
         problem = exc
+    if E.shape[0] == 0:                 # closed: nothing more to say
+        raise problem
     # name the cause where it is not the boundary itself: repeated or reversed triangles,
     # several pieces
     _, F = _compact_ids(as_faces(F, None))

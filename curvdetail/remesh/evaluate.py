@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ..curvature._validate import as_count, as_faces, bbox_diagonal, check_mesh, face_double_areas
+from ..curvature._validate import as_count, as_faces, bbox_diagonal, check_bool, check_mesh, face_double_areas
 from ..curvature.errors import MeshError
 from .locate import FAR_POINTS, _locate, _unit_frame, check_points_and_mesh
 
@@ -146,8 +146,7 @@ def vertex_distance(V, Vs, Fs, *, far=False):
                 ``Vs`` and ``Fs``)
     ValueError  ``far`` not a bool
     """
-    if not isinstance(far, (bool, np.bool_)):       # "no" would count as True
-        raise ValueError(f"far={far!r} must be True or False.")
+    check_bool(far, "far")
     P, Vs, Fs = check_points_and_mesh(V, Vs, Fs, names=("V", "Vs", "Fs"))
     if not far:
         return _locate(P, Vs, Fs)[2]

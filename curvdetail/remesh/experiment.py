@@ -4,7 +4,7 @@ import time
 
 import numpy as np
 
-from ..curvature._validate import bbox_diagonal
+from ..curvature._validate import bbox_diagonal, check_bool
 from ..curvature.boundary_editing import boundary_loop
 from ..curvature.reconstruct import ROW_MODES, Reconstructor
 from ..curvature.sparse_solver import resolve_backend
@@ -171,8 +171,7 @@ def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="cons
     if target is not None and (not isinstance(target, (tuple, list)) or len(target) != 2):
         raise ValueError(f"target must be a pair (Vt, Ft), a ready retriangulation, or None; got "
                          f"{type(target).__name__}.")
-    if not isinstance(evaluate, (bool, np.bool_)):       # "no" would count as True
-        raise ValueError(f"evaluate={evaluate!r} must be True or False.")
+    check_bool(evaluate, "evaluate")
     if progress is not None and not callable(progress):
         raise ValueError(f"progress must be callable (called with each stage name) or None; got "
                          f"{type(progress).__name__}.")
