@@ -4,8 +4,11 @@ pymeshlab's loader silently drops OBJ/OFF/PLY vertices with NaN or infinite coor
 faces using them, renumbering the rest), drops OBJ faces whose vertex indices are out of range
 or repeated and STL triangles with a non-finite or repeated corner, and keeps OFF faces whose
 indices are out of range; its OFF loader then writes out of bounds, which can crash the process
-later, so :func:`check_before_loading` looks for such faces in an ASCII OFF file before the
-loader sees it (reading the file once more, vectorized).
+later. It also misreads without a word: a plain OFF file is one stream of numbers to it (a row
+with a value too many shifts every later coordinate), missing OFF rows are filled from what
+follows, OBJ face indices are truncated (2.5 -> 2) and a comment after a face becomes further
+corners. :func:`check_before_loading` looks for all of these before the loader sees the file
+(reading it once more, vectorized).
 :func:`check_loaded` compares the loaded mesh with the counts the file declares (OFF/PLY
 headers, the binary STL header, a streamed count of OBJ ``v`` and ``f`` lines and of ASCII STL
 facets, never the whole file in memory) and with its own vertex count.
@@ -57,8 +60,9 @@ def _off_counts(path):
 
 
 def _off_header(lines):
-    """``(nv, nf, length of the header in bytes)`` from an OFF file's lines (bytes, newlines
-    kept), or None: not that form ("OFF BINARY", nOFF with its dimension first, too short)."""
+    """``(nv, nf, length of the header in bytes, keyword)`` from an OFF file's lines (bytes,
+    newlines kept), or None: not that form ("OFF BINARY", nOFF with its dimension first, too
+    short)."""
     words, length = [], 0
     for line in itertools.islice(lines, _HEADER_LINES):
         length += len(line)
@@ -69,7 +73,7 @@ def _off_header(lines):
     if len(words) < 3 or not keyword.endswith("OFF") or "n" in keyword:
         return None
     try:
-        return int(words[1]), int(words[2]), length
+        return int(words[1]), int(words[2]), length, keyword
     except ValueError:
         return None
 
@@ -224,7 +228,7 @@ def _off_rows_problem(path):
     header = _off_header(io.BytesIO(data))
     if header is None:
         return None
-    nv, nf, offset = header
+    nv, nf, offset, keyword = header
     body = data[offset:]
     if b"#" in body:
         body = re.sub(rb"#[^\n]*", b"", body)
@@ -239,8 +243,12 @@ def _off_rows_problem(path):
         # each segment runs to the next non-empty line: this line's characters and newlines
         filled[some] = np.logical_or.reduceat(visible, starts[some])
     lines = np.flatnonzero(filled)
-    if nf == 0 or lines.size < nv + nf:
-        return None                                            # short: the counts check reports it
+    if nf == 0:
+        return None                                            # no faces: read_mesh refuses it
+    if lines.size < nv + nf:
+        # pymeshlab fills the missing rows from what follows: a triangle came back twice
+        return (f"the header declares {nv} vertices and {nf} faces, but the file holds {lines.size} rows "
+                f"after it (truncated, or the counts are wrong)")
     rows = lines[:nv + nf]
     faces = rows[nv:]
     first, last = int(starts[rows[0]]), int(ends[rows[-1]])
@@ -252,7 +260,7 @@ def _off_rows_problem(path):
     if seg[-1]:
         token_ends = np.concatenate([token_ends, [last]])
     per_row = np.diff(np.append(np.searchsorted(token_starts, starts[rows]), token_starts.size))
-    problem = _off_vertex_rows_problem(per_row[:nv])
+    problem = _off_vertex_rows_problem(per_row[:nv], plain=keyword == "OFF")
     if problem:
         return problem
     token_starts, token_ends = token_starts[per_row[:nv].sum():], token_ends[per_row[:nv].sum():]
@@ -289,20 +297,19 @@ def _off_rows_problem(path):
             f"(first: face {bad[0][0]}, {bad[0][1]})")
 
 
-def _off_vertex_rows_problem(values_per_row):
+def _off_vertex_rows_problem(values_per_row, plain):
     """What is wrong with an OFF file's vertex rows, given the number of values on each, or
-    None. Every row holds the same number of values (3 coordinates, and the colour, normal or
-    texture values the keyword announces): pymeshlab reads OFF as one stream of numbers, so a
-    row with a value too many or too few shifts every later coordinate without a word."""
-    if not values_per_row.size:
-        return None
-    usual = int(np.bincount(values_per_row).argmax())
-    odd = np.flatnonzero((values_per_row != usual) | (values_per_row < 3))
+    None. pymeshlab reads a plain ``OFF`` file as one stream of numbers, so there a row with a
+    value too many or too few shifts every later coordinate without a word: each row must hold
+    exactly x, y and z. With a prefixed keyword (``COFF``, ``NOFF``, ``STOFF``...) it reads row
+    by row, and a row may carry its colour or not, but needs its three coordinates."""
+    odd = np.flatnonzero(values_per_row != 3 if plain else values_per_row < 3)
     if not odd.size:
         return None
-    return (f"{odd.size} vertex rows hold a number of values other than {usual}, that of the other "
-            f"rows (first: vertex {odd[0]}, {values_per_row[odd[0]]} values), which would shift "
-            "every later coordinate")
+    what = "hold a number of values other than 3 (x y z)" if plain else "hold fewer than 3 values"
+    return (f"{odd.size} vertex rows {what} (first: vertex {odd[0]}, {values_per_row[odd[0]]} values), "
+            "which would shift every later coordinate" + (
+                "; a plain OFF file is read as one stream of numbers (colours need COFF)" if plain else ""))
 
 
 def _maybe_out_of_range(chars, starts, ends, nv):

@@ -47,9 +47,12 @@ def read_mesh(path):
                         vertices or faces: pymeshlab silently removes vertices with NaN or
                         infinite coordinates (and renumbers the rest), OBJ faces with
                         out-of-range or repeated indices, and STL triangles with a non-finite
-                        or repeated corner. Checked before pymeshlab reads the
-                        file, because its loader would corrupt memory: out-of-range face
-                        indices in an ASCII OFF file, indented vertex lines in an OBJ file
+                        or repeated corner. Checked before pymeshlab reads the file, because
+                        its loader would corrupt memory or misread it without a word:
+                        out-of-range face indices, fewer rows than the header declares,
+                        vertex rows with other than x y z (plain OFF) or short rows, face rows
+                        that are not a count and that many integers (ASCII OFF); indented
+                        vertex lines, fractional face indices and comments after a face (OBJ)
 
     Examples
     --------
@@ -93,7 +96,8 @@ def load_failure(path, exc):
     that fits: a damaged file for the common formats, another format otherwise."""
     reason = " ".join(str(exc).split()) or type(exc).__name__
     if os.path.splitext(path)[1].lower() in COMMON_FORMATS:
-        return f"could not read {path!r}: {reason}. The file is damaged or incomplete; export it again."
+        return (f"could not read {path!r}: {reason}. The file is damaged or incomplete, or a variant "
+                "pymeshlab does not read (4OFF, CR-only line ends, ...); export it again, e.g. as PLY.")
     return f"could not read {path!r}: {reason}. Use a format MeshLab reads (.obj, .off, .ply, .stl, ...)."
 
 
@@ -216,7 +220,8 @@ def write_mesh(path, V, F, *, quality=None, overwrite=False):
     # normals, and its OFF writer then says NCOFF, a header libigl's readOFF refuses; and its
     # meshes always carry a quality, which without ours would be written as zeros (in MeshLab:
     # zero error everywhere)
-    plain = dict(_PLAIN_OPTIONS, **({} if quality is not None else {"save_vertex_quality": False}))
+    no_quality = quality is None and os.path.splitext(os.fspath(path))[1].lower() == ".ply"
+    plain = dict(_PLAIN_OPTIONS, **({"save_vertex_quality": False} if no_quality else {}))
     save_mesh(path, mesh, overwrite=overwrite, _plain=plain)
 
 

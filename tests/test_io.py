@@ -117,8 +117,7 @@ def test_temporary_file_keeps_the_extension_and_sits_beside_the_output(tmp_path,
     check_mesh_output(tmp_path / "warm.obj")      # the format check's one-off probe writes elsewhere
     monkeypatch.setattr(pymeshlab.MeshSet, "save_current_mesh", spy)
     write_mesh(tmp_path / "mesh.obj", *nose)
-    # (a second call to the same file: an option OBJ lacks is dropped and the save retried)
-    assert len(set(seen)) == 1 and seen[0].endswith(".obj") and os.path.dirname(seen[0]) == str(tmp_path)
+    assert len(seen) == 1 and seen[0].endswith(".obj") and os.path.dirname(seen[0]) == str(tmp_path)
     assert os.listdir(tmp_path) == ["mesh.obj"]
 
 
@@ -465,9 +464,11 @@ def test_written_ply_holds_positions_faces_and_quality_only(tmp_path):
 
 @pytest.mark.parametrize("rows, message", [
     ("0 0 0\n1 0 0 7\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n",
-     "1 vertex rows hold a number of values other than 3, that of the other rows (first: vertex 1, 4 values)"),
+     "1 vertex rows hold a number of values other than 3 (x y z) (first: vertex 1, 4 values)"),
     ("0 0 0\n1 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n",
-     "1 vertex rows hold a number of values other than 3, that of the other rows (first: vertex 1, 2 values)"),
+     "1 vertex rows hold a number of values other than 3 (x y z) (first: vertex 1, 2 values)"),
+    ("0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n",
+     "the header declares 4 vertices and 2 faces, but the file holds 5 rows after it"),
     ("0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2\n3 0 2 3\n",
      "face 0 is the row '4 0 1 2', which is not a vertex count followed by that many integer"),
     ("0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2.5 3\n",
@@ -528,3 +529,14 @@ def test_obj_decimals_and_comments_outside_faces_are_read(tmp_path):
     path.write_text("# made by hand. v 1\nv 0.5 0 0\nv 1 0 0\nv 0 1 0\nvt 0.5 0.5\nf 1/1 2/1 3/1\n"
                     "# the end.\n")
     assert read_mesh(path)[1].tolist() == [[0, 1, 2]]
+
+
+def test_coff_rows_with_and_without_a_colour_are_read(tmp_path):
+    # with a prefixed keyword pymeshlab reads row by row: a colour on some rows only is fine
+    path = tmp_path / "c.off"
+    path.write_text("COFF\n4 2 0\n0 0 0 255 0 0 255\n1 0 0\n0 1 0 255 0 0 255\n1 1 0\n3 0 1 2\n3 1 3 2\n")
+    V, F = read_mesh(path)
+    assert np.array_equal(V, [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]]) and F.tolist() == [[0, 1, 2], [1, 3, 2]]
+    path.write_text("COFF\n4 2 0\n0 0 0 255 0 0 255\n1 0\n0 1 0\n1 1 0\n3 0 1 2\n3 1 3 2\n")
+    with pytest.raises(MeshFileError, match="1 vertex rows hold fewer than 3 values"):
+        read_mesh(path)
