@@ -186,8 +186,10 @@ def test_report_says_a_given_target_was_not_made_by_the_experiment(height_field)
 
 
 @pytest.mark.parametrize("shift, words", [
-    (lambda V: 2.0 * V, r"\(up to 0\.354 of the source's bbox diagonal; allowed 1e-06\)"),
-    (lambda V: V + [0.0, 0.0, 0.5], r"\(up to 0\.177 of the source's bbox diagonal; allowed 1e-06\)"),
+    (lambda V: 2.0 * V, r"\(up to 0\.354 of the larger of the source's bbox diagonal and its largest "
+                        r"coordinate; allowed 1e-06\)"),
+    (lambda V: V + [0.0, 0.0, 0.5], r"\(up to 0\.177 of the larger of the source's bbox diagonal and its "
+                                    r"largest coordinate; allowed 1e-06\)"),
 ])
 def test_a_target_whose_boundary_is_off_the_source_boundary_is_refused(monkeypatch, shift, words):
     # it was rebuilt with its boundary pinned where it was and reported a 35 % error, no warning
@@ -202,7 +204,7 @@ def test_a_target_whose_boundary_is_off_the_source_boundary_is_refused(monkeypat
 
 def test_a_target_with_one_boundary_vertex_slightly_off_names_it():
     from curvdetail.curvature.boundary_editing import boundary_loop
-    from curvdetail.remesh.experiment import _polyline_distance
+    from curvdetail.remesh._disk import Polyline
 
     V, F = disk(n_rings=6)
     Vt = V.copy()
@@ -216,4 +218,15 @@ def test_a_target_with_one_boundary_vertex_slightly_off_names_it():
     A, B = P, np.roll(P, -1, axis=0)
     t = np.clip(((X[:, None] - A) * (B - A)).sum(-1) / ((B - A) ** 2).sum(-1), 0, 1)
     direct = np.linalg.norm(X[:, None] - (A + t[..., None] * (B - A)), axis=-1).min(1)
-    assert np.allclose(_polyline_distance(P, X, max_entries=5), direct, rtol=1e-12, atol=0)
+    assert np.allclose(Polyline(P).project(X, k=P.shape[0])[2], direct, rtol=1e-12, atol=0)
+
+
+def test_a_float32_target_far_from_the_origin_is_taken():
+    # a MeshLab PLY stores float32: 5 km from the origin that rounds by ~3e-4, above 1e-6 of a
+    # 2.8 m diagonal, and 102 of 333 boundary vertices of such a terrain were refused
+    V, F = disk(n_rings=10)
+    V = (V + [5000.0, 0.0, 0.0]).astype(np.float32).astype(np.float64)
+    Vt, Ft = retriangulate(V, F, target_edge=0.05)
+    Vt = Vt.astype(np.float32).astype(np.float64)
+    (X, _), report = remesh_experiment(V, F, target=(Vt, Ft), evaluate=False)
+    assert report["target"]["vertices"] == Vt.shape[0]

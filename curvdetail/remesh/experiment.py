@@ -28,8 +28,9 @@ BASELINE_SAMPLES = 20000
 #: with the kd-tree engine as well (see :func:`hausdorff`).
 FAR_SURFACE = 0.02
 
-#: A given target's boundary vertex further than this (x the source's bbox diagonal) from the
-#: source's boundary polyline is refused: the reconstruction pins the target's boundary where it
+#: A given target's boundary vertex further than this (x the larger of the source's bbox diagonal
+#: and its largest coordinate, for float32 files far from the origin) from the source's boundary
+#: polyline is refused: the reconstruction pins the target's boundary where it
 #: is, so a target off the source gives a large error that measures the target, not the method.
 #: retriangulate() puts them within 1e-12.
 TARGET_BOUNDARY_TOLERANCE = 1e-6
@@ -96,7 +97,8 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="c
     RemeshError                absurd target edge (with the numbers; not a positive number even
                                with a ``target``), a failed retriangulation, or a ``target`` with
                                boundary vertices off the source's boundary polyline (by more than
-                               ``TARGET_BOUNDARY_TOLERANCE`` = 1e-6 of the bbox diagonal)
+                               ``TARGET_BOUNDARY_TOLERANCE`` = 1e-6 of the larger of the bbox
+                               diagonal and the largest coordinate)
     ValueError                 unknown option values; ``target`` not a pair; ``progress`` not
                                callable; ``evaluate`` not a bool
     SolverError                unknown or uninstalled ``backend`` (before any work)
@@ -115,36 +117,29 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="c
     return (result["X"], result["Ft"]), result["report"]
 
 
-def _polyline_distance(P, X, max_entries=2_000_000):
-    """Exact distance of each point ``X`` (m, 3) to the closed polyline through ``P`` (k, 3),
-    in chunks of points so that no (points x segments) array exceeds ``max_entries``."""
-    AB = np.roll(P, -1, axis=0) - P
-    length2 = np.maximum((AB * AB).sum(1), np.finfo(float).tiny)
-    out = np.empty(X.shape[0])
-    step = max(1, max_entries // P.shape[0])
-    for lo in range(0, X.shape[0], step):
-        AX = X[lo:lo + step, None, :] - P                                    # (c, k, 3)
-        t = np.clip(np.einsum("ckd,kd->ck", AX, AB) / length2, 0.0, 1.0)
-        out[lo:lo + step] = np.sqrt(((AX - t[..., None] * AB) ** 2).sum(-1).min(1))
-    return out
-
-
 def _check_target_boundary(P, X, d):
     """RemeshError unless every target boundary vertex ``X`` lies on the source boundary
-    polyline ``P`` within ``TARGET_BOUNDARY_TOLERANCE * d``."""
-    # nearest-candidate projection first: its distances are upper bounds, so only the points it
-    # does not clear need the exact (points x segments) search
-    _, _, dist = Polyline(P).project(X)
-    dist = dist / d
+    polyline ``P`` within ``TARGET_BOUNDARY_TOLERANCE`` times the larger of the diagonal ``d``
+    and the largest coordinate (float32 files far from the origin round by more than 1e-6 of a
+    small diagonal)."""
+    scale = max(d, float(np.abs(P).max()), float(np.abs(X).max()))
+    polyline = Polyline(P)
+    # the nearest-candidate projection's distances are upper bounds: only the points it does not
+    # clear are projected onto every segment (in chunks of ~2e6 point-segment pairs)
+    dist = polyline.project(X)[2] / scale
     suspect = np.flatnonzero(dist > TARGET_BOUNDARY_TOLERANCE)
-    dist[suspect] = _polyline_distance(P, X[suspect]) / d
+    step = max(1, 2_000_000 // P.shape[0])
+    for lo in range(0, suspect.size, step):
+        chunk = suspect[lo:lo + step]
+        dist[chunk] = polyline.project(X[chunk], k=P.shape[0])[2] / scale
     off = np.flatnonzero(dist > TARGET_BOUNDARY_TOLERANCE)
     if off.size:
         raise RemeshError(
             f"{off.size} of {X.shape[0]} target boundary vertices are off the source's boundary polyline "
-            f"(up to {dist.max():.3g} of the source's bbox diagonal; allowed {TARGET_BOUNDARY_TOLERANCE:g}): "
-            "the target must be a retriangulation of the source with its boundary vertices on the source's "
-            "boundary. Pass one made by curvdetail.remesh.retriangulate, or target=None to make it here.")
+            f"(up to {dist.max():.3g} of the larger of the source's bbox diagonal and its largest "
+            f"coordinate; allowed {TARGET_BOUNDARY_TOLERANCE:g}): the target must be a retriangulation of "
+            "the source with its boundary vertices on the source's boundary. Pass one made by "
+            "curvdetail.remesh.retriangulate, or target=None to make it here.")
 
 
 def _check_choice(name, value, choices):
