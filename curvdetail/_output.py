@@ -18,6 +18,10 @@ from .curvature.errors import MeshError
 
 _FORMATS_HINT = "use .ply, .obj, .off, .stl, ..."
 
+#: Temporary files of the :func:`atomic_output` blocks in progress, for the CLI's SIGTERM
+#: watcher, which removes them before it ends the process.
+PENDING = set()
+
 
 def check_output_path(path, overwrite=False, *, hint=_FORMATS_HINT, error=MeshError):
     """Return ``os.fspath(path)`` or raise before any work if it cannot be written.
@@ -80,10 +84,12 @@ def atomic_output(path, *, overwrite=False, hint=_FORMATS_HINT, error=MeshError)
     except OSError as exc:        # its message would name the temporary file, not the output
         raise type(exc)(exc.errno, f"cannot write {path!r}: {exc.strerror}") from None
     os.close(fd)
+    PENDING.add(tmp)
     try:
         yield tmp
         os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, path)
     finally:
-        if os.path.exists(tmp):
+        PENDING.discard(tmp)
+        with contextlib.suppress(FileNotFoundError):     # the SIGTERM watcher may have taken it
             os.remove(tmp)

@@ -7,6 +7,7 @@ files too).
 """
 
 import argparse
+import contextlib
 import os
 import signal
 import sys
@@ -285,7 +286,6 @@ def _remesh_command(parser):
     add_output_arguments(parser)
 
     def run(args):
-        import contextlib
         import json
 
         from ._output import atomic_output, check_output_path
@@ -517,8 +517,6 @@ def _edit_command(parser):
     add_output_arguments(parser)
 
     def run(args):
-        import contextlib
-
         import numpy as np
 
         from . import read_mesh, write_mesh
@@ -616,29 +614,66 @@ def build_parser():
     return parser
 
 
-class _Terminated(BaseException):
-    """SIGTERM (``timeout``, ``kill``), raised in the main thread so that the output files' ``with``
-    blocks remove their temporary files, as for Ctrl-C."""
+def _watch_sigterm():
+    """End the process promptly and cleanly on SIGTERM (``timeout``, ``kill``): Python runs its
+    signal handlers only between bytecodes, so a handler alone waited for the native call in
+    progress (a factorization, pymeshlab's sampling: 10 s and more). Python's C-level handler
+    writes the signal number to a wakeup pipe at once, from any thread; a watcher thread blocked
+    on it removes the temporary files of the outputs in progress and exits with 128 + SIGTERM
+    (as soon as it gets the GIL, which numerical code mostly releases). Returns the function
+    that stops the watcher and puts everything back; None where this cannot be set up (not the
+    main thread, or no wakeup fd)."""
+    from . import _output
 
+    if threading.current_thread() is not threading.main_thread():
+        return None
+    read_fd, write_fd = os.pipe()
+    os.set_blocking(write_fd, False)
+    try:
+        previous_fd = signal.set_wakeup_fd(write_fd, warn_on_full_buffer=False)
+    except (ValueError, OSError):
+        os.close(read_fd)
+        os.close(write_fd)
+        return None
+    # a handler that does nothing: the watcher does the work (the default would kill at once,
+    # leaving the temporary files)
+    previous = signal.signal(signal.SIGTERM, lambda signum, frame: None)
 
-def _raise_terminated(signum, frame):
-    raise _Terminated()
+    def watch():
+        while True:
+            got = os.read(read_fd, 64)
+            if not got or 0 in got:                     # closed, or stop() asked
+                return
+            if signal.SIGTERM in got:
+                for path in list(_output.PENDING):
+                    with contextlib.suppress(OSError):
+                        os.remove(path)
+                _say("curvdetail: terminated")
+                os._exit(128 + signal.SIGTERM)
+
+    watcher = threading.Thread(target=watch, name="curvdetail-sigterm", daemon=True)
+    watcher.start()
+
+    def stop():
+        signal.signal(signal.SIGTERM, previous if previous is not None else signal.SIG_DFL)
+        signal.set_wakeup_fd(previous_fd)
+        os.write(write_fd, b"\0")
+        watcher.join()
+        os.close(read_fd)
+        os.close(write_fd)
+
+    return stop
 
 
 def main(argv=None):
     parser = build_parser()
     args = parser.parse_args(argv)
-    in_main_thread = threading.current_thread() is threading.main_thread()
-    if in_main_thread:
-        previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    stop_watching = _watch_sigterm()
     try:
         return int(args._run(args) or 0)
     except KeyboardInterrupt:
         _say("curvdetail: interrupted")
         return 130
-    except _Terminated:
-        _say("curvdetail: terminated")
-        return 128 + signal.SIGTERM
     except BrokenPipeError:
         # the reader of stdout went away (`curvdetail list | head`): not an error of ours, as for
         # cat(1); stdout carries only the final figures, written after every output file (stderr
@@ -652,8 +687,8 @@ def main(argv=None):
         _say(f"curvdetail: error: {message}")
         return 1
     finally:
-        if in_main_thread:
-            signal.signal(signal.SIGTERM, previous if previous is not None else signal.SIG_DFL)
+        if stop_watching is not None:
+            stop_watching()
 
 
 if __name__ == "__main__":

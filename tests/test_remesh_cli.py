@@ -177,22 +177,46 @@ def test_an_output_format_that_cannot_hold_the_mesh_is_refused_before_the_work(t
     assert os.listdir(tmp_path) == []
 
 
-def test_sigterm_removes_the_temporary_files_like_ctrl_c(tmp_path, capsys, monkeypatch):
-    # `timeout` and `kill` send SIGTERM; it used to leave .curvdetail-*.png/.ply behind
+def test_sigterm_ends_the_run_during_native_work_and_removes_the_temporary_files(tmp_path):
+    # `timeout` and `kill` send SIGTERM: it left .curvdetail-*.png/.ply behind, and a Python
+    # handler alone would wait for the native call in progress (10 s and more on big meshes)
+    import subprocess
+    import sys
+
+    script = tmp_path / "killed.py"
+    script.write_text(
+        "import os, signal, sys\n"
+        "import numpy as np\n"
+        "import curvdetail.io\n"
+        "from curvdetail.cli import main\n"
+        "real = curvdetail.io.write_mesh\n"
+        "def write_then_killed(path, *args, **kwargs):\n"
+        "    real(path, *args, **kwargs)                  # the temporary file is written ...\n"
+        "    os.kill(os.getpid(), signal.SIGTERM)         # ... and the run is killed before the rename\n"
+        "    A = np.random.default_rng(0).random((2000, 2000))\n"
+        "    try:\n"
+        "        np.linalg.eigvalsh(A + A.T)              # native work, ~1 s\n"
+        "    finally:\n"
+        "        print('the native call ended', flush=True)\n"
+        "curvdetail.io.write_mesh = write_then_killed\n"
+        "sys.exit(main(sys.argv[1:]))\n")
+    out = tmp_path / "out"
+    out.mkdir()
+    done = subprocess.run([sys.executable, str(script), "remesh", os.path.join(DATA, "mannequin_nose.obj"),
+                           str(out / "o.ply"), "--report", str(out / "r.json"), "--quiet"],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 128 + 15, done.stderr
+    assert "curvdetail: terminated" in done.stderr
+    assert "the native call ended" not in done.stdout          # ended during it, not after it
+    assert os.listdir(out) == []
+
+
+def test_main_puts_the_sigterm_handling_back_afterwards(tmp_path, capsys):
     import signal
 
-    import curvdetail.io
-
-    real = curvdetail.io.write_mesh
-
-    def write_then_terminated(path, *args, **kwargs):
-        real(path, *args, **kwargs)                  # the temporary file is written ...
-        os.kill(os.getpid(), signal.SIGTERM)         # ... and the run is killed before the rename
-
-    monkeypatch.setattr(curvdetail.io, "write_mesh", write_then_terminated)
-    rc = main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "o.ply"),
-               "--report", str(tmp_path / "r.json"), "--quiet"])
-    assert rc == 128 + signal.SIGTERM
-    assert "curvdetail: terminated" in capsys.readouterr().err
-    assert os.listdir(tmp_path) == []
-    assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL      # put back after the run
+    before = signal.getsignal(signal.SIGTERM), signal.set_wakeup_fd(-1)
+    signal.set_wakeup_fd(before[1])
+    assert main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "o.ply"), "--quiet",
+                 "--no-evaluate"]) == 0
+    assert signal.getsignal(signal.SIGTERM) == before[0]
+    assert signal.set_wakeup_fd(before[1]) == before[1]
