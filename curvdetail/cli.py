@@ -628,10 +628,10 @@ def _watch_sigterm():
     if threading.current_thread() is not threading.main_thread():
         return None
     read_fd, write_fd = os.pipe()
-    os.set_blocking(write_fd, False)
     try:
+        os.set_blocking(write_fd, False)
         previous_fd = signal.set_wakeup_fd(write_fd, warn_on_full_buffer=False)
-    except (ValueError, OSError):
+    except (ValueError, OSError):         # e.g. Windows, where the wakeup fd must be a socket
         os.close(read_fd)
         os.close(write_fd)
         return None
