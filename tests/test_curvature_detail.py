@@ -4,6 +4,7 @@ import doctest
 import importlib
 
 import numpy as np
+import pytest
 
 from curvdetail import cotan_laplacian, curvature_detail, mean_curvature_normal
 from curvdetail.curvature.testing import icosphere
@@ -11,7 +12,21 @@ from curvdetail.curvature.testing import icosphere
 
 def test_equals_laplacian_times_positions(load_mesh):
     V, F = load_mesh("mannequin_nose.obj")
-    assert np.array_equal(curvature_detail(V, F), cotan_laplacian(V, F) @ V)
+    D = curvature_detail(V, F)
+    # computed about the bounding box's centre: equal to L @ V up to rounding
+    np.testing.assert_allclose(D, cotan_laplacian(V, F) @ V, rtol=0, atol=1e-12 * np.abs(D).max())
+
+
+@pytest.mark.parametrize("offset", [1e6, 6.4e6])
+def test_is_translation_invariant_far_from_the_origin(offset):
+    # UTM / ECEF coordinates: L @ V summed terms of the coordinates' size to a result of the
+    # detail's size; a 1 cm sphere 1e6 m out lost six digits of K
+    V, F = icosphere(radius=0.01, subdivisions=4)
+    shift = np.array([offset, 0.7 * offset, 0.3 * offset])
+    far = V + shift                     # rounded to the coordinates' spacing ...
+    near = far - shift                  # ... and back, exactly: the very same triangles
+    D = curvature_detail(near, F)
+    assert np.abs(curvature_detail(far, F) - D).max() < 1e-12 * np.abs(D).max()
 
 
 def test_equals_mean_curvature_normal_times_area(load_mesh):

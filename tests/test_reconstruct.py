@@ -6,8 +6,8 @@ import importlib
 import numpy as np
 import pytest
 
-from curvdetail import (ConstraintError, MeshError, Reconstructor, available_backends, cotan_laplacian,
-                        boundary_vertices, curvature_detail, reconstruct)
+from curvdetail import (ConstraintError, MeshError, Reconstructor, SolverError, available_backends,
+                        boundary_vertices, cotan_laplacian, curvature_detail, reconstruct)
 from curvdetail.curvature import sparse_solver
 from curvdetail.curvature._validate import bbox_diagonal
 from curvdetail.curvature.testing import grid, icosphere
@@ -299,3 +299,46 @@ def test_a_check_failing_after_the_early_analysis_still_reports_its_error(monkey
     V[F[3]] = V[F[3, 0]]                                                    # collapse a triangle
     with pytest.raises(MeshError, match="zero area"):
         Reconstructor(V, F, boundary_vertices(F), rows="free", backend="pardiso")
+
+
+@pytest.mark.parametrize("rows", ["all", "free"])
+def test_round_trip_far_from_the_origin(rows):
+    # UTM / ECEF: a 1 cm sphere 1e6 m out came back 2.5e-7 of its diagonal off (L_:c X_c summed
+    # terms of the coordinates' size); it is solved about the fixed positions' centre now
+    V, F = icosphere(radius=0.01, subdivisions=4)
+    V = V + [1e6, 7e5, 3e5]
+    X = reconstruct(V, F, curvature_detail(V, F), [0, 7], V[[0, 7]], rows=rows)
+    assert np.abs(X - V).max() < 1e-9 * bbox_diagonal(V)
+
+
+def _wavy_grid_with_a_sliver(double_area):
+    """30 x 30 wavy grid whose vertex 465 is moved next to edge (434, 435), making a triangle of
+    the given doubled area (times the squared diagonal): valid, but badly conditioned."""
+    V, F = grid(30, 30)
+    V[:, 2] = 0.1 * np.sin(3 * V[:, 0]) * np.cos(2 * V[:, 1])
+    d = bbox_diagonal(V)
+    a, b, v = 434, 435, 465
+    mid, e = (V[a] + V[b]) / 2, V[b] - V[a]
+    p = V[v] - mid
+    p -= p @ e / (e @ e) * e
+    V[v] = mid + p / np.linalg.norm(p) * double_area * d * d / np.linalg.norm(e)
+    return V, F
+
+
+def test_rows_all_refines_until_a_sliver_mesh_is_solved():
+    # one refinement step left 7.5e-5 of the diagonal (SuperLU) on this valid mesh
+    V, F = _wavy_grid_with_a_sliver(1e-10)
+    b = boundary_vertices(F)
+    X = reconstruct(V, F, curvature_detail(V, F), b, V[b], backend="splu")
+    assert np.abs(X - V).max() < 1e-9 * bbox_diagonal(V)
+
+
+def test_rows_all_refuses_what_it_cannot_solve_instead_of_returning_a_wrong_surface():
+    # at 1e-12 the normal equations are beyond float64: 'splu' returned 0.4 of the diagonal off
+    V, F = _wavy_grid_with_a_sliver(1e-12)
+    b = boundary_vertices(F)
+    with pytest.raises(SolverError,
+                       match=r"rows='all': the normal equations are too ill-conditioned .* Use rows='free'"):
+        reconstruct(V, F, curvature_detail(V, F), b, V[b], backend="splu")
+    X = reconstruct(V, F, curvature_detail(V, F), b, V[b], rows="free", backend="splu")
+    assert np.abs(X - V).max() < 1e-7 * bbox_diagonal(V)

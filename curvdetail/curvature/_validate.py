@@ -120,6 +120,14 @@ def bbox_diagonal(V):
     return float(np.linalg.norm(Vt.max(axis=1) - Vt.min(axis=1)))
 
 
+def bbox_centre(V):
+    """The centre of the axis-aligned bounding box, shape (3,) (zeros for no vertices)."""
+    Vt = np.ascontiguousarray(np.asarray(V, dtype=np.float64).T)
+    if not Vt.shape[1]:
+        return np.zeros(Vt.shape[0])
+    return 0.5 * (Vt.max(axis=1) + Vt.min(axis=1))
+
+
 def check_mesh(V, F, *, check_manifold=True, check_unreferenced=True):
     """Validate a triangle mesh and return ``(V, F)`` as float64 / int64 arrays.
 

@@ -7,7 +7,7 @@ import numpy as np
 
 from ._validate import (_compact_ids, as_faces, as_values, as_vertices, boundary_edges, check_bool,
                         check_mesh, check_oriented, vertex_components)
-from .cotan_laplacian import _cotan_laplacian_unchecked
+from .cotan_laplacian import _cotan_laplacian_unchecked, laplacian_product
 from .curvature_coefficients import DEFAULT_RCOND
 from .curvature_editor import CurvatureEditor
 from .errors import MeshError
@@ -116,7 +116,7 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
         Lf = L[inner][:, inner]
         U[inner] = factorize(Lf, symmetric=True, backend=backend).solve(-(L[inner][:, loop] @ d))
     Vp = V + U
-    Db = (_cotan_laplacian_unchecked(Vp, F) @ Vp)[loop]
+    Db = laplacian_product(_cotan_laplacian_unchecked(Vp, F), Vp)[loop]
     X = editor.solve(positions=P + d, details=Db)
     if not return_info:
         return X

@@ -6,7 +6,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ._validate import as_float, bbox_diagonal
-from .cotan_laplacian import checked_cotan_laplacian
+from .cotan_laplacian import checked_cotan_laplacian, laplacian_product
 from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
 
 #: Default relative threshold on the singular values of a one-ring's detail matrix (see
@@ -107,7 +107,7 @@ def curvature_coefficients(V, F, *, rcond=DEFAULT_RCOND, return_info=False):
     V, F, L = checked_cotan_laplacian(V, F)
     rcond = check_rcond(rcond)
     n = V.shape[0]
-    D = L @ V
+    D = laplacian_product(L, V)
     A = _mixed_voronoi_area_unchecked(V, F)
     rows, cols = _one_ring_pairs(F, n)
     C, rank, scale = _coefficients(D, A, rows, cols, n, rcond, bbox_diagonal(V), want_scale=return_info)

@@ -1,6 +1,6 @@
 """Curvature detail ``D = L V`` (the paper's ``K_i A_i``)."""
 
-from .cotan_laplacian import checked_cotan_laplacian
+from .cotan_laplacian import checked_cotan_laplacian, laplacian_product
 
 
 def curvature_detail(V, F):
@@ -34,4 +34,4 @@ def curvature_detail(V, F):
     True
     """
     V, F, L = checked_cotan_laplacian(V, F)
-    return L @ V
+    return laplacian_product(L, V)      # L @ V, without cancellation far from the origin

@@ -6,8 +6,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from ._validate import as_index_set, as_values, bbox_diagonal
-from .cotan_laplacian import checked_cotan_laplacian
+from ._validate import as_index_set, as_values, bbox_centre, bbox_diagonal
+from .cotan_laplacian import checked_cotan_laplacian, laplacian_product
 from .curvature_coefficients import DEFAULT_RCOND, _coefficients, _one_ring_pairs, check_rcond
 from .errors import ConstraintError, first_indices
 from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
@@ -176,7 +176,7 @@ class CurvatureEditor:
         self.roi = np.flatnonzero(in_roi)
 
         t0 = time.perf_counter()
-        D = L @ V
+        D = laplacian_product(L, V)
         rows, cols = _one_ring_pairs(F, n)
         A, diag = _mixed_voronoi_area_unchecked(V, F), bbox_diagonal(V)
         C, rank, _ = _coefficients(D, A, rows, cols, n, rcond, diag)
@@ -285,8 +285,11 @@ class CurvatureEditor:
         A = sp.csr_matrix((lv[k], (at_R[li[k]], at_fp[lj[k]])), shape=(R.size, fp.size))
         k = in_R & (at_pc[lj] >= 0)
         self._L_pc = sp.csr_matrix((lv[k], (at_R[li[k]], at_pc[lj[k]])), shape=(R.size, pc.size))
+        # positions about a centre inside the constraints: large coordinates (UTM, ECEF) do not
+        # cancel in the right-hand side (L 1 = 0: the solution moves with the centre)
+        self._centre = bbox_centre(V[pc] if pc.size else V)
         k = in_R & ~in_roi[lj]                                 # exterior positions stay as in V
-        w = lv[k][:, None] * V[lj[k]]
+        w = lv[k][:, None] * (V[lj[k]] - self._centre)
         self._rhs_const = -np.stack([np.bincount(at_R[li[k]], weights=w[:, c], minlength=R.size)
                                      for c in range(3)], axis=1)
         self._A_T = A.T.tocsr()
@@ -357,8 +360,8 @@ class CurvatureEditor:
         X = self.V.copy()
         X[self._pc] = Xk
         if self._embed is not None:
-            rhs = D_R + self._rhs_const - self._L_pc @ Xk
-            X[self._fp] = self._embedding_solve(rhs)
+            rhs = D_R + self._rhs_const - self._L_pc @ (Xk - self._centre)
+            X[self._fp] = self._embedding_solve(rhs) + self._centre
         if not return_details:
             return X
         D = self.detail.copy()

@@ -1,6 +1,6 @@
 """Mean curvature normal per vertex (Meyer et al. 2002)."""
 
-from .cotan_laplacian import checked_cotan_laplacian
+from .cotan_laplacian import checked_cotan_laplacian, laplacian_product
 from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
 
 
@@ -34,4 +34,4 @@ def mean_curvature_normal(V, F):
     """
     V, F, L = checked_cotan_laplacian(V, F)
     A = _mixed_voronoi_area_unchecked(V, F)
-    return (L @ V) / A[:, None], A
+    return laplacian_product(L, V) / A[:, None], A

@@ -3,8 +3,8 @@
 import numpy as np
 
 from ._geometry import corner_cotangents
-from ._validate import (ZERO_AREA_RELATIVE, as_count, as_index_set, as_positive_number, bbox_diagonal,
-                        check_every_component_fixed, vertex_components)
+from ._validate import (ZERO_AREA_RELATIVE, as_count, as_index_set, as_positive_number, bbox_centre,
+                        bbox_diagonal, check_every_component_fixed, vertex_components)
 from .cotan_laplacian import _assemble_upper, checked_cotan_triangle
 from .errors import ConstraintError, MeshError, first_indices
 from .reconstruct import _FreeSystemLayout
@@ -122,6 +122,7 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, backend
     # was (a nose beside an ear 10 units away stopped after 4 of its 44 steps)
     scale = _piece_diagonals(V, F, U)
     factor = None
+    centre = bbox_centre(V[fixed])
     layout = _FreeSystemLayout(U, is_free, fixed)    # the same for every step: F does not change
     X = V.copy()
     converged = free.size == 0
@@ -139,7 +140,8 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, backend
         else:
             factor.refactor(system)
         X_new = X.copy()
-        X_new[free] = factor.solve(-(L_fc @ X[fixed]))
+        # about the fixed vertices' centre: large coordinates (UTM, ECEF) do not cancel
+        X_new[free] = factor.solve(-(L_fc @ (X[fixed] - centre))) + centre
         # one cross product per triangle serves the collapse check and the normals
         cross = np.cross(X_new[F[:, 1]] - X_new[F[:, 0]], X_new[F[:, 2]] - X_new[F[:, 0]])
         dbl = np.sqrt(np.einsum("ij,ij->i", cross, cross))

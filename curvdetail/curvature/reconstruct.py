@@ -3,10 +3,11 @@
 import numpy as np
 import scipy.sparse as sp
 
-from ._validate import as_count, as_faces, as_index_set, as_values, as_vertices, check_every_component_fixed
+from ._validate import (as_count, as_faces, as_index_set, as_values, as_vertices, bbox_centre,
+                        check_every_component_fixed)
 from .cotan_laplacian import _edge_pattern, _symmetric_from_upper, checked_cotan_triangle
 from .errors import ConstraintError
-from .sparse_solver import SMALL_SYSTEM_NNZ, PendingFactorization, factorize, resolve_backend
+from .sparse_solver import SMALL_SYSTEM_NNZ, PendingFactorization, SolverError, factorize, resolve_backend
 
 ROW_MODES = ("all", "free")
 
@@ -25,7 +26,11 @@ class Reconstructor:
     least-squares residual. Without it the normal equations lose accuracy with the square of the
     condition number (camelhead, 11k vertices: 1.5e-9 of the bbox diagonal on its own round trip);
     with it the error is ~1e-14, as for the square system. The step costs one extra
-    back-substitution and two sparse products.
+    back-substitution and two sparse products. Where one step is not enough (needle or sliver
+    triangles), more follow while the estimated error left is above ``REFINEMENT_TOLERANCE``
+    (1e-12 of the solution), up to ``MAX_REFINEMENT_STEPS``; a refinement that stalls raises
+    SolverError instead of returning a wrong surface. Solves run relative to the fixed
+    positions' centre, so coordinates far from the origin (UTM, ECEF) lose no digits.
     ``rows="free"`` sums over the free vertices only: the square system
     ``L_ff X_f = D_f - L_fc X_c``. Both are symmetric positive definite when every connected
     component holds a fixed vertex, and both reproduce ``V_ref`` exactly from its own detail.
@@ -38,9 +43,10 @@ class Reconstructor:
     rows : {"all", "free"}       which residual rows enter the energy
     backend : str                sparse solver: "auto", "pardiso", "cholmod", "splu" or "banded"
                                  (see :mod:`.sparse_solver` for what "auto" picks)
-    refinement_steps : int, optional   refinement steps of ``rows="all"`` solves (default: the
-                                 class attribute, 1). 0 halves the back-substitution time and
-                                 gives the plain normal-equation solution (~cond^2 eps).
+    refinement_steps : int, optional   least refinement steps of ``rows="all"`` solves (default:
+                                 the class attribute, 1; more where the error estimate asks for
+                                 them). 0 halves the back-substitution time and gives the plain
+                                 normal-equation solution (~cond^2 eps).
 
     Attributes
     ----------
@@ -55,7 +61,8 @@ class Reconstructor:
     ConstraintError   no fixed vertex, fixed indices out of range or repeated, a boolean mask of
                       the wrong length, or a connected piece without a fixed vertex
     ValueError        an unknown ``rows`` mode
-    SolverError       an unknown or uninstalled ``backend``
+    SolverError       an unknown or uninstalled ``backend``; in :meth:`solve`, ``rows="all"``
+                      normal equations too ill-conditioned to refine (near-degenerate triangles)
 
     Examples
     --------
@@ -157,6 +164,8 @@ class Reconstructor:
         Raises
         ------
         ConstraintError   ``detail`` or ``fixed_positions`` has the wrong shape or non-finite rows
+        SolverError       ``rows="all"``: the refinement stalled (normal equations too
+                          ill-conditioned, see the class docstring)
         """
         D = as_values(detail, self.n, "detail")
         Xc = as_values(fixed_positions, self.fixed.size, "fixed_positions")
@@ -164,8 +173,13 @@ class Reconstructor:
         X[self.fixed] = Xc
         if self._factor is None:
             return X
+        # solved relative to the fixed positions' centre c: L 1 = 0, so the solution moves with
+        # c, and large coordinates (UTM, ECEF) do not cancel in L_:c X_c (a 1 mm sphere 1e6 m out
+        # came back 4e-6 of its diagonal off); X_c - c is exact for coordinates near c
+        centre = bbox_centre(Xc)
+        Yc = Xc - centre
         if self.rows == "free":
-            X[self.free] = self._factor.solve(D[self.free] - self._L_fc @ Xc)
+            X[self.free] = self._factor.solve(D[self.free] - self._L_fc @ Yc) + centre
             return X
         # Normal equations L_:f^T L_:f X_f = L_:f^T r with r = D - L_:c X_c, then corrected
         # semi-normal refinement: the correction is computed from the least-squares residual
@@ -175,14 +189,51 @@ class Reconstructor:
         # Coordinate by coordinate on contiguous (3, .) rows: one-column sparse products are
         # ~25 % faster than three-column ones, and the solver takes the columns as they are.
         L_f, L_f_T = self._L_f, self._L_f.T
-        r = np.ascontiguousarray(D.T) - (self._L_c @ Xc).T                    # (3, n)
+        r = np.ascontiguousarray(D.T) - (self._L_c @ Yc).T                    # (3, n)
         X_f = self._factor.solve(np.stack([L_f @ rj for rj in r]).T).T         # (3, f)
-        for _ in range(self.refinement_steps):
-            s = np.stack([L_f @ (rj - L_f_T @ xj) for rj, xj in zip(r, X_f)])
-            X_f += self._factor.solve(s.T).T
-        X[self.free] = X_f.T
+        X_f = self._refine(X_f, r)
+        X[self.free] = X_f.T + centre
         return X
 
+    def _refine(self, X_f, r):
+        """Corrected semi-normal refinement of the normal-equation solution ``X_f`` (3, f) for
+        the right-hand side ``r`` (3, n).
+
+        Each step solves for the correction from the least-squares residual ``r - L_:f X_f``. It
+        contracts the error by about ``cond(L_:f)^2 eps``, which the size of the first
+        correction estimates (it is about the first solution's relative error). After
+        ``refinement_steps`` steps, more follow (up to ``MAX_REFINEMENT_STEPS``) while the error
+        left, estimated from the last correction and the contraction, is above
+        ``REFINEMENT_TOLERANCE`` of the solution; a correction that does not shrink means the
+        normal equations are too ill-conditioned (near-degenerate triangles) and raises
+        SolverError rather than return a wrong surface."""
+        L_f, L_f_T = self._L_f, self._L_f.T
+        size = max(float(np.abs(X_f).max()), np.finfo(float).tiny)
+        previous = None
+        for step in range(MAX_REFINEMENT_STEPS if self.refinement_steps else 0):
+            s = np.stack([L_f @ (rj - L_f_T @ xj) for rj, xj in zip(r, X_f)])
+            correction = self._factor.solve(s.T).T
+            X_f += correction
+            relative = float(np.abs(correction).max()) / size
+            contraction = relative if previous is None else relative / max(previous, np.finfo(float).tiny)
+            if previous is not None and contraction > 0.5 and relative > REFINEMENT_TOLERANCE:
+                raise SolverError(
+                    f"rows='all': the normal equations are too ill-conditioned to solve accurately "
+                    f"(the refinement stalled at a correction of {relative:.1e} of the solution), "
+                    "most likely from needle or sliver triangles. Use rows='free', or remesh the "
+                    "near-degenerate triangles away (e.g. pymeshlab's "
+                    "meshing_isotropic_explicit_remeshing).")
+            previous = relative
+            if step + 1 >= self.refinement_steps and relative * contraction <= REFINEMENT_TOLERANCE:
+                break
+        return X_f
+
+
+#: ``rows="all"``: refinement continues while the estimated error left is above this fraction of
+#: the solution (one step reaches it on ordinary meshes: 1e-18 ... 1e-13 estimated), for at most
+#: ``MAX_REFINEMENT_STEPS`` steps
+REFINEMENT_TOLERANCE = 1e-12
+MAX_REFINEMENT_STEPS = 10
 
 #: From this many free vertices, ``rows="all"`` with PARDISO forms the normal matrix's upper
 #: triangle with MKL's ``mkl_sparse_syrk`` (see :mod:`._mkl_sparse`); below, SciPy's product

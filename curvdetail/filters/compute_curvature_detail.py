@@ -3,7 +3,7 @@
 import numpy as np
 
 from ..curvature._validate import boundary_vertices
-from ..curvature.cotan_laplacian import checked_cotan_laplacian
+from ..curvature.cotan_laplacian import checked_cotan_laplacian, laplacian_product
 from ..curvature.mixed_voronoi_area import _mixed_voronoi_area_unchecked
 from .detail_attributes import AREA, DETAIL, NORMAL, store_detail  # noqa: F401  (names re-exported)
 from .meshset import layer_id, mesh_arrays, set_vertex_quality, vertex_normals
@@ -40,7 +40,7 @@ def compute_curvature_detail(ms):
     mid = layer_id(ms)
     V, F = mesh_arrays(ms, mid)
     V, F, L = checked_cotan_laplacian(V, F)        # validated once
-    D = L @ V                                      # = curvature_detail(V, F)
+    D = laplacian_product(L, V)                    # = curvature_detail(V, F)
     A = _mixed_voronoi_area_unchecked(V, F)        # = mixed_voronoi_area(V, F)
     K = D / A[:, None]                             # = mean_curvature_normal(V, F)[0], bit for bit
     H = signed_mean_curvature(V, F, K)
