@@ -294,3 +294,15 @@ def test_editing_far_from_the_origin_loses_no_digits(load_mesh):
     X_near = CurvatureEditor(near, F, b, b).solve(positions=moved)
     X_far = CurvatureEditor(far, F, b, b).solve(positions=moved + shift)
     assert np.abs((X_far - shift) - X_near).max() < 1e-9 * _diag(V)
+
+
+@pytest.mark.parametrize("relations", ["one-ring", "one+two-ring"])
+def test_unchanged_constraints_give_the_rest_shape_with_rank_deficient_rings(load_mesh, relations):
+    # the grid's valence-2 corners do not reproduce their detail from their coefficients; with
+    # 8 random handles (I - C)_uu amplified that into a rest shape 5 diagonals off. The rest
+    # residual is kept as a constant now, so the rest state solves the system exactly
+    V, F = load_mesh("terrainA_1k.obj")
+    handles = np.random.default_rng(0).choice(V.shape[0], 8, replace=False)
+    ed = CurvatureEditor(V, F, handles, handles, relations=relations)
+    assert ed.rank_deficient > 0
+    assert np.abs(ed.solve() - V).max() < 1e-8 * _diag(V)
