@@ -5,6 +5,7 @@ import pytest
 
 from curvdetail import curvature_coefficients, curvature_detail
 from curvdetail.curvature.errors import MeshError
+from curvdetail.curvature.testing import grid
 
 
 def _rotation(rng):
@@ -121,3 +122,18 @@ def test_malformed_mesh_is_refused_before_any_algebra(plane_grid):
     bad[3, 1] = V.shape[0] + 5
     with pytest.raises(MeshError, match="outside"):
         curvature_coefficients(V, bad)
+
+
+def test_a_rotation_does_not_move_the_flatness_threshold():
+    # the threshold's length was the bounding-box diagonal, which a 45-degree turn of a square
+    # lengthens from 1.41 to 2: rings of curvature 5.9e-7 counted as flat before the turn and
+    # not after, and 64 rows of C changed by 0.17
+    V, F = grid(12, 12)
+    V[:, :2] -= 0.5
+    V[:, 2] = 0.5 * 5.9e-7 * V[:, 0] ** 2
+    c = np.cos(np.pi / 4)
+    turn = np.array([[c, -c, 0.0], [c, c, 0.0], [0.0, 0.0, 1.0]])
+    C, info = curvature_coefficients(V, F, return_info=True)
+    C_turned, info_turned = curvature_coefficients(V @ turn.T, F, return_info=True)
+    assert np.array_equal(info.rank, info_turned.rank)
+    assert abs(C_turned - C).max() < 1e-12

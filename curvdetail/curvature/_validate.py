@@ -120,6 +120,17 @@ def bbox_diagonal(V):
     return float(np.linalg.norm(Vt.max(axis=1) - Vt.min(axis=1)))
 
 
+def centroid_diameter(V):
+    """Twice the largest distance of a vertex from the vertices' centroid: a length of the
+    bounding-box diagonal's size (equal to it for a box) that, unlike the diagonal, does not
+    change when the mesh is rotated. For thresholds that must be rotation-invariant."""
+    V = np.asarray(V, dtype=np.float64)
+    if not V.shape[0]:
+        return 0.0
+    offsets = V - V.mean(axis=0)
+    return float(2.0 * np.sqrt(np.einsum("ij,ij->i", offsets, offsets).max()))
+
+
 def bbox_centre(V):
     """The centre of the axis-aligned bounding box, shape (3,) (zeros for no vertices)."""
     Vt = np.ascontiguousarray(np.asarray(V, dtype=np.float64).T)

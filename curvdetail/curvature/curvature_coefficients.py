@@ -5,7 +5,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ._validate import as_float, bbox_diagonal
+from ._validate import as_float, centroid_diameter
 from .cotan_laplacian import checked_cotan_laplacian, laplacian_product
 from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
 
@@ -58,12 +58,14 @@ def curvature_coefficients(V, F, *, rcond=DEFAULT_RCOND, return_info=False):
     number; the threshold below is chosen well above the resulting ~1.5e-8 noise floor.
 
     Regularization (rank-deficient rings): a singular value ``sigma_k`` of ``D_N`` is kept only if
-    ``sigma_k > rcond * s_i`` with ``s_i = max(sigma_1(D_N), sqrt(sum_j A_j^2) / diag)``; the
+    ``sigma_k > rcond * s_i`` with ``s_i = max(sigma_1(D_N), sqrt(sum_j A_j^2) / size)``; the
     others are truncated (a truncated pseudo-inverse). ``sigma_1`` makes the threshold relative
     to the ring itself (coplanar details on a cylinder: the third singular value is roundoff);
-    the second term is the detail a curvature of ``1 / diag`` would give on the ring (``A_j`` mixed
-    Voronoi areas, ``diag`` the bounding-box diagonal), so that a ring whose curvature is below
-    ``rcond / diag`` counts as flat: its details are roundoff and its coefficients are zero
+    the second term is the detail a curvature of ``1 / size`` would give on the ring (``A_j`` mixed
+    Voronoi areas, ``size`` twice the largest distance from the vertices' centroid: the
+    bounding-box diagonal's size, but unchanged by rotations, as the coefficients must be), so
+    that a ring whose curvature is below ``rcond / size`` counts as flat: its details are
+    roundoff and its coefficients are zero
     (``D_i = 0`` is kept there). Vertices with fewer than three kept singular values are
     counted as rank-deficient; their detail is represented only where it lies in the kept span.
 
@@ -110,7 +112,7 @@ def curvature_coefficients(V, F, *, rcond=DEFAULT_RCOND, return_info=False):
     D = laplacian_product(L, V)
     A = _mixed_voronoi_area_unchecked(V, F)
     rows, cols = _one_ring_pairs(F, n)
-    C, rank, scale = _coefficients(D, A, rows, cols, n, rcond, bbox_diagonal(V), want_scale=return_info)
+    C, rank, scale = _coefficients(D, A, rows, cols, n, rcond, centroid_diameter(V), want_scale=return_info)
     if not return_info:
         return C
     residual = np.linalg.norm(D - C @ D, axis=1)
@@ -147,7 +149,7 @@ def check_rcond(rcond):
     return number
 
 
-def _coefficients(D, A, rows, cols, n, rcond, diag, *, want_scale=False):
+def _coefficients(D, A, rows, cols, n, rcond, size, *, want_scale=False):
     """Batched truncated pseudo-inverse solve; returns (C, rank, scale or None)."""
     Dj = D[cols]
     # the 6 distinct entries of G_i = sum_j D_j D_j^T
@@ -156,7 +158,7 @@ def _coefficients(D, A, rows, cols, n, rcond, diag, *, want_scale=False):
         for b in range(a, 3):
             g[a, b] = np.bincount(rows, weights=Dj[:, a] * Dj[:, b], minlength=n)
     area_scale = (np.sqrt(np.bincount(rows, weights=A[cols] ** 2, minlength=n))
-                  / max(diag, np.finfo(float).tiny))
+                  / max(size, np.finfo(float).tiny))
     # closed form where G is safely full rank: adjugate / det
     c00 = g[1, 1] * g[2, 2] - g[1, 2] ** 2
     c01 = g[0, 2] * g[1, 2] - g[0, 1] * g[2, 2]

@@ -6,7 +6,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from ._validate import as_index_set, as_values, bbox_centre, bbox_diagonal
+from ._validate import as_index_set, as_values, bbox_centre, centroid_diameter
 from .cotan_laplacian import checked_cotan_laplacian, laplacian_product
 from .curvature_coefficients import DEFAULT_RCOND, _coefficients, _one_ring_pairs, check_rcond
 from .errors import ConstraintError, first_indices
@@ -184,8 +184,8 @@ class CurvatureEditor:
         t0 = time.perf_counter()
         D = laplacian_product(L, V)
         rows, cols = _one_ring_pairs(F, n)
-        A, diag = _mixed_voronoi_area_unchecked(V, F), bbox_diagonal(V)
-        C, rank, _ = _coefficients(D, A, rows, cols, n, rcond, diag)
+        A, size = _mixed_voronoi_area_unchecked(V, F), centroid_diameter(V)     # rotation-invariant
+        C, rank, _ = _coefficients(D, A, rows, cols, n, rcond, size)
         cvals = C.data if C.nnz == rows.size else np.asarray(C[rows, cols]).ravel()  # (rows, cols) order
         self.detail, self.coefficients, self.laplacian = D, C, L
         self.rank_deficient = int(np.count_nonzero(rank < 3))
@@ -197,7 +197,7 @@ class CurvatureEditor:
         _check_reached(rows, cols, free_d, n, "detail", "detail_constrained")
         if relations == "one+two-ring":
             rows2, cols2 = _two_ring_pairs(rows, cols, n)
-            C2, rank2, _ = _coefficients(D, A, rows2, cols2, n, rcond, diag)
+            C2, rank2, _ = _coefficients(D, A, rows2, cols2, n, rcond, size)
             cvals2 = C2.data if C2.nnz == rows2.size else np.asarray(C2[rows2, cols2]).ravel()
             self.coefficients_two_ring = C2
             island = _detail_islands(np.concatenate([rows, rows2]), np.concatenate([cols, cols2]),
