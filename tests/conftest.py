@@ -59,3 +59,26 @@ def flat_disk():
 @pytest.fixture
 def rng():
     return np.random.default_rng(20061210)
+
+
+@pytest.fixture
+def wavy_grid_with_a_sliver():
+    """A builder: ``(V, F)`` of a 30 x 30 wavy grid with one valid but near-degenerate triangle
+    of the given doubled area (times the squared bbox diagonal)."""
+    from curvdetail.curvature._validate import bbox_diagonal
+    from curvdetail.curvature.testing import grid
+
+    def _build(double_area):
+        """30 x 30 wavy grid whose vertex 465 is moved next to edge (434, 435), making a triangle of
+        the given doubled area (times the squared diagonal): valid, but badly conditioned."""
+        V, F = grid(30, 30)
+        V[:, 2] = 0.1 * np.sin(3 * V[:, 0]) * np.cos(2 * V[:, 1])
+        d = bbox_diagonal(V)
+        a, b, v = 434, 435, 465
+        mid, e = (V[a] + V[b]) / 2, V[b] - V[a]
+        p = V[v] - mid
+        p -= p @ e / (e @ e) * e
+        V[v] = mid + p / np.linalg.norm(p) * double_area * d * d / np.linalg.norm(e)
+        return V, F
+
+    return _build

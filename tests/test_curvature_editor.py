@@ -306,3 +306,19 @@ def test_unchanged_constraints_give_the_rest_shape_with_rank_deficient_rings(loa
     ed = CurvatureEditor(V, F, handles, handles, relations=relations)
     assert ed.rank_deficient > 0
     assert np.abs(ed.solve() - V).max() < 1e-8 * _diag(V)
+
+
+def test_the_embedding_refuses_normal_equations_it_cannot_refine(wavy_grid_with_a_sliver):
+    # every detail given, a valid sliver of doubled area 1e-12 of the squared diagonal: the fixed
+    # single step returned the rest shape 2e-2 of the diagonal off without an error
+    from curvdetail import SolverError
+
+    for double_area, fails in ((1e-10, False), (1e-12, True)):
+        V, F = wavy_grid_with_a_sliver(double_area)
+        b = boundary_vertices(F)
+        ed = CurvatureEditor(V, F, b, np.arange(V.shape[0]), backend="splu")
+        if fails:
+            with pytest.raises(SolverError, match="too ill-conditioned"):
+                ed.solve()
+        else:
+            assert np.abs(ed.solve() - V).max() < 1e-9 * _diag(V)

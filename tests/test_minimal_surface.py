@@ -182,3 +182,17 @@ def test_steps_are_the_textbook_iteration_with_one_symbolic_analysis(load_mesh, 
     got = minimal_surface(V, F, fixed, max_iterations=3, tol=1e-300, backend=backend)
     assert got.iterations == 3 and sparse_solver.factorization_count == before + 3
     assert np.abs(got - X).max() < 1e-10 * np.abs(V).max()
+
+
+def test_far_from_the_origin_the_iteration_loses_no_digits():
+    # UTM / ECEF: the right-hand side L_fc X_c is formed about the fixed vertices' centre
+    V, F = grid(12, 12)
+    V[:, 2] = 0.1 * np.sin(3 * V[:, 0]) * np.cos(2 * V[:, 1])
+    shift = np.array([4e6, 5e5, 3e3])
+    far = V + shift
+    near = far - shift                        # the same triangles, exactly, near the origin
+    b = boundary_vertices(F)
+    X_near = minimal_surface(near, F, b, max_iterations=5)
+    X_far = minimal_surface(far, F, b, max_iterations=5)
+    # (5e-9 of the diagonal before, 4e-10 now: the coordinates' own spacing out there is 5e-10)
+    assert np.abs((np.asarray(X_far) - shift) - np.asarray(X_near)).max() < 2e-9 * bbox_diagonal(V)

@@ -311,31 +311,27 @@ def test_round_trip_far_from_the_origin(rows):
     assert np.abs(X - V).max() < 1e-9 * bbox_diagonal(V)
 
 
-def _wavy_grid_with_a_sliver(double_area):
-    """30 x 30 wavy grid whose vertex 465 is moved next to edge (434, 435), making a triangle of
-    the given doubled area (times the squared diagonal): valid, but badly conditioned."""
-    V, F = grid(30, 30)
-    V[:, 2] = 0.1 * np.sin(3 * V[:, 0]) * np.cos(2 * V[:, 1])
-    d = bbox_diagonal(V)
-    a, b, v = 434, 435, 465
-    mid, e = (V[a] + V[b]) / 2, V[b] - V[a]
-    p = V[v] - mid
-    p -= p @ e / (e @ e) * e
-    V[v] = mid + p / np.linalg.norm(p) * double_area * d * d / np.linalg.norm(e)
-    return V, F
-
-
-def test_rows_all_refines_until_a_sliver_mesh_is_solved():
-    # one refinement step left 7.5e-5 of the diagonal (SuperLU) on this valid mesh
-    V, F = _wavy_grid_with_a_sliver(1e-10)
+@pytest.mark.parametrize("double_area", [1e-10, 5.01e-11, 3.16e-11, 2e-11])
+def test_rows_all_refines_until_a_sliver_mesh_is_solved(wavy_grid_with_a_sliver, double_area):
+    # one refinement step left 7.5e-5 of the diagonal (SuperLU) at 1e-10; a first adaptive
+    # version raised on 5.01e-11 at the rounding floor and returned 4.9e-9 / 2.2e-7 on the others
+    V, F = wavy_grid_with_a_sliver(double_area)
     b = boundary_vertices(F)
     X = reconstruct(V, F, curvature_detail(V, F), b, V[b], backend="splu")
     assert np.abs(X - V).max() < 1e-9 * bbox_diagonal(V)
 
 
-def test_rows_all_refuses_what_it_cannot_solve_instead_of_returning_a_wrong_surface():
+def test_more_refinement_steps_than_needed_stop_at_the_rounding_floor_without_an_error(load_mesh):
+    # the corrections stop shrinking at ~1e-13: that is the answer, not a stall
+    V, F = load_mesh("mannequin_ear.obj")
+    b = boundary_vertices(F)
+    X = Reconstructor(V, F, b, refinement_steps=12).solve(curvature_detail(V, F), V[b])
+    assert np.abs(X - V).max() < 1e-12 * bbox_diagonal(V)
+
+
+def test_rows_all_refuses_what_it_cannot_solve_instead_of_returning_a_wrong_surface(wavy_grid_with_a_sliver):
     # at 1e-12 the normal equations are beyond float64: 'splu' returned 0.4 of the diagonal off
-    V, F = _wavy_grid_with_a_sliver(1e-12)
+    V, F = wavy_grid_with_a_sliver(1e-12)
     b = boundary_vertices(F)
     with pytest.raises(SolverError,
                        match=r"rows='all': the normal equations are too ill-conditioned .* Use rows='free'"):

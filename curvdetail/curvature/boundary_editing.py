@@ -191,9 +191,9 @@ def boundary_loop(F):
     _, first, counts = np.unique(corners, axis=0, return_index=True, return_counts=True)
     if np.any(counts > 1):
         twice = np.sort(first[counts > 1])
-        raise MeshError(f"{twice.size} triangles appear more than once (first: {', '.join(map(str, twice[:3]))}), "
-                        "which takes their edges off the boundary; remove the copies (e.g. pymeshlab's "
-                        "meshing_remove_duplicate_faces).")
+        raise MeshError(f"{twice.size} triangles appear more than once (first: "
+                        f"{', '.join(map(str, twice[:3]))}), which takes their edges off the boundary; "
+                        "remove the copies (e.g. pymeshlab's meshing_remove_duplicate_faces).")
     check_oriented(F)
     labels, _ = vertex_components(F, int(F.max()) + 1)
     pieces = np.unique(labels[F.ravel()]).size          # unreferenced vertices are no pieces

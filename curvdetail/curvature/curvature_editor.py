@@ -11,6 +11,7 @@ from .cotan_laplacian import checked_cotan_laplacian, laplacian_product
 from .curvature_coefficients import DEFAULT_RCOND, _coefficients, _one_ring_pairs, check_rcond
 from .errors import ConstraintError, first_indices
 from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
+from .reconstruct import refine_least_squares
 from .sparse_solver import _chosen_automatically, factorize, resolve_backend
 
 
@@ -389,15 +390,16 @@ class CurvatureEditor:
     def _embedding_solve(self, rhs):
         """Free positions minimizing ``|A X_f - rhs|`` over the rows ``R`` (rows="all"), or
         solving the square system (rows="free"); ``rhs`` (|R|, k). The normal equations are
-        followed by ``refinement_steps`` steps of corrected semi-normal refinement, as in
-        :class:`Reconstructor`: without them the error grows with the squared condition number
-        (mannequin_devil, every detail given: 4e-8 of the diagonal against 4e-14)."""
+        followed by corrected semi-normal refinement, as in :class:`Reconstructor`
+        (:func:`refine_least_squares`: at least ``refinement_steps`` steps, more where the error
+        estimate asks, SolverError where it stalls): without it the error grows with the
+        squared condition number (mannequin_devil, every detail given: 4e-8 of the diagonal
+        against 4e-14)."""
         if self._A_T is None:
             return self._embed.solve(rhs)
         X = self._embed.solve(self._A_T @ rhs)
-        for _ in range(self.refinement_steps):
-            X += self._embed.solve(self._A_T @ (rhs - self._A @ X))
-        return X
+        return refine_least_squares(X, lambda X: self._embed.solve(self._A_T @ (rhs - self._A @ X)),
+                                    self.refinement_steps)
 
     def precompute_handles(self, handles, positions=None, details=None):
         """Precompute the response to the constraints of a few vertices, for real-time edits.

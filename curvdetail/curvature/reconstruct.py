@@ -28,9 +28,10 @@ class Reconstructor:
     with it the error is ~1e-14, as for the square system. The step costs one extra
     back-substitution and two sparse products. Where one step is not enough (needle or sliver
     triangles), more follow while the estimated error left is above ``REFINEMENT_TOLERANCE``
-    (1e-12 of the solution), up to ``MAX_REFINEMENT_STEPS``; a refinement that stalls raises
-    SolverError instead of returning a wrong surface. Solves run relative to the fixed
-    positions' centre, so coordinates far from the origin (UTM, ECEF) lose no digits.
+    (1e-12 of the solution), up to ``MAX_REFINEMENT_STEPS``; a refinement that stalls above
+    ``REFINEMENT_FLOOR`` (1e-9) raises SolverError instead of returning a wrong surface. Solves
+    run relative to the fixed positions' centre, so coordinates far from the origin (UTM, ECEF)
+    lose no digits.
     ``rows="free"`` sums over the free vertices only: the square system
     ``L_ff X_f = D_f - L_fc X_c``. Both are symmetric positive definite when every connected
     component holds a fixed vertex, and both reproduce ``V_ref`` exactly from its own detail.
@@ -197,36 +198,52 @@ class Reconstructor:
 
     def _refine(self, X_f, r):
         """Corrected semi-normal refinement of the normal-equation solution ``X_f`` (3, f) for
-        the right-hand side ``r`` (3, n).
-
-        Each step solves for the correction from the least-squares residual ``r - L_:f X_f``. It
-        contracts the error by about ``cond(L_:f)^2 eps``, which the size of the first
-        correction estimates (it is about the first solution's relative error). After
-        ``refinement_steps`` steps, more follow (up to ``MAX_REFINEMENT_STEPS``) while the error
-        left, estimated from the last correction and the contraction, is above
-        ``REFINEMENT_TOLERANCE`` of the solution; a correction that does not shrink means the
-        normal equations are too ill-conditioned (near-degenerate triangles) and raises
-        SolverError rather than return a wrong surface."""
+        the right-hand side ``r`` (3, n): each correction solves the same factored system with
+        the least-squares residual ``r - L_:f X_f`` (see :func:`refine_least_squares`)."""
         L_f, L_f_T = self._L_f, self._L_f.T
-        size = max(float(np.abs(X_f).max()), np.finfo(float).tiny)
-        previous = None
-        for step in range(MAX_REFINEMENT_STEPS if self.refinement_steps else 0):
-            s = np.stack([L_f @ (rj - L_f_T @ xj) for rj, xj in zip(r, X_f)])
-            correction = self._factor.solve(s.T).T
-            X_f += correction
-            relative = float(np.abs(correction).max()) / size
-            contraction = relative if previous is None else relative / max(previous, np.finfo(float).tiny)
-            if previous is not None and contraction > 0.5 and relative > REFINEMENT_TOLERANCE:
-                raise SolverError(
-                    f"rows='all': the normal equations are too ill-conditioned to solve accurately "
-                    f"(the refinement stalled at a correction of {relative:.1e} of the solution), "
-                    "most likely from needle or sliver triangles. Use rows='free', or remesh the "
-                    "near-degenerate triangles away (e.g. pymeshlab's "
-                    "meshing_isotropic_explicit_remeshing).")
-            previous = relative
-            if step + 1 >= self.refinement_steps and relative * contraction <= REFINEMENT_TOLERANCE:
-                break
-        return X_f
+
+        def correction(X):
+            s = np.stack([L_f @ (rj - L_f_T @ xj) for rj, xj in zip(r, X)])
+            return self._factor.solve(s.T).T
+
+        return refine_least_squares(X_f, correction, self.refinement_steps)
+
+
+def refine_least_squares(X, correction, min_steps):
+    """Refine a normal-equation solution ``X`` in place by ``X += correction(X)`` and return it.
+
+    Each corrected semi-normal step contracts the error by about ``cond^2 eps``, which the
+    size of the first correction estimates (it is about the first solution's relative error).
+    At least ``min_steps`` steps run (none for 0); more follow while the error left, estimated
+    from the last correction and the contraction, is above ``REFINEMENT_TOLERANCE`` of the
+    solution, up to ``max(MAX_REFINEMENT_STEPS, min_steps)``. Corrections that stop shrinking
+    have reached the problem's rounding floor: the result is taken where they are below
+    ``REFINEMENT_FLOOR`` of the solution, and SolverError raised where they are not (the normal
+    equations are then too ill-conditioned: near-degenerate triangles), as where the steps run
+    out above it."""
+    if not min_steps:
+        return X
+    size = max(float(np.abs(X).max()), np.finfo(float).tiny)
+    previous = None
+    for step in range(max(MAX_REFINEMENT_STEPS, min_steps)):
+        delta = correction(X)
+        X += delta
+        relative = float(np.abs(delta).max()) / size
+        contraction = relative if previous is None else relative / max(previous, np.finfo(float).tiny)
+        if step + 1 >= min_steps and relative * min(contraction, 1.0) <= REFINEMENT_TOLERANCE:
+            return X                                            # converged
+        if previous is not None and contraction > 0.5 and step + 1 >= min_steps:
+            if relative <= REFINEMENT_FLOOR:                    # at the rounding floor
+                return X
+            break                                               # stalled above it
+        previous = relative
+    if relative <= REFINEMENT_FLOOR:
+        return X
+    raise SolverError(
+        f"rows='all': the normal equations are too ill-conditioned to solve accurately (the "
+        f"refinement stalled at a correction of {relative:.1e} of the solution), most likely from "
+        "needle or sliver triangles. Use rows='free', or remesh the near-degenerate triangles away "
+        "(e.g. pymeshlab's meshing_isotropic_explicit_remeshing).")
 
 
 #: ``rows="all"``: refinement continues while the estimated error left is above this fraction of
@@ -234,6 +251,9 @@ class Reconstructor:
 #: ``MAX_REFINEMENT_STEPS`` steps
 REFINEMENT_TOLERANCE = 1e-12
 MAX_REFINEMENT_STEPS = 10
+#: a refinement whose corrections stop shrinking (the rounding floor) is taken where they are
+#: below this fraction of the solution (the round-trip bound), else SolverError
+REFINEMENT_FLOOR = 1e-9
 
 #: From this many free vertices, ``rows="all"`` with PARDISO forms the normal matrix's upper
 #: triangle with MKL's ``mkl_sparse_syrk`` (see :mod:`._mkl_sparse`); below, SciPy's product
