@@ -40,8 +40,9 @@ class CurvatureEditor:
        summed over every row that involves them (as :class:`Reconstructor` with
        ``rows="all"``); position-constrained vertices and all vertices outside ``roi`` keep
        their positions exactly. Normal equations, Cholesky-type factorization, once; each
-       solve adds one step of corrected semi-normal refinement (``refinement_steps``), which
-       keeps the error at solver precision as in :class:`Reconstructor`.
+       solve adds corrected semi-normal refinement (at least ``refinement_steps`` steps, see
+       :func:`refine_least_squares`), which keeps the error at solver precision as in
+       :class:`Reconstructor`.
 
     Vertices outside ``roi`` are fixed: position and detail as in ``V`` (a smooth transition
     across the region's border), and they are left out of both systems, whose sizes are those
@@ -238,18 +239,15 @@ class CurvatureEditor:
         to_dc = r_in & (at_dc[cols] >= 0)
         self._C_dc = sp.csr_matrix((cvals[to_dc], (at_fd[rows[to_dc]], at_dc[cols[to_dc]])),
                                    shape=(fd.size, dc.size))
-        to_ext = r_in & ~in_roi[cols]                          # exterior details stay as in V
-        w = cvals[to_ext][:, None] * D[cols[to_ext]]
-        self._d_const = np.stack([np.bincount(at_fd[rows[to_ext]], weights=w[:, k], minlength=fd.size)
-                                  for k in range(3)], axis=1)
-        # the rest detail's residual (I - C) D, kept as it is: rank-deficient rings (a grid's
-        # valence-2 corners, flat regions) do not reproduce their detail, and (I - C)_uu amplified
-        # that into a rest shape 5 diagonals off with 8 handles; with it the rest state solves
-        # the system exactly
-        w = cvals[r_in][:, None] * D[cols[r_in]]
-        CD = np.stack([np.bincount(at_fd[rows[r_in]], weights=w[:, k], minlength=fd.size) for k in range(3)],
-                      axis=1)
-        self._d_const = self._d_const + (D[fd] - CD)
+        # constant term: the exterior details as in V (C_u,ext D_ext), plus the rest detail's
+        # residual (I - C) D kept as it is: rank-deficient rings (a grid's valence-2 corners, flat
+        # regions) do not reproduce their detail, and (I - C)_uu amplified that into a rest shape
+        # 5 diagonals off with 8 handles. Together: D_u - C_u,roi D_roi at rest, so the rest
+        # state solves the system exactly
+        inside = r_in & in_roi[cols]
+        w = cvals[inside][:, None] * D[cols[inside]]
+        self._d_const = D[fd] - np.stack([np.bincount(at_fd[rows[inside]], weights=w[:, k], minlength=fd.size)
+                                          for k in range(3)], axis=1)
         # "auto" takes SuperLU (symmetric mode, no pivoting) for (I - C) below CURVATURE_SPLU_MAX
         # unknowns, for its faster back-substitution (see there).
         self._curv = factorize(M, symmetric=False, backend=curv_backend) if fd.size else None
@@ -272,13 +270,10 @@ class CurvatureEditor:
         Au = sp.csr_matrix((mv[k], (mr[k], at_fd[mc[k]])), shape=(m, fd.size))
         k = at_dc[mc] >= 0
         Bdc = sp.csr_matrix((mv[k], (mr[k], at_dc[mc[k]])), shape=(m, dc.size))
-        k = ~in_roi[mc]
-        w = mv[k][:, None] * D[mc[k]]
-        ext = np.stack([np.bincount(mr[k], weights=w[:, j], minlength=m) for j in range(3)], axis=1)
         AuT = Au.T.tocsr()
-        # the rest detail's residual in every stacked row, kept as it is (see _square_system)
-        rest_residual = Au @ D[fd] + Bdc @ D[dc] + ext
-        self._d_const = AuT @ (rest_residual - ext)
+        # the exterior details as in V and the rest residual of every stacked row, kept as it
+        # is (see _square_system): together -A_ext D_ext + (A D)_rest = A_u D_u + A_dc D_dc at rest
+        self._d_const = AuT @ (Au @ D[fd] + Bdc @ D[dc])
         self._C_dc = -(AuT @ Bdc).tocsr()
         self._curv = factorize((AuT @ Au).tocsr(), symmetric=True, backend=backend) if fd.size else None
 
