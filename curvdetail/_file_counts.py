@@ -123,15 +123,18 @@ def declared_counts(path):
 
 
 def check_before_loading(path, error=ValueError):
-    """Raise ``error`` for files that pymeshlab's loader would read into corrupt memory: an ASCII
-    OFF file whose faces name vertices the file does not have (the loader keeps such faces and
+    """Raise ``error`` for files that pymeshlab's loader would read into corrupt memory or
+    misread without a word.
+
+    ASCII OFF: faces that name vertices the file does not have (the loader keeps such faces and
     writes out of bounds; the process can crash later, even after :func:`check_loaded` has
-    reported them) or whose rows the loader would misread without a word (it takes OFF as one
-    stream of numbers, so a vertex row with a value too many or too few, or a short face row,
-    shifts everything after it), and an OBJ file with indented vertex lines (the loader counts them in one
-    pass and not in the other; reading one aborted the process), a fractional face index (the
-    loader truncates it) or a comment after a face (read as corners out of range). A binary OFF file, which the
-    loader refuses with only "Invalid file", is named as such. Other files pass unread."""
+    reported them), and rows it would misread (plain OFF is one stream of numbers to it, so a
+    vertex row with a value too many or too few, or a short face row, shifts everything after
+    it; missing rows are filled from what follows). A binary OFF file, which the loader refuses
+    with only "Invalid file", is named as such. OBJ: indented vertex lines (the loader counts
+    them in one pass and not in the other; reading one aborted the process), a fractional face
+    index (truncated) and a comment after a face (read as corners out of range). Other files
+    pass unread."""
     extension = os.path.splitext(os.fspath(path))[1].lower()
     if extension == ".off":
         if _off_is_binary(path):
