@@ -31,6 +31,8 @@ def check_output_path(path, overwrite=False, *, hint=_FORMATS_HINT, error=MeshEr
     ValueError        ``path`` is not a path, or ``overwrite`` is not a bool
     FileExistsError   ``path`` exists and ``overwrite`` is False
     IsADirectoryError ``path`` is a folder, where ``error`` is an ``OSError`` (else ``error``)
+    PermissionError   its folder is not writable, where ``error`` is an ``OSError`` (else
+                      ``error``)
     error             (default :class:`~curvdetail.curvature.errors.MeshError`; the filters
                       pass their ``MeshFileError``) ``path`` is a folder, its folder does not
                       exist, or ``path`` has no extension to pick the format (``hint`` says
@@ -48,6 +50,9 @@ def check_output_path(path, overwrite=False, *, hint=_FORMATS_HINT, error=MeshEr
     folder = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(folder):
         raise error(f"cannot write {path!r}: folder {folder!r} does not exist.")
+    if not os.access(folder, os.W_OK | os.X_OK):       # found now, not after minutes of work
+        kind = PermissionError if issubclass(error, OSError) else error
+        raise kind(f"cannot write {path!r}: folder {folder!r} is not writable.")
     if hint is not None and not os.path.splitext(path)[1]:
         raise error(f"cannot write {path!r}: no file extension to choose the format from ({hint}).")
     return path

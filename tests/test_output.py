@@ -204,3 +204,21 @@ def test_edit_refuses_a_picture_that_is_not_png_before_work(tmp_path, capsys):
     assert rc == 1
     assert "only PNG pictures" in capsys.readouterr().err
     assert os.listdir(tmp_path) == []
+
+
+def test_a_folder_without_write_permission_is_named_before_the_work(tmp_path, monkeypatch, capsys):
+    # it was found only by mkstemp, after the whole run (root ignores permissions, so the test
+    # makes os.access say what a user without write permission would get)
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    real_access = os.access
+    monkeypatch.setattr(os, "access", lambda p, mode, **kw: False if os.fspath(p) == str(locked)
+                        else real_access(p, mode, **kw))
+    with pytest.raises(PermissionError, match=r"cannot write '.*m\.ply': folder '.*locked' is not writable"):
+        check_output_path(locked / "m.ply", error=FileNotFoundError)
+    with pytest.raises(MeshError, match="is not writable"):
+        check_output_path(locked / "m.ply")
+    nose = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "mannequin_nose.obj")
+    rc = main(["remesh", nose, str(tmp_path / "o.ply"), "--report", str(locked / "r.json"), "--quiet"])
+    assert rc == 1 and "is not writable" in capsys.readouterr().err
+    assert sorted(os.listdir(tmp_path)) == ["locked"]
