@@ -322,3 +322,13 @@ def test_the_embedding_refuses_normal_equations_it_cannot_refine(wavy_grid_with_
                 ed.solve()
         else:
             assert np.abs(ed.solve() - V).max() < 1e-9 * _diag(V)
+
+
+def test_constraints_moved_far_away_at_solve_time_lose_no_digits(load_mesh):
+    # the right-hand side was formed about the rest constraints' centre: moved 4e6 away, the
+    # result came back 9.7e-9 of the diagonal off (the coordinates' own spacing there: 5e-10)
+    V, F = load_mesh("mannequin_nose.obj")
+    b = boundary_vertices(F)
+    shift = np.array([4e6, 5e5, 3e3])
+    X = CurvatureEditor(V, F, b, b).solve(positions=V[b] + shift)
+    assert np.abs(X - (V + shift)).max() < 2e-9 * _diag(V)

@@ -304,6 +304,8 @@ class CurvatureEditor:
         w = lv[k][:, None] * (V[lj[k]] - self._centre)
         self._rhs_const = -np.stack([np.bincount(at_R[li[k]], weights=w[:, c], minlength=R.size)
                                      for c in range(3)], axis=1)
+        # sum of each row's exterior weights: moves rhs_const to another centre (see _solve)
+        self._exterior_weight = np.bincount(at_R[li[k]], weights=lv[k], minlength=R.size)
         self._A_T = A.T.tocsr()
         # where each row of R gets its detail from: solved (fd), given (dc) or rest (exterior)
         self._R_fd = at_R[self._fd] >= 0
@@ -372,8 +374,12 @@ class CurvatureEditor:
         X = self.V.copy()
         X[self._pc] = Xk
         if self._embed is not None:
-            rhs = D_R + self._rhs_const - self._L_pc @ (Xk - self._centre)
-            X[self._fp] = self._embedding_solve(rhs) + self._centre
+            # about the centre of the constraints as given (they may have moved far), with the
+            # exterior's constant term moved there: -L_ext (V_ext - c) = rhs_const + w_ext (c - c0)
+            centre = bbox_centre(Xk) if Xk.size else self._centre
+            rhs = (D_R + self._rhs_const + self._exterior_weight[:, None] * (centre - self._centre)
+                   - self._L_pc @ (Xk - centre))
+            X[self._fp] = self._embedding_solve(rhs) + centre
         if not return_details:
             return X
         D = self.detail.copy()
