@@ -189,9 +189,8 @@ class Reconstructor:
         # ~cond(L_:f) eps. L_:f is L_f:^T (L is symmetric).
         # Coordinate by coordinate on contiguous (3, .) rows: one-column sparse products are
         # ~25 % faster than three-column ones, and the solver takes the columns as they are.
-        L_f, L_f_T = self._L_f, self._L_f.T
         r = np.ascontiguousarray(D.T) - (self._L_c @ Yc).T                    # (3, n)
-        X_f = self._factor.solve(np.stack([L_f @ rj for rj in r]).T).T         # (3, f)
+        X_f = self._factor.solve(np.stack([self._L_f @ rj for rj in r]).T).T   # (3, f)
         X_f = self._refine(X_f, r)
         X[self.free] = X_f.T + centre
         return X
