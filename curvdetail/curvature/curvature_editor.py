@@ -6,7 +6,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from ._validate import as_index_set, as_values, bbox_centre, centroid_diameter
+from ._validate import as_index_set, as_values, bbox_centre, bbox_diagonal, centroid_diameter
 from .cotan_laplacian import checked_cotan_laplacian, laplacian_product
 from .curvature_coefficients import DEFAULT_RCOND, _coefficients, _one_ring_pairs, check_rcond
 from .errors import ConstraintError, first_indices
@@ -23,6 +23,10 @@ RELATIONS = ("one-ring", "one+two-ring")
 #: 300k 4.1 / 0.30 against 2.1 / 0.33 s; 1M 24 / 0.85 against 8.5 / 1.0 s (SuperLU's
 #: factorization grows faster than linearly).
 CURVATURE_SPLU_MAX = 300_000
+
+#: Largest distance (over the bbox diagonal) at which the rest constraints may give back the
+#: rest shape; above it the constructor raises ConstraintError (see ``rest_error``).
+MAX_REST_ERROR = 1e-3
 
 
 class CurvatureEditor:
@@ -102,13 +106,17 @@ class CurvatureEditor:
                                 "embedding": "banded"}`` ("none" where a stage has no unknowns)
     timings : dict              seconds spent in the constructor: ``coefficients`` (L, D and C),
                                 ``curvature_setup`` (checks and LU of ``(I - C)_uu``),
-                                ``embedding_setup`` (normal equations and their factorization)
+                                ``embedding_setup`` (normal equations and their factorization),
+                                ``rest_check`` (one solve with the rest values, ``rest_error``)
     rank_deficient : int        vertices whose one-ring detail is rank-deficient (see
                                 :func:`curvature_coefficients`)
     detail_islands : int        free vertices whose detail the coefficients cannot determine
                                 (groups cut off from every known detail by flat vertices, whose
                                 coefficients are zero, e.g. a bump in a plane); they keep their
                                 rest detail, like detail-constrained vertices
+    rest_error : float          largest distance of :meth:`solve` with the rest values from ``V``,
+                                over the bbox diagonal: rounding (1e-16 ... 1e-7 on real meshes)
+                                where the constraints determine the edit
 
     Raises
     ------
@@ -116,7 +124,9 @@ class CurvatureEditor:
     ConstraintError   indices out of range or repeated; a constraint outside ``roi``; an empty
                       ``roi``; no position constraint (or fewer than three detail constraints)
                       while ``roi`` is the whole mesh; a connected free region that touches no position (or no
-                      detail) constraint
+                      detail) constraint; constraints that do not determine the edit (the rest
+                      values give back a shape more than :data:`MAX_REST_ERROR` of the
+                      diagonal off ``V``)
     ValueError        unknown ``rows`` or ``relations``; ``rcond`` outside (0, 1)
     SolverError       unknown or uninstalled ``backend`` (before any work); a system could not
                       be factored (the constraints do not determine it)
@@ -223,10 +233,33 @@ class CurvatureEditor:
         t2 = time.perf_counter()
         self._embedding(L, V, F, in_roi, pc, rows, cols, backend)
         self._response = None
+        t3 = time.perf_counter()
+        self.rest_error = self._check_rest_state()
         self.timings = {"coefficients": t1 - t0, "curvature_setup": t2 - t1,
-                        "embedding_setup": time.perf_counter() - t2}
+                        "embedding_setup": t3 - t2, "rest_check": time.perf_counter() - t3}
         self.backend = {"curvature": self._curv.backend if self._curv else "none",
                         "embedding": self._embed.backend if self._embed else "none"}
+
+    def _check_rest_state(self):
+        """Largest distance of the rest constraints' result from ``V`` over the bbox diagonal;
+        ConstraintError above :data:`MAX_REST_ERROR`.
+
+        The rest state solves both stages exactly (the rest residual is kept as a constant
+        term), so anything but rounding means a system singular to working precision, whose
+        every edit would be one arbitrary solution among many (a flat grid with three detail
+        constraints: 0.9 of the diagonal at rest). Real meshes come back to 1e-7 and better,
+        ill-conditioned ones included (fandisk, cond(I - C) ~1e14). One solve: ~5 % of the
+        set-up at 951 vertices."""
+        X = self._solve(self._positions(None), self._details(None))
+        error = float(np.linalg.norm(X - self.V, axis=1).max()) / bbox_diagonal(self.V)
+        if not error <= MAX_REST_ERROR:       # NaN included
+            raise ConstraintError(
+                f"the constraints do not determine the edit: solved with their rest values they give "
+                f"back a shape {error:.2g} of the bbox diagonal off the rest shape (the curvature "
+                f"stage (I - C) is singular to working precision: its {self._user_dc} detail constraints "
+                "leave rings free to turn). Constrain more details (e.g. the handles' or the "
+                "region border's), or pass a smaller roi.")
+        return error
 
     def _square_system(self, D, in_roi, free_d, fd, dc, at_fd, at_dc, rows, cols, cvals, curv_backend):
         """The paper: (I - C)_uu D_u = C_uk D_k over the free rows (square, not symmetric)."""
