@@ -5,22 +5,53 @@ atomically with a normal file's permissions.
 there (with pymeshlab, matplotlib, ``open``...), and the file is renamed over the destination
 only when the ``with`` block succeeded, with the permissions a new file gets from the umask
 (``tempfile.mkstemp`` alone leaves ``0600``). A failed block removes the temporary file, so no
-half-written output is ever left behind. Several outputs of one run (mesh, report, picture)
-nest in one ``with`` statement and appear together, only when all were written.
+half-written output is ever left behind.
+
+:func:`atomic_outputs` does the same for the several outputs of one run (mesh, report,
+picture), committed together in two phases: every output is written to its temporary file
+first; only when the whole ``with`` block succeeded are the destinations checked again and the
+files renamed into place, each destination's old file kept meanwhile in a hidden folder
+``.curvdetail-old-XXXXXXXX`` beside it (a hard link, so that the destination is never missing;
+where the file system refuses one, the file itself is moved there). If a rename fails, the
+outputs already placed are taken back (new files removed, old ones put back) and the error
+names the output that failed. So a run writes all its outputs or none, and leaves every
+destination as it was when it writes none.
+
+What POSIX does not allow: the renames are one system call each, not one for all.
+
+- A process reading the destinations during the commit (a few system calls) may see some new
+  files and some old ones.
+- A crash of the machine, or SIGKILL, in the middle of a commit leaves that mix, and beside
+  each output the commit had reached a hidden ``.curvdetail-old-*`` folder holding the output's
+  old file under its own name (where hard links are refused, the output being replaced may be
+  missing, its old file only there). Nothing removes these folders later, the next run
+  neither: move a file back, or delete them. (The ``.curvdetail-*`` temporary files of a
+  killed run are left the same way.)
+- Where taking an output back fails too, the error names it and where its old file is kept.
+- SIGTERM (the CLI's watcher, which takes :data:`COMMIT_LOCK`) waits for a commit in progress,
+  so it ends a run before the commit (nothing written) or after it (everything written, though
+  the exit status says terminated).
 """
 
 import contextlib
 import os
 import tempfile
+import threading
+import typing
 
 from .curvature._validate import check_bool
 from .curvature.errors import MeshError
 
 _FORMATS_HINT = "use .ply, .obj, .off, .stl, ..."
 
-#: Temporary files of the :func:`atomic_output` blocks in progress, for the CLI's SIGTERM
+#: Temporary files of the :func:`atomic_outputs` blocks in progress, for the CLI's SIGTERM
 #: watcher, which removes them before it ends the process.
 PENDING = set()
+
+#: Held while :func:`atomic_outputs` renames its files into place. The SIGTERM watcher takes it
+#: before it removes :data:`PENDING` and ends the process, so that a commit is never cut short
+#: (the old files kept aside would be left in hidden folders, and the outputs a mix).
+COMMIT_LOCK = threading.Lock()
 
 
 def check_output_path(path, overwrite=False, *, hint=_FORMATS_HINT, error=MeshError):
@@ -64,6 +95,15 @@ def _umask():
     return mask
 
 
+class Output(typing.NamedTuple):
+    """One output of :func:`atomic_outputs`: its path, and ``hint`` and ``error`` for
+    :func:`check_output_path`."""
+
+    path: typing.Any
+    hint: typing.Optional[str] = _FORMATS_HINT
+    error: type = MeshError
+
+
 @contextlib.contextmanager
 def atomic_output(path, *, overwrite=False, hint=_FORMATS_HINT, error=MeshError):
     """Context manager yielding a temporary path to write ``path``'s content to.
@@ -82,7 +122,73 @@ def atomic_output(path, *, overwrite=False, hint=_FORMATS_HINT, error=MeshError)
     >>> open(path).read()
     'done'
     """
-    path = check_output_path(path, overwrite, hint=hint, error=error)
+    with atomic_outputs([Output(path, hint, error)], overwrite=overwrite) as (tmp,):
+        yield tmp
+
+
+@contextlib.contextmanager
+def atomic_outputs(outputs, *, overwrite=False):
+    """Context manager yielding the temporary paths (a list, in order) to write ``outputs`` to;
+    all are renamed into place together, or none (see the module docstring).
+
+    ``outputs`` holds :class:`Output` entries, or None for an output not asked for (its
+    temporary path is None). Every destination is checked (:func:`check_output_path`, in order)
+    before any temporary file is made, and again before any rename.
+
+    Raises
+    ------
+    ValueError  two outputs name one file
+    OSError     (its own type) a temporary file could not be made, or an output could not be
+                renamed into place (the message names it; no output was written)
+    and what :func:`check_output_path` raises.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> folder = tempfile.mkdtemp()
+    >>> a, b = os.path.join(folder, "a.txt"), os.path.join(folder, "b.txt")
+    >>> with atomic_outputs([Output(a), None, Output(b)]) as (tmp_a, nothing, tmp_b):
+    ...     for tmp, text in ((tmp_a, "one"), (tmp_b, "two")):
+    ...         with open(tmp, "w") as fh:
+    ...             _ = fh.write(text)
+    >>> open(a).read(), open(b).read(), nothing
+    ('one', 'two', None)
+    """
+    outputs = list(outputs)
+    paths = [None if out is None else check_output_path(out.path, overwrite, hint=out.hint, error=out.error)
+             for out in outputs]
+    _check_distinct([p for p in paths if p is not None])
+    temps = []
+    try:
+        for path in paths:
+            temps.append(None if path is None else _temporary(path))
+        yield list(temps)
+        with COMMIT_LOCK:
+            for path, out in zip(paths, outputs):       # what changed during the work
+                if out is not None:
+                    check_output_path(path, overwrite, hint=out.hint, error=out.error)
+            mode = 0o666 & ~_umask()
+            for tmp in temps:
+                if tmp is not None:
+                    os.chmod(tmp, mode)
+            _commit([(tmp, path) for tmp, path in zip(temps, paths) if tmp is not None])
+    finally:
+        for tmp in temps:
+            if tmp is not None:
+                PENDING.discard(tmp)
+                with contextlib.suppress(FileNotFoundError):    # renamed, or the SIGTERM watcher took it
+                    os.remove(tmp)
+
+
+def _check_distinct(paths):
+    real = [os.path.realpath(p) for p in paths]
+    for k, r in enumerate(real):
+        if r in real[:k]:
+            raise ValueError(f"{paths[k]} is given for two outputs; name a separate file for each.")
+
+
+def _temporary(path):
+    """An empty temporary file for ``path`` in its folder, with its extension, in :data:`PENDING`."""
     try:
         fd, tmp = tempfile.mkstemp(prefix=".curvdetail-", suffix=os.path.splitext(path)[1],
                                    dir=os.path.dirname(os.path.abspath(path)))
@@ -90,11 +196,87 @@ def atomic_output(path, *, overwrite=False, hint=_FORMATS_HINT, error=MeshError)
         raise type(exc)(exc.errno, f"cannot write {path!r}: {exc.strerror}") from None
     os.close(fd)
     PENDING.add(tmp)
+    return tmp
+
+
+class _Aside:
+    """A destination's old file, kept during a commit in a new hidden folder beside it under
+    its own name: a hard link (the destination keeps its file until it is replaced) or, where
+    the file system refuses one (FAT, Linux's protected_hardlinks for another user's file),
+    the file itself moved there."""
+
+    def __init__(self, path):
+        self.path = path
+        self.folder = tempfile.mkdtemp(prefix=".curvdetail-old-", dir=os.path.dirname(os.path.abspath(path)))
+        self.file = os.path.join(self.folder, os.path.basename(path))
+        self.moved = False
+        try:
+            os.link(path, self.file, follow_symlinks=False)
+        except (OSError, NotImplementedError):
+            try:
+                os.rename(path, self.file)
+            except BaseException:
+                os.rmdir(self.folder)
+                raise
+            self.moved = True
+
+    def restore(self, replaced):
+        """Put the old file back (``replaced``: the new file is in its place)."""
+        if replaced or self.moved:
+            os.replace(self.file, self.path)
+        else:
+            os.remove(self.file)                        # the destination still is the old file
+        os.rmdir(self.folder)
+
+    def drop(self):
+        with contextlib.suppress(OSError):              # the outputs are written: not worth failing for
+            os.remove(self.file)
+            os.rmdir(self.folder)
+
+
+def _commit(pairs):
+    """Rename each ``(tmp, path)`` over ``path``, keeping the old files aside; on a failure take
+    back those done and raise, naming the output."""
+    placed = []         # (tmp, path, its _Aside or None)
+    keep = len(pairs) > 1           # a single rename that fails has changed nothing
     try:
-        yield tmp
-        os.chmod(tmp, 0o666 & ~_umask())
-        os.replace(tmp, path)
-    finally:
-        PENDING.discard(tmp)
-        with contextlib.suppress(FileNotFoundError):     # the SIGTERM watcher may have taken it
-            os.remove(tmp)
+        for tmp, path in pairs:
+            aside = _Aside(path) if keep and os.path.lexists(path) else None
+            placed.append((tmp, path, aside))
+            os.replace(tmp, path)
+    except BaseException as exc:    # KeyboardInterrupt too: half a commit is what this prevents
+        stuck = _take_back(placed)
+        if not isinstance(exc, OSError):
+            raise
+        raise _naming(exc, path, stuck) from exc
+    for _, _, aside in placed:
+        if aside is not None:
+            aside.drop()
+
+
+def _take_back(placed):
+    """Undo the renames of a failed commit, newest first; return the messages of the old files
+    that could not be put back (where they are kept)."""
+    stuck = []
+    for tmp, path, aside in reversed(placed):
+        replaced = not os.path.lexists(tmp)             # os.replace either moved it or did nothing
+        try:
+            if aside is not None:
+                aside.restore(replaced)
+            elif replaced:
+                os.remove(path)
+        except OSError as exc:
+            where = f"; its old file is kept in {aside.file!r}" if aside is not None else ""
+            stuck.append(f"{path!r} could not be taken back ({exc.strerror}){where}")
+    return stuck
+
+
+def _naming(exc, path, stuck):
+    """``exc`` (an OSError), its message naming the output ``path`` and what a failed commit left."""
+    reason = exc.strerror or str(exc)
+    if stuck:
+        left = "the outputs placed could not all be taken back: " + "; ".join(stuck)
+    else:
+        left = "no output was written, the existing files are as they were"
+    message = f"cannot write {path!r}: {reason}; {left}"
+    return type(exc)(exc.errno, message) if exc.errno is not None else type(exc)(message)

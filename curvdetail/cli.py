@@ -288,7 +288,7 @@ def _remesh_command(parser):
     def run(args):
         import json
 
-        from ._output import atomic_output, check_output_path
+        from ._output import Output, atomic_outputs, check_output_path
         from .io import MeshFileError, read_mesh, write_mesh
         from .remesh.experiment import run_experiment
 
@@ -321,24 +321,20 @@ def _remesh_command(parser):
                                     progress=progress.stage)
             report = result["report"]
             # all outputs appear together, only once every one of them is written
-            with contextlib.ExitStack() as outputs:
-                if args.image is not None:
+            outputs = [_extra_output(args.image), _extra_output(args.report),
+                       Output(args.output, error=MeshFileError)]
+            with atomic_outputs(outputs, overwrite=args.overwrite) as (image_tmp, report_tmp, mesh_tmp):
+                if image_tmp is not None:
                     progress.stage("image")
                     from .remesh.figure import save_figure
 
-                    tmp = outputs.enter_context(atomic_output(args.image, overwrite=args.overwrite,
-                                                              hint=None, error=FileNotFoundError))
-                    save_figure(tmp, V, F, result["X"], result["Ft"], result["Z"], result["distance"],
+                    save_figure(image_tmp, V, F, result["X"], result["Ft"], result["Z"], result["distance"],
                                 report, overwrite=True)
-                if args.report is not None:
-                    tmp = outputs.enter_context(atomic_output(args.report, overwrite=args.overwrite,
-                                                              hint=None, error=FileNotFoundError))
-                    with open(tmp, "w", encoding="utf-8") as fh:
+                if report_tmp is not None:
+                    with open(report_tmp, "w", encoding="utf-8") as fh:
                         json.dump(report, fh, indent=2)
                         fh.write("\n")
-                tmp = outputs.enter_context(atomic_output(args.output, overwrite=args.overwrite,
-                                                          error=MeshFileError))
-                write_mesh(tmp, result["X"], result["Ft"], quality=result["distance"], overwrite=True)
+                write_mesh(mesh_tmp, result["X"], result["Ft"], quality=result["distance"], overwrite=True)
         finally:
             progress.close()
         if args.no_evaluate:
@@ -520,7 +516,7 @@ def _edit_command(parser):
         import numpy as np
 
         from . import read_mesh, write_mesh
-        from ._output import atomic_output, check_output_path
+        from ._output import Output, atomic_outputs, check_output_path
         from .curvature._validate import bbox_diagonal, check_mesh
         from .deformation_benchmark import (edit_with_selection, read_selection, read_transform,
                                             render_panels)
@@ -545,16 +541,13 @@ def _edit_command(parser):
         progress.stage("write")
         moved = np.linalg.norm(X - V, axis=1)
         # the picture and the mesh appear together, only once both are written
-        with contextlib.ExitStack() as outputs:
-            if args.image:
-                tmp = outputs.enter_context(atomic_output(args.image, overwrite=args.overwrite,
-                                                          hint=None, error=FileNotFoundError))
-                render_panels(tmp, [(V, F, "rest (status 0/1/2)", status),
-                                    (X, F, f"edited (handle detail: {args.handle_detail})", moved)],
+        outputs = [_extra_output(args.image or None), Output(args.output, error=MeshFileError)]
+        with atomic_outputs(outputs, overwrite=args.overwrite) as (image_tmp, mesh_tmp):
+            if image_tmp is not None:
+                render_panels(image_tmp, [(V, F, "rest (status 0/1/2)", status),
+                                          (X, F, f"edited (handle detail: {args.handle_detail})", moved)],
                               overwrite=True)
-            tmp = outputs.enter_context(atomic_output(args.output, overwrite=args.overwrite,
-                                                      error=MeshFileError))
-            write_mesh(tmp, X, F, quality=moved, overwrite=True)
+            write_mesh(mesh_tmp, X, F, quality=moved, overwrite=True)
         progress.close()
         counts = np.bincount(status, minlength=3)
         print(f"{V.shape[0]} vertices ({counts[0]} fixed, {counts[1]} free, {counts[2]} handles); "
@@ -575,6 +568,14 @@ def _edit_command(parser):
 
 
 # --- entry point ----------------------------------------------------------------------------
+
+def _extra_output(path):
+    """The :class:`curvdetail._output.Output` of a report or picture (any name, checked as
+    before the work), or None where it is not asked for."""
+    from ._output import Output
+
+    return None if path is None else Output(path, hint=None, error=FileNotFoundError)
+
 
 def _check_image_and_distinct(image, output, *extras, inputs=(), other_inputs=()):
     """``--image`` must end in .png (only PNG is written), no two outputs may be one file, and
@@ -620,7 +621,8 @@ def _watch_sigterm():
     progress (a factorization, pymeshlab's sampling: 10 s and more). Python's C-level handler
     writes the signal number to a wakeup pipe at once, from any thread; a watcher thread blocked
     on it removes the temporary files of the outputs in progress and exits with 128 + SIGTERM
-    (as soon as it gets the GIL, which numerical code mostly releases). Returns the function
+    (as soon as it gets the GIL, which numerical code mostly releases; after the renames of a
+    commit in progress, see :mod:`curvdetail._output`). Returns the function
     that stops the watcher and puts everything back; None where this cannot be set up (not the
     main thread, or no wakeup fd)."""
     from . import _output
@@ -645,6 +647,9 @@ def _watch_sigterm():
             if not got or 0 in got:                     # closed, or stop() asked
                 return
             if signal.SIGTERM in got:
+                # a commit in progress is let finish (milliseconds), so that its outputs are all
+                # written or none, and no old file is left in its hidden folder
+                _output.COMMIT_LOCK.acquire(timeout=10)
                 for path in list(_output.PENDING):
                     with contextlib.suppress(OSError):
                         os.remove(path)

@@ -5,11 +5,14 @@ import doctest
 import importlib
 import os
 import stat
+import subprocess
+import sys
 
 import numpy as np
 import pytest
 
-from curvdetail._output import atomic_output, check_output_path
+from curvdetail import _output
+from curvdetail._output import Output, atomic_output, atomic_outputs, check_output_path
 from curvdetail.cli import main
 from curvdetail.curvature.errors import MeshError
 from curvdetail.curvature.testing import grid
@@ -153,8 +156,9 @@ def test_remesh_failed_mesh_write_leaves_no_report_or_image(tmp_path, capsys, mo
     assert os.listdir(tmp_path) == []
 
 
-def test_edit_failed_mesh_write_leaves_no_image(tmp_path, capsys, monkeypatch):
-    import curvdetail
+def _edit_inputs(tmp_path):
+    """An 8 x 8 plane with its .sel / .def in tmp_path / "in", and an empty tmp_path / "out";
+    returns the ``curvdetail edit`` arguments before OUTPUT, and the out folder."""
     from curvdetail.curvature.testing import grid as _grid
     from curvdetail.deformation_benchmark import write_selection, write_transform
     from curvdetail.io import write_mesh
@@ -169,13 +173,20 @@ def test_edit_failed_mesh_write_leaves_no_image(tmp_path, capsys, monkeypatch):
     write_transform(tmp_path / "in" / "p.def", T)
     out = tmp_path / "out"
     out.mkdir()
+    args = ["edit", str(src), "--sel", str(tmp_path / "in" / "p.sel"), "--def", str(tmp_path / "in" / "p.def")]
+    return args, out
+
+
+def test_edit_failed_mesh_write_leaves_no_image(tmp_path, capsys, monkeypatch):
+    import curvdetail
+
+    args, out = _edit_inputs(tmp_path)
 
     def broken(*args, **kwargs):
         raise curvdetail.io.MeshFileError("disk full")
 
     monkeypatch.setattr(curvdetail, "write_mesh", broken)
-    rc = main(["edit", str(src), str(out / "o.ply"), "--sel", str(tmp_path / "in" / "p.sel"),
-               "--def", str(tmp_path / "in" / "p.def"), "--image", str(out / "e.png")])
+    rc = main([*args, str(out / "o.ply"), "--image", str(out / "e.png")])
     assert rc == 1
     assert "disk full" in capsys.readouterr().err
     assert os.listdir(out) == []
@@ -222,3 +233,162 @@ def test_a_folder_without_write_permission_is_named_before_the_work(tmp_path, mo
     rc = main(["remesh", nose, str(tmp_path / "o.ply"), "--report", str(locked / "r.json"), "--quiet"])
     assert rc == 1 and "is not writable" in capsys.readouterr().err
     assert sorted(os.listdir(tmp_path)) == ["locked"]
+
+
+# --- atomic_outputs: several outputs committed together -----------------------------------------
+
+def _write(tmp, text):
+    with open(tmp, "w") as fh:
+        fh.write(text)
+
+
+def _failing_replace(monkeypatch, fails_on):
+    """Make os.replace fail where a temporary file would be renamed over ``fails_on`` (what a
+    destination replaced by a folder, a permission change or a disk error do mid-commit)."""
+    real = os.replace
+
+    def replace(src, dst):
+        if os.path.basename(src).startswith(".curvdetail-") and os.fspath(dst) == str(fails_on):
+            raise PermissionError(13, "Permission denied")
+        return real(src, dst)
+
+    monkeypatch.setattr(os, "replace", replace)
+
+
+def test_atomic_outputs_writes_all_with_normal_permissions(tmp_path, umask_022):
+    a, b = tmp_path / "a.txt", tmp_path / "b.txt"
+    a.write_text("old a")
+    with atomic_outputs([Output(a, hint=None), None, Output(b, hint=None)], overwrite=True) as temps:
+        assert temps[1] is None and [os.path.dirname(t) for t in (temps[0], temps[2])] == [str(tmp_path)] * 2
+        _write(temps[0], "new a")
+        _write(temps[2], "new b")
+    assert (a.read_text(), b.read_text()) == ("new a", "new b")
+    assert [_mode(a), _mode(b)] == [umask_022] * 2
+    assert sorted(os.listdir(tmp_path)) == ["a.txt", "b.txt"]      # no temporary file, no old one kept
+
+
+@pytest.mark.parametrize("hard_links", [True, False])
+def test_a_failed_rename_puts_every_destination_back_as_it_was(tmp_path, monkeypatch, hard_links):
+    # each output was renamed on its own: a.txt was replaced (its old content lost) and b.txt
+    # written before c.txt failed
+    a, b, c = tmp_path / "a.txt", tmp_path / "b.txt", tmp_path / "c.txt"
+    a.write_text("old a")
+    c.write_text("old c")
+    inode_a = os.stat(a).st_ino
+    def refused(*args, **kwargs):   # FAT, or another user's file under protected_hardlinks
+        raise PermissionError(1, "Operation not permitted")
+
+    if not hard_links:
+        monkeypatch.setattr(os, "link", refused)
+    _failing_replace(monkeypatch, c)
+    with pytest.raises(PermissionError, match=r"cannot write '.*c\.txt': Permission denied; no output was "
+                                              r"written, the existing files are as they were"):
+        with atomic_outputs([Output(p, hint=None) for p in (a, b, c)], overwrite=True) as temps:
+            for tmp, text in zip(temps, ("new a", "new b", "new c")):
+                _write(tmp, text)
+    assert (a.read_text(), c.read_text()) == ("old a", "old c")
+    assert os.stat(a).st_ino == inode_a                             # the very file, not a copy
+    assert sorted(os.listdir(tmp_path)) == ["a.txt", "c.txt"]      # no b.txt, temporary or old file
+
+
+def test_an_old_file_that_cannot_be_put_back_is_named_with_where_it_is(tmp_path, monkeypatch):
+    a, b = tmp_path / "a.txt", tmp_path / "b.txt"
+    a.write_text("old a")
+    real = os.replace
+
+    def replace(src, dst):
+        if os.fspath(dst) == str(b) or ".curvdetail-old-" in os.fspath(src):
+            raise PermissionError(13, "Permission denied")
+        return real(src, dst)
+
+    monkeypatch.setattr(os, "replace", replace)
+    with pytest.raises(PermissionError, match=r"could not all be taken back: '.*a\.txt' could not be taken "
+                                              r"back \(Permission denied\); its old file is kept in "
+                                              r"'.*\.curvdetail-old-\w+/a\.txt'"):
+        with atomic_outputs([Output(a, hint=None), Output(b, hint=None)], overwrite=True) as temps:
+            _write(temps[0], "new a")
+            _write(temps[1], "new b")
+    kept = [n for n in os.listdir(tmp_path) if n.startswith(".curvdetail-old-")]
+    assert len(kept) == 1 and (tmp_path / kept[0] / "a.txt").read_text() == "old a"
+
+
+def test_atomic_outputs_failed_block_leaves_nothing_and_keeps_the_old_files(tmp_path):
+    a, b = tmp_path / "a.txt", tmp_path / "b.txt"
+    a.write_text("old a")
+    with pytest.raises(RuntimeError):
+        with atomic_outputs([Output(a, hint=None), Output(b, hint=None)], overwrite=True) as temps:
+            _write(temps[0], "new a")
+            assert temps[1] in _output.PENDING                      # for the SIGTERM watcher
+            raise RuntimeError("writer failed")
+    assert a.read_text() == "old a"
+    assert os.listdir(tmp_path) == ["a.txt"]
+    assert not _output.PENDING
+
+
+def test_a_destination_made_a_folder_during_the_work_stops_the_commit_before_any_rename(tmp_path):
+    a, b = tmp_path / "a.txt", tmp_path / "b.txt"
+    a.write_text("old a")
+    with pytest.raises(IsADirectoryError, match=r"'.*b\.txt': it is a folder"):
+        with atomic_outputs([Output(a, hint=None, error=FileNotFoundError),
+                             Output(b, hint=None, error=FileNotFoundError)], overwrite=True) as temps:
+            _write(temps[0], "new a")
+            b.mkdir()
+    assert a.read_text() == "old a"
+    assert sorted(os.listdir(tmp_path)) == ["a.txt", "b.txt"] and os.listdir(b) == []
+
+
+def test_atomic_outputs_checks_every_destination_before_the_block(tmp_path):
+    (tmp_path / "b.txt").write_text("old b")
+    with pytest.raises(FileExistsError, match="b.txt exists"):
+        with atomic_outputs([Output(tmp_path / "a.txt", hint=None), Output(tmp_path / "b.txt", hint=None)]):
+            pytest.fail("the block must not run")
+    with pytest.raises(ValueError, match="given for two outputs"):
+        with atomic_outputs([Output(tmp_path / name, hint=None) for name in ("a.txt", "./a.txt")]):
+            pytest.fail("the block must not run")
+    assert os.listdir(tmp_path) == ["b.txt"]
+
+
+def test_edit_failed_mesh_rename_keeps_the_old_picture_and_mesh(tmp_path, capsys, monkeypatch):
+    # the picture was renamed first, over the old one, then the mesh's rename failed
+    args, out = _edit_inputs(tmp_path)
+    (out / "o.ply").write_text("old mesh")
+    (out / "e.png").write_text("old picture")
+    _failing_replace(monkeypatch, out / "o.ply")
+    rc = main([*args, str(out / "o.ply"), "--image", str(out / "e.png"), "--overwrite"])
+    assert rc == 1
+    assert "o.ply': Permission denied; no output was written" in capsys.readouterr().err
+    assert ((out / "o.ply").read_text(), (out / "e.png").read_text()) == ("old mesh", "old picture")
+    assert sorted(os.listdir(out)) == ["e.png", "o.ply"]
+
+
+def test_sigterm_during_a_commit_lets_it_finish(tmp_path):
+    # the watcher removed the temporary files at once: outputs renamed before the signal were
+    # new, the others old (one possibly missing), and the old files were left in hidden folders
+    script = tmp_path / "killed.py"
+    script.write_text(
+        "import os, signal, sys, time\n"
+        "from curvdetail import cli\n"
+        "from curvdetail._output import Output, atomic_outputs\n"
+        "real = os.replace\n"
+        "def replace(src, dst):\n"
+        "    real(src, dst)\n"
+        "    if dst.endswith('a.txt'):\n"
+        "        os.kill(os.getpid(), signal.SIGTERM)   # between the renames of a.txt and b.txt\n"
+        "        time.sleep(1)                          # (the GIL released: the watcher runs)\n"
+        "os.replace = replace\n"
+        "cli._watch_sigterm()\n"
+        "a, b = sys.argv[1:]\n"
+        "with atomic_outputs([Output(a, hint=None), Output(b, hint=None)], overwrite=True) as temps:\n"
+        "    for tmp, text in zip(temps, ('new a', 'new b')):\n"
+        "        open(tmp, 'w').write(text)\n"
+        "time.sleep(10)\n"
+        "print('not ended', flush=True)\n")
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "a.txt").write_text("old a")
+    (out / "b.txt").write_text("old b")
+    done = subprocess.run([sys.executable, str(script), str(out / "a.txt"), str(out / "b.txt")],
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 128 + 15 and "not ended" not in done.stdout, done.stderr
+    assert ((out / "a.txt").read_text(), (out / "b.txt").read_text()) == ("new a", "new b")
+    assert sorted(os.listdir(out)) == ["a.txt", "b.txt"]
