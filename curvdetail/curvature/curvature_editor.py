@@ -37,8 +37,11 @@ class CurvatureEditor:
     1. **Curvature stage.** The details ``D_u`` of the vertices without a detail constraint
        minimize ``|(I - C) D|^2`` over their own rows, i.e. they solve the square system
        ``(I - C)_uu D_u = C_uk D_k`` exactly (``C`` = :func:`curvature_coefficients` of ``V``,
-       ``k`` = detail-constrained vertices and every vertex outside ``roi``). The system is not
-       symmetric; it is LU-factored once.
+       ``k`` = detail-constrained vertices and every vertex outside ``roi``): the paper's
+       linear-system form ``C D = D``. (The paper names a second form, the least-squares
+       minimum over all rows, and used it; through normal equations it squares a condition
+       number of up to 1e14, see docs/editing.md.) The system is not symmetric; it is
+       LU-factored once.
     2. **Embedding stage.** Positions minimize the paper's ``E_Q = sum_i |(L X)_i - D_i|^2``
        (``L`` = cotangent Laplacian of ``V``) over the vertices without a position constraint,
        summed over every row that involves them (as :class:`Reconstructor` with
@@ -78,8 +81,8 @@ class CurvatureEditor:
                                 fill), ``"free"`` over the free vertices' rows only (the square
                                 system ``L_ff X_f = D_f - L_fc X_c``: sparser, faster re-solves)
     relations : {"one-ring", "one+two-ring"}
-                                curvature stage: ``"one-ring"`` is the paper (the square system
-                                above); ``"one+two-ring"`` also computes minimum-norm coefficients
+                                curvature stage: ``"one-ring"`` is the paper's relations (in
+                                the square system's form above); ``"one+two-ring"`` also computes minimum-norm coefficients
                                 over each vertex's two-ring, ``C2``, and minimizes
                                 ``|(I - C) D|^2 + |(I - C2) D|^2`` over the region's rows (normal
                                 equations). Same invariance and the same rest state, but twice the
@@ -157,7 +160,7 @@ class CurvatureEditor:
         if rows not in ("all", "free"):
             raise ValueError(f"rows={rows!r} is not a row mode; use 'all' (the paper's E_Q) or 'free'.")
         if relations not in RELATIONS:
-            raise ValueError(f"relations={relations!r}; use 'one-ring' (the paper) or 'one+two-ring'.")
+            raise ValueError(f"relations={relations!r}; use 'one-ring' (the paper's relations) or 'one+two-ring'.")
         rcond = check_rcond(rcond)
         resolve_backend(backend)           # an unknown or missing backend fails before the work
         self.relations = relations
@@ -262,7 +265,9 @@ class CurvatureEditor:
         return error
 
     def _square_system(self, D, in_roi, free_d, fd, dc, at_fd, at_dc, rows, cols, cvals, curv_backend):
-        """The paper: (I - C)_uu D_u = C_uk D_k over the free rows (square, not symmetric)."""
+        """The paper's linear-system form: (I - C)_uu D_u = C_uk D_k over the free rows (square,
+        not symmetric). The paper's implementation minimized |(I - C) D|^2 over all rows instead;
+        through normal equations that squares a condition number of up to 1e14 (docs/editing.md)."""
         r_in = free_d[rows]
         both = r_in & free_d[cols]
         M = sp.csr_matrix((np.concatenate([-cvals[both], np.ones(fd.size)]),
