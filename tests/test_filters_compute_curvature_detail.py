@@ -82,3 +82,16 @@ def test_running_again_after_moving_vertices_updates_the_attributes():
     set_vertex_positions(ms, 0, V)
     apply(ms, "compute_curvature_detail")
     assert np.array_equal(vertex_attribute(ms, 0, "curvature_detail", "point"), curvature_detail(V, F))
+
+
+def test_reversed_triangles_are_refused_not_given_random_signs():
+    # half the sphere's triangles reversed: H came out +-1/R at random, without a word
+    from curvdetail import MeshError
+
+    V, F = icosphere(radius=2.0, subdivisions=3)
+    F = F.copy()
+    F[::2] = F[::2, ::-1]
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=V, face_matrix=F))
+    with pytest.raises(MeshError, match="not consistently oriented.*meshing_re_orient_faces_coherently"):
+        apply(ms, "compute_curvature_detail")

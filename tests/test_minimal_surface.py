@@ -196,3 +196,13 @@ def test_far_from_the_origin_the_iteration_loses_no_digits():
     X_far = minimal_surface(far, F, b, max_iterations=5)
     # (5e-9 of the diagonal before, 4e-10 now: the coordinates' own spacing out there is 5e-10)
     assert np.abs((np.asarray(X_far) - shift) - np.asarray(X_near)).max() < 2e-9 * bbox_diagonal(V)
+
+
+def test_reversed_triangles_are_named_instead_of_a_run_that_never_converges(load_mesh):
+    # the step is measured along vertex normals, which reversed triangles cancel: the nose ran
+    # all 200 steps and came back "not converged" (44 steps when oriented)
+    V, F = load_mesh("mannequin_nose.obj")
+    F = F.copy()
+    F[::3] = F[::3, ::-1]
+    with pytest.raises(MeshError, match="not consistently oriented"):
+        minimal_surface(V, F, boundary_vertices(F))

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ..curvature._validate import boundary_vertices
+from ..curvature._validate import boundary_vertices, check_oriented
 from ..curvature.cotan_laplacian import checked_cotan_laplacian, laplacian_product
 from ..curvature.mixed_voronoi_area import _mixed_voronoi_area_unchecked
 from .detail_attributes import AREA, DETAIL, NORMAL, store_detail  # noqa: F401  (names re-exported)
@@ -31,7 +31,9 @@ def signed_mean_curvature(V, F, K):
         area-weighted vertex normal; H > 0 on a sphere with outward normals) so that MeshLab can
         colour it. Returns the range and the 10/90 percentiles of H over the interior vertices,
         like pymeshlab's compute_scalar_by_discrete_curvature_per_vertex (boundary vertices carry
-        the boundary's geodesic curvature in K and are left out of the figures). {PAPER},
+        the boundary's geodesic curvature in K and are left out of the figures). H's sign needs
+        consistently oriented triangles: others are refused (meshing_re_orient_faces_coherently
+        orients them). {PAPER},
         section "Curvature detail representation".
     """,
     parameters=[],
@@ -40,6 +42,8 @@ def compute_curvature_detail(ms):
     mid = layer_id(ms)
     V, F = mesh_arrays(ms, mid)
     V, F, L = checked_cotan_laplacian(V, F)        # validated once
+    # H's sign comes from the vertex normals: with reversed triangles it was +-H at random
+    check_oriented(F, "the current mesh")
     D = laplacian_product(L, V)                    # = curvature_detail(V, F)
     A = _mixed_voronoi_area_unchecked(V, F)        # = mixed_voronoi_area(V, F)
     K = D / A[:, None]                             # = mean_curvature_normal(V, F)[0], bit for bit
