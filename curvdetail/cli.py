@@ -189,6 +189,10 @@ def _minimal_command(parser):
                         help="stop when no vertex moves more than TOL x the bbox diagonal of its piece "
                              "normal to the surface in a step (tangential sliding is not counted; "
                              f"default {DEFAULT_TOL:g})")
+    parser.add_argument("--step", choices=("normal", "full"), default="normal",
+                        help="what TOL is compared with: the step normal to the surface (default; needs "
+                             "consistently oriented triangles) or the full vertex displacement, "
+                             "tangential sliding included")
     add_fix_arguments(parser)
     add_backend_argument(parser)
     add_output_arguments(parser)
@@ -208,7 +212,7 @@ def _minimal_command(parser):
                                   "(or vertices named with --fix).")
         progress = Progress(args.max_iterations, enabled=sys.stderr.isatty())
         X = minimal_surface(V, F, fixed, max_iterations=args.max_iterations, tol=args.tol,
-                            backend=args.backend, callback=lambda i, s: progress.stage(f"step {i}"))
+                            step=args.step, backend=args.backend, callback=lambda i, s: progress.stage(f"step {i}"))
         progress.close()
         write_mesh(args.output, X, F, quality=np.linalg.norm(X - V, axis=1), overwrite=args.overwrite)
         state = "converged" if X.converged else "stopped (not converged)"

@@ -206,3 +206,29 @@ def test_reversed_triangles_are_named_instead_of_a_run_that_never_converges(load
     F[::3] = F[::3, ::-1]
     with pytest.raises(MeshError, match="not consistently oriented"):
         minimal_surface(V, F, boundary_vertices(F))
+
+
+def test_full_step_measure_needs_no_orientation_and_gives_the_same_surface(load_mesh):
+    # the geometry of a step does not depend on orientation: with step="full" a mesh with
+    # reversed triangles gives the oriented mesh's surface, step by step
+    V, F = load_mesh("mannequin_nose.obj")
+    b = boundary_vertices(F)
+    Fr = F.copy()
+    Fr[::3] = Fr[::3, ::-1]
+    X = minimal_surface(V, F, b, max_iterations=6, step="full")
+    Xr = minimal_surface(V, Fr, b, max_iterations=6, step="full")
+    assert X.iterations == Xr.iterations == 6 and not Xr.converged
+    assert np.abs(X - Xr).max() < 1e-12 * bbox_diagonal(V)
+    assert X.last_step == X.last_full_step > minimal_surface(V, F, b, max_iterations=6).last_step
+
+
+def test_full_step_measure_stops_on_the_whole_displacement():
+    V, F = grid(9, 9)
+    V[:, 2] = V[:, 0] * (1 - V[:, 0]) * V[:, 1] * (1 - V[:, 1])
+    seen = []
+    X = minimal_surface(V, F, boundary_vertices(F), step="full", tol=1e-6,
+                        callback=lambda i, s: seen.append(s))
+    assert X.converged and X.last_full_step < 1e-6 and seen[-1] == X.last_full_step
+    assert all(s >= 1e-6 for s in seen[:-1])
+    with pytest.raises(ValueError, match="step='sideways'"):
+        minimal_surface(V, F, boundary_vertices(F), step="sideways")

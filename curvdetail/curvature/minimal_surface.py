@@ -13,8 +13,9 @@ from .sparse_solver import factorize
 
 class MinimalSurfaceResult(np.ndarray):
     """(n, 3) positions with ``iterations``, ``converged``, ``last_step`` (the last step's largest
-    normal displacement) and ``last_full_step`` (its largest displacement, tangential sliding
-    included), both relative to the bbox diagonal of the vertex's piece, attached."""
+    displacement as ``step`` measures it: by default its part normal to the surface) and
+    ``last_full_step`` (its largest displacement, tangential sliding included), both relative to
+    the bbox diagonal of the vertex's piece, attached."""
 
 
 #: Default stopping tolerance of :func:`minimal_surface`: the shape moves by less than 1e-4 of the
@@ -49,7 +50,8 @@ def _piece_diagonals(V, F, adjacency):
     return piece[labels]
 
 
-def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, backend="auto", callback=None):
+def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, step="normal", backend="auto",
+                    callback=None):
     """Minimal surface with the ``fixed`` vertices kept: the paper's validity check, ``D = 0``.
 
     Each step solves the free rows ``L_ff X_f = -L_fc X_c`` with the cotangent weights of the
@@ -57,7 +59,8 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, backend
     weights. It stops when the shape has settled: when the largest displacement of a step
     *normal to the surface* (projected on the area-weighted vertex normals of the new surface) is
     below ``tol`` times the bbox diagonal of the vertex's connected piece (the mesh's, for one
-    piece), or after ``max_iterations`` steps.
+    piece), or after ``max_iterations`` steps. ``step="full"`` compares the whole displacement
+    instead (the largest vertex step, as the issue words it).
 
     Why the normal part: after the first few steps the shape is found, but on irregular meshes
     the vertices keep sliding *within* the surface, because sliding lowers the discrete area by
@@ -76,9 +79,13 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, backend
     tol : float                 stop when no vertex moves more than ``tol`` x its piece's bbox
                                 diagonal across the surface in a step (default 1e-4,
                                 :data:`DEFAULT_TOL`), > 0
+    step : {"normal", "full"}   what ``tol`` is compared with: the step's part normal to the
+                                surface (needs consistently oriented triangles) or the whole
+                                vertex displacement (tangential sliding included: on irregular
+                                meshes it may not fall below ``tol`` in ``max_iterations``)
     backend : str               sparse solver backend
     callback : callable or None called as ``callback(iteration, relative_step)`` after each step
-                                (``relative_step``: the normal step that ``tol`` is compared with)
+                                (``relative_step``: the step that ``tol`` is compared with)
 
     Returns
     -------
@@ -87,12 +94,13 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, backend
 
     Raises
     ------
-    MeshError         malformed mesh, triangles not consistently oriented (the step is measured
-                      along vertex normals), or triangles collapsed during the iteration (the
+    MeshError         malformed mesh, triangles not consistently oriented with ``step="normal"``
+                      (the step is measured along vertex normals), or triangles collapsed during the iteration (the
                       boundary spans no minimal surface of this topology, e.g. two circles too
                       far apart)
     ConstraintError   bad fixed set or a piece with no fixed vertex
-    ValueError        ``max_iterations`` not a whole number >= 1, ``tol`` not a positive number
+    ValueError        ``max_iterations`` not a whole number >= 1, ``tol`` not a positive number,
+                      ``step`` not "normal" or "full"
     SolverError       an unknown or uninstalled ``backend``
 
     Examples
@@ -106,6 +114,9 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, backend
     """
     max_iterations = as_count(max_iterations, "max_iterations")
     tol = as_positive_number(tol, "tol", " (relative to the bbox diagonal)")
+    if step not in ("normal", "full"):
+        raise ValueError(f"step={step!r}; use 'normal' (the step across the surface) or 'full' (the "
+                         "whole vertex displacement).")
     if callback is not None and not callable(callback):
         raise ValueError(f"callback={callback!r} is not callable; pass a function (iteration, step) or None.")
     V, F, U, diagonal = checked_cotan_triangle(V, F)     # every mesh check; L of the first step
@@ -115,9 +126,13 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, backend
         raise ConstraintError("no fixed vertices: a minimal surface needs a fixed boundary; pass e.g. "
                               "boundary_vertices(F).")
     check_every_component_fixed(F, n, fixed, adjacency=U)
-    # the step is measured along the vertex normals: reversed triangles cancel them, and the
-    # iteration ran to max_iterations "not converged" (1M vertices: ~0.9 s, a fifth of a step)
-    check_oriented(F)
+    if step == "normal":
+        # the step is measured along the vertex normals: reversed triangles cancel them, and the
+        # iteration ran to max_iterations "not converged" (1M vertices: ~0.9 s, a fifth of a step)
+        try:
+            check_oriented(F)
+        except MeshError as exc:
+            raise MeshError(f"{exc} (Or pass step='full', which needs no orientation.)") from None
     is_free = np.ones(n, dtype=bool)
     is_free[fixed] = False
     free = np.flatnonzero(is_free)
@@ -131,7 +146,7 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, backend
     layout = _FreeSystemLayout(U, is_free, fixed)    # the same for every step: F does not change
     X = V.copy()
     converged = free.size == 0
-    step = full_step = 0.0 if converged else np.inf
+    measured = full_step = 0.0 if converged else np.inf
     it = 0
     while not converged and it < max_iterations:
         if it > 0:                          # weights of the current surface
@@ -159,12 +174,15 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, backend
             )
         move = X_new - X
         full_step = float((np.abs(move).max(axis=1) / scale).max())
-        step = float((np.abs(np.einsum("ij,ij->i", move, _vertex_normals(X_new, F, cross))) / scale).max())
+        if step == "normal":
+            measured = float((np.abs(np.einsum("ij,ij->i", move, _vertex_normals(X_new, F, cross))) / scale).max())
+        else:
+            measured = full_step
         X = X_new
         it += 1
-        converged = step < tol
+        converged = measured < tol
         if callback is not None:
-            callback(it, step)
+            callback(it, measured)
     out = X.view(MinimalSurfaceResult)
-    out.iterations, out.converged, out.last_step, out.last_full_step = it, bool(converged), step, full_step
+    out.iterations, out.converged, out.last_step, out.last_full_step = it, bool(converged), measured, full_step
     return out

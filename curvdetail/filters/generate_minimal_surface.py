@@ -21,7 +21,7 @@ from .registry import PAPER, filter
         weights recomputed from the current surface (Pinkall and Polthier 1993) until no vertex
         moves more than tol times the bounding-box diagonal of its piece normal to the surface in a step
         (vertices keep sliding within the surface on irregular meshes; that is not counted, and
-        last_step is this normal step). It is the paper's validity check
+        last_step is this normal step; step=full counts the whole displacement). It is the paper's validity check
         and the zero-detail baseline of the remeshing experiment. The result is added as a new
         layer (same triangles) and made current; its vertex quality is the distance each vertex
         moved. {PAPER}, the validity check of section "Base presentation".
@@ -31,10 +31,14 @@ from .registry import PAPER, filter
         Parameter("tol", "float", DEFAULT_TOL,
                   "stop when no vertex moves more than tol x its piece's bbox diagonal normal to the "
                   "surface in a step (tangential sliding is not counted)", positive=True),
+        Parameter("step", "str", "normal",
+                  "what tol is compared with: the step normal to the surface (needs consistently "
+                  "oriented triangles) or the full vertex displacement, tangential sliding included",
+                  choices=("normal", "full")),
         Parameter("backend", "str", "auto", BACKEND_DESCRIPTION, choices=BACKENDS),
     ],
 )
-def generate_minimal_surface(ms, *, max_iterations, tol, backend):
+def generate_minimal_surface(ms, *, max_iterations, tol, step, backend):
     mid = layer_id(ms)
     V, F = mesh_arrays(ms, mid)
     label = get_mesh(ms, mid).label()
@@ -44,7 +48,7 @@ def generate_minimal_surface(ms, *, max_iterations, tol, backend):
                               "boundary to span.")
     if not tol > 0:
         raise ConstraintError(f"tol={tol} must be positive (a fraction of the bbox diagonal).")
-    X = minimal_surface(V, F, fixed, max_iterations=max_iterations, tol=tol, backend=backend)
+    X = minimal_surface(V, F, fixed, max_iterations=max_iterations, tol=tol, step=step, backend=backend)
     moved = np.linalg.norm(X - V, axis=1)
     add_layer(ms, np.asarray(X), F, f"{label} minimal surface", quality=moved)
     return {
