@@ -55,7 +55,9 @@ def test_reconstruct_closed_mesh_with_fixed_vertices(tmp_path):
 def test_reconstruct_example(tmp_path, capsys):
     out = tmp_path / "terrain.obj"
     assert main(["reconstruct", "--example", str(out)]) == 0
-    assert out.exists() and "1089 vertices" in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    # the default: E_Q over all rows
+    assert out.exists() and "1089 vertices" in printed and "rows=all" in printed
 
 
 def test_minimal_example_converges(tmp_path, capsys):

@@ -220,3 +220,18 @@ def test_main_puts_the_sigterm_handling_back_afterwards(tmp_path, capsys):
                  "--no-evaluate"]) == 0
     assert signal.getsignal(signal.SIGTERM) == before[0]
     assert signal.set_wakeup_fd(before[1]) == before[1]
+
+
+def test_remesh_defaults_are_the_experiment_defaults(tmp_path):
+    # the paper's setting: isotropic remeshing at 1 % of the bbox diagonal, and the library's
+    # own defaults (conservative transfer, free rows, closest-point location)
+    from curvdetail.remesh.experiment import DEFAULTS
+
+    rep = tmp_path / "r.json"
+    assert main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "o.ply"),
+                 "--report", str(rep), "--no-evaluate", "--quiet"]) == 0
+    options = json.loads(rep.read_text())["options"]
+    assert options["target_edge"] == pytest.approx(0.01) and options["method"] == "isotropic"
+    assert {k: options[k] for k in ("transfer", "rows", "location")} == \
+        {k: DEFAULTS[k] for k in ("transfer", "rows", "location")}
+    assert DEFAULTS["target_edge"] == 0.01

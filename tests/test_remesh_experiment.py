@@ -246,3 +246,15 @@ def test_the_zero_detail_baseline_is_the_harmonic_surface_for_both_row_modes(hei
     assert np.abs(LZ[free]).max() < 1e-12 * np.abs(cotan_laplacian(Vt, Ft) @ Vt).max()
     np.testing.assert_allclose(Z, runs["free"]["Z"], rtol=0, atol=1e-12)
     assert not np.allclose(runs["all"]["X"], runs["free"]["X"], rtol=0, atol=1e-9)   # the rows did change X
+
+
+def test_function_defaults_are_the_documented_defaults():
+    # remesh_experiment, run_experiment and the filter read their defaults from different places
+    import inspect
+
+    from curvdetail.remesh.experiment import DEFAULTS, run_experiment
+
+    assert DEFAULTS["target_edge"] == 0.01 and DEFAULTS["method"] == "isotropic"
+    for function in (remesh_experiment, run_experiment):
+        parameters = inspect.signature(function).parameters
+        assert {k: parameters[k].default for k in DEFAULTS} == DEFAULTS, function.__name__

@@ -97,3 +97,21 @@ def test_a_target_half_given_is_refused_not_ignored():
         parameterize(V, F, None, F)
     with pytest.raises(ValueError, match="Vt was given without Ft: pass both"):
         parameterize(V, F, V)
+
+
+def test_source_boundary_is_placed_on_the_circle_by_arc_length(load_mesh):
+    # the nose's boundary edges differ in length (0.4x ... 2.5x their mean): each boundary
+    # vertex's angle on the circle is its arc-length fraction along the loop, not its index
+    from curvdetail.curvature.boundary_editing import boundary_loop
+
+    V, F = load_mesh("mannequin_nose.obj")
+    loop = boundary_loop(F)
+    UV, _, _ = parameterize(V, F)
+    seg = np.linalg.norm(np.roll(V[loop], -1, axis=0) - V[loop], axis=1)
+    assert seg.max() > 1.5 * seg.min()          # uneven spacing: arc length and index differ
+    s = np.concatenate([[0.0], np.cumsum(seg)[:-1]]) / seg.sum()
+    angle = np.arctan2(UV[loop, 1], UV[loop, 0])
+    turn = np.mod(angle - angle[0], 2 * np.pi) / (2 * np.pi)      # fraction of a turn from loop[0]
+    if turn[1] > 0.5:                   # the loop runs clockwise on the circle
+        turn = np.mod(-turn, 1.0)
+    assert np.abs(turn - s).max() < 1e-12
