@@ -361,13 +361,21 @@ def _remesh_command(parser):
 @command("list", help="list the filters (curvdetail.filters) with their parameters")
 def _list_command(parser):
     parser.add_argument("filter", metavar="FILTER", nargs="?", help="show this filter only")
+    parser.add_argument("--json", action="store_true",
+                        help="print JSON (a list of filters, or the one filter) for scripts")
 
     def run(args):
         from .filters import get_filter, list_filters
         from .filters.registry import describe_filter
 
         specs = [get_filter(args.filter)] if args.filter else list_filters()
-        print("\n\n".join(describe_filter(spec) for spec in specs))
+        if args.json:
+            import json
+
+            found = [spec.to_dict() for spec in specs]
+            print(json.dumps(found[0] if args.filter else found, indent=2))
+        else:
+            print("\n\n".join(describe_filter(spec) for spec in specs))
         return 0
 
     return run

@@ -51,6 +51,25 @@ def test_list_one_filter(capsys):
     assert "rows : str = 'all'  (all | free)" in out and "generate_minimal_surface" not in out
 
 
+def test_list_json_is_every_filter_with_typed_parameters(capsys):
+    import json
+
+    rc, out, _ = run_cli(capsys, "list", "--json")
+    assert rc == 0
+    found = json.loads(out)
+    assert [f["name"] for f in found] == [spec.name for spec in list_filters()]
+    remesh = {f["name"]: f for f in found}["generate_curvature_remeshing"]
+    params = {p["name"]: p for p in remesh["parameters"]}
+    assert params["target_edge"]["type"] == "PercentageValue" and params["target_edge"]["default"] == "1.0%"
+    assert params["rows"]["default"] == "free" and params["rows"]["choices"] == ["free", "all"]
+    assert "\n" not in remesh["description"] and "Fig. 3" in remesh["description"]
+    rc, out, _ = run_cli(capsys, "list", "generate_minimal_surface", "--json")
+    one = json.loads(out)
+    assert one["name"] == "generate_minimal_surface"
+    assert {"name": "max_iterations", "type": "int", "default": 200, "min": 1} == \
+        {k: v for k, v in one["parameters"][0].items() if k != "description"}
+
+
 def test_list_unknown_filter_fails(capsys):
     assert_failed(capsys, ["list", "generate_minimal_surfaces"], "did you mean generate_minimal_surface")
 

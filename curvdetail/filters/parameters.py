@@ -93,6 +93,22 @@ class Parameter:
         if self.default is not None or self.type != "mesh":
             object.__setattr__(self, "default", self.check(self.default))
 
+    def to_dict(self):
+        """The parameter as JSON-ready values: ``name``, ``type``, ``default`` (a percentage as
+        text, e.g. ``"1.0%"``), ``description``, and ``choices`` / ``min`` / ``max`` /
+        ``positive`` where set."""
+        out = {"name": self.name, "type": self.type,
+               "default": str(self.default) if isinstance(self.default, BBoxLength) else self.default,
+               "description": " ".join(self.description.split())}
+        if self.choices is not None:
+            out["choices"] = list(self.choices)
+        for key in ("min", "max"):
+            if getattr(self, key) is not None:
+                out[key] = getattr(self, key)
+        if self.positive:
+            out["positive"] = True
+        return out
+
     # -- checking Python values -----------------------------------------------------------------
 
     def _fail(self, value, expected):

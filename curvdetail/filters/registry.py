@@ -63,6 +63,13 @@ class FilterSpec:
         """``{name: default}`` for every parameter."""
         return {p.name: p.default for p in self.parameters}
 
+    def to_dict(self):
+        """The filter as JSON-ready values (``json.dumps`` takes it): ``name``, ``category``,
+        ``description`` (one line) and ``parameters`` (each :meth:`Parameter.to_dict`)."""
+        return {"name": self.name, "category": self.category,
+                "description": " ".join(self.description.split()),
+                "parameters": [p.to_dict() for p in self.parameters]}
+
 
 def filter(*, name, category, description, parameters=()):  # noqa: A001 (pymeshlab's word)
     """Declare and register a filter (decorator).
