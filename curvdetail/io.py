@@ -10,7 +10,8 @@ import re
 
 import numpy as np
 
-from ._file_counts import check_before_loading, check_loaded
+from ._file_counts import check_loaded
+from ._file_scan import check_before_loading
 from ._output import atomic_output, check_output_path
 from .curvature._validate import as_faces, as_vertices
 from .curvature.errors import MeshError, first_indices
@@ -50,9 +51,11 @@ def read_mesh(path):
                         or repeated corner. Checked before pymeshlab reads the file, because
                         its loader would corrupt memory or misread it without a word:
                         out-of-range face indices, fewer rows than the header declares,
-                        vertex rows with other than x y z (plain OFF) or short rows, face rows
-                        that are not a count and that many integers (ASCII OFF); indented
-                        vertex lines, fractional face indices and comments after a face (OBJ)
+                        vertex rows it would read shifted (a value too many or too few, a
+                        comment among the values; a vertex split over lines that hold exactly
+                        its values passes), lines of blanks, counts or indices that are not
+                        whole numbers (ASCII OFF); indented vertex lines, fractional face
+                        indices and comments after a face (OBJ; ``f 1 2 3#note`` passes)
 
     Examples
     --------

@@ -15,7 +15,8 @@ import os
 import numpy as np
 
 from .. import _output
-from .._file_counts import check_before_loading, check_loaded
+from .._file_counts import check_loaded
+from .._file_scan import check_before_loading
 from ..io import MeshFileError, check_mesh_output, input_path, load_failure
 from .meshset import WRITTEN_ATTRIBUTES, set_vertex_attribute, vertex_attribute
 from .ply_attributes import read_ply_vertex_attributes
