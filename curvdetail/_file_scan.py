@@ -288,7 +288,12 @@ def _off_rows_problem(path):
         (chars[token_starts[head]] <= 57)
     k = np.where(one_digit, chars[token_starts[head]].astype(np.int64) - 48, 0)
     suspect = ~one_digit | (per_face < k + 1)
-    odd = token_starts[_maybe_out_of_range(chars, token_starts, token_ends, nv)]
+    # indices only (rank 1 .. k in their row): float colours after them are longer than the
+    # vertex count's digits and sent every face of a coloured 1M-vertex file to the loop below
+    owner = np.repeat(np.arange(nf), per_face)
+    rank = np.arange(token_starts.size) - head[owner]
+    idx = np.flatnonzero((rank >= 1) & (rank <= k[owner]))
+    odd = token_starts[idx[_maybe_out_of_range(chars, token_starts[idx], token_ends[idx], nv)]]
     suspect[np.searchsorted(line_starts, odd, side="right") - 1] = True
     # a character other than a digit in the count or an index (atoi reads 2.5 as 2, "#" and "x"
     # as 0); those in colours after the indices do not matter

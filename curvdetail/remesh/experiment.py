@@ -207,9 +207,8 @@ def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="cons
     # the baseline is the harmonic surface (L Z)_free = 0 whatever the rows: with rows="all",
     # D = 0 would give the least-squares argmin |L Z|^2 instead, another surface (nose: 9.1 %
     # RMS against the harmonic 10.3 %), and the baseline would change with the option
-    if rows != "free":
-        rec = Reconstructor(Vt, Ft, loop_t, rows="free", backend=backend)
-    Z = rec.solve(np.zeros_like(Dt), Vt[loop_t])
+    harmonic = rec if rows == "free" else Reconstructor(Vt, Ft, loop_t, rows="free", backend=backend)
+    Z = harmonic.solve(np.zeros_like(Dt), Vt[loop_t])
     seconds["reconstruct"] = time.perf_counter() - t
 
     report = {
