@@ -187,12 +187,11 @@ def _minimal_command(parser):
 
     parser.add_argument("--tol", type=float, default=DEFAULT_TOL,
                         help="stop when no vertex moves more than TOL x the bbox diagonal of its piece "
-                             "normal to the surface in a step (tangential sliding is not counted; "
-                             f"default {DEFAULT_TOL:g})")
+                             "in a step, as --step measures it (by default normal to the surface: "
+                             f"tangential sliding is not counted; default {DEFAULT_TOL:g})")
     parser.add_argument("--step", choices=("normal", "full"), default="normal",
-                        help="what TOL is compared with: the step normal to the surface (default; needs "
-                             "consistently oriented triangles) or the full vertex displacement, "
-                             "tangential sliding included")
+                        help="what TOL is compared with: the step normal to the surface (default) or "
+                             "the full vertex displacement, tangential sliding included")
     add_fix_arguments(parser)
     add_backend_argument(parser)
     add_output_arguments(parser)
@@ -216,8 +215,12 @@ def _minimal_command(parser):
         progress.close()
         write_mesh(args.output, X, F, quality=np.linalg.norm(X - V, axis=1), overwrite=args.overwrite)
         state = "converged" if X.converged else "stopped (not converged)"
-        print(f"{state} after {X.iterations} steps, last step {X.last_step:.2e} of the bbox diagonal "
-              f"normal to the surface ({X.last_full_step:.2e} with tangential sliding)")
+        if args.step == "normal":
+            last = (f"last step {X.last_step:.2e} of the bbox diagonal normal to the surface "
+                    f"({X.last_full_step:.2e} with tangential sliding)")
+        else:
+            last = f"last step {X.last_full_step:.2e} of the bbox diagonal (tangential sliding included)"
+        print(f"{state} after {X.iterations} steps, {last}")
         return 0 if X.converged else 3
 
     return run

@@ -228,3 +228,10 @@ def test_minimal_surface_with_a_pinned_inner_vertex(tmp_path, capsys):
     b = boundary_vertices(F)
     assert np.array_equal(pinned[b], V[b]) and np.array_equal(pinned[300], V[300])
     assert np.linalg.norm(free[300] - V[300]) > 1e-3 * bbox_diagonal(V)    # it would have moved
+
+
+def test_minimal_full_step_says_what_it_measured(tmp_path, capsys):
+    # the line said "normal to the surface" for --step full too, with the full step twice
+    assert main(["minimal", NOSE, str(tmp_path / "m.ply"), "--step", "full", "--max-iterations", "3"]) == 3
+    printed = capsys.readouterr().out
+    assert "tangential sliding included" in printed and "normal to the surface" not in printed

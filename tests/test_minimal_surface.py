@@ -198,14 +198,44 @@ def test_far_from_the_origin_the_iteration_loses_no_digits():
     assert np.abs((np.asarray(X_far) - shift) - np.asarray(X_near)).max() < 2e-9 * bbox_diagonal(V)
 
 
-def test_reversed_triangles_are_named_instead_of_a_run_that_never_converges(load_mesh):
-    # the step is measured along vertex normals, which reversed triangles cancel: the nose ran
-    # all 200 steps and came back "not converged" (44 steps when oriented)
+def test_reversed_triangles_stop_as_the_oriented_mesh_does(load_mesh):
+    # the step is measured along vertex normals, which reversed triangles cancelled: the nose
+    # ran all 200 steps and came back "not converged" (44 steps when oriented)
     V, F = load_mesh("mannequin_nose.obj")
-    F = F.copy()
-    F[::3] = F[::3, ::-1]
-    with pytest.raises(MeshError, match="not consistently oriented"):
-        minimal_surface(V, F, boundary_vertices(F))
+    b = boundary_vertices(F)
+    Fr = F.copy()
+    Fr[::3] = Fr[::3, ::-1]
+    X, Xr = minimal_surface(V, F, b), minimal_surface(V, Fr, b)
+    assert X.converged and Xr.converged and Xr.iterations == X.iterations < 100
+    assert np.abs(Xr - X).max() < 1e-12 * bbox_diagonal(V)
+
+
+def _moebius_strip(n_around=60, n_across=6):
+    u = np.linspace(0, 2 * np.pi, n_around, endpoint=False)
+    w = np.linspace(-0.3, 0.3, n_across)
+    U, W = np.meshgrid(u, w, indexing="ij")
+    V = np.stack([(1 + W * np.cos(U / 2)) * np.cos(U), (1 + W * np.cos(U / 2)) * np.sin(U),
+                  W * np.sin(U / 2)], -1).reshape(-1, 3)
+    i, j = np.meshgrid(np.arange(n_around), np.arange(n_across - 1), indexing="ij")
+    i, j = i.ravel(), j.ravel()
+    last = i == n_around - 1                       # glued to the first column with a half turn
+    a, d = i * n_across + j, i * n_across + j + 1
+    b = np.where(last, n_across - 1 - j, (i + 1) * n_across + j)
+    c = np.where(last, n_across - 2 - j, (i + 1) * n_across + j + 1)
+    return V, np.concatenate([np.column_stack([a, b, c]), np.column_stack([a, c, d])])
+
+
+def test_a_moebius_strip_which_no_orientation_fits_converges():
+    from curvdetail.curvature._validate import misoriented_edges
+
+    V, F = _moebius_strip()
+    assert misoriented_edges(F).shape[0] > 0              # not orientable
+    b = boundary_vertices(F)
+    X = minimal_surface(V, F, b)
+    assert X.converged and X.iterations < 50
+    assert np.array_equal(X[b], V[b])
+    full = minimal_surface(V, F, b, step="full", max_iterations=X.iterations)
+    assert np.abs(full - X).max() < 1e-12                 # the same steps, another stopping measure
 
 
 def test_full_step_measure_needs_no_orientation_and_gives_the_same_surface(load_mesh):

@@ -4,7 +4,7 @@ import numpy as np
 
 from ._geometry import corner_cotangents
 from ._validate import (ZERO_AREA_RELATIVE, as_count, as_index_set, as_positive_number, bbox_centre,
-                        bbox_diagonal, check_every_component_fixed, check_oriented, vertex_components)
+                        bbox_diagonal, check_every_component_fixed, misoriented_edges, vertex_components)
 from .cotan_laplacian import _assemble_upper, checked_cotan_triangle
 from .errors import ConstraintError, MeshError, first_indices
 from .reconstruct import _FreeSystemLayout
@@ -24,13 +24,26 @@ class MinimalSurfaceResult(np.ndarray):
 DEFAULT_TOL = 1e-4
 
 
-def _vertex_normals(X, F, face_cross=None):
+def _vertex_normals(X, F, face_cross=None, aligned=False):
     """Area-weighted unit vertex normals, shape (n, 3); ``face_cross`` (m, 3), the triangles'
-    ``(x1 - x0) x (x2 - x0)``, where the caller has it."""
+    ``(x1 - x0) x (x2 - x0)``, where the caller has it. ``aligned=True`` is for triangles that
+    are not consistently oriented (a Moebius strip cannot be): each triangle's normal enters a
+    vertex's sum turned to agree with one of the vertex's triangles, so reversed triangles do not
+    cancel it (the result's sign is then arbitrary; the step measure takes its absolute value)."""
     fn = np.cross(X[F[:, 1]] - X[F[:, 0]], X[F[:, 2]] - X[F[:, 0]]) if face_cross is None else face_cross
     n = X.shape[0]
-    N = np.column_stack([np.bincount(F.ravel(), weights=np.repeat(fn[:, k], 3), minlength=n)
-                         for k in range(3)])
+    if not aligned:
+        N = np.column_stack([np.bincount(F.ravel(), weights=np.repeat(fn[:, k], 3), minlength=n)
+                             for k in range(3)])
+    else:
+        reference = np.zeros((n, 3))
+        for corner in range(3):
+            reference[F[:, corner]] = fn
+        N = np.zeros((n, 3))
+        for corner in range(3):
+            sign = np.where(np.einsum("ij,ij->i", fn, reference[F[:, corner]]) < 0, -1.0, 1.0)
+            N += np.column_stack([np.bincount(F[:, corner], weights=sign * fn[:, k], minlength=n)
+                                  for k in range(3)])
     length = np.linalg.norm(N, axis=1, keepdims=True)
     return N / np.where(length > 0, length, 1.0)
 
@@ -80,7 +93,7 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, step="n
                                 diagonal across the surface in a step (default 1e-4,
                                 :data:`DEFAULT_TOL`), > 0
     step : {"normal", "full"}   what ``tol`` is compared with: the step's part normal to the
-                                surface (needs consistently oriented triangles) or the whole
+                                surface (triangles need not be consistently oriented) or the whole
                                 vertex displacement (tangential sliding included: on irregular
                                 meshes it may not fall below ``tol`` in ``max_iterations``)
     backend : str               sparse solver backend
@@ -94,10 +107,8 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, step="n
 
     Raises
     ------
-    MeshError         malformed mesh, triangles not consistently oriented with ``step="normal"``
-                      (the step is measured along vertex normals), or triangles collapsed during the iteration (the
-                      boundary spans no minimal surface of this topology, e.g. two circles too
-                      far apart)
+    MeshError         malformed mesh, or triangles collapsed during the iteration (the boundary
+                      spans no minimal surface of this topology, e.g. two circles too far apart)
     ConstraintError   bad fixed set or a piece with no fixed vertex
     ValueError        ``max_iterations`` not a whole number >= 1, ``tol`` not a positive number,
                       ``step`` not "normal" or "full"
@@ -126,13 +137,11 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, step="n
         raise ConstraintError("no fixed vertices: a minimal surface needs a fixed boundary; pass e.g. "
                               "boundary_vertices(F).")
     check_every_component_fixed(F, n, fixed, adjacency=U)
-    if step == "normal":
-        # the step is measured along the vertex normals: reversed triangles cancel them, and the
-        # iteration ran to max_iterations "not converged" (1M vertices: ~0.9 s, a fifth of a step)
-        try:
-            check_oriented(F)
-        except MeshError as exc:
-            raise MeshError(f"{exc} (Or pass step='full', which needs no orientation.)") from None
+    # the step is measured along vertex normals, which reversed triangles cancel: the iteration
+    # ran to max_iterations "not converged". Where triangles are not consistently oriented (or
+    # cannot be: a Moebius strip), the normals are summed sign-aligned instead (1M vertices: the
+    # check ~0.9 s, a fifth of a step)
+    aligned = step == "normal" and misoriented_edges(F).shape[0] > 0
     is_free = np.ones(n, dtype=bool)
     is_free[fixed] = False
     free = np.flatnonzero(is_free)
@@ -175,7 +184,8 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, step="n
         move = X_new - X
         full_step = float((np.abs(move).max(axis=1) / scale).max())
         if step == "normal":
-            measured = float((np.abs(np.einsum("ij,ij->i", move, _vertex_normals(X_new, F, cross))) / scale).max())
+            normals = _vertex_normals(X_new, F, cross, aligned=aligned)
+            measured = float((np.abs(np.einsum("ij,ij->i", move, normals)) / scale).max())
         else:
             measured = full_step
         X = X_new

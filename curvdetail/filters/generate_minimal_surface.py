@@ -19,21 +19,23 @@ from .registry import PAPER, filter
         Generate the minimal surface spanned by the current mesh's boundary: zero curvature
         detail (D = 0) with the boundary vertices fixed, found by cotangent-harmonic steps with the
         weights recomputed from the current surface (Pinkall and Polthier 1993) until no vertex
-        moves more than tol times the bounding-box diagonal of its piece normal to the surface in a step
-        (vertices keep sliding within the surface on irregular meshes; that is not counted, and
-        last_step is this normal step; step=full counts the whole displacement). It is the paper's validity check
-        and the zero-detail baseline of the remeshing experiment. The result is added as a new
+        moves more than tol times the bounding-box diagonal of its piece normal to the surface in
+        a step (vertices keep sliding within the surface on irregular meshes; that is not counted,
+        and last_step is this normal step; step=full counts the whole displacement). It is the
+        paper's validity check; its first step, the harmonic surface, is the remeshing
+        experiment's zero-detail baseline. The result is added as a new
         layer (same triangles) and made current; its vertex quality is the distance each vertex
         moved. {PAPER}, the validity check of section "Base presentation".
     """,
     parameters=[
         Parameter("max_iterations", "int", 200, "Pinkall-Polthier steps at most", min=1),
         Parameter("tol", "float", DEFAULT_TOL,
-                  "stop when no vertex moves more than tol x its piece's bbox diagonal normal to the "
-                  "surface in a step (tangential sliding is not counted)", positive=True),
+                  "stop when no vertex moves more than tol x its piece's bbox diagonal in a step, as "
+                  "step measures it (by default normal to the surface: tangential sliding is not "
+                  "counted)", positive=True),
         Parameter("step", "str", "normal",
-                  "what tol is compared with: the step normal to the surface (needs consistently "
-                  "oriented triangles) or the full vertex displacement, tangential sliding included",
+                  "what tol is compared with: the step normal to the surface or the full vertex "
+                  "displacement, tangential sliding included",
                   choices=("normal", "full")),
         Parameter("backend", "str", "auto", BACKEND_DESCRIPTION, choices=BACKENDS),
     ],
