@@ -103,3 +103,19 @@ def test_closed_mesh_is_refused_with_what_was_found():
     with pytest.raises(NotADiskError, match="closed"):
         apply(ms, "generate_curvature_remeshing", evaluate=False)
     assert ms.mesh_number() == 1
+
+
+def test_the_baseline_layer_is_coloured_by_its_distance_to_the_source():
+    # the distances came from run_experiment for every run; only this layer uses them. The
+    # fast far-surface candidates give the exact closest-point distances here (to rounding)
+    from curvdetail.remesh import vertex_distance
+
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(os.path.join(DATA, "mannequin_nose.obj"))
+    V, F = ms.mesh(0).vertex_matrix(), ms.mesh(0).face_matrix()
+    report = apply(ms, "generate_curvature_remeshing", target_edge=pymeshlab.PercentageValue(3.0),
+                   add_baseline=True)
+    zero = ms.mesh(report["layers"]["zero_detail"])
+    expected = vertex_distance(zero.vertex_matrix(), V, F)
+    assert expected.max() > 0.05 * report["source"]["bbox_diagonal"]       # far from the source
+    np.testing.assert_allclose(zero.vertex_scalar_array(), expected, rtol=0, atol=1e-9 * expected.max())

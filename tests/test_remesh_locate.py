@@ -192,3 +192,19 @@ def test_a_mesh_too_small_to_square_its_extent_is_located_not_called_a_point():
     _, _, d = locate(P, V, F)
     _, _, d_tiny = locate(P * 1e-170, V * 1e-170, F)
     assert np.allclose(d_tiny / 1e-170, d, rtol=1e-12)
+
+
+def test_blocks_of_the_exact_step_give_the_one_block_answer(load_mesh, rng, monkeypatch):
+    # the exact closest-point step runs in blocks to bound its memory; block edges change nothing
+    import importlib
+
+    locate_module = importlib.import_module("curvdetail.remesh.locate")
+
+    V, F = load_mesh("mannequin_nose.obj")
+    _, _, P = _points_on_faces(V, F, rng, k=1000)
+    P = P + rng.normal(scale=0.01, size=P.shape)
+    whole = locate(P, V, F)
+    monkeypatch.setattr(locate_module, "EXACT_BLOCK", 77)
+    blocks = locate(P, V, F)
+    for a, b in zip(whole, blocks):
+        assert np.array_equal(a, b)
