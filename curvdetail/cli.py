@@ -535,6 +535,7 @@ def _edit_command(parser):
         from .curvature._validate import bbox_diagonal, check_mesh
         from .deformation_benchmark import (edit_with_selection, read_selection, read_transform,
                                             render_panels)
+        from .curvature.errors import UndeterminedEditError
         from .io import MeshFileError, check_mesh_output
 
         _check_image_and_distinct(args.image, args.output, inputs=[args.mesh],
@@ -549,9 +550,13 @@ def _edit_command(parser):
         T = read_transform(args.transform)
         progress.stage("factor and solve")
         t = time.perf_counter()
-        X, editor = edit_with_selection(V, F, status, T, handle_detail=args.handle_detail,
-                                        relations=args.relations, backend=args.backend,
-                                        return_editor=True)
+        try:
+            X, editor = edit_with_selection(V, F, status, T, handle_detail=args.handle_detail,
+                                            relations=args.relations, backend=args.backend,
+                                            return_editor=True)
+        except UndeterminedEditError as exc:
+            raise UndeterminedEditError(f"{exc} Here: more handles (status 2) or fixed vertices (status 0) "
+                                        f"in {args.sel}, or --handle-detail transform.") from None
         seconds = time.perf_counter() - t
         progress.stage("write")
         moved = np.linalg.norm(X - V, axis=1)

@@ -110,3 +110,21 @@ def test_output_over_an_input_file_is_refused_even_with_overwrite(tmp_path, caps
     # the mesh over the input mesh is what --overwrite asks for
     assert main(["edit", str(paths["off"]), str(paths["off"]), "--sel", str(paths["sel"]),
                  "--def", str(paths["def"]), "--overwrite"]) == 0
+
+
+def test_a_selection_that_does_not_determine_the_edit_is_refused_with_what_to_change(tmp_path, capsys):
+    # a flat grid, one strip fixed, three handles: the curvature stage is singular, and the
+    # shape came back 2.4 diagonals off without a word; the message named the library's roi
+    V, F = grid(30, 30)
+    status = np.ones(V.shape[0], dtype=int)
+    status[V[:, 0] < 0.05] = 0
+    status[[450, 451, 480]] = 2
+    write_mesh(tmp_path / "plane.obj", V, F)
+    write_selection(tmp_path / "q.sel", status)
+    write_transform(tmp_path / "p.def", np.eye(4))
+    rc = main(["edit", str(tmp_path / "plane.obj"), "--sel", str(tmp_path / "q.sel"), "--def",
+               str(tmp_path / "p.def"), str(tmp_path / "o.ply")])
+    err = capsys.readouterr().err
+    assert rc == 1 and "do not determine the edit" in err
+    assert "more handles (status 2) or fixed vertices (status 0) in" in err and "q.sel" in err
+    assert not (tmp_path / "o.ply").exists()

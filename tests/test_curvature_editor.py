@@ -310,18 +310,17 @@ def test_unchanged_constraints_give_the_rest_shape_with_rank_deficient_rings(loa
 
 def test_the_embedding_refuses_normal_equations_it_cannot_refine(wavy_grid_with_a_sliver):
     # every detail given, a valid sliver of doubled area 1e-12 of the squared diagonal: the fixed
-    # single step returned the rest shape 2e-2 of the diagonal off without an error. The
-    # constructor's rest solve meets it first
+    # single step returned the rest shape 2e-2 of the diagonal off without an error
     from curvdetail import SolverError
 
     for double_area, fails in ((1e-10, False), (1e-12, True)):
         V, F = wavy_grid_with_a_sliver(double_area)
         b = boundary_vertices(F)
+        ed = CurvatureEditor(V, F, b, np.arange(V.shape[0]), backend="splu")
         if fails:
             with pytest.raises(SolverError, match="too ill-conditioned"):
-                CurvatureEditor(V, F, b, np.arange(V.shape[0]), backend="splu")
+                ed.solve()
         else:
-            ed = CurvatureEditor(V, F, b, np.arange(V.shape[0]), backend="splu")
             assert np.abs(ed.solve() - V).max() < 1e-9 * _diag(V)
 
 
@@ -341,17 +340,21 @@ def test_constraints_that_do_not_determine_the_edit_are_refused():
     # rest values gave back a shape 0.3-0.9 of the diagonal off without a word
     V, F = grid(30, 30)
     b = boundary_vertices(F)
-    with pytest.raises(ConstraintError, match="do not determine the edit.*of the bbox diagonal off"):
+    from curvdetail.curvature.errors import UndeterminedEditError
+
+    with pytest.raises(UndeterminedEditError, match="do not determine the edit.*of the bbox diagonal off"):
         CurvatureEditor(V, F, b, [450, 451, 480])
     # the same grid with its boundary details constrained is determined: the rest shape exactly
     assert CurvatureEditor(V, F, b, b).rest_error < 1e-14
 
 
 def test_rest_error_is_rounding_where_the_constraints_determine_the_edit(load_mesh):
-    # ill-conditioned but determined systems pass the rest check: fandisk's near-flat rings
-    # (cond(I - C) ~1e14) come back to ~1e-7, a smooth patch to rounding
-    V, F = load_mesh("mannequin_nose.obj")
+    # ill-conditioned but determined systems pass the rest check (fandisk's near-flat rings,
+    # cond(I - C) ~1e14, come back to ~1e-7; this terrain's, with 8 handles, to 1.5e-10). The
+    # check follows the curvature stage's rest-detail error through the embedding, which is
+    # what solve() does: the two agree but for the embedding's own rounding
+    V, F = load_mesh("terrainA_1k.obj")
     h = np.random.default_rng(0).choice(V.shape[0], 8, replace=False)
     ed = CurvatureEditor(V, F, h, h)
-    assert ed.rest_error == pytest.approx(np.linalg.norm(ed.solve() - V, axis=1).max() / _diag(V), abs=1e-15)
-    assert ed.rest_error < 1e-10
+    error = np.linalg.norm(ed.solve() - V, axis=1).max() / _diag(V)
+    assert 1e-11 < ed.rest_error < 1e-9 and ed.rest_error == pytest.approx(error, rel=1e-2)

@@ -129,3 +129,24 @@ def test_no_selection_is_refused():
     ms.load_new_mesh(os.path.join(DATA, "mannequin_ear.obj"))
     with pytest.raises(ConstraintError, match="no selected vertices"):
         apply(ms, "apply_curvature_editing", handles="1 2 3")
+
+
+def test_an_edit_the_handles_do_not_determine_is_refused_with_the_filter_s_options():
+    import pymeshlab
+
+    from curvdetail.curvature.errors import UndeterminedEditError
+    from curvdetail.curvature.testing import grid
+    from curvdetail.filters import apply
+
+    V, F = grid(30, 30)
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=V, face_matrix=F))
+    # free handle details on a flat grid: nothing ties the in-plane rings of the region down
+    with pytest.raises(UndeterminedEditError, match="do not determine the edit.*more handles, handle_detail"):
+        apply(ms, "apply_curvature_editing", handles="450 451 480", handle_detail="free",
+              region_radius=pymeshlab.PercentageValue(45.0))
+    assert np.array_equal(ms.current_mesh().vertex_matrix(), V)      # untouched
+    # the advice works: the handles' details given
+    report = apply(ms, "apply_curvature_editing", handles="450 451 480", handle_detail="transform",
+                   region_radius=pymeshlab.PercentageValue(45.0))
+    assert report["max_displacement"] < 1e-12

@@ -9,7 +9,7 @@ from scipy.sparse.csgraph import connected_components
 from ._validate import as_index_set, as_values, bbox_centre, bbox_diagonal, centroid_diameter
 from .cotan_laplacian import checked_cotan_laplacian, laplacian_product
 from .curvature_coefficients import DEFAULT_RCOND, _coefficients, _one_ring_pairs, check_rcond
-from .errors import ConstraintError, first_indices
+from .errors import ConstraintError, UndeterminedEditError, first_indices
 from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
 from .reconstruct import refine_least_squares
 from .sparse_solver import _chosen_automatically, factorize, resolve_backend
@@ -110,7 +110,7 @@ class CurvatureEditor:
     timings : dict              seconds spent in the constructor: ``coefficients`` (L, D and C),
                                 ``curvature_setup`` (checks and LU of ``(I - C)_uu``),
                                 ``embedding_setup`` (normal equations and their factorization),
-                                ``rest_check`` (one solve with the rest values, ``rest_error``)
+                                ``rest_check`` (``rest_error``: one back-substitution of each stage)
     rank_deficient : int        vertices whose one-ring detail is rank-deficient (see
                                 :func:`curvature_coefficients`)
     detail_islands : int        free vertices whose detail the coefficients cannot determine
@@ -118,8 +118,9 @@ class CurvatureEditor:
                                 coefficients are zero, e.g. a bump in a plane); they keep their
                                 rest detail, like detail-constrained vertices
     rest_error : float          largest distance of :meth:`solve` with the rest values from ``V``,
-                                over the bbox diagonal: rounding (1e-16 ... 1e-7 on real meshes)
-                                where the constraints determine the edit
+                                over the bbox diagonal, as far as the curvature stage causes it:
+                                rounding (0 ... 1e-7 on real meshes) where the constraints
+                                determine the edit
 
     Raises
     ------
@@ -127,9 +128,9 @@ class CurvatureEditor:
     ConstraintError   indices out of range or repeated; a constraint outside ``roi``; an empty
                       ``roi``; no position constraint (or fewer than three detail constraints)
                       while ``roi`` is the whole mesh; a connected free region that touches no position (or no
-                      detail) constraint; constraints that do not determine the edit (the rest
-                      values give back a shape more than :data:`MAX_REST_ERROR` of the
-                      diagonal off ``V``)
+                      detail) constraint; constraints that do not determine the edit
+                      (UndeterminedEditError: the rest values give back a shape more than
+                      :data:`MAX_REST_ERROR` of the diagonal off ``V``)
     ValueError        unknown ``rows`` or ``relations``; ``rcond`` outside (0, 1)
     SolverError       unknown or uninstalled ``backend`` (before any work); a system could not
                       be factored (the constraints do not determine it)
@@ -244,24 +245,33 @@ class CurvatureEditor:
                         "embedding": self._embed.backend if self._embed else "none"}
 
     def _check_rest_state(self):
-        """Largest distance of the rest constraints' result from ``V`` over the bbox diagonal;
-        ConstraintError above :data:`MAX_REST_ERROR`.
+        """Distance from ``V`` (over the bbox diagonal) of the shape the rest constraints give;
+        UndeterminedEditError above :data:`MAX_REST_ERROR`.
 
         The rest state solves both stages exactly (the rest residual is kept as a constant
         term), so anything but rounding means a system singular to working precision, whose
         every edit would be one arbitrary solution among many (a flat grid with three detail
-        constraints: 0.9 of the diagonal at rest). Real meshes come back to 1e-7 and better,
-        ill-conditioned ones included (fandisk, cond(I - C) ~1e14). One solve: ~5 % of the
-        set-up at 951 vertices."""
-        X = self._solve(self._positions(None), self._details(None))
-        error = float(np.linalg.norm(X - self.V, axis=1).max()) / bbox_diagonal(self.V)
+        constraints: 0.3-0.9 of the diagonal at rest). Real meshes come back to 1e-7 and better,
+        ill-conditioned ones included (fandisk, cond(I - C) ~1e14). Both stages are linear, so
+        the shape's error is the embedding's response to the curvature stage's rest-detail
+        error alone: one back-substitution of each stage, no refinement (~0.4 ms at 951
+        vertices, ~2 % of the set-up; it only has to tell 1e-7 from 1e-3)."""
+        error = 0.0
+        if self._curv is not None and self._embed is not None:
+            dc_rest = self.detail[self._dc]
+            Du = self._curv.solve(self._d_const + self._C_dc @ dc_rest)
+            dD = np.zeros_like(self._D_R_rest)
+            dD[self._R_fd_at] = Du[self._R_fd] - self.detail[self._fd][self._R_fd]
+            if dD.any():
+                dX = self._embed.solve(dD if self._A_T is None else self._A_T @ dD)
+                error = float(np.linalg.norm(dX, axis=1).max()) / bbox_diagonal(self.V)
         if not error <= MAX_REST_ERROR:       # NaN included
-            raise ConstraintError(
+            raise UndeterminedEditError(
                 f"the constraints do not determine the edit: solved with their rest values they give "
                 f"back a shape {error:.2g} of the bbox diagonal off the rest shape (the curvature "
-                f"stage (I - C) is singular to working precision: its {self._user_dc} detail constraints "
-                "leave rings free to turn). Constrain more details (e.g. the handles' or the "
-                "region border's), or pass a smaller roi.")
+                f"stage is singular to working precision with these {self._user_dc} detail "
+                "constraints: groups of rings can turn together). Constrain more details (e.g. the "
+                "handles' or the region border's), or pass a smaller roi.")
         return error
 
     def _square_system(self, D, in_roi, free_d, fd, dc, at_fd, at_dc, rows, cols, cvals, curv_backend):

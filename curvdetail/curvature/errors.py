@@ -15,6 +15,12 @@ class ConstraintError(ValueError):
     """A set of constrained (fixed) vertices or their values is malformed or insufficient."""
 
 
+class UndeterminedEditError(ConstraintError):
+    """The constraints of an edit leave the curvature stage singular to working precision (see
+    ``CurvatureEditor.rest_error``); callers with their own way of giving constraints (a
+    selection file, a filter's parameters) add how to give more."""
+
+
 def first_indices(indices, count=3):
     """Format the first few offending indices for an error message: ``'17, 402, 9311'``."""
     indices = [int(i) for i in list(indices)[:count]]

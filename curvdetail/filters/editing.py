@@ -6,7 +6,7 @@ import numpy as np
 
 from ..curvature._validate import bbox_diagonal, check_transformed_values
 from ..curvature.curvature_editor import CurvatureEditor
-from ..curvature.errors import ConstraintError
+from ..curvature.errors import ConstraintError, UndeterminedEditError
 from .apply_curvature_reconstruction import BACKEND_DESCRIPTION, BACKENDS
 from .errors import FilterParameterError
 from .meshset import (get_mesh, layer_id, mesh_arrays, selected_vertices, set_vertex_positions,
@@ -121,7 +121,11 @@ def apply_curvature_editing(ms, *, handles, region_radius, transform, detail_sca
     t = time.perf_counter()
     pc = h if move_handles else np.empty(0, dtype=np.int64)
     dc = h if handle_detail == "transform" else np.empty(0, dtype=np.int64)
-    editor = CurvatureEditor(V, F, pc, dc, roi=roi, relations=relations, backend=backend)
+    try:
+        editor = CurvatureEditor(V, F, pc, dc, roi=roi, relations=relations, backend=backend)
+    except UndeterminedEditError as exc:
+        raise UndeterminedEditError(f"{exc} Here: more handles, handle_detail='transform' (the "
+                                    "handles' details given), or a smaller region.") from None
     with np.errstate(over="ignore", invalid="ignore"):      # named below instead
         details = detail_scale * (editor.detail[dc] @ T[:3, :3].T) if dc.size else None
         positions = V[pc] @ T[:3, :3].T + T[:3, 3] if pc.size else None
