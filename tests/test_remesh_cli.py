@@ -232,6 +232,30 @@ def test_remesh_defaults_are_the_experiment_defaults(tmp_path):
                  "--report", str(rep), "--no-evaluate", "--quiet"]) == 0
     options = json.loads(rep.read_text())["options"]
     assert options["target_edge"] == pytest.approx(0.01) and options["method"] == "isotropic"
-    assert {k: options[k] for k in ("transfer", "rows", "location")} == \
-        {k: DEFAULTS[k] for k in ("transfer", "rows", "location")}
-    assert DEFAULTS["target_edge"] == 0.01
+    assert {k: options[k] for k in ("transfer", "rows", "location", "surface_check")} == \
+        {k: DEFAULTS[k] for k in ("transfer", "rows", "location", "surface_check")}
+    assert DEFAULTS["target_edge"] == 0.01 and DEFAULTS["surface_check"] is True
+
+
+@pytest.mark.parametrize("flag, expected", [([], True), (["--no-surface-check"], False)])
+def test_no_surface_check_is_passed_to_the_remesher_and_recorded(tmp_path, monkeypatch, flag, expected):
+    # the ear at 3 % retriangulates to 648 vertices with the check and 644 without (measured)
+    import pymeshlab
+
+    from curvdetail.remesh import retriangulate
+
+    calls, real = [], pymeshlab.MeshSet.meshing_isotropic_explicit_remeshing
+
+    def spy(self, **kwargs):
+        calls.append(kwargs["checksurfdist"])
+        return real(self, **kwargs)
+
+    monkeypatch.setattr(pymeshlab.MeshSet, "meshing_isotropic_explicit_remeshing", spy)
+    src, out, rep = os.path.join(DATA, "mannequin_ear.obj"), tmp_path / "o.ply", tmp_path / "r.json"
+    assert main(["remesh", src, str(out), "--target-edge", "3", "--no-evaluate", "--report", str(rep),
+                 "--quiet"] + flag) == 0
+    assert calls == [expected]
+    assert json.loads(rep.read_text())["options"]["surface_check"] is expected
+    V, F = read_mesh(src)
+    Vt, Ft = retriangulate(V, F, target_edge=0.03, surface_check=expected)
+    assert read_mesh(str(out))[0].shape == Vt.shape

@@ -261,3 +261,50 @@ def test_function_defaults_are_the_documented_defaults():
     for function in (remesh_experiment, run_experiment):
         parameters = inspect.signature(function).parameters
         assert {k: parameters[k].default for k in DEFAULTS} == DEFAULTS, function.__name__
+
+
+@pytest.fixture
+def isotropic_calls(monkeypatch):
+    """The ``checksurfdist`` of every ``meshing_isotropic_explicit_remeshing`` call (a spy that
+    still runs the filter)."""
+    import pymeshlab
+
+    calls, real = [], pymeshlab.MeshSet.meshing_isotropic_explicit_remeshing
+
+    def spy(self, **kwargs):
+        calls.append(kwargs["checksurfdist"])
+        return real(self, **kwargs)
+
+    monkeypatch.setattr(pymeshlab.MeshSet, "meshing_isotropic_explicit_remeshing", spy)
+    return calls
+
+
+@pytest.mark.parametrize("kwargs, expected", [({}, True), ({"surface_check": False}, False)])
+def test_surface_check_reaches_the_remesher_and_the_report(load_mesh, isotropic_calls, kwargs, expected):
+    V, F = load_mesh("mannequin_ear.obj")
+    (X, Ft), report = remesh_experiment(V, F, target_edge=0.03, evaluate=False, **kwargs)
+    assert isotropic_calls == [expected]
+    assert report["options"]["surface_check"] is expected
+    # the ear at 3 % retriangulates differently without the check: the experiment rebuilds
+    # that retriangulation
+    Vt, Ft_direct = retriangulate(V, F, target_edge=0.03, **kwargs)
+    np.testing.assert_array_equal(Ft, Ft_direct)
+    assert X.shape == Vt.shape
+
+
+def test_surface_check_is_recorded_as_none_where_no_isotropic_remeshing_ran(height_field):
+    V, F = height_field
+    _, decimated = remesh_experiment(V, F, method="decimate", target_edge=0.06, surface_check=False,
+                                     evaluate=False)
+    assert decimated["options"]["surface_check"] is None
+    Vt, Ft = retriangulate(V, F, target_edge=0.06)
+    _, given = remesh_experiment(V, F, target=(Vt, Ft), evaluate=False)
+    assert given["options"]["surface_check"] is None
+
+
+@pytest.mark.parametrize("value", ["no", 0, None])
+def test_a_surface_check_that_is_not_a_bool_is_refused_before_any_work(height_field, isotropic_calls, value):
+    V, F = height_field
+    with pytest.raises(ValueError, match=f"surface_check={value!r} must be True or False"):
+        remesh_experiment(V, F, target_edge=0.05, surface_check=value)
+    assert isotropic_calls == []

@@ -141,6 +141,11 @@ def test_unknown_method_is_refused(load_mesh):
     # target_edge ** 2 raised an OverflowError: the admissible range is given instead
     ({"target_edge": 1e300}, r"fewer than 50; choose a target edge between 0.\d+ % and \d+.\d+ %"),
     ({"target_edge": 1e-300}, r"about inf target vertices, more than 5,000,000; choose a target edge between"),
+    # "no" or 0 would otherwise count as an answer (a truthy string as True)
+    ({"surface_check": "no"}, r"surface_check='no' must be True or False"),
+    ({"surface_check": 0}, r"surface_check=0 must be True or False"),
+    ({"surface_check": None}, r"surface_check=None must be True or False"),
+    ({"method": "decimate", "surface_check": "yes"}, r"surface_check='yes' must be True or False"),
 ])
 def test_out_of_range_remesher_options_are_refused_before_remeshing(load_mesh, kwargs, words):
     # they used to be passed on: -1 iterations returned the source unchanged, a negative surface
@@ -157,3 +162,68 @@ def test_decimation_keeps_the_source_boundary_vertices_bit_for_bit(load_mesh):
     _, _, loop = check_disk(V, F)
     _, _, loop_t = check_disk(Vt, Ft)
     assert sorted(map(tuple, Vt[loop_t])) == sorted(map(tuple, V[loop]))
+
+
+@pytest.fixture
+def isotropic_calls(monkeypatch):
+    """The keyword arguments of every ``meshing_isotropic_explicit_remeshing`` call (a spy that
+    still runs the filter)."""
+    import pymeshlab
+
+    calls, real = [], pymeshlab.MeshSet.meshing_isotropic_explicit_remeshing
+
+    def spy(self, **kwargs):
+        calls.append(kwargs)
+        return real(self, **kwargs)
+
+    monkeypatch.setattr(pymeshlab.MeshSet, "meshing_isotropic_explicit_remeshing", spy)
+    return calls
+
+
+@pytest.mark.parametrize("kwargs, expected", [({}, True), ({"surface_check": True}, True),
+                                              ({"surface_check": False}, False),
+                                              ({"surface_check": np.bool_(False)}, False)])
+def test_surface_check_is_passed_to_pymeshlab_as_checksurfdist(load_mesh, isotropic_calls, kwargs, expected):
+    V, F = load_mesh("mannequin_nose.obj")
+    retriangulate(V, F, target_edge=0.05, **kwargs)
+    (call,) = isotropic_calls
+    assert call["checksurfdist"] is expected            # a plain bool, as pymeshlab wants
+    # the surface distance is passed either way (pymeshlab keeps values from earlier calls)
+    assert call["maxsurfdist"].value() == pytest.approx(0.05)
+
+
+def test_decimation_does_not_call_the_isotropic_remesher(load_mesh, isotropic_calls):
+    V, F = load_mesh("mannequin_nose.obj")
+    a = retriangulate(V, F, method="decimate", target_edge=0.06)
+    b = retriangulate(V, F, method="decimate", target_edge=0.06, surface_check=False)
+    assert isotropic_calls == []
+    np.testing.assert_array_equal(a[1], b[1])
+    np.testing.assert_array_equal(a[0], b[0])
+
+
+def test_without_the_surface_check_the_ear_retriangulates_otherwise_but_still_a_disk_on_its_boundary(load_mesh):
+    # mannequin_ear at 3 %: 648 target vertices with the check, 644 without (measured); both are
+    # disks with every boundary vertex on the source's boundary
+    V, F = load_mesh("mannequin_ear.obj")
+    checked = retriangulate(V, F, target_edge=0.03)
+    unchecked = retriangulate(V, F, target_edge=0.03, surface_check=False)
+    assert checked[0].shape != unchecked[0].shape or not np.array_equal(checked[0], unchecked[0])
+    for Vt, Ft in (checked, unchecked):
+        assert _boundary_distance(V, F, Vt, Ft) <= 1e-9
+    # pymeshlab carries parameters over between calls: the default after an unchecked call is
+    # the checked result again, bit for bit
+    again = retriangulate(V, F, target_edge=0.03)
+    np.testing.assert_array_equal(again[0], checked[0])
+    np.testing.assert_array_equal(again[1], checked[1])
+
+
+def test_a_smooth_patch_gives_a_disk_near_the_target_edge_either_way():
+    from curvdetail.curvature.testing import disk
+
+    V, F = disk(n_rings=16)
+    V[:, 2] = 0.2 * (1 - (V[:, :2] ** 2).sum(1))
+    for surface_check in (True, False):
+        Vt, Ft = retriangulate(V, F, target_edge=0.04, surface_check=surface_check)
+        assert _boundary_distance(V, F, Vt, Ft) <= 1e-9
+        E = np.linalg.norm(Vt[Ft[:, [1, 2, 0]]] - Vt[Ft], axis=2)
+        assert np.median(E) / (0.04 * bbox_diagonal(V)) == pytest.approx(1.0, abs=0.2)
