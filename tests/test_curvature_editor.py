@@ -348,6 +348,19 @@ def test_constraints_that_do_not_determine_the_edit_are_refused():
     assert CurvatureEditor(V, F, b, b).rest_error < 1e-14
 
 
+def test_one_plus_two_ring_refusals_point_to_the_one_ring_relations(load_mesh):
+    # the stacked normal equations square the coefficients' condition number: the same
+    # constraints that one-ring relations determine can be refused there, and "constrain more
+    # details" alone was the wrong advice
+    from curvdetail.curvature.errors import UndeterminedEditError
+
+    V, F = grid(30, 30)
+    b = boundary_vertices(F)
+    with pytest.raises(UndeterminedEditError, match="normal equations.*relations='one-ring'") as exc:
+        CurvatureEditor(V, F, b, [450, 451, 480], relations="one+two-ring")
+    assert exc.value.advice.startswith("Use relations='one-ring'") and "roi" in exc.value.advice
+
+
 def test_rest_error_is_rounding_where_the_constraints_determine_the_edit(load_mesh):
     # ill-conditioned but determined systems pass the rest check (fandisk's near-flat rings,
     # cond(I - C) ~1e14, come back to ~1e-7; this terrain's, with 8 handles, to 1.5e-10). The

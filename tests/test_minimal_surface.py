@@ -262,3 +262,16 @@ def test_full_step_measure_stops_on_the_whole_displacement():
     assert all(s >= 1e-6 for s in seen[:-1])
     with pytest.raises(ValueError, match="step='sideways'"):
         minimal_surface(V, F, boundary_vertices(F), step="sideways")
+
+
+def test_aligned_normals_take_the_largest_triangle_as_reference():
+    # a flat fan around vertex 0 with two triangles reversed, and a small triangle standing
+    # perpendicular to it: taken as the reference, the small one flipped the fan's normals
+    # into its own plane ([0, 1, 0] instead of the fan's -z)
+    from curvdetail.curvature.minimal_surface import _vertex_normals
+
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0], [0.05, 0, 0.05]], dtype=float)
+    fan = [[0, 1, 2], [0, 3, 2], [0, 3, 4], [0, 1, 4]]          # the second and fourth reversed
+    for F in (np.array(fan + [[0, 1, 5]]), np.array([[0, 1, 5]] + fan)):
+        n0 = _vertex_normals(V, F, aligned=True)[0]
+        assert abs(abs(n0[2]) - 1.0) < 0.05, F.tolist()

@@ -254,8 +254,10 @@ class CurvatureEditor:
         constraints: 0.3-0.9 of the diagonal at rest). Real meshes come back to 1e-7 and better,
         ill-conditioned ones included (fandisk, cond(I - C) ~1e14). Both stages are linear, so
         the shape's error is the embedding's response to the curvature stage's rest-detail
-        error alone: one back-substitution of each stage, no refinement (~0.4 ms at 951
-        vertices, ~2 % of the set-up; it only has to tell 1e-7 from 1e-3)."""
+        error: one back-substitution of each stage, no refinement (~1.4 ms at 951 vertices,
+        ~6 % of the set-up; it only has to tell 1e-7 from 1e-3). The embedding's own rounding
+        is not counted: its system is positive definite and refined at every solve, its error
+        far below the threshold (or a SolverError from solve())."""
         error = 0.0
         if self._curv is not None and self._embed is not None:
             dc_rest = self.detail[self._dc]
@@ -266,12 +268,21 @@ class CurvatureEditor:
                 dX = self._embed.solve(dD if self._A_T is None else self._A_T @ dD)
                 error = float(np.linalg.norm(dX, axis=1).max()) / bbox_diagonal(self.V)
         if not error <= MAX_REST_ERROR:       # NaN included
+            if self.relations == "one+two-ring":
+                # the stacked normal equations square the coefficients' condition number (fandisk,
+                # 3 handles: refused with one+two-ring, 2e-6 with one-ring)
+                cause = ("the curvature stage's normal equations are singular to working precision "
+                         f"with these {self._user_dc} detail constraints")
+                advice = ("Use relations='one-ring', constrain more details (e.g. the handles' or the "
+                          "region border's), or pass a smaller roi.")
+            else:
+                cause = (f"the curvature stage is singular to working precision with these {self._user_dc} "
+                         "detail constraints: groups of rings can turn together")
+                advice = ("Constrain more details (e.g. the handles' or the region border's), or pass a "
+                          "smaller roi.")
             raise UndeterminedEditError(
                 f"the constraints do not determine the edit: solved with their rest values they give "
-                f"back a shape {error:.2g} of the bbox diagonal off the rest shape (the curvature "
-                f"stage is singular to working precision with these {self._user_dc} detail "
-                "constraints: groups of rings can turn together). Constrain more details (e.g. the "
-                "handles' or the region border's), or pass a smaller roi.")
+                f"back a shape {error:.2g} of the bbox diagonal off the rest shape ({cause}).", advice)
         return error
 
     def _square_system(self, D, in_roi, free_d, fd, dc, at_fd, at_dc, rows, cols, cvals, curv_backend):

@@ -17,8 +17,13 @@ class ConstraintError(ValueError):
 
 class UndeterminedEditError(ConstraintError):
     """The constraints of an edit leave the curvature stage singular to working precision (see
-    ``CurvatureEditor.rest_error``); callers with their own way of giving constraints (a
-    selection file, a filter's parameters) add how to give more."""
+    ``CurvatureEditor.rest_error``). ``problem`` is what was found and ``advice`` what to change
+    in the editor's terms; callers with their own way of giving constraints (a selection file, a
+    filter's parameters) raise it again with their own advice."""
+
+    def __init__(self, problem, advice):
+        super().__init__(f"{problem} {advice}")
+        self.problem, self.advice = problem, advice
 
 
 def first_indices(indices, count=3):

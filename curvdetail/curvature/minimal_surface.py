@@ -29,16 +29,23 @@ def _vertex_normals(X, F, face_cross=None, aligned=False):
     ``(x1 - x0) x (x2 - x0)``, where the caller has it. ``aligned=True`` is for triangles that
     are not consistently oriented (a Moebius strip cannot be): each triangle's normal enters a
     vertex's sum turned to agree with one of the vertex's triangles, so reversed triangles do not
-    cancel it (the result's sign is then arbitrary; the step measure takes its absolute value)."""
+    cancel it (the result's sign is then arbitrary; the step measure takes its absolute value).
+    That triangle is the vertex's largest."""
     fn = np.cross(X[F[:, 1]] - X[F[:, 0]], X[F[:, 2]] - X[F[:, 0]]) if face_cross is None else face_cross
     n = X.shape[0]
     if not aligned:
         N = np.column_stack([np.bincount(F.ravel(), weights=np.repeat(fn[:, k], 3), minlength=n)
                              for k in range(3)])
     else:
+        # each vertex's reference is its largest triangle: one nearly perpendicular to the rest
+        # (a sharp crease) would otherwise flip them and the sum could lie in their plane
+        corner_vertex = F.ravel()
+        corner_face = np.repeat(np.arange(F.shape[0]), 3)
+        size = np.repeat(np.einsum("ij,ij->i", fn, fn), 3)
+        order = np.lexsort((size, corner_vertex))
+        last = np.flatnonzero(np.r_[corner_vertex[order][1:] != corner_vertex[order][:-1], True])
         reference = np.zeros((n, 3))
-        for corner in range(3):
-            reference[F[:, corner]] = fn
+        reference[corner_vertex[order][last]] = fn[corner_face[order][last]]
         N = np.zeros((n, 3))
         for corner in range(3):
             sign = np.where(np.einsum("ij,ij->i", fn, reference[F[:, corner]]) < 0, -1.0, 1.0)
@@ -182,7 +189,7 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, step="n
                 "topology (e.g. two circles too far apart for a catenoid)."
             )
         move = X_new - X
-        full_step = float((np.abs(move).max(axis=1) / scale).max())
+        full_step = float((np.linalg.norm(move, axis=1) / scale).max())
         if step == "normal":
             normals = _vertex_normals(X_new, F, cross, aligned=aligned)
             measured = float((np.abs(np.einsum("ij,ij->i", move, normals)) / scale).max())
