@@ -82,3 +82,19 @@ def wavy_grid_with_a_sliver():
         return V, F
 
     return _build
+
+
+@pytest.fixture
+def isotropic_calls(monkeypatch):
+    """The keyword arguments of every ``meshing_isotropic_explicit_remeshing`` call, in order (a
+    spy that still runs the filter)."""
+    import pymeshlab
+
+    calls, real = [], pymeshlab.MeshSet.meshing_isotropic_explicit_remeshing
+
+    def spy(self, **kwargs):
+        calls.append(kwargs)
+        return real(self, **kwargs)
+
+    monkeypatch.setattr(pymeshlab.MeshSet, "meshing_isotropic_explicit_remeshing", spy)
+    return calls

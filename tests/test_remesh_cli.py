@@ -238,23 +238,14 @@ def test_remesh_defaults_are_the_experiment_defaults(tmp_path):
 
 
 @pytest.mark.parametrize("flag, expected", [([], True), (["--no-surface-check"], False)])
-def test_no_surface_check_is_passed_to_the_remesher_and_recorded(tmp_path, monkeypatch, flag, expected):
+def test_no_surface_check_is_passed_to_the_remesher_and_recorded(tmp_path, isotropic_calls, flag, expected):
     # the ear at 3 % retriangulates to 648 vertices with the check and 644 without (measured)
-    import pymeshlab
-
     from curvdetail.remesh import retriangulate
 
-    calls, real = [], pymeshlab.MeshSet.meshing_isotropic_explicit_remeshing
-
-    def spy(self, **kwargs):
-        calls.append(kwargs["checksurfdist"])
-        return real(self, **kwargs)
-
-    monkeypatch.setattr(pymeshlab.MeshSet, "meshing_isotropic_explicit_remeshing", spy)
     src, out, rep = os.path.join(DATA, "mannequin_ear.obj"), tmp_path / "o.ply", tmp_path / "r.json"
     assert main(["remesh", src, str(out), "--target-edge", "3", "--no-evaluate", "--report", str(rep),
                  "--quiet"] + flag) == 0
-    assert calls == [expected]
+    assert [call["checksurfdist"] for call in isotropic_calls] == [expected]
     assert json.loads(rep.read_text())["options"]["surface_check"] is expected
     V, F = read_mesh(src)
     Vt, Ft = retriangulate(V, F, target_edge=0.03, surface_check=expected)

@@ -164,22 +164,6 @@ def test_decimation_keeps_the_source_boundary_vertices_bit_for_bit(load_mesh):
     assert sorted(map(tuple, Vt[loop_t])) == sorted(map(tuple, V[loop]))
 
 
-@pytest.fixture
-def isotropic_calls(monkeypatch):
-    """The keyword arguments of every ``meshing_isotropic_explicit_remeshing`` call (a spy that
-    still runs the filter)."""
-    import pymeshlab
-
-    calls, real = [], pymeshlab.MeshSet.meshing_isotropic_explicit_remeshing
-
-    def spy(self, **kwargs):
-        calls.append(kwargs)
-        return real(self, **kwargs)
-
-    monkeypatch.setattr(pymeshlab.MeshSet, "meshing_isotropic_explicit_remeshing", spy)
-    return calls
-
-
 @pytest.mark.parametrize("kwargs, expected", [({}, True), ({"surface_check": True}, True),
                                               ({"surface_check": False}, False),
                                               ({"surface_check": np.bool_(False)}, False)])
