@@ -211,7 +211,8 @@ def _minimal_command(parser):
                                   "(or vertices named with --fix).")
         progress = Progress(args.max_iterations, enabled=sys.stderr.isatty())
         X = minimal_surface(V, F, fixed, max_iterations=args.max_iterations, tol=args.tol,
-                            step=args.step, backend=args.backend, callback=lambda i, s: progress.stage(f"step {i}"))
+                            step=args.step, backend=args.backend,
+                            callback=lambda i, s: progress.stage(f"step {i}"))
         progress.close()
         write_mesh(args.output, X, F, quality=np.linalg.norm(X - V, axis=1), overwrite=args.overwrite)
         state = "converged" if X.converged else "stopped (not converged)"

@@ -25,7 +25,7 @@ RELATIONS = ("one-ring", "one+two-ring")
 CURVATURE_SPLU_MAX = 300_000
 
 #: Largest distance (over the bbox diagonal) at which the rest constraints may give back the
-#: rest shape; above it the constructor raises ConstraintError (see ``rest_error``).
+#: rest shape; above it the constructor raises UndeterminedEditError (see ``rest_error``).
 MAX_REST_ERROR = 1e-3
 
 
@@ -82,8 +82,9 @@ class CurvatureEditor:
                                 system ``L_ff X_f = D_f - L_fc X_c``: sparser, faster re-solves)
     relations : {"one-ring", "one+two-ring"}
                                 curvature stage: ``"one-ring"`` is the paper's relations (in
-                                the square system's form above); ``"one+two-ring"`` also computes minimum-norm coefficients
-                                over each vertex's two-ring, ``C2``, and minimizes
+                                the square system's form above); ``"one+two-ring"`` also
+                                computes minimum-norm coefficients over each vertex's two-ring,
+                                ``C2``, and minimizes
                                 ``|(I - C) D|^2 + |(I - C2) D|^2`` over the region's rows (normal
                                 equations). Same invariance and the same rest state, but twice the
                                 equations for the same unknowns: far less amplification of
@@ -161,7 +162,8 @@ class CurvatureEditor:
         if rows not in ("all", "free"):
             raise ValueError(f"rows={rows!r} is not a row mode; use 'all' (the paper's E_Q) or 'free'.")
         if relations not in RELATIONS:
-            raise ValueError(f"relations={relations!r}; use 'one-ring' (the paper's relations) or 'one+two-ring'.")
+            raise ValueError(f"relations={relations!r}; use 'one-ring' (the paper's relations) or "
+                             "'one+two-ring'.")
         rcond = check_rcond(rcond)
         resolve_backend(backend)           # an unknown or missing backend fails before the work
         self.relations = relations

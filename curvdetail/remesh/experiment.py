@@ -51,8 +51,9 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="c
     included), reconstruct (target positions from the transferred detail with the target's
     boundary fixed: one :class:`~curvdetail.Reconstructor` factorization, solved for the detail
     and for the zero-detail baseline, the harmonic surface ``(L Z)_free = 0``: with
-    ``rows="all"`` a second, free-row factorization gives it), evaluate (:func:`hausdorff` for the rebuilt mesh, the
-    zero-detail baseline and the retriangulated surface itself, the floor).
+    ``rows="all"`` a second, free-row factorization gives it), evaluate (:func:`hausdorff` for
+    the rebuilt mesh, the zero-detail baseline and the retriangulated surface itself, the
+    floor).
 
     Parameters
     ----------
@@ -232,7 +233,8 @@ def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="cons
                     "transfer": transfer, "rows": rows,
                     "location": location, "parameterization": parameterization if location == "uv" else None,
                     "backend": solver,
-                    "surface_check": bool(surface_check) if target is None and method == "isotropic" else None},
+                    "surface_check": (bool(surface_check) if target is None and method == "isotropic"
+                                      else None)},
     }
     if param_info is not None:
         report["parameterization"] = param_info

@@ -2,7 +2,8 @@
 
 import numpy as np
 
-from ..curvature._validate import as_count, as_float, as_positive_number, bbox_diagonal, check_bool, face_double_areas
+from ..curvature._validate import (as_count, as_float, as_positive_number, bbox_diagonal, check_bool,
+                                   face_double_areas)
 from ._disk import NotADiskError, Polyline, RemeshError, check_disk
 
 METHODS = ("isotropic", "decimate")
