@@ -338,3 +338,17 @@ def test_rows_all_refuses_what_it_cannot_solve_instead_of_returning_a_wrong_surf
         reconstruct(V, F, curvature_detail(V, F), b, V[b], backend="splu")
     X = reconstruct(V, F, curvature_detail(V, F), b, V[b], rows="free", backend="splu")
     assert np.abs(X - V).max() < 1e-7 * bbox_diagonal(V)
+
+
+def test_a_stalled_refinement_raises_or_returns_its_last_iterate_as_asked():
+    # the editor's stacked curvature stage judges its result by the rest check instead
+    from curvdetail import SolverError
+    from curvdetail.curvature.reconstruct import refine_least_squares
+
+    def stalled(X):                  # corrections that never shrink, 1e-3 of the solution
+        return np.full_like(X, 1e-3)
+
+    with pytest.raises(SolverError, match="refinement stalled"):
+        refine_least_squares(np.ones((4, 3)), stalled, 1)
+    X = refine_least_squares(np.ones((4, 3)), stalled, 1, stall="return")
+    assert np.allclose(X, 1.002, rtol=0, atol=1e-12)           # two steps: the stall is seen

@@ -152,8 +152,9 @@ class CurvatureEditor:
     True
     """
 
-    #: corrected semi-normal refinement steps of the ``rows="all"`` embedding (each one more
-    #: back-substitution); 0 gives the plain normal-equation solution (~cond^2 eps)
+    #: corrected semi-normal refinement steps of every normal-equation solve: the ``rows="all"``
+    #: embedding and the ``"one+two-ring"`` curvature stage (each one more back-substitution);
+    #: 0 gives the plain normal-equation solutions (~cond^2 eps)
     refinement_steps = 1
 
     def __init__(self, V, F, position_constrained, detail_constrained, *, roi=None,
@@ -263,28 +264,19 @@ class CurvatureEditor:
         error = 0.0
         if self._curv is not None and self._embed is not None:
             dc_rest = self.detail[self._dc]
-            Du = self._curv.solve(self._d_const + self._C_dc @ dc_rest)
+            Du = self._curvature_solve(dc_rest)
             dD = np.zeros_like(self._D_R_rest)
             dD[self._R_fd_at] = Du[self._R_fd] - self.detail[self._fd][self._R_fd]
             if dD.any():
                 dX = self._embed.solve(dD if self._A_T is None else self._A_T @ dD)
                 error = float(np.linalg.norm(dX, axis=1).max()) / bbox_diagonal(self.V)
         if not error <= MAX_REST_ERROR:       # NaN included
-            if self.relations == "one+two-ring":
-                # the stacked normal equations square the coefficients' condition number (fandisk,
-                # 3 handles: refused with one+two-ring, 2e-6 with one-ring)
-                cause = ("the curvature stage's normal equations are singular to working precision "
-                         f"with these {self._user_dc} detail constraints")
-                advice = ("Use relations='one-ring', constrain more details (e.g. the handles' or the "
-                          "region border's), or pass a smaller roi.")
-            else:
-                cause = (f"the curvature stage is singular to working precision with these {self._user_dc} "
-                         "detail constraints: groups of rings can turn together")
-                advice = ("Constrain more details (e.g. the handles' or the region border's), or pass a "
-                          "smaller roi.")
             raise UndeterminedEditError(
                 f"the constraints do not determine the edit: solved with their rest values they give "
-                f"back a shape {error:.2g} of the bbox diagonal off the rest shape ({cause}).", advice)
+                f"back a shape {error:.2g} of the bbox diagonal off the rest shape (the curvature stage "
+                f"is singular to working precision with these {self._user_dc} detail constraints: "
+                "groups of rings can turn together).",
+                "Constrain more details (e.g. the handles' or the region border's), or pass a smaller roi.")
         return error
 
     def _square_system(self, D, in_roi, free_d, fd, dc, at_fd, at_dc, rows, cols, cvals, curv_backend):
@@ -312,6 +304,7 @@ class CurvatureEditor:
         # "auto" takes SuperLU (symmetric mode, no pivoting) for (I - C) below CURVATURE_SPLU_MAX
         # unknowns, for its faster back-substitution (see there).
         self._curv = factorize(M, symmetric=False, backend=curv_backend) if fd.size else None
+        self._Au = None                                     # square: solved exactly, no refinement
 
     def _stacked_system(self, D, in_roi, fd, dc, at_fd, at_dc, rel1, rel2, backend):
         """Least squares over the region's rows of both (I - C1) and (I - C2): normal equations
@@ -336,6 +329,11 @@ class CurvatureEditor:
         # is (see _square_system): together -A_ext D_ext + (A D)_rest = A_u D_u + A_dc D_dc at rest
         self._d_const = AuT @ (Au @ D[fd] + Bdc @ D[dc])
         self._C_dc = -(AuT @ Bdc).tocsr()
+        # for the corrected semi-normal refinement (_curvature_solve): the normal equations square
+        # the coefficients' condition number (fandisk, 3 handles: the rest shape 7e-3 ... 3e-2 of
+        # the diagonal off without it)
+        self._Au, self._AuT, self._Bdc = Au, AuT, Bdc
+        self._b_rest = Au @ D[fd] + Bdc @ D[dc]
         self._curv = factorize((AuT @ Au).tocsr(), symmetric=True, backend=backend) if fd.size else None
 
     def _embedding(self, L, V, F, in_roi, pc, rows, cols, backend):
@@ -397,7 +395,7 @@ class CurvatureEditor:
         D = self.detail.copy()
         D[self._dc] = Dk
         if self._curv is not None:
-            D[self._fd] = self._curv.solve(self._d_const + self._C_dc @ Dk)
+            D[self._fd] = self._curvature_solve(Dk)
         return D
 
     def solve(self, positions=None, details=None, *, return_details=False):
@@ -429,7 +427,7 @@ class CurvatureEditor:
         D_R = self._D_R_rest.copy()
         Du = None
         if self._curv is not None:
-            Du = self._curv.solve(self._d_const + self._C_dc @ Dk)
+            Du = self._curvature_solve(Dk)
             D_R[self._R_fd_at] = Du[self._R_fd]
         D_R[self._R_dc_at] = Dk[self._R_dc]
         X = self.V.copy()
@@ -448,6 +446,21 @@ class CurvatureEditor:
         if Du is not None:
             D[self._fd] = Du
         return X, D
+
+    def _curvature_solve(self, Dk=None, *, columns=None):
+        """The curvature stage's unknown details for the constraint values ``Dk`` (q, 3), or its
+        response to the detail constraints ``columns`` (one column each, values 1). The square
+        system is solved exactly; the stacked least squares (``relations="one+two-ring"``) through
+        its normal equations and corrected semi-normal refinement (:func:`refine_least_squares`,
+        at least ``refinement_steps`` steps; where it stalls, as on near-null directions of detail
+        islands, the last iterate is taken and the rest check judges the shape it gives)."""
+        if self._Au is None:
+            rhs = self._C_dc[:, columns].toarray() if columns is not None else self._d_const + self._C_dc @ Dk
+            return self._curv.solve(rhs)
+        b = -self._Bdc[:, columns].toarray() if columns is not None else self._b_rest - self._Bdc @ Dk
+        x = self._curv.solve(self._AuT @ b)
+        return refine_least_squares(x, lambda x: self._curv.solve(self._AuT @ (b - self._Au @ x)),
+                                    self.refinement_steps, stall="return")
 
     def _embedding_solve(self, rhs):
         """Free positions minimizing ``|A X_f - rhs|`` over the rows ``R`` (rows="all"), or
@@ -508,7 +521,7 @@ class CurvatureEditor:
         if self._embed is not None and jd.size:
             dR = np.zeros((self._R.size, jd.size))
             if self._curv is not None:
-                du = self._curv.solve(self._C_dc[:, jd].toarray())
+                du = self._curvature_solve(columns=jd)
                 dR[self._R_fd_at] = du[self._R_fd]
             at = np.full(self._dc.size, -1, dtype=np.int64)
             at[np.flatnonzero(self._R_dc)] = self._R_dc_at

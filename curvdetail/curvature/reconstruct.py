@@ -208,7 +208,7 @@ class Reconstructor:
         return refine_least_squares(X_f, correction, self.refinement_steps)
 
 
-def refine_least_squares(X, correction, min_steps):
+def refine_least_squares(X, correction, min_steps, *, stall="raise"):
     """Refine a normal-equation solution ``X`` in place by ``X += correction(X)`` and return it.
 
     Each corrected semi-normal step contracts the error by about ``cond^2 eps``, which the
@@ -219,7 +219,8 @@ def refine_least_squares(X, correction, min_steps):
     have reached the problem's rounding floor: the result is taken where they are below
     ``REFINEMENT_FLOOR`` of the solution, and SolverError raised where they are not (the normal
     equations are then too ill-conditioned: near-degenerate triangles), as where the steps run
-    out above it."""
+    out above it; ``stall="return"`` returns the last iterate there instead (for callers that
+    judge the result themselves)."""
     if not min_steps:
         return X
     size = max(float(np.abs(X).max()), np.finfo(float).tiny)
@@ -236,7 +237,7 @@ def refine_least_squares(X, correction, min_steps):
                 return X
             break                                               # stalled above it
         previous = relative
-    if relative <= REFINEMENT_FLOOR:
+    if relative <= REFINEMENT_FLOOR or stall == "return":
         return X
     raise SolverError(
         f"rows='all': the normal equations are too ill-conditioned to solve accurately (the "
