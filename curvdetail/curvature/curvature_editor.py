@@ -257,8 +257,9 @@ class CurvatureEditor:
         constraints: 0.3-0.9 of the diagonal at rest). Real meshes come back to 1e-7 and better,
         ill-conditioned ones included (fandisk, cond(I - C) ~1e14). Both stages are linear, so
         the shape's error is the embedding's response to the curvature stage's rest-detail
-        error: one back-substitution of each stage, no refinement (~1.4 ms at 951 vertices,
-        ~6 % of the set-up; it only has to tell 1e-7 from 1e-3). The embedding's own rounding
+        error: one back-substitution of each stage, no refinement of the embedding (~1.4 ms at
+        951 vertices, ~6 % of the set-up; it only has to tell 1e-7 from 1e-3; the stacked
+        one+two-ring curvature stage keeps its own refinement). The embedding's own rounding
         is not counted: its system is positive definite and refined at every solve, its error
         far below the threshold (or a SolverError from solve())."""
         error = 0.0
