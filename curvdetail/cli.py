@@ -560,7 +560,8 @@ def _edit_command(parser):
                                             relations=args.relations, backend=args.backend,
                                             return_editor=True)
         except UndeterminedEditError as exc:
-            other = " or --handle-detail transform" if args.handle_detail == "free" else ""
+            other = (" or --relations one-ring" if args.relations == "one+two-ring" else
+                     " or --handle-detail transform" if args.handle_detail == "free" else "")
             raise UndeterminedEditError(exc.problem, f"Add handles (status 2) or fixed vertices (status 0) "
                                                      f"in {args.sel}{other}.") from None
         seconds = time.perf_counter() - t

@@ -373,3 +373,35 @@ def test_rest_error_is_rounding_where_the_constraints_determine_the_edit(load_me
     ed = CurvatureEditor(V, F, h, h)
     error = np.linalg.norm(ed.solve() - V, axis=1).max() / _diag(V)
     assert 1e-11 < ed.rest_error < 1e-9 and ed.rest_error == pytest.approx(error, rel=1e-2)
+
+
+def test_one_plus_two_ring_refusals_name_the_one_ring_relations_that_determine_them():
+    # on flat regions the stacked relations are singular where the square one-ring system is
+    # not (second review: refused 0.055 off, one-ring exact); the advice had lost that option
+    from curvdetail.curvature.errors import UndeterminedEditError
+
+    V, F = grid(30, 30)
+    b = boundary_vertices(F)
+    with pytest.raises(UndeterminedEditError) as exc:
+        CurvatureEditor(V, F, b, [100, 460, 800], relations="one+two-ring")
+    assert "relations='one-ring'" in exc.value.advice
+    assert CurvatureEditor(V, F, b, [100, 460, 800]).rest_error < 1e-14      # the advice works
+
+
+def test_a_curvature_stage_that_cannot_be_factored_is_an_undetermined_edit(monkeypatch):
+    # PARDISO stopped on an exactly singular stacked stage (the benchmark cylinder with free
+    # handle details) with only "error -4"; the edit's own error says what to change
+    from curvdetail.curvature import curvature_editor
+    from curvdetail.curvature.errors import UndeterminedEditError
+    from curvdetail.curvature.sparse_solver import SolverError
+
+    def failing(M, symmetric, backend, **kwargs):
+        raise SolverError("PARDISO could not factor the matrix (PARDISO error -4); it may be singular.")
+
+    V, F = grid(12, 12)
+    V[:, 2] = 0.1 * np.sin(3 * V[:, 0])
+    b = boundary_vertices(F)
+    monkeypatch.setattr(curvature_editor, "factorize", failing)
+    with pytest.raises(UndeterminedEditError, match="curvature stage could not be factored.*error -4") as exc:
+        CurvatureEditor(V, F, b, b[:5], relations="one+two-ring")
+    assert "relations='one-ring'" in exc.value.advice

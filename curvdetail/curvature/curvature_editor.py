@@ -12,7 +12,7 @@ from .curvature_coefficients import DEFAULT_RCOND, _coefficients, _one_ring_pair
 from .errors import ConstraintError, UndeterminedEditError, first_indices
 from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
 from .reconstruct import refine_least_squares
-from .sparse_solver import _chosen_automatically, factorize, resolve_backend
+from .sparse_solver import SolverError, _chosen_automatically, factorize, resolve_backend
 
 
 RELATIONS = ("one-ring", "one+two-ring")
@@ -131,10 +131,11 @@ class CurvatureEditor:
                       while ``roi`` is the whole mesh; a connected free region that touches no position (or no
                       detail) constraint; constraints that do not determine the edit
                       (UndeterminedEditError: the rest values give back a shape more than
-                      :data:`MAX_REST_ERROR` of the diagonal off ``V``)
+                      :data:`MAX_REST_ERROR` of the diagonal off ``V``, or the curvature stage
+                      could not be factored)
     ValueError        unknown ``rows`` or ``relations``; ``rcond`` outside (0, 1)
-    SolverError       unknown or uninstalled ``backend`` (before any work); a system could not
-                      be factored (the constraints do not determine it)
+    SolverError       unknown or uninstalled ``backend`` (before any work); the embedding could
+                      not be factored
 
     Examples
     --------
@@ -276,9 +277,26 @@ class CurvatureEditor:
                 f"the constraints do not determine the edit: solved with their rest values they give "
                 f"back a shape {error:.2g} of the bbox diagonal off the rest shape (the curvature stage "
                 f"is singular to working precision with these {self._user_dc} detail constraints: "
-                "groups of rings can turn together).",
-                "Constrain more details (e.g. the handles' or the region border's), or pass a smaller roi.")
+                "groups of rings can turn together).", self._undetermined_advice())
         return error
+
+    def _undetermined_advice(self):
+        # on flat and near-flat regions the stacked relations are singular where the square
+        # one-ring system is not (a flat grid, 3 detail constraints: 0.055 off, one-ring exact)
+        other = "use relations='one-ring', " if self.relations == "one+two-ring" else ""
+        return (f"Constrain more details (e.g. the handles' or the region border's), {other}or pass a "
+                "smaller roi.")
+
+    def _factor_curvature_stage(self, M, symmetric, backend):
+        """factorize(M), a failure named as constraints that do not determine the edit (an
+        exactly singular stage: the cylinder with free handle details and one+two-ring
+        relations, where PARDISO stopped with only "error -4")."""
+        try:
+            return factorize(M, symmetric=symmetric, backend=backend)
+        except SolverError as exc:
+            raise UndeterminedEditError(f"the constraints do not determine the edit: the curvature stage "
+                                        f"could not be factored with these {self._user_dc} detail "
+                                        f"constraints ({exc})", self._undetermined_advice()) from None
 
     def _square_system(self, D, in_roi, free_d, fd, dc, at_fd, at_dc, rows, cols, cvals, curv_backend):
         """The paper's linear-system form: (I - C)_uu D_u = C_uk D_k over the free rows (square,
@@ -304,7 +322,7 @@ class CurvatureEditor:
                                           for k in range(3)], axis=1)
         # "auto" takes SuperLU (symmetric mode, no pivoting) for (I - C) below CURVATURE_SPLU_MAX
         # unknowns, for its faster back-substitution (see there).
-        self._curv = factorize(M, symmetric=False, backend=curv_backend) if fd.size else None
+        self._curv = self._factor_curvature_stage(M, False, curv_backend) if fd.size else None
         self._Au = None                                     # square: solved exactly, no refinement
 
     def _stacked_system(self, D, in_roi, fd, dc, at_fd, at_dc, rel1, rel2, backend):
@@ -335,7 +353,7 @@ class CurvatureEditor:
         # the diagonal off without it)
         self._Au, self._AuT, self._Bdc = Au, AuT, Bdc
         self._b_rest = Au @ D[fd] + Bdc @ D[dc]
-        self._curv = factorize((AuT @ Au).tocsr(), symmetric=True, backend=backend) if fd.size else None
+        self._curv = self._factor_curvature_stage((AuT @ Au).tocsr(), True, backend) if fd.size else None
 
     def _embedding(self, L, V, F, in_roi, pc, rows, cols, backend):
         """E_Q over the rows that involve the free positions (normal equations) or the free rows."""

@@ -233,6 +233,9 @@ def refine_least_squares(X, correction, min_steps, *, stall="raise"):
         if step + 1 >= min_steps and relative * min(contraction, 1.0) <= REFINEMENT_TOLERANCE:
             return X                                            # converged
         if previous is not None and contraction > 0.5 and step + 1 >= min_steps:
+            if contraction > 1.0:                               # a correction that grew: undo it
+                X -= delta
+                relative = previous
             if relative <= REFINEMENT_FLOOR:                    # at the rounding floor
                 return X
             break                                               # stalled above it

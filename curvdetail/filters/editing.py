@@ -124,7 +124,8 @@ def apply_curvature_editing(ms, *, handles, region_radius, transform, detail_sca
     try:
         editor = CurvatureEditor(V, F, pc, dc, roi=roi, relations=relations, backend=backend)
     except UndeterminedEditError as exc:
-        other = "handle_detail='transform' (the handles' details given), " if handle_detail == "free" else ""
+        other = ("relations='one-ring', " if relations == "one+two-ring" else
+                 "handle_detail='transform' (the handles' details given), " if handle_detail == "free" else "")
         raise UndeterminedEditError(exc.problem, f"Use more handles, {other}or a smaller region "
                                                  "(selection, region_radius).") from None
     with np.errstate(over="ignore", invalid="ignore"):      # named below instead
