@@ -344,13 +344,12 @@ class CurvatureEditor:
         k = at_dc[mc] >= 0
         Bdc = sp.csr_matrix((mv[k], (mr[k], at_dc[mc[k]])), shape=(m, dc.size))
         AuT = Au.T.tocsr()
-        # the exterior details as in V and the rest residual of every stacked row, kept as it
-        # is (see _square_system): together -A_ext D_ext + (A D)_rest = A_u D_u + A_dc D_dc at rest
-        self._d_const = AuT @ (Au @ D[fd] + Bdc @ D[dc])
-        self._C_dc = -(AuT @ Bdc).tocsr()
-        # for the corrected semi-normal refinement (_curvature_solve): the normal equations square
-        # the coefficients' condition number (fandisk, 3 handles: the rest shape 7e-3 ... 3e-2 of
-        # the diagonal off without it)
+        # the least squares |A_u D_u - b| with b = b_rest - A_dc D_dc: b_rest holds the exterior
+        # details as in V and the rest residual of every stacked row, kept as it is (see
+        # _square_system), so that the rest state solves it exactly. Au and its transpose are
+        # kept for the corrected semi-normal refinement (_curvature_solve): the normal equations
+        # square the coefficients' condition number (fandisk, 3 handles: the rest shape 7e-3 ...
+        # 3e-2 of the diagonal off without it)
         self._Au, self._AuT, self._Bdc = Au, AuT, Bdc
         self._b_rest = Au @ D[fd] + Bdc @ D[dc]
         self._curv = self._factor_curvature_stage((AuT @ Au).tocsr(), True, backend) if fd.size else None
