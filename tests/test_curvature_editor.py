@@ -72,6 +72,23 @@ def test_constraints_are_kept_exactly_and_outside_roi_is_untouched(load_mesh):
     assert moved[roi].max() > 0.5 * 0.05 * _diag(V)
 
 
+def test_changing_the_callers_arrays_afterwards_does_not_change_the_editor(load_mesh):
+    V, F = load_mesh("mannequin_ear.obj")
+    V, F = np.ascontiguousarray(V, dtype=np.float64), np.ascontiguousarray(F, dtype=np.int64)
+    centre = np.argmin(np.linalg.norm(V - V.mean(0), axis=1))
+    dist = np.linalg.norm(V - V[centre], axis=1)
+    roi, handle = np.flatnonzero(dist < np.quantile(dist, 0.6)), np.flatnonzero(dist < np.quantile(dist, 0.05))
+    ed = CurvatureEditor(V, F, handle, handle, roi=roi)
+    rest = ed.solve()
+    V_before = V.copy()
+    V += 10.0                 # the caller reuses its array
+    F[:] = F[:, ::-1]
+    assert np.array_equal(ed.solve(), rest)
+    assert np.abs(rest - V_before).max() < 1e-8 * _diag(V_before)
+    with pytest.raises(ValueError):    # and the editor's own copies are read-only
+        ed.V[0] = 0.0
+
+
 @pytest.mark.parametrize("rows", ["all", "free"])
 def test_embedding_equals_core_reconstruction_when_every_detail_is_given(load_mesh, rng, rows):
     V, F = load_mesh("mannequin_nose.obj")

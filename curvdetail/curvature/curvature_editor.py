@@ -170,6 +170,10 @@ class CurvatureEditor:
         resolve_backend(backend)           # an unknown or missing backend fails before the work
         self.relations = relations
         n = V.shape[0]
+        # own read-only copies: the checks pass a contiguous caller array through, and an edit of
+        # it afterwards would reach the vertices outside the ROI but not L or the coefficients
+        V, F = V.copy(), F.copy()
+        V.flags.writeable = F.flags.writeable = False
         self.n, self.V, self.F, self.rows = n, V, F, rows
         pc = as_index_set(position_constrained, n, "position_constrained")
         dc = as_index_set(detail_constrained, n, "detail_constrained")
