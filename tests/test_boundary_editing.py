@@ -54,6 +54,11 @@ def test_displacement_array_of_the_wrong_shape_is_refused(load_mesh):
         edit_boundary(V, F, np.zeros((3, 3)))
     with pytest.raises(ValueError, match="callable returned shape"):
         edit_boundary(V, F, lambda s, P: np.zeros(3))
+    # complex or bool values are refused as in an array, not cast (imaginary part dropped, 0/1)
+    with pytest.raises(ValueError, match="callable returned dtype complex128"):
+        edit_boundary(V, F, lambda s, P: np.zeros((s.size, 3)) + 1j)
+    with pytest.raises(ValueError, match="callable returned dtype bool"):
+        edit_boundary(V, F, lambda s, P: np.ones((s.size, 3), dtype=bool))
 
 
 def test_rest_boundary_detail_keeps_the_inside_detail(load_mesh):

@@ -89,10 +89,14 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
     s = np.concatenate([[0.0], np.cumsum(seg)[:-1]]) / seg.sum()
     if callable(displacement):
         try:
-            d = np.asarray(displacement(s.copy(), P.copy()), dtype=np.float64)
+            d = np.asarray(displacement(s.copy(), P.copy()))
         except (TypeError, ValueError) as exc:
             raise ValueError(f"the displacement callable failed ({exc}); it must map (s, P) to a "
                              f"({loop.size}, 3) float array.") from None
+        if d.dtype.kind not in "fiu":   # complex would lose its imaginary part, bool mean 0/1
+            raise ValueError(f"the displacement callable returned dtype {d.dtype}; it must return a "
+                             f"({loop.size}, 3) array of real numbers.")
+        d = d.astype(np.float64)
         if d.shape != (loop.size, 3) or not np.all(np.isfinite(d)):
             raise ValueError(f"the displacement callable returned shape {d.shape} (or non-finite "
                              f"values); it must return a finite ({loop.size}, 3) array.")
