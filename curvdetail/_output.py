@@ -76,8 +76,9 @@ def check_output_path(path, overwrite=False, *, hint=_FORMATS_HINT, error=MeshEr
     if os.path.isdir(path):       # --overwrite cannot help: a folder is never replaced
         kind = IsADirectoryError if issubclass(error, OSError) else error
         raise kind(f"cannot write {path!r}: it is a folder; name a file (in it, or elsewhere).")
-    if os.path.exists(path) and not overwrite:
-        raise FileExistsError(f"{path} exists; pass --overwrite (overwrite=True) to replace it.")
+    if os.path.lexists(path) and not overwrite:     # a dangling link exists too
+        what = "is a link to a missing file" if not os.path.exists(path) else "exists"
+        raise FileExistsError(f"{path} {what}; pass --overwrite (overwrite=True) to replace it.")
     folder = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(folder):
         raise error(f"cannot write {path!r}: folder {folder!r} does not exist.")

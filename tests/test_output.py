@@ -62,6 +62,19 @@ def test_atomic_output_refuses_an_existing_file_before_the_block(tmp_path):
     assert os.listdir(tmp_path) == ["a.txt"]
 
 
+def test_a_dangling_link_is_not_replaced_without_overwrite(tmp_path):
+    link = tmp_path / "a.txt"
+    os.symlink(tmp_path / "missing.txt", link)
+    with pytest.raises(FileExistsError, match="link to a missing file.*--overwrite"):
+        with atomic_output(link):
+            pytest.fail("the block must not run")
+    assert os.path.islink(link)
+    with atomic_output(link, overwrite=True) as tmp:
+        with open(tmp, "w") as fh:
+            fh.write("new")
+    assert not os.path.islink(link) and link.read_text() == "new"
+
+
 def test_check_output_path_names_missing_folder_and_extension(tmp_path):
     with pytest.raises(MeshError, match="does not exist"):
         check_output_path(tmp_path / "no" / "a.ply")
