@@ -328,7 +328,7 @@ def _remesh_command(parser):
         try:
             result = run_experiment(V, F, method=args.method, target_edge=args.target_edge / 100.0,
                                     transfer=args.transfer, rows=args.rows, location=args.location,
-                                    parameterization=args.parameterization or "harmonic", backend=args.backend,
+                                    parameterization=args.parameterization, backend=args.backend,
                                     evaluate=not args.no_evaluate, source_path=os.path.abspath(args.input),
                                     progress=progress.stage, surface_check=not args.no_surface_check)
             report = result["report"]

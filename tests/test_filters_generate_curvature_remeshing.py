@@ -9,6 +9,7 @@ import pytest
 from curvdetail import boundary_vertices
 from curvdetail.curvature._validate import bbox_diagonal
 from curvdetail.filters import apply
+from curvdetail.filters.errors import FilterParameterError
 from curvdetail.filters.meshset import vertex_attribute
 from curvdetail.remesh import NotADiskError, transfer_curvature, vertex_distance
 
@@ -102,6 +103,14 @@ def test_closed_mesh_is_refused_with_what_was_found():
     ms.load_new_mesh(os.path.join(DATA, "spot.obj"))
     with pytest.raises(NotADiskError, match="closed"):
         apply(ms, "generate_curvature_remeshing", evaluate=False)
+    assert ms.mesh_number() == 1
+
+
+def test_a_parameterization_without_uv_location_is_refused_not_ignored():
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(os.path.join(DATA, "terrainA_1k.obj"))
+    with pytest.raises(FilterParameterError, match="parameterization='lscm' applies to location='uv' only"):
+        apply(ms, "generate_curvature_remeshing", parameterization="lscm", evaluate=False)
     assert ms.mesh_number() == 1
 
 

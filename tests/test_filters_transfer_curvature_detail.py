@@ -9,6 +9,7 @@ import pytest
 from curvdetail import MeshError, curvature_detail, mixed_voronoi_area
 from curvdetail.curvature._validate import bbox_diagonal
 from curvdetail.filters import FilterError, apply
+from curvdetail.filters.errors import FilterParameterError
 from curvdetail.filters.meshset import vertex_attribute
 from curvdetail.remesh.transfer import transfer_curvature
 
@@ -80,6 +81,13 @@ def test_uv_location_reports_the_parameterization_and_carries_the_detail():
     apply(ms, "apply_curvature_reconstruction", rows="free")
     error = apply(ms, "get_curvature_reconstruction_error", samplenum=20000)
     assert error["hausdorff_rms"] < 2e-3        # measured 0.074 % (closest point: 0.034 %)
+
+
+def test_a_parameterization_without_uv_location_is_refused_not_ignored():
+    ms = remeshed_nose()
+    with pytest.raises(FilterParameterError, match="applies to location='uv' only"):
+        apply(ms, "transfer_curvature_detail", parameterization="meshlab_harmonic")
+    assert "parameterization" not in apply(ms, "transfer_curvature_detail")    # the default passes
 
 
 def test_closed_target_is_refused():

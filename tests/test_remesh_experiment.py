@@ -78,6 +78,12 @@ def test_report_figures_are_the_distances_over_the_source_diagonal(height_field)
     assert r["ratio_to_floor"] == pytest.approx(rms / r["floor_retriangulated"]["hausdorff_rms"])
 
 
+def test_a_parameterization_without_uv_location_is_refused_not_ignored(height_field):
+    V, F = height_field
+    with pytest.raises(ValueError, match="parameterization='lscm' applies to location='uv' only"):
+        remesh_experiment(V, F, parameterization="lscm", evaluate=False)
+
+
 def test_uv_location_and_given_target_run_and_record_the_parameterization(height_field):
     V, F = height_field
     target = retriangulate(V, F, target_edge=0.04)
@@ -86,6 +92,7 @@ def test_uv_location_and_given_target_run_and_record_the_parameterization(height
     assert np.array_equal(Ft, target[1])
     assert r["seconds"]["retriangulate"] == 0.0 and "parameterize" in r["seconds"]
     assert r["parameterization"]["flipped_target"] == 0
+    assert r["options"]["parameterization"] == "harmonic"      # the default of location="uv"
     # not measured: the measured keys are absent, as the docstring says (not None)
     assert not {"error", "baseline_zero_detail", "floor_retriangulated", "improvement_over_zero_detail",
                 "ratio_to_floor"} & set(r)

@@ -6,6 +6,7 @@ from .detail_attributes import DETAIL, stamp
 from .meshset import add_layer, get_mesh, layer_id, mesh_arrays
 from .parameters import BBoxLength, Parameter
 from .registry import PAPER, filter
+from .transfer_curvature_detail import planar_map
 
 
 @filter(
@@ -40,7 +41,7 @@ from .registry import PAPER, filter
         Parameter("location", "str", "closest",
                   "where target vertices lie on the source: 'closest' point in space or 'uv' "
                   "(shared planar parameterization)", choices=("closest", "uv")),
-        Parameter("parameterization", "str", "harmonic", "planar map for location='uv'",
+        Parameter("parameterization", "str", "harmonic", "planar map for location='uv' (only)",
                   choices=("harmonic", "meshlab_harmonic", "lscm")),
         Parameter("backend", "str", "auto", BACKEND_DESCRIPTION, choices=BACKENDS),
         Parameter("surface_check", "bool", True,
@@ -63,8 +64,8 @@ def generate_curvature_remeshing(ms, *, method, target_edge, transfer, rows, loc
     label = get_mesh(ms, mid).label()
     fraction = target_edge.resolve(bbox_diagonal(V)) / bbox_diagonal(V)
     result = run_experiment(V, F, method=method, target_edge=fraction, transfer=transfer, rows=rows,
-                            location=location, parameterization=parameterization, backend=backend,
-                            evaluate=evaluate, source_path=label, surface_check=surface_check)
+                            location=location, parameterization=planar_map(location, parameterization),
+                            backend=backend, evaluate=evaluate, source_path=label, surface_check=surface_check)
     Ft = result["Ft"]
     layers = {"source": mid,
               "retriangulated": add_layer(ms, result["Vt"], Ft, f"{label} retriangulated")}

@@ -5,10 +5,22 @@ import numpy as np
 from ..curvature import curvature_detail, mixed_voronoi_area
 from .compute_curvature_detail import signed_mean_curvature
 from .detail_attributes import store_detail
-from .errors import FilterError
+from .errors import FilterError, FilterParameterError
 from .meshset import layer_id, mesh_arrays, set_vertex_quality
 from .parameters import Parameter
 from .registry import PAPER, filter
+
+
+def planar_map(location, parameterization, default="harmonic"):
+    """The ``parameterization`` a filter passes on: None where ``location`` is not 'uv', where a
+    value other than the default is a mistake (it would be ignored) and refused."""
+    if location == "uv":
+        return parameterization
+    if parameterization != default:
+        raise FilterParameterError(f"parameterization={parameterization!r} applies to location='uv' only "
+                                   f"(location={location!r} uses no planar map); pass location='uv' or "
+                                   "leave parameterization at its default.")
+    return None
 
 
 @filter(
@@ -37,13 +49,14 @@ from .registry import PAPER, filter
                   "where a target vertex lies on the source: 'closest' point in space or 'uv' "
                   "(shared planar parameterization)", choices=("closest", "uv")),
         Parameter("parameterization", "str", "harmonic",
-                  "planar map for location='uv': own cotangent 'harmonic' map, pymeshlab's "
+                  "planar map for location='uv' (only): own cotangent 'harmonic' map, pymeshlab's "
                   "'meshlab_harmonic' or 'lscm'", choices=("harmonic", "meshlab_harmonic", "lscm")),
     ],
 )
 def transfer_curvature_detail(ms, *, sourcemesh, targetmesh, method, location, parameterization):
     from ..remesh import check_disk, parameterize, transfer_curvature
 
+    parameterization = planar_map(location, parameterization)
     source = layer_id(ms, sourcemesh, "sourcemesh")
     target = layer_id(ms, targetmesh, "targetmesh")
     if source == target:

@@ -38,11 +38,11 @@ TARGET_BOUNDARY_TOLERANCE = 1e-6
 STAGES = ("retriangulate", "parameterize", "transfer", "reconstruct", "evaluate")
 
 DEFAULTS = {"method": "isotropic", "target_edge": 0.01, "transfer": "conservative", "rows": "free",
-            "location": "closest", "parameterization": "harmonic", "backend": "auto", "surface_check": True}
+            "location": "closest", "parameterization": None, "backend": "auto", "surface_check": True}
 
 
 def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="conservative", rows="free",
-                      location="closest", parameterization="harmonic", backend="auto", evaluate=True,
+                      location="closest", parameterization=None, backend="auto", evaluate=True,
                       source_path=None, progress=None, target=None, surface_check=True):
     """Retriangulate a disk patch, carry its curvature detail over, rebuild it, and measure.
 
@@ -63,7 +63,9 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="c
     transfer : {"conservative", "pointwise"}   how detail is carried over (conservative: measured better)
     rows : {"free", "all"}                     residual rows of the reconstruction energy
     location : {"closest", "uv"}               3D closest point, or a shared planar domain
-    parameterization : {"harmonic", "meshlab_harmonic", "lscm"}   the domain for ``location="uv"``
+    parameterization : {"harmonic", "meshlab_harmonic", "lscm"} or None   the planar domain of
+                                               ``location="uv"`` (None: "harmonic"); refused with
+                                               ``location="closest"``, which uses no planar map
     backend : str                              sparse solver backend
     evaluate : bool                            measure distances (the costly part on big meshes)
     source_path : str or None                  recorded in the report
@@ -108,7 +110,8 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="c
                                boundary vertices off the source's boundary polyline (by more than
                                ``TARGET_BOUNDARY_TOLERANCE`` = 1e-6 of the larger of the bbox
                                diagonal and the largest coordinate)
-    ValueError                 unknown option values; ``target`` not a pair; ``progress`` not
+    ValueError                 unknown option values, or a ``parameterization`` without
+                               ``location="uv"``; ``target`` not a pair; ``progress`` not
                                callable; ``evaluate`` or ``surface_check`` not a bool
     SolverError                unknown or uninstalled ``backend`` (before any work)
 
@@ -158,7 +161,7 @@ def _check_choice(name, value, choices):
 
 
 def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="conservative", rows="free",
-                   location="closest", parameterization="harmonic", backend="auto", evaluate=True,
+                   location="closest", parameterization=None, backend="auto", evaluate=True,
                    source_path=None, progress=None, target=None, surface_check=True):
     """:func:`remesh_experiment` returning everything as a dict: ``X``, ``Ft``, ``Vt`` (the
     retriangulated surface), ``Z`` (zero-detail baseline), ``Dt``, ``distance`` (per rebuilt
@@ -167,7 +170,14 @@ def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="cons
     _check_choice("transfer", transfer, TRANSFERS)
     _check_choice("rows", rows, ROW_MODES)
     _check_choice("location", location, LOCATIONS)
-    _check_choice("parameterization", parameterization, PARAMETERIZATIONS)
+    if parameterization is not None:
+        _check_choice("parameterization", parameterization, PARAMETERIZATIONS)
+        if location != "uv":
+            raise ValueError(f"parameterization={parameterization!r} applies to location='uv' only "
+                             f"(location={location!r} uses no planar map); pass location='uv' or "
+                             "leave parameterization out.")
+    elif location == "uv":
+        parameterization = "harmonic"
     resolve_backend(backend)               # an unknown or missing backend fails before the work
     # checked even with a ready target, where it is only recorded: a bad value is a mistake
     # either way (as pymeshlab checks every parameter of a filter)
