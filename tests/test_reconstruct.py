@@ -55,6 +55,14 @@ def test_refinement_steps_must_be_a_whole_number(load_mesh, steps):
         Reconstructor(V, F, fixed, refinement_steps=steps)
 
 
+@pytest.mark.parametrize("steps", [101, 1e9])
+def test_refinement_steps_beyond_the_most_useful_are_refused_not_run_by_every_solve(load_mesh, steps):
+    V, F, fixed = _problem(load_mesh, "spot.obj")
+    with pytest.raises(ValueError, match="must be at most 100"):
+        Reconstructor(V, F, fixed, refinement_steps=steps)
+    assert Reconstructor(V, F, fixed, refinement_steps=100).refinement_steps == 100
+
+
 @pytest.mark.parametrize("steps", [2, 2.0, np.int64(2), np.array(2)])
 def test_refinement_steps_take_whole_numbers_as_every_other_count_does(load_mesh, steps):
     V, F, fixed = _problem(load_mesh, "spot.obj")

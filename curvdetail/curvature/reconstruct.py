@@ -46,8 +46,9 @@ class Reconstructor:
                                  (see :mod:`.sparse_solver` for what "auto" picks)
     refinement_steps : int, optional   least refinement steps of ``rows="all"`` solves (default:
                                  the class attribute, 1; more where the error estimate asks for
-                                 them). 0 halves the back-substitution time and gives the plain
-                                 normal-equation solution (~cond^2 eps).
+                                 them), at most ``MAX_LEAST_REFINEMENT_STEPS`` (100). 0 halves
+                                 the back-substitution time and gives the plain normal-equation
+                                 solution (~cond^2 eps).
 
     Attributes
     ----------
@@ -86,6 +87,10 @@ class Reconstructor:
         if refinement_steps is not None:
             try:
                 self.refinement_steps = as_count(refinement_steps, "refinement_steps", minimum=0)
+                if self.refinement_steps > MAX_LEAST_REFINEMENT_STEPS:   # every solve runs them all
+                    raise ValueError(f"refinement_steps={refinement_steps!r} must be at most "
+                                     f"{MAX_LEAST_REFINEMENT_STEPS}: each step is a back-substitution, "
+                                     "and beyond a few the corrections are rounding")
             except ValueError as exc:
                 raise ValueError(f"{exc} (1, the default, gives solver precision; 0 skips the "
                                  "refinement).") from None
@@ -254,6 +259,8 @@ def refine_least_squares(X, correction, min_steps, *, stall="raise"):
 #: ``MAX_REFINEMENT_STEPS`` steps
 REFINEMENT_TOLERANCE = 1e-12
 MAX_REFINEMENT_STEPS = 10
+#: the most steps ``refinement_steps`` may ask for (every solve runs that many)
+MAX_LEAST_REFINEMENT_STEPS = 100
 #: a refinement whose corrections stop shrinking (the rounding floor) is taken where they are
 #: below this fraction of the solution (the round-trip bound), else SolverError
 REFINEMENT_FLOOR = 1e-9
