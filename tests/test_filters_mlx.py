@@ -259,3 +259,53 @@ def test_progress_is_called_before_each_step(tmp_path):
     seen = []
     run_script(meshset(), path, progress=lambda k, n, name: seen.append((k, n, name)))
     assert seen == [(1, 2, "Select Border"), (2, 2, "compute_curvature_detail")]
+
+
+# MeshLab misreads these without a word (measured): a bool other than "false" is true, an int
+# that does not parse is 0, a RichAbsPerc without min and max is ignored, an unknown name too
+@pytest.mark.parametrize("param, words", [
+    ('name="Boundary" value="0" type="RichBool"', r"'Boundary' \(RichBool\) has value '0'; write 'true' or 'false'"),
+    ('name="Boundary" value="False" type="RichBool"', r"has value 'False'; write 'true' or 'false'"),
+    ('name="stepSmoothNum" value="3.7" type="RichInt"', r"'stepSmoothNum' \(RichInt\) has value '3.7'; write a whole"),
+    ('name="stepSmoothNum" value="abc" type="RichInt"', r"has value 'abc'"),
+    ('name="stepSmoothNum" type="RichInt"', r"has value None"),
+    ('name="Smoothing steps" value="2" type="RichInt"', r"no parameter 'Smoothing steps' .*stepsmoothnum"),
+])
+def test_native_parameters_meshlab_would_misread_are_refused_before_any_step(tmp_path, param, words):
+    body = NATIVE_SMOOTH + f'\n <filter name="Laplacian Smooth"><Param {param}/></filter>'
+    ms = meshset()
+    V0 = ms.current_mesh().vertex_matrix().copy()
+    with pytest.raises(ScriptError, match=r"step 2 \(Laplacian Smooth\): .*" + words):
+        run_script(ms, write(tmp_path, body))
+    assert np.array_equal(ms.current_mesh().vertex_matrix(), V0)     # step 1 did not run either
+
+
+@pytest.mark.parametrize("attrs", ['', 'min="0"'])
+def test_a_native_absolute_or_percentage_value_without_min_and_max_is_refused(tmp_path, attrs):
+    body = ('<filter name="Remeshing: Isotropic Explicit Remeshing"><Param name="TargetLen" value="0.05" '
+            'type="RichAbsPerc" {}/></filter>')
+    with pytest.raises(ScriptError, match="needs min and max attributes"):
+        run_script(meshset(), write(tmp_path, body.format(attrs)))
+    # with them (their values do not matter to MeshLab) the value is used: a coarser mesh
+    ms = meshset()
+    run_script(ms, write(tmp_path, body.format('min="0" max="1"')))
+    assert ms.current_mesh().vertex_number() < 400
+
+
+def test_a_native_parameter_name_with_other_capitals_is_reported_after_its_step(tmp_path):
+    # MeshLab's own name check is case-sensitive; the step has run without the parameter
+    body = '<filter name="Laplacian Smooth"><Param name="stepsmoothnum" value="2" type="RichInt"/></filter>'
+    with pytest.raises(ScriptError, match=r"ran this step without parameter\(s\) 'stepsmoothnum'"):
+        run_script(meshset(), write(tmp_path, body))
+
+
+def test_a_script_pymeshlab_saved_runs_through_the_checks(tmp_path):
+    # keyword names ('lambda' is pymeshlab's lambda_) and x/y/z parameters without a value
+    ms = meshset()
+    ms.apply_coord_taubin_smoothing(lambda_=0.5, mu=-0.53, stepsmoothnum=3, selected=False)
+    ms.compute_matrix_from_translation(traslmethod="XYZ translation", axisx=1.0, axisy=0.0, axisz=0.0,
+                                       freeze=True, alllayers=False)
+    ms.save_filter_script(str(tmp_path / "saved.mlx"))
+    scripted = meshset()
+    run_script(scripted, tmp_path / "saved.mlx")
+    assert np.array_equal(scripted.current_mesh().vertex_matrix(), ms.current_mesh().vertex_matrix())

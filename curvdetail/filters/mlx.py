@@ -96,27 +96,120 @@ def _our_parameters(spec, element, where):
 @contextlib.contextmanager
 def _quiet_output():
     """pymeshlab prints 'Reading filter with name ...' when it loads a script; its failures come
-    back as exceptions, so its console output is dropped while a native step runs."""
-    saved = []
-    try:
-        for stream in (sys.stdout, sys.stderr):
-            try:
-                stream.flush()
-            except (AttributeError, OSError, ValueError):
-                pass
-        for fd in (1, 2):                  # pymeshlab writes to the process's own descriptors
-            try:
-                saved.append((fd, os.dup(fd)))
-            except OSError:
-                continue
-        with open(os.devnull, "w") as null:
+    back as exceptions, so its console output is kept from the console while a native step runs.
+    Yields a list that holds the output (one str) once the block has ended."""
+    saved, captured = [], []
+    with tempfile.TemporaryFile() as sink:
+        try:
+            for stream in (sys.stdout, sys.stderr):
+                try:
+                    stream.flush()
+                except (AttributeError, OSError, ValueError):
+                    pass
+            for fd in (1, 2):                  # pymeshlab writes to the process's own descriptors
+                try:
+                    saved.append((fd, os.dup(fd)))
+                except OSError:
+                    continue
             for fd, _ in saved:
-                os.dup2(null.fileno(), fd)
-            yield
-    finally:
-        for fd, copy in saved:
-            os.dup2(copy, fd)
-            os.close(copy)
+                os.dup2(sink.fileno(), fd)
+            yield captured
+        finally:
+            _flush_c_streams()              # what pymeshlab's C++ side still buffers goes to the sink
+            for fd, copy in saved:
+                os.dup2(copy, fd)
+                os.close(copy)
+            sink.seek(0)
+            captured.append(sink.read().decode("utf-8", "replace"))
+
+
+def _flush_c_streams():
+    try:
+        import ctypes
+
+        ctypes.CDLL(None).fflush(None)
+    except (OSError, AttributeError):      # no C library to ask (not on a POSIX system)
+        pass
+
+
+#: How MeshLab reads a ``<Param>`` value of each type it checks: a bool is false only as the
+#: exact text "false" ("0", "False" are true), an int or a float that does not parse is 0, and a
+#: ``RichAbsPerc`` without both ``min`` and ``max`` attributes is ignored (measured with pymeshlab
+#: 2023.12). So these are refused before any step runs.
+_INTEGER = re.compile(r"\s*[+-]?\d+\s*")
+_NATIVE_CHECKS = {
+    "RichBool": (lambda v: v in ("true", "false"), "'true' or 'false' (MeshLab reads any other text as true)"),
+    "RichInt": (lambda v: bool(_INTEGER.fullmatch(v)), "a whole number (MeshLab reads other text as 0)"),
+    "RichEnum": (lambda v: bool(_INTEGER.fullmatch(v)), "the index of the choice, a whole number"),
+    "RichMesh": (lambda v: bool(_INTEGER.fullmatch(v)), "a layer index, a whole number"),
+    "RichFloat": (lambda v: _finite(v), "a finite number with a decimal point (MeshLab reads other text as 0)"),
+    "RichDynamicFloat": (lambda v: _finite(v), "a finite number with a decimal point"),
+    "RichAbsPerc": (lambda v: _finite(v), "a finite number with a decimal point, in model units"),
+}
+
+
+def _finite(text):
+    try:
+        return abs(float(text)) < float("inf")
+    except ValueError:
+        return False
+
+
+def _name_key(name):
+    """A parameter name as MeshLab and pymeshlab both spell it: pymeshlab's Python names are
+    MeshLab's in lower case, a Python keyword with "_" appended ('lambda' -> 'lambda_')."""
+    return re.sub(r"[^a-z0-9]+", "", name.lower())
+
+
+@functools.lru_cache(maxsize=None)
+def _native_parameter_names(meshlab_name):
+    """pymeshlab's Python names of a MeshLab filter's parameters, found through its rename table
+    and a one-triangle MeshSet; None where either fails."""
+    import numpy as np
+    import pymeshlab
+
+    python_name = _pymeshlab_renames().get(_snake(meshlab_name))
+    if python_name is None:
+        return None
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(np.eye(3), np.array([[0, 1, 2]], dtype=np.int32)))
+    try:
+        with _quiet_output():
+            return frozenset(ms.filter_parameter_values(python_name))
+    except Exception:
+        return None
+
+
+def _check_native_parameters(element, where):
+    """Refuse what MeshLab would misread in a native step's parameters without a word: values
+    of the wrong kind for their type (see ``_NATIVE_CHECKS``), a parameter given twice, and
+    names the filter does not have (checked in lower case against pymeshlab's names; MeshLab's
+    own check, case-sensitive, runs with the step)."""
+    names = _native_parameter_names(element.get("name"))
+    seen = set()
+    for child in element:
+        if child.tag != "Param":
+            continue
+        name, value, kind = child.get("name"), child.get("value"), child.get("type")
+        if name is None:
+            raise ScriptError(f"{where}: a <Param> lacks a name.")
+        if name in seen:
+            raise ScriptError(f"{where}: parameter {name!r} is given twice; keep one <Param name={name!r}>.")
+        seen.add(name)
+        if names is not None and _name_key(name) not in {_name_key(n) for n in names}:
+            raise ScriptError(f"{where}: this MeshLab filter has no parameter {name!r} (pymeshlab ignores it "
+                              f"without a word); its parameters, in pymeshlab's lower case: "
+                              f"{', '.join(sorted(names))}.")
+        check, meaning = _NATIVE_CHECKS.get(kind, (None, None))
+        if check is not None and (value is None or not check(value.strip() if kind != "RichBool" else value)):
+            raise ScriptError(f"{where}: parameter {name!r} ({kind}) has value {value!r}; write {meaning}.")
+        if kind == "RichAbsPerc" and (child.get("min") is None or child.get("max") is None):
+            raise ScriptError(f"{where}: parameter {name!r} (RichAbsPerc) needs min and max attributes, "
+                              "as MeshLab writes them (e.g. min=\"0\" max=\"1\"); without them MeshLab "
+                              "ignores its value.")
+
+
+_IGNORED_PARAMETER = re.compile(r"Warning: parameter (\S*) not required by filter")
 
 
 def _refuse_a_near_miss(name, where):
@@ -200,7 +293,7 @@ def _run_native(ms, element, where):
         with open(tmp, "w", encoding="utf-8") as out:
             out.write("<!DOCTYPE FilterScript>\n" + ET.tostring(script, encoding="unicode") + "\n")
         try:
-            with _quiet_output():
+            with _quiet_output() as output:
                 ms.load_filter_script(tmp)
                 ms.apply_filter_script()
         except pymeshlab.PyMeshLabException as exc:
@@ -210,6 +303,11 @@ def _run_native(ms, element, where):
             raise ScriptError(f"{where}: {reason}") from None
     finally:
         os.remove(tmp)
+    ignored = _IGNORED_PARAMETER.findall(output[0])
+    if ignored:      # a name right but for its capitals: MeshLab's check is case-sensitive
+        raise ScriptError(f"{where}: pymeshlab ran this step without parameter(s) {', '.join(map(repr, ignored))}, "
+                          "which the filter does not know under that spelling (MeshLab's names are "
+                          "case-sensitive, e.g. 'TargetLen'); the MeshSet holds the step's result.")
 
 
 def run_script(ms, path, *, progress=None):
@@ -231,8 +329,13 @@ def run_script(ms, path, *, progress=None):
     FileNotFoundError   the script does not exist
     ScriptError         not a MeshSet, ``path`` not a path or a folder, malformed XML (or an
                         unknown encoding), a parameter given twice, a step name that is a typo of
-                        one of ours, a MeshLab filter that needs a mesh on an empty MeshSet, or a
-                        step failed (the message names the step number and filter, then the reason)
+                        one of ours, a MeshLab filter that needs a mesh on an empty MeshSet, a
+                        parameter of a MeshLab step that MeshLab would misread without a word (a
+                        bool other than 'true'/'false', a number that does not parse, a RichAbsPerc
+                        without min and max, a name the filter does not have; all found before
+                        any step runs, except a name right but for its capitals, found after its
+                        step), or a step failed (the message names the step number and filter,
+                        then the reason)
 
     Examples
     --------
@@ -255,6 +358,9 @@ def run_script(ms, path, *, progress=None):
     results = []
     path = _script_path(path)
     steps = _steps(path)
+    for k, element in enumerate(steps, start=1):      # before any step changes the MeshSet
+        if element.get("name") not in _REGISTRY and element.tag == "filter":
+            _check_native_parameters(element, f"{os.path.basename(path)} step {k} ({element.get('name')})")
     for k, element in enumerate(steps, start=1):
         name = element.get("name")
         if progress is not None:
