@@ -1,5 +1,7 @@
 """Curvature coefficients: D_i = sum_j C_ij D_j, minimum norm, invariant, batched and robust."""
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -45,6 +47,18 @@ def test_coefficients_are_invariant_under_rotation_and_uniform_scale(load_mesh, 
     C2 = curvature_coefficients(2.5 * V @ _rotation(rng).T + [3.0, -1.0, 7.0], F)
     # D -> 2.5 R D leaves the minimum-norm solution unchanged; the difference is roundoff
     # amplified by the ring's conditioning (coefficients are O(1), max |c| ~ 6 here).
+    assert abs(C2 - C).max() < 1e-8
+
+
+@pytest.mark.parametrize("scale", [1e-60, 1e70])
+def test_coefficients_at_extreme_scales_are_the_same_and_quiet(load_mesh, scale):
+    # the closed-form cofactors overflow at 1e70 (G ~ 1e140 per entry): those rings take the SVD
+    # path, without numpy's overflow warnings reaching the user
+    V, F = load_mesh("mannequin_nose.obj")
+    C = curvature_coefficients(V, F)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        C2 = curvature_coefficients(scale * V, F)
     assert abs(C2 - C).max() < 1e-8
 
 

@@ -159,18 +159,19 @@ def _coefficients(D, A, rows, cols, n, rcond, size, *, want_scale=False):
             g[a, b] = np.bincount(rows, weights=Dj[:, a] * Dj[:, b], minlength=n)
     area_scale = (np.sqrt(np.bincount(rows, weights=A[cols] ** 2, minlength=n))
                   / max(size, np.finfo(float).tiny))
-    # closed form where G is safely full rank: adjugate / det
-    c00 = g[1, 1] * g[2, 2] - g[1, 2] ** 2
-    c01 = g[0, 2] * g[1, 2] - g[0, 1] * g[2, 2]
-    c02 = g[0, 1] * g[1, 2] - g[0, 2] * g[1, 1]
-    c11 = g[0, 0] * g[2, 2] - g[0, 2] ** 2
-    c12 = g[0, 1] * g[0, 2] - g[0, 0] * g[1, 2]
-    c22 = g[0, 0] * g[1, 1] - g[0, 1] ** 2
-    det = g[0, 0] * c00 + g[0, 1] * c01 + g[0, 2] * c02
-    tr = g[0, 0] + g[1, 1] + g[2, 2]
-    # sigma_3 >= sqrt(det) / tr and sigma_1 <= sqrt(tr): rank 3 is certain when the bound clears
-    # the threshold; cond(G) <= tr^3 / det keeps the adjugate accurate
-    with np.errstate(divide="ignore", invalid="ignore"):
+    # closed form where G is safely full rank: adjugate / det. On huge coordinates (~1e70) the
+    # cofactors overflow to inf / nan: those rows fail the test below and take the SVD path
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        c00 = g[1, 1] * g[2, 2] - g[1, 2] ** 2
+        c01 = g[0, 2] * g[1, 2] - g[0, 1] * g[2, 2]
+        c02 = g[0, 1] * g[1, 2] - g[0, 2] * g[1, 1]
+        c11 = g[0, 0] * g[2, 2] - g[0, 2] ** 2
+        c12 = g[0, 1] * g[0, 2] - g[0, 0] * g[1, 2]
+        c22 = g[0, 0] * g[1, 1] - g[0, 1] ** 2
+        det = g[0, 0] * c00 + g[0, 1] * c01 + g[0, 2] * c02
+        tr = g[0, 0] + g[1, 1] + g[2, 2]
+        # sigma_3 >= sqrt(det) / tr and sigma_1 <= sqrt(tr): rank 3 is certain when the bound
+        # clears the threshold; cond(G) <= tr^3 / det keeps the adjugate accurate
         good = (det > WELL_CONDITIONED * tr ** 3) & \
                (np.sqrt(np.maximum(det, 0.0)) / tr > rcond * np.maximum(np.sqrt(tr), area_scale))
     w = np.zeros((n, 3))
