@@ -215,6 +215,10 @@ def test_float_indices_too_large_for_int64_are_named_not_wrapped():
         as_index_set(np.array([2 ** 64 - 1], dtype=np.uint64), 5, "fixed")
     with pytest.raises(MeshError, match=r"entries of 1e\+20"):
         check_mesh(np.eye(3), [[0, 1, 1e20]])
+    # Python ints beyond int64 make an object array: still "outside", not "dtype object"
+    for big in (10 ** 20, -10 ** 20):
+        with pytest.raises(ConstraintError, match=rf"1 indices are outside \[0, 5\) \(first: {big}\)"):
+            as_index_set([1, big], 5, "fixed")
 
 
 @pytest.mark.parametrize("values", [np.ones((2, 3)) + 1j, np.ones((2, 3), bool), np.full((2, 3), "1")])
@@ -245,6 +249,8 @@ def test_a_mesh_too_small_for_its_areas_is_named_by_its_size():
     check_mesh(V * 1e-70, F)                                  # still fine
     with pytest.raises(MeshError, match=r"the mesh is 1.*e-100 across .* scale it up"):
         check_mesh(V * 1e-100, F)
+    with pytest.raises(MeshError, match=r"the mesh is 1.*e-200 across .* scale it up"):
+        check_mesh(V * 1e-200, F)                              # its squared extent underflows
 
 
 def test_the_core_is_exact_across_its_range_of_scales():

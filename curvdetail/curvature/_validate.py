@@ -117,7 +117,12 @@ def face_double_areas(V, F):
 def bbox_diagonal(V):
     # reductions along the contiguous axis of V^T: ~7x faster than V.max(axis=0) on (n, 3)
     Vt = np.ascontiguousarray(np.asarray(V, dtype=np.float64).T)
-    return float(np.linalg.norm(Vt.max(axis=1) - Vt.min(axis=1)))
+    extent = Vt.max(axis=1) - Vt.min(axis=1)
+    largest = float(np.abs(extent).max()) if extent.size else 0.0
+    if 1e-150 < largest < 1e150 or not 0.0 < largest < np.inf:
+        return float(np.linalg.norm(extent))
+    # scaled: the squares of a 1e-200 mesh's extent underflow to a diagonal of 0
+    return largest * float(np.linalg.norm(extent / largest))
 
 
 def centroid_diameter(V):
@@ -360,6 +365,10 @@ def as_index_set(indices, n, name):
             raise ConstraintError(f"{name} is a boolean mask of shape {arr.shape}; it must have shape ({n},).")
         return np.flatnonzero(arr)
     arr = arr.reshape(-1)
+    if arr.dtype == object and arr.size and all(isinstance(i, numbers.Integral) for i in arr):
+        big = np.flatnonzero([not -2 ** 63 <= i < 2 ** 63 for i in arr])    # beyond int64
+        raise ConstraintError(f"{name}: {big.size} indices are outside [0, {n}) (first: {arr[big[0]]}); "
+                              "indices are 0-based into V.")
     if arr.size and not np.issubdtype(arr.dtype, np.integer):
         if not (np.issubdtype(arr.dtype, np.floating) and np.all(np.isfinite(arr)) and np.all(arr == np.round(arr))):
             raise ConstraintError(f"{name} has dtype {arr.dtype}; pass integer vertex indices.")
