@@ -90,6 +90,27 @@ def test_repeated_index_in_a_face_is_refused_with_the_face():
         mixed_voronoi_area(V, F)
 
 
+def test_the_advice_for_flat_slivers_works_where_removing_them_would_leave_slits():
+    import pymeshlab
+
+    from curvdetail import read_mesh
+    from curvdetail.data import example_path
+
+    V, F = read_mesh(example_path())
+    for f in (17, 402, 931):                       # third corner onto the middle of the first edge
+        a, b, c = F[f]
+        V[c] = (V[a] + V[b]) / 2
+    with pytest.raises(MeshError, match=r"3 triangles have zero area .*meshing_remove_t_vertices\(method=1\)"):
+        mean_curvature_normal(V, F)
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(V, F))
+    ms.meshing_remove_t_vertices(method=1, threshold=40, repeat=True)     # flips the slivers away
+    V2, F2 = ms.current_mesh().vertex_matrix(), ms.current_mesh().face_matrix()
+    assert F2.shape == F.shape and boundary_vertices(F2).size == boundary_vertices(F).size    # no slit
+    K, A = mean_curvature_normal(V2, F2)
+    assert np.all(np.isfinite(K)) and np.all(A > 0)
+
+
 def test_zero_area_faces_are_refused_with_the_faces():
     V, F = _square()
     V[4] = V[0] + 0.5 * (V[1] - V[0])         # centre vertex onto the bottom edge, between 0 and 1

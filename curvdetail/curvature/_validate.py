@@ -26,6 +26,10 @@ MIN_DIAGONAL = 1e-60
 # A triangle whose area is below this fraction of the squared bbox diagonal is degenerate:
 # its cotangents overflow. 1e-14 leaves room for meshes of ~1e12 well-shaped triangles.
 ZERO_AREA_RELATIVE = 1e-14
+#: what to do about them: removing one leaves a slit in the surface where it was
+ZERO_AREA_ADVICE = ("flip or collapse them away, e.g. with pymeshlab's meshing_remove_t_vertices(method=1) "
+                    "for flat slivers (meshing_remove_null_faces drops exactly-zero triangles only, and "
+                    "leaves a slit where each was)")
 
 
 def as_vertices(V, name="V", dim=3, max_coordinate=MAX_COORDINATE):
@@ -199,10 +203,9 @@ def _check_mesh(V, F, check_manifold, check_unreferenced, cotangents=False):
         raise MeshError(f"the mesh is {diag:.3g} across (bbox diagonal): its triangle areas underflow double "
                         f"precision ({zero.size} come out as zero); scale it up, e.g. to unit size.")
     if zero.size:
-        raise MeshError(
-            f"{zero.size} triangles have zero area (first: {first_indices(zero)}); remove them, e.g. "
-            "with pymeshlab's meshing_remove_null_faces, before computing curvature."
-        )
+        raise MeshError(f"{zero.size} triangles have zero area (first: {first_indices(zero)}; areas up to "
+                        f"{ZERO_AREA_RELATIVE:g} of the bbox diagonal squared count); {ZERO_AREA_ADVICE}, "
+                        "before computing curvature.")
     if check_manifold:
         bad = non_manifold_edges(F)
         if bad.shape[0]:

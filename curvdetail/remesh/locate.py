@@ -4,7 +4,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
-from ..curvature._validate import (ZERO_AREA_RELATIVE, as_count, as_faces, as_vertices, bbox_diagonal,
+from ..curvature._validate import (ZERO_AREA_ADVICE, ZERO_AREA_RELATIVE, as_count, as_faces, as_vertices, bbox_diagonal,
                                    face_double_areas)
 from ..curvature.errors import MeshError, first_indices
 
@@ -165,8 +165,9 @@ def _check_areas(V, F, names):
     U = U if U.shape[1] == 3 else np.column_stack([U, np.zeros(U.shape[0])])
     zero = np.flatnonzero(face_double_areas(U, F) <= 2.0 * ZERO_AREA_RELATIVE)
     if zero.size:
-        raise MeshError(f"{names[2]}: {zero.size} triangles have zero area (first: {first_indices(zero)}); "
-                        "remove them, e.g. with pymeshlab's meshing_remove_null_faces.")
+        raise MeshError(f"{names[2]}: {zero.size} triangles have zero area (first: {first_indices(zero)}; "
+                        f"areas up to {ZERO_AREA_RELATIVE:g} of the bbox diagonal squared count); "
+                        f"{ZERO_AREA_ADVICE}.")
 
 
 def _unit_frame(P, V):
