@@ -13,6 +13,7 @@ import signal
 import sys
 import threading
 import time
+import warnings
 
 _COMMANDS = {}
 
@@ -229,11 +230,6 @@ def _minimal_command(parser):
 
 # --- remesh (remeshing issue) ---------------------------------------------------------------
 
-#: From this many estimated target vertices ``curvdetail remesh`` says beforehand that it will
-#: take a while (measured: 88k vertices 65 s, 547k ~10 min, most of it the evaluation).
-BIG_TARGET = 200_000
-
-
 def _note_a_big_target(V, F, fraction, *, evaluate=True, given=None, skip="--no-evaluate"):
     """A line on stderr when a target edge of ``fraction`` of the bbox diagonal asks for more than
     ``BIG_TARGET`` vertices (an estimate only: on a mesh the checks will refuse, nothing is
@@ -242,7 +238,7 @@ def _note_a_big_target(V, F, fraction, *, evaluate=True, given=None, skip="--no-
     import numpy as np
 
     from .curvature._validate import bbox_diagonal
-    from .remesh.retriangulate import MAX_VERTICES, estimated_vertices
+    from .remesh.retriangulate import BIG_TARGET, MAX_VERTICES, estimated_vertices
 
     try:
         with np.errstate(all="ignore"):
@@ -466,6 +462,11 @@ def _apply_command(parser):
                     _note_a_big_target(V, F, value.resolve(diagonal) / diagonal,
                                        evaluate=params.get("evaluate", True) is not False,
                                        given=f"target_edge={value}", skip="--param evaluate=false")
+                from .remesh.retriangulate import LongRunWarning
+
+                with warnings.catch_warnings():       # the note above said it in the CLI's terms
+                    warnings.simplefilter("ignore", LongRunWarning)
+                    return apply(ms, spec.name, **params)
             return apply(ms, spec.name, **params)
 
         return _run_on_file(args, work)
@@ -697,12 +698,27 @@ def _watch_sigterm():
     return stop
 
 
+def _show_warning(message, category, filename, lineno, file=None, line=None):
+    """A LongRunWarning (a filter in a script about to take minutes) as a note line."""
+    from .remesh.retriangulate import LongRunWarning
+
+    if issubclass(category, LongRunWarning):
+        _say(f"note: {message}")
+    else:
+        _default_showwarning(message, category, filename, lineno, file, line)
+
+
+_default_showwarning = warnings.showwarning
+
+
 def main(argv=None):
     parser = build_parser()
     args = parser.parse_args(argv)
     stop_watching = _watch_sigterm()
     try:
-        return int(args._run(args) or 0)
+        with warnings.catch_warnings():
+            warnings.showwarning = _show_warning
+            return int(args._run(args) or 0)
     except KeyboardInterrupt:
         _say("curvdetail: interrupted")
         return 130

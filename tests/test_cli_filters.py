@@ -1,5 +1,6 @@
 """`curvdetail list / apply / run`: outputs, figures on stdout, and every error path."""
 
+import importlib
 import json
 import os
 import subprocess
@@ -306,20 +307,36 @@ def test_apply_remeshing_with_a_big_target_is_announced_with_the_value_given(cap
     from curvdetail.curvature._validate import bbox_diagonal
 
     diagonal = bbox_diagonal(read_mesh(NOSE)[0])
-    monkeypatch.setattr(cli, "BIG_TARGET", 500)
+    monkeypatch.setattr(importlib.import_module("curvdetail.remesh.retriangulate"), "BIG_TARGET", 500)
     length = round(0.03 * diagonal, 6)
     rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "o.ply",
                            "--param", f"target_edge={length}", "--param", "evaluate=false")
     assert rc == 0
     assert f"note: target_edge={length} gives about " in err and "target vertices; this takes minutes." in err
     assert "skips them" not in err                             # evaluate=false: nothing to skip
+    assert err.count("note:") == 1 and "LongRunWarning" not in err      # said once, in the CLI's terms
     rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "q.ply",
                            "--param", f"target_edge={length}")
     assert rc == 0 and "(the measurements most of it; --param evaluate=false skips them)" in err
-    monkeypatch.setattr(cli, "BIG_TARGET", 1_000_000)
+    monkeypatch.setattr(importlib.import_module("curvdetail.remesh.retriangulate"), "BIG_TARGET", 1_000_000)
     rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "p.ply",
                            "--param", f"target_edge={length}", "--param", "evaluate=false")
     assert rc == 0 and "note:" not in err
+
+
+def test_a_script_step_with_a_big_target_is_announced_as_a_note(capsys, tmp_path, monkeypatch):
+    from curvdetail import read_mesh
+    from curvdetail.curvature._validate import bbox_diagonal
+    from curvdetail.filters import save_script
+
+    monkeypatch.setattr(importlib.import_module("curvdetail.remesh.retriangulate"), "BIG_TARGET", 500)
+    length = round(0.03 * bbox_diagonal(read_mesh(NOSE)[0]), 6)
+    save_script(tmp_path / "s.mlx", [("generate_curvature_remeshing", {"target_edge": length, "evaluate": False})])
+    rc, out, err = run_cli(capsys, "run", tmp_path / "s.mlx", NOSE, tmp_path / "o.ply")
+    assert rc == 0
+    notes = [line for line in err.splitlines() if line.startswith("note: target_edge=")]
+    assert len(notes) == 1 and "target vertices; this takes minutes." in notes[0], err
+    assert "LongRunWarning" not in err
 
 
 def test_apply_refuses_to_write_over_an_added_layer_even_with_overwrite(capsys, tmp_path):

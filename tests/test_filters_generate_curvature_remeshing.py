@@ -165,3 +165,23 @@ def test_a_surface_check_that_is_not_a_bool_is_refused(isotropic_calls, value):
     with pytest.raises(FilterParameterError, match="'surface_check' expects a bool"):
         apply(ms, "generate_curvature_remeshing", surface_check=value, evaluate=False)
     assert isotropic_calls == [] and ms.mesh_number() == 1
+
+
+def test_a_big_target_is_said_beforehand_with_the_unit_of_a_plain_number(monkeypatch):
+    # target_edge=0.01 is 0.01 model units: on the 15 km terrain ~1.3M vertices, 10 minutes
+    # without a word before this warning
+    import importlib
+    import warnings
+
+    from curvdetail.remesh.retriangulate import LongRunWarning
+
+    monkeypatch.setattr(importlib.import_module("curvdetail.remesh.retriangulate"), "BIG_TARGET", 100)
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(os.path.join(DATA, "terrainA_1k.obj"))
+    with pytest.warns(LongRunWarning, match=r"target_edge=1\.0 \(6\.55 % of the bbox diagonal\) gives about "
+                                            r"\d+ target vertices; this takes minutes\. A plain number is in model units"):
+        apply(ms, "generate_curvature_remeshing", target_edge=1.0, evaluate=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", LongRunWarning)          # a smaller target: nothing said
+        ms.set_current_mesh(0)
+        apply(ms, "generate_curvature_remeshing", target_edge=1.3, evaluate=False)

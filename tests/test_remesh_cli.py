@@ -1,5 +1,6 @@
 """The ``curvdetail remesh`` command (curvdetail.cli, remesh section)."""
 
+import importlib
 import json
 import os
 
@@ -132,14 +133,14 @@ def test_a_target_edge_asking_for_a_big_mesh_is_announced(tmp_path, capsys, monk
     # the nose at 0.1 % took ~10 minutes without a word; the note comes before the work
     import curvdetail.cli as cli
 
-    monkeypatch.setattr(cli, "BIG_TARGET", 1_000)
+    monkeypatch.setattr(importlib.import_module("curvdetail.remesh.retriangulate"), "BIG_TARGET", 1_000)
     rc = main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "o.ply"), "--target-edge", "2",
                "--no-evaluate"])
     err = capsys.readouterr().err
     assert rc == 0
     assert "note: a 2 % target edge gives about " in err and "target vertices; this takes minutes." in err
     assert err.index("note:") < err.index("[1/3] retriangulate")
-    monkeypatch.setattr(cli, "BIG_TARGET", 1_000_000)
+    monkeypatch.setattr(importlib.import_module("curvdetail.remesh.retriangulate"), "BIG_TARGET", 1_000_000)
     main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "p.ply"), "--target-edge", "2",
           "--no-evaluate"])
     assert "note:" not in capsys.readouterr().err

@@ -1,5 +1,7 @@
 """Filter ``generate_curvature_remeshing``: the paper's remeshing experiment on the current mesh."""
 
+import numpy as np
+
 from ..curvature._validate import bbox_diagonal
 from .apply_curvature_reconstruction import BACKEND_DESCRIPTION, BACKENDS
 from .detail_attributes import DETAIL, stamp
@@ -63,6 +65,7 @@ def generate_curvature_remeshing(ms, *, method, target_edge, transfer, rows, loc
     V, F = mesh_arrays(ms, mid)
     label = get_mesh(ms, mid).label()
     fraction = target_edge.resolve(bbox_diagonal(V)) / bbox_diagonal(V)
+    _warn_of_a_big_target(V, F, target_edge, fraction, evaluate)
     result = run_experiment(V, F, method=method, target_edge=fraction, transfer=transfer, rows=rows,
                             location=location, parameterization=planar_map(location, parameterization),
                             backend=backend, evaluate=evaluate, source_path=label, surface_check=surface_check)
@@ -79,3 +82,21 @@ def generate_curvature_remeshing(ms, *, method, target_edge, transfer, rows, loc
     report = dict(result["report"])
     report["layers"] = layers
     return report
+
+
+def _warn_of_a_big_target(V, F, target_edge, fraction, evaluate):
+    """A LongRunWarning before a retriangulation of more than BIG_TARGET vertices: a plain
+    target_edge=0.01 is 0.01 model units (on a 15 km terrain 1.3M vertices, 10 minutes without a
+    word), not 1 %."""
+    import warnings
+
+    from ..remesh.retriangulate import BIG_TARGET, MAX_VERTICES, LongRunWarning, estimated_vertices
+
+    with np.errstate(all="ignore"):
+        count = float(estimated_vertices(V, F, fraction * bbox_diagonal(V)))
+    if BIG_TARGET < count <= MAX_VERTICES:              # beyond, the remesher refuses it at once
+        why = " (the measurements most of it; evaluate=False skips them)" if evaluate else ""
+        warnings.warn(f"target_edge={target_edge} ({100 * fraction:.3g} % of the bbox diagonal) gives about "
+                      f"{count:,.0f} target vertices; this takes minutes{why}. A plain number is in model "
+                      "units; pymeshlab.PercentageValue(1) is 1 % of the diagonal.", LongRunWarning,
+                      stacklevel=4)
