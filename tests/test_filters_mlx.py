@@ -132,11 +132,13 @@ def test_failing_native_step_names_the_step(tmp_path):
 @pytest.mark.parametrize("name, words", [
     # pymeshlab answers each with "Something really bad happened. Please report this issue"
     ("meshing_remove_duplicate_vertices",
-     r"'meshing_remove_duplicate_vertices' is pymeshlab's Python name, not MeshLab's \('remove duplicate vertices'"),
+     r"'meshing_remove_duplicate_vertices' is pymeshlab's Python name, not MeshLab's \(its words, in lower "
+     r"case and without punctuation: 'remove duplicate vertices'"),
     ("remove duplicate vertices",
-     r"MeshLab spells this filter differently \('remove duplicate vertices' in lower case; pymeshlab's "
-     r"meshing_remove_duplicate_vertices\)"),
-    ("Remove Duplicated Vertex", r"no filter called 'Remove Duplicated Vertex'; did you mean 'remove duplicate vertices'"),
+     r"MeshLab's name for this filter \(pymeshlab's meshing_remove_duplicate_vertices\) has these words, "
+     r"'remove duplicate vertices', with other capitals or punctuation"),
+    ("Remove Duplicated Vertex", r"no filter called 'Remove Duplicated Vertex'; did you mean 'remove duplicate "
+                                 r"vertices'.* \(their words, in lower case and without punctuation\)"),
 ])
 def test_misnamed_meshlab_step_says_what_meshlab_calls_it(tmp_path, name, words):
     path = write(tmp_path, f'<filter name="{name}"/>')

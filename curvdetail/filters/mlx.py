@@ -263,16 +263,18 @@ def _unknown_native_step(name):
     renames = _pymeshlab_renames()
     if re.fullmatch(r"[a-z0-9_]+", name) and (name in renames.values() or hasattr(pymeshlab.MeshSet, name)):
         old = next((o for o, new in renames.items() if new == name), None)
-        words = f" ({old.replace('_', ' ')!r} in lower case)" if old else ""
-        return f"{name!r} is pymeshlab's Python name, not MeshLab's{words}. {_HOW_NAMES_ARE_WRITTEN}"
+        words = f" (its words, in lower case and without punctuation: {old.replace('_', ' ')!r})" if old else ""
+        return (f"{name!r} is pymeshlab's Python name, not MeshLab's{words}. {_HOW_NAMES_ARE_WRITTEN}")
     key = _snake(name)
     if key in renames:
-        return (f"MeshLab spells this filter differently ({key.replace('_', ' ')!r} in lower case; "
-                f"pymeshlab's {renames[key]}). {_HOW_NAMES_ARE_WRITTEN}")
+        return (f"MeshLab's name for this filter (pymeshlab's {renames[key]}) has these words, "
+                f"{key.replace('_', ' ')!r}, with other capitals or punctuation (a colon, a comma, a "
+                f"dash). {_HOW_NAMES_ARE_WRITTEN}")
     matches = close_matches(key, renames, cutoff=0.75)
     if matches:
         return (f"MeshLab has no filter called {name!r}; did you mean "
-                f"{', '.join(repr(m.replace('_', ' ')) for m in matches)} (in lower case)? {_HOW_NAMES_ARE_WRITTEN}")
+                f"{', '.join(repr(m.replace('_', ' ')) for m in matches)} (their words, in lower case "
+                f"and without punctuation)? {_HOW_NAMES_ARE_WRITTEN}")
     return (f"pymeshlab failed without a reason ({_UNKNOWN_STEP!r}); the usual cause is a filter name "
             f"MeshLab does not know. {_HOW_NAMES_ARE_WRITTEN}")
 
