@@ -181,12 +181,12 @@ def _reconstruct_command(parser):
 def _minimal_command(parser):
     add_input_output_arguments(parser, "mesh file with a boundary",
                                "minimal surface; quality = distance moved")
-    parser.add_argument("--max-iterations", type=int, default=200,
+    parser.add_argument("--max-iterations", type=_whole_number_from_one, default=200,
                         help="Pinkall-Polthier steps at most; if the shape has not settled by then, "
                              "OUTPUT is still written and the exit status is 3")
     from .curvature.minimal_surface import DEFAULT_TOL
 
-    parser.add_argument("--tol", type=float, default=DEFAULT_TOL,
+    parser.add_argument("--tol", type=_positive_number, default=DEFAULT_TOL,
                         help="stop when no vertex moves more than TOL x the bbox diagonal of its piece "
                              "in a step, as --step measures it (by default normal to the surface: "
                              f"tangential sliding is not counted; default {DEFAULT_TOL:g})")
@@ -249,6 +249,28 @@ def _note_a_big_target(V, F, fraction, *, evaluate=True, given=None, skip="--no-
         why = f" (the measurements most of it; {skip} skips them)" if evaluate else ""
         given = given or f"a {100 * fraction:g} % target edge"
         _say(f"note: {given} gives about {count:,.0f} target vertices; this takes minutes{why}.")
+
+
+def _whole_number_from_one(text):
+    """An option's value as an int >= 1, or an argparse error in the option's own terms."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number of at least 1")
+    return value
+
+
+def _positive_number(text):
+    """An option's value as a finite float > 0, or an argparse error in the option's own terms."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not 0.0 < value < float("inf"):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a positive number")
+    return value
 
 
 def _percentage(text):

@@ -235,3 +235,17 @@ def test_minimal_full_step_says_what_it_measured(tmp_path, capsys):
     assert main(["minimal", NOSE, str(tmp_path / "m.ply"), "--step", "full", "--max-iterations", "3"]) == 3
     printed = capsys.readouterr().out
     assert "tangential sliding included" in printed and "normal to the surface" not in printed
+
+
+@pytest.mark.parametrize("option, value, words", [
+    ("--max-iterations", "0", "argument --max-iterations: '0' is not a whole number of at least 1"),
+    ("--max-iterations", "2.5", "argument --max-iterations: '2.5' is not a whole number"),
+    ("--tol", "-1e-4", "argument --tol: '-1e-4' is not a positive number"),
+    ("--tol", "nan", "argument --tol: 'nan' is not a positive number"),
+])
+def test_minimal_options_out_of_range_are_named_as_options(tmp_path, capsys, option, value, words):
+    # the library's words were "max_iterations=0 must be at least 1": a Python name, not the option
+    with pytest.raises(SystemExit) as exit_:
+        main(["minimal", NOSE, str(tmp_path / "m.ply"), f"{option}={value}"])
+    assert exit_.value.code == 2 and words in capsys.readouterr().err
+    assert not os.listdir(tmp_path)
