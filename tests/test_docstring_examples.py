@@ -12,6 +12,7 @@ MODULES = [
     "curvdetail.filters.dispatch", "curvdetail.filters.mlx", "curvdetail.filters.parameters",
     "curvdetail.deformation_benchmark", "curvdetail.curvature.curvature_editor",
     "curvdetail.curvature.curvature_coefficients", "curvdetail.curvature.boundary_editing",
+    "curvdetail.remesh._disk",
 ]
 
 

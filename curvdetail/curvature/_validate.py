@@ -262,6 +262,21 @@ def boundary_edges(F):
     ``F`` is checked as in :func:`check_mesh` (shape, integer entries, no negative or repeated
     index in a triangle): MeshError otherwise.
 
+    Parameters
+    ----------
+    F : (m, 3) int array   triangles (integral floats are accepted); no vertex positions are needed,
+                           and indices need not be contiguous
+
+    Returns
+    -------
+    E : (k, 2) int64 array   boundary edges as (from, to) in their triangle's winding, rows ordered
+                             by the sorted pair (min, max); (0, 2) for a closed surface
+
+    Raises
+    ------
+    MeshError   ``F`` not an (m, 3) integer array, empty, or with a negative or repeated index
+                in a triangle
+
     Examples
     --------
     >>> import numpy as np
@@ -330,6 +345,22 @@ def _compact_ids(F):
 
 def boundary_vertices(F):
     """Sorted indices of the vertices on a boundary edge; empty for a closed surface.
+
+    A boundary edge is one used by exactly one triangle (as in :func:`boundary_edges`).
+
+    Parameters
+    ----------
+    F : (m, 3) int array   triangles (integral floats are accepted), checked as in
+                           :func:`boundary_edges`
+
+    Returns
+    -------
+    b : (k,) int64 array   vertex indices in increasing order, each once
+
+    Raises
+    ------
+    MeshError   ``F`` not an (m, 3) integer array, empty, or with a negative or repeated index
+                in a triangle
 
     Examples
     --------

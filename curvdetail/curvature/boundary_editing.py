@@ -171,15 +171,28 @@ def sine_displacement(amplitude, periods=1, axis=1, phase=0.0):
 def boundary_loop(F):
     """The single boundary loop of a disk-topology patch, in the orientation of its triangles.
 
+    Parameters
+    ----------
+    F : (m, 3) int array    triangles, consistently oriented (checked as in :func:`boundary_edges`;
+                            no vertex positions are needed)
+
     Returns
     -------
-    loop : (b,) int array   boundary vertices in order; ``loop[0]`` is the smallest index
+    loop : (b,) int64 array   boundary vertices in order, each once; ``loop[0]`` is the smallest
+                              index and each ``(loop[i], loop[i + 1])`` runs as in its triangle (for
+                              a patch whose normals face the viewer: counter-clockwise)
 
     Raises
     ------
     MeshError   the mesh has no boundary, several loops, or a vertex where the boundary
                 touches itself; triangles wound against their neighbours and several pieces are
-                named as such
+                named as such; ``F`` malformed (as :func:`boundary_edges` refuses it)
+
+    Examples
+    --------
+    >>> from curvdetail.curvature.testing import grid
+    >>> boundary_loop(grid(3, 3)[1]).tolist()      # vertices 0 1 2 / 3 4 5 / 6 7 8, normals +z
+    [0, 1, 2, 5, 8, 7, 6, 3]
     """
     E = boundary_edges(F)
     try:

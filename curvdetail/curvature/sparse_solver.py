@@ -58,6 +58,15 @@ def _has_cholmod():
 def available_backends():
     """Names of the installed backends, fastest first; ``"splu"`` and ``"banded"`` are always there.
 
+    Takes no parameters. Whether ``"pardiso"`` (``pypardiso``) and ``"cholmod"``
+    (``scikit-sparse``) are listed depends on what imports on this machine; ``"auto"`` is not a
+    backend name and is never listed.
+
+    Returns
+    -------
+    names : list of str   a subset of :data:`BACKENDS`, in its order: ``"pardiso"``, ``"cholmod"``
+                          where installed, then always ``"splu"`` and ``"banded"``
+
     Examples
     --------
     >>> available_backends()[-2:]

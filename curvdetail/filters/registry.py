@@ -84,6 +84,35 @@ def filter(*, name, category, description, parameters=()):  # noqa: A001 (pymesh
 
     The decorated function keeps working as a plain function; the spec is attached as
     ``function.spec``.
+
+    Returns
+    -------
+    register : callable   the decorator: it registers a :class:`FilterSpec` under ``name`` (the
+                          description with its whitespace collapsed to single spaces), sets
+                          ``function.spec``, gives a function without a docstring one built from
+                          the declaration, and returns the same function
+
+    Raises
+    ------
+    TypeError   when the decorator is applied: ``name`` not snake_case or not starting with one of
+                :data:`FAMILIES`, already registered, an empty ``category`` or ``description``,
+                a parameter declared twice, or declared parameters that differ from the
+                function's keyword-only arguments
+
+    Examples
+    --------
+    >>> from curvdetail.filters import Parameter, filter, get_filter, registry
+    >>> @filter(name="get_vertex_count", category="Example", description="Count the vertices.",
+    ...         parameters=[Parameter("scale", "float", 1.0, "factor on the count")])
+    ... def get_vertex_count(ms, *, scale):
+    ...     return {"vertex_count": scale * ms.current_mesh().vertex_number()}
+    >>> get_filter("get_vertex_count") is get_vertex_count.spec, get_vertex_count.spec.defaults()
+    (True, {'scale': 1.0})
+    >>> del registry._REGISTRY["get_vertex_count"]          # unregister the example again
+    >>> filter(name="vertex_count", category="Example", description="d")(lambda ms: {})
+    Traceback (most recent call last):
+    ...
+    TypeError: filter name 'vertex_count' must be snake_case and start with one of (...).
     """
     def register(function):
         if not name.startswith(FAMILIES) or name != name.lower() or " " in name:
@@ -127,6 +156,12 @@ def _docstring(spec):
 def list_filters():
     """Every registered filter's :class:`FilterSpec`, sorted by name.
 
+    Takes no parameters; importing :mod:`curvdetail.filters` registers the package's filters.
+
+    Returns
+    -------
+    specs : list of FilterSpec   a new list each call, sorted by ``name``
+
     Examples
     --------
     >>> from curvdetail.filters import list_filters
@@ -143,7 +178,32 @@ def close_matches(word, candidates, cutoff=0.5):
 
 
 def get_filter(name):
-    """The :class:`FilterSpec` called ``name``, or UnknownFilterError listing the close matches."""
+    """The :class:`FilterSpec` called ``name``, or UnknownFilterError listing the close matches.
+
+    Parameters
+    ----------
+    name : str   the filter's exact name, e.g. ``"compute_curvature_detail"``
+
+    Returns
+    -------
+    spec : FilterSpec   the registered declaration (name, category, description, parameters,
+                        function)
+
+    Raises
+    ------
+    UnknownFilterError   no filter of that name (also for a name that is not a string); the
+                         message lists up to three close matches or points to the list
+
+    Examples
+    --------
+    >>> from curvdetail.filters import get_filter
+    >>> get_filter("apply_curvature_reconstruction").defaults()["rows"]
+    'all'
+    >>> get_filter("compute_curvature_details")
+    Traceback (most recent call last):
+    ...
+    curvdetail.filters.errors.UnknownFilterError: unknown filter ...; did you mean compute_curvature_detail...?
+    """
     try:
         return _REGISTRY[name]
     except (KeyError, TypeError):
@@ -155,7 +215,20 @@ def get_filter(name):
 
 
 def print_filter_list():
-    """Print the filter names, as ``pymeshlab.print_filter_list()`` does."""
+    """Print the filter names, as ``pymeshlab.print_filter_list()`` does.
+
+    Takes no parameters and returns None: prints a header line, then each registered name on a
+    line of its own, indented by a tab, sorted by name (as :func:`list_filters`).
+
+    Examples
+    --------
+    >>> from curvdetail.filters import print_filter_list
+    >>> print_filter_list()                                # doctest: +NORMALIZE_WHITESPACE
+    curvdetail.filters - list of filter names:
+    ...
+        compute_curvature_detail
+    ...
+    """
     print("curvdetail.filters - list of filter names:")
     for spec in list_filters():
         print(f"\t{spec.name}")
@@ -163,7 +236,31 @@ def print_filter_list():
 
 def print_filter_parameter_list(name):
     """Print a filter's parameters as ``name : type = default``, as
-    ``pymeshlab.print_filter_parameter_list(name)`` does."""
+    ``pymeshlab.print_filter_parameter_list(name)`` does.
+
+    Returns None: prints a header line, then one tab-indented line per parameter in declaration
+    order (``None.`` for a filter without parameters).
+
+    Parameters
+    ----------
+    name : str   the filter's exact name
+
+    Raises
+    ------
+    UnknownFilterError   no filter of that name (as :func:`get_filter`)
+
+    Examples
+    --------
+    >>> from curvdetail.filters import print_filter_parameter_list
+    >>> print_filter_parameter_list("apply_curvature_reconstruction")    # doctest: +NORMALIZE_WHITESPACE
+    apply_curvature_reconstruction filter - list of parameter names:
+        rows : str = 'all'
+        fix_boundary : bool = True
+    ...
+    >>> print_filter_parameter_list("compute_curvature_detail")          # doctest: +NORMALIZE_WHITESPACE
+    compute_curvature_detail filter - list of parameter names:
+        None.
+    """
     spec = get_filter(name)
     print(f"{spec.name} filter - list of parameter names:")
     if not spec.parameters:

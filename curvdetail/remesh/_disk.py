@@ -32,11 +32,37 @@ def check_disk(V, F, what="the source"):
     (the mesh lies to the left when walking it with the normals up) and starting at its
     smallest vertex index.
 
+    Parameters
+    ----------
+    V : (n, 3) float array   vertex positions (checked as in :func:`check_mesh`)
+    F : (m, 3) int array     triangles, consistently oriented; every vertex used
+    what : str               how the messages name the mesh, e.g. ``"the target"``
+
+    Returns
+    -------
+    V : (n, 3) float64 array   the checked positions (C-contiguous)
+    F : (m, 3) int64 array     the checked triangles (C-contiguous)
+    loop : (k,) int64 array    the boundary loop, as above
+
     Raises
     ------
-    MeshError        malformed mesh (shapes, NaN, zero-area or non-manifold edges, ...)
-    NotADiskError    closed, several boundary loops, several pieces, a pinched boundary vertex
-                     or handles; the message says what was found and what is needed
+    MeshError        malformed mesh (shapes, NaN, zero-area triangles, unreferenced vertices, ...)
+    NotADiskError    (a MeshError) edges shared by more than two triangles, closed, several
+                     boundary loops, several pieces, a pinched boundary vertex or handles;
+                     triangles wound against their neighbours are named as such where they make
+                     the boundary look pinched, split or open. The message says what was found
+                     and what is needed
+
+    Examples
+    --------
+    >>> from curvdetail.curvature.testing import grid, icosphere
+    >>> V, F, loop = check_disk(*grid(3, 3))      # vertices 0 1 2 / 3 4 5 / 6 7 8, normals +z
+    >>> loop.tolist()
+    [0, 1, 2, 5, 8, 7, 6, 3]
+    >>> check_disk(*icosphere(subdivisions=1), what="the sphere")
+    Traceback (most recent call last):
+    ...
+    curvdetail.remesh._disk.NotADiskError: the sphere is closed (0 boundary loops); ...
     """
     need = ("a disk-topology patch is needed: one connected piece with exactly one boundary loop "
             "and no handles (cut one out, e.g. with pymeshlab's compute_selection_by_condition_per_"

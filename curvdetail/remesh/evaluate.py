@@ -140,11 +140,32 @@ def vertex_distance(V, Vs, Fs, *, far=False):
     points far from the surface, overestimating by at most ~``r^2 / 2d``) instead of the exact
     :func:`locate` (whose grid search slows down with the distance).
 
+    Parameters
+    ----------
+    V : (k, 3) float array    query points, e.g. a rebuilt mesh's vertices (k = 0 allowed); or
+                              (k, 2) with a planar ``Vs``
+    Vs : (n, 3) float array   the surface's vertex positions ((n, 2) for planar points)
+    Fs : (m, 3) int array     its triangles
+    far : bool                take the kd-tree candidates instead of the exact search (see above)
+
+    Returns
+    -------
+    d : (k,) float64 array    unsigned distances, in the unit of the coordinates (0, up to
+                              rounding, for a point on the surface), row i for ``V[i]``
+
     Raises
     ------
     MeshError   malformed points or surface, as :func:`locate` refuses them (names ``V``,
                 ``Vs`` and ``Fs``)
     ValueError  ``far`` not a bool
+
+    Examples
+    --------
+    >>> from curvdetail.curvature.testing import grid
+    >>> Vs, Fs = grid(3, 3)                               # the unit square in z = 0
+    >>> P = np.array([[0.5, 0.5, 2.0], [0.2, 0.3, 0.0], [2.0, 0.5, 0.0]])
+    >>> vertex_distance(P, Vs, Fs).round(12).tolist()     # above, on, and beside the square
+    [2.0, 0.0, 1.0]
     """
     check_bool(far, "far")
     P, Vs, Fs = check_points_and_mesh(V, Vs, Fs, names=("V", "Vs", "Fs"))

@@ -16,7 +16,33 @@ def flipped_triangles(UV, F):
     """Indices of triangles whose orientation in the plane is reversed or degenerate (signed area
     <= 0 relative to the orientation of the majority, by area), shape (k,).
 
-    ``UV``: finite (n, 2) floats; ``F``: (m, 3) integers in [0, n). MeshError otherwise."""
+    The majority orientation is the sign of the total signed area (counter-clockwise when it is
+    >= 0), so a map that mirrors the whole mesh flips no triangle.
+
+    Parameters
+    ----------
+    UV : (n, 2) float array   planar positions, finite
+    F : (m, 3) int array      triangles, indices in [0, n)
+
+    Returns
+    -------
+    flipped : (k,) int64 array   indices into ``F``, increasing; empty when no triangle is flipped
+
+    Raises
+    ------
+    MeshError   ``UV`` not a finite (n, 2) array of real numbers, or ``F`` not an (m, 3) integer
+                array with indices in [0, n) and no repeated index in a triangle
+
+    Examples
+    --------
+    >>> from curvdetail.curvature.testing import grid
+    >>> V, F = grid(3, 3)
+    >>> flipped_triangles(V[:, :2], F).tolist(), flipped_triangles(V[:, 1::-1], F).tolist()   # x <-> y
+    ([], [])
+    >>> F[3] = F[3, [0, 2, 1]]                  # wind one triangle the other way
+    >>> flipped_triangles(V[:, :2], F).tolist()
+    [3]
+    """
     # NaN UVs would compare as "not flipped" and float faces fail to index: refuse both here
     UV = as_vertices(UV, "UV", dim=2)
     F = as_faces(F, None)
@@ -35,13 +61,14 @@ def harmonic_map(V, F, boundary, boundary_uv, *, backend="auto"):
     ----------
     V : (n, 3) float array          vertex positions (supply the cotangent weights)
     F : (m, 3) int array            triangles
-    boundary : (k,) int array       pinned vertices
-    boundary_uv : (k, 2) float      their planar positions
+    boundary : (k,) int array       pinned vertices (or an (n,) bool mask: its true positions in
+                                    increasing order)
+    boundary_uv : (k, 2) float      their planar positions, row r for ``boundary[r]``
     backend : str                   sparse solver backend (one factorization, two right-hand sides)
 
     Returns
     -------
-    UV : (n, 2) float array
+    UV : (n, 2) float array         planar positions; ``UV[boundary] == boundary_uv`` exactly
 
     Raises
     ------
@@ -49,6 +76,19 @@ def harmonic_map(V, F, boundary, boundary_uv, *, backend="auto"):
     ConstraintError   ``boundary`` empty, out of range or repeated, a piece of the mesh without a
                       pinned vertex (the map is undetermined there), or ``boundary_uv`` not a
                       finite (k, 2) array
+
+    Examples
+    --------
+    A flat patch pinned at its own boundary positions maps onto itself (the cotangent Laplacian
+    reproduces linear functions in the plane):
+
+    >>> from curvdetail.curvature import boundary_vertices
+    >>> from curvdetail.curvature.testing import grid
+    >>> V, F = grid(5, 5)
+    >>> b = boundary_vertices(F)
+    >>> UV = harmonic_map(V, F, b, V[b, :2])
+    >>> bool(np.allclose(UV, V[:, :2], atol=1e-12))
+    True
     """
     V, F = check_mesh(V, F)
     boundary = as_index_set(boundary, V.shape[0], "boundary")
