@@ -187,7 +187,10 @@ def test_spread_takes_numpy_and_whole_float_counts():
 
     V, F, face, bary = _located_on_grid()
     assert spread(np.ones(face.size), F, face, bary, np.int64(25)).sum() == pytest.approx(face.size, abs=1e-12)
-    assert spread(np.ones(face.size), F, face, bary, 30.0).shape == (30, 1)
+    assert spread(np.ones(face.size), F, face, bary, 30.0).shape == (30,)        # 1-D in, 1-D out
+    assert spread(np.ones((face.size, 2)), F, face, bary, 30).shape == (30, 2)
+    # no points at all: zeros (it was numpy's "cannot reshape array of size 0")
+    assert np.array_equal(spread(np.ones(0), F, face[:0], bary[:0], 30), np.zeros(30))
 
 
 @pytest.mark.parametrize("values, words", [

@@ -403,11 +403,33 @@ def _as_point_values(values, count, what, per):
 
 
 def interpolate(values, F, face, bary):
-    """Values at located points: ``sum_k bary_k values[F[face, k]]`` (values (n,) or (n, c)).
+    """Values at located points: ``sum_k bary_k values[F[face, k]]``.
 
-    ``values`` must be finite with one row per vertex of the mesh ``F`` indexes, ``face`` and
-    ``bary`` as :func:`locate` returns them (rows in [0, 1] summing to 1, within
-    ``BARY_TOLERANCE``); MeshError otherwise."""
+    Parameters
+    ----------
+    values : (n,) or (n, c) float array   finite, one value (or row) per vertex of the mesh ``F``
+                                          indexes (at least ``F.max() + 1``)
+    F : (m, 3) int array                  triangles
+    face : (k,) int array                 triangle of each point, as :func:`locate` returns it
+    bary : (k, 3) float array             barycentric coordinates in that triangle (rows in [0, 1]
+                                          summing to 1, within ``BARY_TOLERANCE``)
+
+    Returns
+    -------
+    (k,) or (k, c) float array   the interpolated values, as ``values`` is 1-D or 2-D
+
+    Raises
+    ------
+    MeshError   any of the above not so
+
+    Examples
+    --------
+    >>> from curvdetail.curvature.testing import grid
+    >>> V, F = grid(3, 3)
+    >>> face, bary, _ = locate(np.array([[0.25, 0.25], [0.6, 0.1]]), V[:, :2], F)
+    >>> interpolate(V, F, face, bary)[:, :2].round(12).tolist()      # linear data is reproduced
+    [[0.25, 0.25], [0.6, 0.1]]
+    """
     F, face, bary = _located(F, face, bary, "interpolate")
     need = int(F.max()) + 1 if F.size else 0
     vals = _as_point_values(values, need, "interpolate", "vertex of the mesh F indexes")
@@ -422,12 +444,36 @@ def interpolate(values, F, face, bary):
 
 def spread(values, F, face, bary, n):
     """Adjoint of :func:`interpolate`: each point's value split over the 3 corners of its
-    triangle by barycentric weights and summed per vertex, shape (n, c). The sum is conserved
-    exactly (up to rounding), since the weights of a point sum to 1.
+    triangle by barycentric weights and summed per vertex. The sum is conserved exactly (up to
+    rounding), since the weights of a point sum to 1.
 
-    ``n`` is a whole number, at least the number of vertices ``F`` references and at most
-    ``MAX_SPREAD_VERTICES``; ``values`` finite with one value (or row) per located point;
-    ValueError / MeshError otherwise."""
+    Parameters
+    ----------
+    values : (k,) or (k, c) float array   finite, one value (or row) per located point
+    F : (m, 3) int array                  triangles
+    face : (k,) int array, bary : (k, 3) float array   as for :func:`interpolate`
+    n : int                               vertex count of the result: a whole number, at least
+                                          ``F.max() + 1`` and at most ``MAX_SPREAD_VERTICES``
+
+    Returns
+    -------
+    (n,) or (n, c) float array   per-vertex sums, as ``values`` is 1-D or 2-D (zeros where no
+                                 point lies on a vertex's triangles, and for no points at all)
+
+    Raises
+    ------
+    ValueError   ``n`` not a whole number or too large
+    MeshError    the others not as above
+
+    Examples
+    --------
+    >>> from curvdetail.curvature.testing import grid
+    >>> V, F = grid(3, 3)
+    >>> face, bary, _ = locate(np.array([[0.25, 0.25], [0.6, 0.1]]), V[:, :2], F)
+    >>> D = spread(np.array([1.0, 2.0]), F, face, bary, len(V))
+    >>> D.shape, round(float(D.sum()), 12)                          # the total is kept
+    ((9,), 3.0)
+    """
     n = as_count(n, "n")
     if n > MAX_SPREAD_VERTICES:
         raise ValueError(f"n={n} asks for a dense ({n}, c) result, more than {MAX_SPREAD_VERTICES:,} rows; "
@@ -440,7 +486,6 @@ def spread(values, F, face, bary, n):
     if vals.shape[0] != face.shape[0]:
         raise MeshError(f"spread: values has {vals.shape[0]} rows for {face.shape[0]} located "
                         "points; give one value (or row) per point.")
-    vals = vals.reshape(face.shape[0], -1)
     rows = F[face].ravel()
     W = sp.csr_matrix((bary.ravel(), (rows, np.repeat(np.arange(face.shape[0]), 3))), shape=(n, face.shape[0]))
-    return W @ vals
+    return W @ vals                     # as interpolate: 1-D values give a 1-D result
