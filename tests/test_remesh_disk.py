@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from curvdetail.curvature.testing import disk, icosphere
+from curvdetail.curvature.errors import MeshError
+from curvdetail.curvature.testing import disk, grid, icosphere
 from curvdetail.remesh import NotADiskError
 from curvdetail.remesh._disk import Polyline, check_disk
 
@@ -84,3 +85,14 @@ def test_a_reversed_boundary_triangle_is_named_as_an_orientation_problem(flat_di
     with pytest.raises(NotADiskError, match=r"not consistently oriented: 2 interior edges run the same way "
                                             r"in both their triangles .*meshing_re_orient_faces_coherently"):
         check_disk(V, F)
+
+
+def test_fractional_indices_are_named_not_read_as_a_non_manifold_edge():
+    # the non-manifold look-up cast F to int64: 5.5 became 5, a third triangle on edge (5, 6)
+    V, F = grid(4, 4)
+    a, b = 5, 6                                         # an interior edge: two triangles have it
+    assert sum(set((a, b)) <= set(t) for t in F.tolist()) == 2
+    F = np.vstack([F.astype(float), [a + 0.5, b, 15.0]])
+    with pytest.raises(MeshError, match="F has non-integer entries") as error:
+        check_disk(V, F)
+    assert not isinstance(error.value, NotADiskError)

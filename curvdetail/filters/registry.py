@@ -119,7 +119,7 @@ def filter(*, name, category, description, parameters=()):  # noqa: A001 (pymesh
             raise TypeError(f"filter name {name!r} must be snake_case and start with one of {FAMILIES}.")
         if name in _REGISTRY:
             raise TypeError(f"filter {name!r} is registered twice.")
-        if not description or not description.strip() or not category:
+        if not description or not description.strip() or not category or not category.strip():
             raise TypeError(f"filter {name!r} needs a category and a description.")
         params = tuple(parameters)
         names = [p.name for p in params]

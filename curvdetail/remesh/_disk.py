@@ -1,6 +1,7 @@
 """Disk-topology checks and projection onto the boundary polyline.
 
-Private helpers of :mod:`curvdetail.remesh`. A *disk* here is a triangle mesh that is one
+Used across :mod:`curvdetail.remesh`, which exports ``check_disk``, ``NotADiskError`` and
+``RemeshError`` from here. A *disk* here is a triangle mesh that is one
 connected, edge- and vertex-manifold piece with exactly one boundary loop and Euler
 characteristic 1 (no handles).
 """
@@ -10,7 +11,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-from ..curvature._validate import (boundary_edges, check_mesh, check_oriented, non_manifold_edges,
+from ..curvature._validate import (as_faces, boundary_edges, check_mesh, check_oriented, non_manifold_edges,
                                    vertex_components)
 from ..curvature.boundary_editing import loop_of_boundary_edges
 from ..curvature.errors import MeshError, first_indices
@@ -72,7 +73,7 @@ def check_disk(V, F, what="the source"):
         V, F = check_mesh(V, F)
     except MeshError as exc:
         try:
-            nm = non_manifold_edges(np.asarray(F, dtype=np.int64))
+            nm = non_manifold_edges(as_faces(F, None))    # checked: a cast would truncate 1.5 to 1
         except Exception:  # F too malformed to look at: the original message says why
             nm = None
         if nm is not None and nm.shape[0]:

@@ -19,9 +19,9 @@ MAX_EDGE_SAMPLES = 20_000_000
 def edge_curvature_measure(V, F):
     """The curvature detail of a polyhedral surface as a measure on its edges.
 
-    For edge e, ``c_e = sum over its 1 or 2 triangles of |e| * (outward in-plane conormal of e in
-    that triangle)``: zero on a flat interior edge, bending-normal on a folded one, in-plane on a
-    boundary edge. Each vertex's detail is half the measure of its edges:
+    For edge e, ``c_e = sum over its triangles of |e| * (outward in-plane conormal of e in that
+    triangle)`` (1 triangle on the boundary, 2 inside, more where edges are not manifold): zero on
+    a flat interior edge, bending-normal on a folded one, in-plane on a boundary edge. Each vertex's detail is half the measure of its edges:
     ``D_i = (L V)_i = 1/2 sum_{e ni i} c_e`` exactly (the area gradient, edge by edge).
 
     Parameters
