@@ -176,6 +176,10 @@ def test_apply_bad_value(capsys, tmp_path):
     assert_failed(capsys, ["apply", "apply_curvature_reconstruction", NOSE, tmp_path / "o.ply",
                            "--param", "rows=some"], "'rows' is 'some'; it must be one of all, free",
                   tmp_path / "o.ply")
+    # an index out of range: the message says indices are taken too
+    assert_failed(capsys, ["apply", "apply_curvature_reconstruction", NOSE, tmp_path / "o.ply",
+                           "--param", "rows=2"], "'rows' is '2'; it must be one of all, free (or its index, 0 to 1)",
+                  tmp_path / "o.ply")
 
 
 def test_apply_bad_param_syntax(capsys, tmp_path):

@@ -154,7 +154,8 @@ class Parameter:
                     if value.lower() == c.lower():
                         return c
                 raise FilterParameterError(
-                    f"parameter {self.name!r} is {value!r}; it must be one of {', '.join(self.choices)}."
+                    f"parameter {self.name!r} is {value!r}; it must be one of {', '.join(self.choices)} "
+                    f"(or its index, 0 to {len(self.choices) - 1})."
                 )
             return value
         # PercentageValue
