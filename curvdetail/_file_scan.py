@@ -7,9 +7,12 @@ words to it (a row with a value too many shifts every later coordinate, a commen
 read as numbers, a vertex split over lines is read right), missing OFF rows are filled from
 what follows, a line of blanks among the faces repeats the face before it, OFF and OBJ indices
 and counts are read with atoi (2.5 -> 2, 2.0 -> 2) and a comment after an OBJ face becomes
-further corners. The scans read the file once more, vectorized over its bytes.
+further corners; OFF face rows beyond the header's count are dropped, and a decimal comma ends
+an OFF or OBJ number (``1,5`` -> 1). PLY files are scanned by :mod:`._ply_scan`. The scans
+read the file once more, vectorized over its bytes.
 """
 
+import contextlib
 import io
 import mmap
 import os
@@ -18,6 +21,7 @@ import re
 import numpy as np
 
 from ._file_counts import _off_header, _whole
+from ._ply_scan import _ply_problem
 
 
 def check_before_loading(path, error=ValueError):
@@ -35,8 +39,22 @@ def check_before_loading(path, error=ValueError):
     refuses with only "Invalid file", is named as such. OBJ: indented vertex lines (the loader
     counts them in one pass and not in the other; reading one aborted the process), a fractional
     face index (truncated; 2.0 passes) and a comment after a face (read as corners out of range;
-    a one-word comment glued to the last index, ``f 1 2 3#note``, passes). Other files pass
-    unread."""
+    a one-word comment glued to the last index, ``f 1 2 3#note``, passes). OFF and OBJ: a comma
+    in a number (``v 1,5 2 3`` was read as the vertex (1, 2, 3); commas in comments and names
+    pass); OFF: rows after the header's faces (dropped; empty lines and comments pass).
+
+    PLY, ASCII or binary: a header pymeshlab misparses (an element count that is not a whole
+    number, or none: that crashed it) and face lists of types its importer does not read (it
+    takes the faces from whatever memory held). ASCII PLY (:func:`_ply_body_problem`): every
+    value fscanf would not read whole as its type (a fractional or comma'd index, ``1.5.5``),
+    list counts that are not whole numbers, faces of fewer than 3 or more than 255 vertices,
+    lines that hold values of two rows or a face row not on a line of its own, and fewer or more
+    rows than the header declares; rows split over lines that hold exactly their values (not
+    faces), blank lines, comments in the header, other elements and properties pass.
+
+    Other files pass unread. Returns the number of triangles an ASCII PLY file's faces make (a
+    polygon of k vertices k - 2; pymeshlab drops faces with a repeated index or the 'deleted'
+    flag bit, which the caller finds by comparing), else None."""
     extension = os.path.splitext(os.fspath(path))[1].lower()
     if extension == ".off":
         if _off_is_binary(path):
@@ -45,7 +63,18 @@ def check_before_loading(path, error=ValueError):
         problem = _off_rows_problem(path)
         if problem:
             raise error(f"{path!r}: {problem}; fix the file and read it again.")
+    elif extension == ".ply":
+        problem, triangles = _ply_problem(path)
+        if problem:
+            raise error(f"{path!r}: {problem}; fix the file and read it again.")
+        return triangles
     elif extension == ".obj":
+        comma = _obj_comma(path)
+        if comma is not None:
+            raise error(f"{path!r}: line {comma[0]} ({comma[1]!r}) writes a number with a comma, which "
+                        "pymeshlab's OBJ loader reads only up to the comma without a word ('v 1,5 2 3' was "
+                        "read as the vertex (1, 2, 3)); write decimals with a point (and separate values with "
+                        "spaces) and read the file again.")
         count, line = _obj_indented_vertices(path)
         if count:
             raise error(f"{path!r}: {count} vertex lines start with spaces or tabs (first: line {line}), "
@@ -70,21 +99,54 @@ def _off_is_binary(path):
     return len(words) >= 2 and words[0].endswith(b"OFF") and words[1] == b"BINARY"
 
 
-def _obj_indented_vertices(path):
-    """``(number, first 1-based line)`` of ``v`` lines with leading blanks in an OBJ file; the
-    file is scanned through a memory map, never read whole."""
+@contextlib.contextmanager
+def _mapped(path):
+    """The file's bytes as a read-only memory map (never read whole), or None for an empty file."""
     with open(path, "rb") as f:
         try:
             data = mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ)
-        except ValueError:                 # an empty file
-            return 0, None
+        except ValueError:                 # an empty file cannot be mapped
+            yield None
+            return
         with data:
-            starts = [m.start() + 1 for m in re.finditer(rb"\n[ \t]+v[ \t]", data)]
-            if re.match(rb"[ \t]+v[ \t]", data):
-                starts.insert(0, 0)
-            if not starts:
-                return 0, None
-            return len(starts), data[:starts[0]].count(b"\n") + 1
+            yield data
+
+
+def _obj_comma(path):
+    """``(1-based line, its text)`` of the first ``v``, ``vt``, ``vn``, ``vp`` or ``f`` line of
+    an OBJ file with a comma before any ``#``, or None. pymeshlab's loader reads each value with
+    atof or atoi, which stop at the comma: ``v 1,5 2 3`` came back as (1, 2, 3). Commas are found
+    through a memory map (C speed); only lines holding one are looked at."""
+    with _mapped(path) as data:
+        if data is None:
+            return None
+        at = data.find(b",")
+        while at >= 0:
+            start = data.rfind(b"\n", 0, at) + 1
+            end = data.find(b"\n", at)
+            end = len(data) if end < 0 else end
+            line = data[start:end]
+            words = line.split(b"#", 1)[0].split()
+            if words and words[0] in (b"v", b"vt", b"vn", b"vp", b"f") and b"," in b" ".join(words):
+                text = line.decode("ascii", "replace").strip()
+                line = int(np.count_nonzero(np.frombuffer(data, dtype=np.uint8, count=start) == 10)) + 1
+                return line, text if len(text) <= 80 else text[:77] + "..."
+            at = data.find(b",", end)
+    return None
+
+
+def _obj_indented_vertices(path):
+    """``(number, first 1-based line)`` of ``v`` lines with leading blanks in an OBJ file; the
+    file is scanned through a memory map, never read whole."""
+    with _mapped(path) as data:
+        if data is None:
+            return 0, None
+        starts = [m.start() + 1 for m in re.finditer(rb"\n[ \t]+v[ \t]", data)]
+        if re.match(rb"[ \t]+v[ \t]", data):
+            starts.insert(0, 0)
+        if not starts:
+            return 0, None
+        return len(starts), data[:starts[0]].count(b"\n") + 1
 
 
 def _obj_odd_face(path):
@@ -97,14 +159,11 @@ def _obj_odd_face(path):
     (``f 1 2 3#note``) is read right, atoi stopping at the ``#``, and passes. Vectorized over the
     bytes from the first face line on (~0.4 s for a million vertices); only lines holding one of
     the two characters are looked at."""
-    with open(path, "rb") as f:
-        try:
-            data = mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ)
-        except ValueError:                 # an empty file
+    with _mapped(path) as data:
+        if data is None:
             return None
-        with data:
-            found = [k + 1 for k in (data.find(b"\nf "), data.find(b"\nf\t")) if k >= 0]
-            first = 0 if data[:2] in (b"f ", b"f\t") else min(found, default=-1)
+        found = [k + 1 for k in (data.find(b"\nf "), data.find(b"\nf\t")) if k >= 0]
+        first = 0 if data[:2] in (b"f ", b"f\t") else min(found, default=-1)
     if first < 0:
         return None
     chars = np.fromfile(path, dtype=np.uint8, offset=first)
@@ -269,6 +328,10 @@ def _off_rows_problem(path):
                 "OFF reader, unlike an empty line, does not skip (among the vertices it stops with "
                 "'Invalid file'; among the faces it reads the face before it a second time); delete "
                 f"{'those lines' if blank.size > 1 else 'that line'} ({blank.size} in all)")
+    comma = _off_comma(body, chars, visible, starts, rows[:taken + nf], first_line) if data.find(b",", offset) >= 0 \
+        else None
+    if comma:
+        return comma
     problem = _off_vertex_rows_problem(chars if data.find(b"#", offset) >= 0 else None, visible,
                                        token_starts, starts, rows[:taken], per_row[:taken], nv, per_vertex,
                                        colours, keyword, first_line, text)
@@ -276,6 +339,13 @@ def _off_rows_problem(path):
         return problem
     if rows.size < taken + nf or (not colours and per_row[:taken].sum() < per_vertex * nv):
         return too_short()
+    if rows.size > taken + nf:
+        # pymeshlab stops after the declared faces: the rest was dropped without a word
+        extra = rows[taken + nf]
+        return (f"the header declares {nv} vertices and {nf} faces, but {rows.size - taken - nf} more rows follow "
+                f"the last face (first: line {first_line + extra}, {text(extra)!r}), which pymeshlab's OFF reader "
+                "ignores without a word; fix the header's counts or remove those rows (comments and empty lines "
+                "may follow the faces)")
     faces = rows[taken:taken + nf]
     per_face = per_row[taken:taken + nf]
     first, end = int(starts[faces[0]]), int(ends[faces[-1]])
@@ -325,6 +395,27 @@ def _off_rows_problem(path):
         return None
     return (f"{len(bad)} faces use vertex indices outside the file's {nv} vertices "
             f"(first: face {bad[0][0]}, {bad[0][1]})")
+
+
+def _off_comma(body, chars, visible, starts, rows, first_line):
+    """The message for the first comma in a word of an OFF file's rows ``rows`` (body line
+    numbers of the lines pymeshlab reads: the vertices and faces) before any ``#`` on its line,
+    or None. pymeshlab reads the values with atof and atoi, which stop at the comma: the row
+    ``1,5 2 3`` came back as the vertex (1, 2, 3). Only the commas are looked at."""
+    commas = np.flatnonzero(visible & (chars == 44))
+    if not commas.size or not rows.size:
+        return None
+    line = np.searchsorted(starts, commas, side="right") - 1
+    commas = commas[np.isin(line, rows)]
+    for at in commas.tolist():
+        row = int(np.searchsorted(starts, at, side="right") - 1)
+        if b"#" in bytes(body[starts[row]:at]):
+            continue                                           # in a comment's words
+        words = bytes(body[starts[row]:]).split(b"\n", 1)[0].decode("ascii", "replace").strip()
+        return (f"line {first_line + row} ({words[:80]!r}) writes a number with a comma, which pymeshlab's OFF "
+                "reader reads only up to the comma without a word (the row '1,5 2 3' was read as the vertex "
+                "(1, 2, 3)); write decimals with a point")
+    return None
 
 
 def _off_vertex_rows_problem(chars, visible, token_starts, starts, rows, per_row, nv, per_vertex, colours,

@@ -47,15 +47,23 @@ def read_mesh(path):
                         face index is out of range, or (OBJ, OFF, PLY, STL) the loader dropped
                         vertices or faces: pymeshlab silently removes vertices with NaN or
                         infinite coordinates (and renumbers the rest), OBJ faces with
-                        out-of-range or repeated indices, and STL triangles with a non-finite
-                        or repeated corner. Checked before pymeshlab reads the file, because
-                        its loader would corrupt memory or misread it without a word:
-                        out-of-range face indices, fewer rows than the header declares,
-                        vertex rows it would read shifted (a value too many or too few, a
-                        comment among the values; a vertex split over lines that hold exactly
-                        its values passes), lines of blanks, counts or indices that are not
-                        whole numbers (ASCII OFF); indented vertex lines, fractional face
-                        indices and comments after a face (OBJ; ``f 1 2 3#note`` passes)
+                        out-of-range or repeated indices, STL triangles with a non-finite
+                        or repeated corner, and ASCII PLY faces with a repeated index or the
+                        'deleted' flag bit (found by the triangles the file's faces make).
+                        Checked before pymeshlab reads the file, because its loader would
+                        corrupt memory or misread it without a word:
+                        out-of-range face indices, fewer or more rows than the header
+                        declares, vertex rows it would read shifted (a value too many or too
+                        few, a comment among the values; a vertex split over lines that hold
+                        exactly its values passes), lines of blanks, counts or indices that
+                        are not whole numbers (ASCII OFF); indented vertex lines, fractional
+                        face indices and comments after a face (OBJ; ``f 1 2 3#note``
+                        passes); decimal commas (OFF, OBJ, ASCII PLY); a PLY header pymeshlab
+                        misparses or crashes on, or face lists of types it does not read;
+                        ASCII PLY values it would not read whole as their type, faces of
+                        fewer than 3 or more than 255 vertices, a face row not on a line of
+                        its own, rows with values missing or extra (see
+                        :func:`curvdetail._file_scan.check_before_loading`)
 
     Examples
     --------
@@ -66,19 +74,10 @@ def read_mesh(path):
     (3, 3)
     """
     path = input_path(path)
-    try:
-        check_before_loading(path, error=MeshFileError)
-    except OSError as exc:          # unreadable: named as the file's problem, as pymeshlab's are
-        raise MeshFileError(f"could not read {path!r}: {exc.strerror or exc}.") from None
-    ms = _meshset()
-    try:
-        ms.load_new_mesh(path)
-    except Exception as exc:
-        raise MeshFileError(load_failure(path, exc)) from None
-    mesh = ms.current_mesh()
+    ms = _meshset()                 # kept referenced: the mesh is a view into it
+    mesh = load_checked(ms, path)
     V = np.ascontiguousarray(mesh.vertex_matrix(), dtype=np.float64)
     F = np.ascontiguousarray(mesh.face_matrix(), dtype=np.int64)
-    check_loaded(path, V.shape[0], F, error=MeshFileError)
     if F.shape[0] == 0 and V.shape[0] == 0:       # pymeshlab "reads" some other files as nothing
         raise MeshFileError(f"pymeshlab read nothing from {path!r} (no vertices, no triangles); is it a "
                             "mesh file? Use a format MeshLab reads (.obj, .off, .ply, .stl, ...).")
@@ -91,6 +90,33 @@ def read_mesh(path):
 #: Extensions whose files pymeshlab reads (and that most meshes come in): a failed read of one
 #: of these means a damaged file, not the wrong format.
 COMMON_FORMATS = (".ply", ".obj", ".off", ".stl")
+
+
+def load_checked(ms, path):
+    """Load the mesh file ``path`` into the MeshSet ``ms`` as its new current layer and return
+    that ``pymeshlab.Mesh``, with the checks pymeshlab's loader lacks: before it reads the file
+    (:func:`curvdetail._file_scan.check_before_loading`) and after (what it dropped:
+    :func:`curvdetail._file_counts.check_loaded`, and the triangles an ASCII PLY's faces make).
+    MeshFileError for each; ``path`` is expected to exist (see :func:`input_path`)."""
+    try:
+        triangles = check_before_loading(path, error=MeshFileError)
+    except OSError as exc:          # unreadable: named as the file's problem, as pymeshlab's are
+        raise MeshFileError(f"could not read {path!r}: {exc.strerror or exc}.") from None
+    try:
+        ms.load_new_mesh(path)
+    except Exception as exc:
+        raise MeshFileError(load_failure(path, exc)) from None
+    mesh = ms.current_mesh()
+    F = mesh.face_matrix()
+    check_loaded(path, mesh.vertex_number(), F, error=MeshFileError)
+    if triangles is not None and F.shape[0] and F.shape[0] != triangles:
+        # polygons are triangulated, so a header's face count cannot tell a dropped face
+        raise MeshFileError(
+            f"{path!r}: its faces make {triangles} triangles (a polygon of k vertices k - 2), but pymeshlab "
+            f"loaded {F.shape[0]}: its PLY loader drops, without a word, faces that repeat a vertex index and "
+            "faces whose 'flags' value has the 'deleted' bit (1) set. Fix or remove those faces (or their "
+            "flags) in the file and read it again.")
+    return mesh
 
 
 def load_failure(path, exc):
@@ -158,11 +184,168 @@ def _why_not_written(extension):
     with tempfile.TemporaryDirectory(prefix="curvdetail-format-") as folder:
         ms = _meshset()
         ms.add_mesh(pymeshlab.Mesh(vertex_matrix=np.eye(3), face_matrix=np.array([[0, 1, 2]], dtype=np.int32)))
+        probe = os.path.join(folder, "probe" + extension)
         try:
-            ms.save_current_mesh(os.path.join(folder, "probe" + extension))
+            ms.save_current_mesh(probe)
         except Exception as exc:
             return " ".join(str(exc).replace(folder + os.sep, "").split()) or type(exc).__name__
+        if not os.path.exists(probe) or os.path.getsize(probe) == 0:
+            return "it reports success but writes no file"      # .u3d: it needs a converter it lacks
     return None
+
+
+#: Loss allowed in the formats that write doubles as text (.obj, .off, ASCII .ply), as a share
+#: of the bounding-box diagonal: they can keep every double to an ulp or so; what they lose
+#: beyond 1e-9 of the mesh's size comes from their fixed layout (16 decimals, 16 digits), not
+#: from what the format is meant to hold.
+DOUBLE_TOLERANCE = 1e-9
+#: Loss allowed from the fixed decimals of the single-precision text formats (.3mf, .idtf), as a
+#: share of the bounding-box diagonal: about the 6 to 7 digits that single precision holds.
+SINGLE_TOLERANCE = 1e-6
+_FLOAT32_MAX = float(np.finfo(np.float32).max)
+_SAFE = ".ply (binary: doubles, every coordinate exact)"
+
+#: How pymeshlab writes vertex coordinates, by extension, measured by writing meshes of every
+#: scale and reading the files (pymeshlab 2023.12): ``("exact",)`` binary doubles; ``("digits",
+#: n)`` text with n significant digits ("%.16g"); ``("decimals", n, bits, tolerance, rounding)``
+#: text with n decimals after rounding (0.5) or truncating (1.0) to ``bits`` mantissa bits (52:
+#: the double itself, 23: a float32 first); ``("float32",)`` single precision (binary, or text
+#: of 6-7 significant digits in formats that declare single precision: COLLADA ``float``,
+#: JSON ``float32``, VRML/X3D ``SFFloat``); a str: why the format cannot hold coordinates.
+#: PLY and STL depend on ``binary``, CTM on ``lossless`` (see :func:`check_coordinates`).
+_COORDINATES = {
+    ".obj": ("decimals", 16, 52, DOUBLE_TOLERANCE, 0.5),   # "%.16f": 1e-20 is written as 0.0000000000000000
+    ".off": ("digits", 16),                                # "%.16g"
+    ".ply": ("exact",),                                    # binary: double x, y, z
+    ".ply ascii": ("digits", 16),                          # "%.16g"
+    ".stl": ("float32",),                                  # binary float32; ASCII "%e" of the float32
+    ".3ds": ("float32",),
+    ".ctm": ("float32",),                                  # lossless (MG1): the float32 values
+    ".ctm lossy": ("with lossless=False pymeshlab's CTM writer compresses the coordinates to a grid (MG2: 2e-5 of a "
+                   "sphere's bounding-box diagonal lost at radius 1, 2e-2 at 1e-3, 6e-2 at 1e-30 and 1e30); "
+                   f"pass lossless=True (save_mesh's default: single precision), or write {_SAFE}"),
+    ".nxs": ("float32",),
+    ".nxz": ("pymeshlab's NXZ writer compresses the coordinates with a quantization whose error is not "
+             f"known here; write .nxs (single precision), or {_SAFE}"),
+    ".dae": ("float32",),                                  # "%g": 6 significant digits
+    ".json": ("float32",),
+    ".wrl": ("float32",),
+    ".x3d": ("float32",),
+    ".3mf": ("decimals", 6, 23, SINGLE_TOLERANCE, 1.0),    # float32, 6 decimals truncated
+    ".idtf": ("decimals", 6, 52, SINGLE_TOLERANCE, 0.5),   # "%f"
+}
+_SINGLE = (".stl", ".3ds", ".ctm", ".nxs", ".dae", ".json", ".wrl", ".x3d", ".3mf", ".idtf")
+_SIX_DIGITS = (".dae", ".json", ".wrl", ".x3d")
+#: Loss allowed in the single-precision formats, as a share of the bounding-box diagonal, from
+#: where the mesh lies: single precision keeps ~6e-8 of the largest coordinate, so a mesh more
+#: than ~1,700 diagonals from the origin is refused (a 15 km terrain in UTM coordinates passes).
+OFFSET_TOLERANCE = 1e-4
+
+
+def check_coordinates(path, V, *, binary=True, lossless=True, **save_options):
+    """Raise MeshFileError, before anything is written, if pymeshlab would write the vertex
+    coordinates ``V`` to ``path``'s format with a loss the format does not stand for; return
+    None if they fit. A few numpy reductions over ``V``; ``binary`` and ``lossless`` are
+    ``save_current_mesh``'s options (other options are ignored).
+
+    What each format holds (measured by writing meshes of every scale with pymeshlab and
+    reading the files back) and what is refused:
+
+    - binary .ply: doubles, exact. Nothing is refused.
+    - .obj: text with 16 decimals ("%.16f": 1e-20 becomes 0, 1e-13 keeps 3 digits). Refused
+      where that loses more than :data:`DOUBLE_TOLERANCE` (1e-9) of the bounding-box diagonal:
+      meshes smaller than about 5e-8.
+    - .off, ASCII .ply: text with 16 significant digits ("%.16g", a few ulps). Refused where
+      that loses more than 1e-9 of the diagonal: coordinates more than about 2e6 diagonals from
+      the origin.
+    - .stl (binary and ASCII), .3ds, .ctm (lossless), .nxs: single precision; .dae, .json,
+      .wrl, .x3d: 6 significant digits, declared single precision. Accepted at that precision
+      (about 6e-8 of the largest coordinate, 5e-6 for the 6-digit ones), but refused where a
+      coordinate overflows it (above 3.4e38: written as inf), underflows it (a mesh so small
+      that its coordinates lose more than single precision keeps, down to being written as 0),
+      or where the mesh lies so far from the origin that the loss is more than
+      :data:`OFFSET_TOLERANCE` (1e-4) of the diagonal.
+    - .3mf (single precision, then 6 decimals truncated) and .idtf (6 decimals): as single
+      precision, and refused where the decimals lose more than :data:`SINGLE_TOLERANCE` (1e-6)
+      of the diagonal: meshes smaller than about 1 (.3mf) and 0.5 (.idtf).
+    - .ctm with ``lossless=False`` and .nxz: compressed with a loss not bounded here; refused.
+
+    Where the diagonal is 0 (one point) the largest coordinate stands for it. Non-finite
+    coordinates are refused (pymeshlab's loaders drop such vertices). The message names the
+    format's limit and a format that holds the coordinates (binary .ply)."""
+    extension = os.path.splitext(os.fsdecode(path))[1].lower()
+    key = extension + (" ascii" if extension == ".ply" and not binary else "") + \
+        (" lossy" if extension == ".ctm" and not lossless else "")
+    kind = _COORDINATES.get(key)
+    where = f"cannot write {os.fspath(path)!r}"
+    if isinstance(kind, str):
+        raise MeshFileError(f"{where}: {kind}.")
+    V = np.asarray(V, dtype=np.float64).reshape(-1, 3)
+    if kind is None or not V.size:
+        return
+    finite = np.isfinite(V).all(axis=1)
+    if not finite.all():
+        bad = np.flatnonzero(~finite)
+        raise MeshFileError(f"{where}: {bad.size} vertices have NaN or infinite coordinates (first: "
+                            f"{first_indices(bad)}), which pymeshlab's loaders drop (renumbering the rest); "
+                            "fix them first.")
+    low, high = V.min(axis=0), V.max(axis=0)
+    largest = float(max(np.abs(low).max(), np.abs(high).max()))
+    diagonal = float(np.linalg.norm(high - low))
+    scale = diagonal if diagonal > 0 else largest
+    if largest == 0:
+        return
+    name = extension[1:].upper() + (" (ASCII)" if key.endswith("ascii") else "")
+    size = f"the mesh's bounding-box diagonal ({diagonal:.3g})" if diagonal > 0 else \
+        f"its largest coordinate ({largest:.3g}; all vertices coincide)"
+    if kind[0] == "digits":
+        loss = 0.5 * 10.0 ** (1 - kind[1]) * largest
+        if loss > DOUBLE_TOLERANCE * scale:
+            raise MeshFileError(
+                f"{where}: pymeshlab writes {name} coordinates with {kind[1]} significant digits, which loses up "
+                f"to {loss:.3g} ({loss / scale:.2g} of {size}; the limit is {DOUBLE_TOLERANCE:g}) for coordinates "
+                f"this far from the origin (largest {largest:.3g}). Write {_SAFE}, or move the mesh near the "
+                "origin.")
+        return
+    if extension in _SINGLE:
+        with np.errstate(over="ignore"):
+            single = V.astype(np.float32)
+        over = ~np.isfinite(single).all(axis=1)
+        if over.any():
+            bad = np.flatnonzero(over)
+            raise MeshFileError(
+                f"{where}: {name} holds coordinates in single precision, whose largest value is "
+                f"{_FLOAT32_MAX:.4g}; {bad.size} vertices exceed it (first: {first_indices(bad)}) and would be "
+                f"written as inf. Write {_SAFE}, or scale the mesh down.")
+        error = float(np.abs(single - V).max())
+        if error > 2.0 ** -23 * largest:          # more than single precision's rounding: underflow
+            raise MeshFileError(
+                f"{where}: {name} holds coordinates in single precision, which keeps this mesh's coordinates "
+                f"(largest {largest:.3g}) only to {error:.3g} ({error / largest:.2g} of the largest; single "
+                f"precision keeps {2.0 ** -24:.1g}): values below {float(np.finfo(np.float32).tiny):.3g} lose "
+                f"digits or become 0. Write {_SAFE}, or scale the mesh up.")
+        # far from the origin single precision keeps little of a small mesh (a unit sphere at 1e7
+        # lost 0.14 of its diagonal in .3ds); the 6-digit text formats keep less still
+        loss = max(error, 5e-6 * largest) if extension in _SIX_DIGITS else error
+        if loss > OFFSET_TOLERANCE * scale:
+            raise MeshFileError(
+                f"{where}: {name} holds coordinates in single precision{' with 6 digits' if extension in _SIX_DIGITS else ''}"
+                f", which loses up to {loss:.3g} ({loss / scale:.2g} of {size}; the limit is {OFFSET_TOLERANCE:g}) "
+                f"for coordinates this far from the origin (largest {largest:.3g}). Write {_SAFE}, or move the mesh "
+                "near the origin.")
+    if kind[0] == "decimals":
+        _, decimals, bits, tolerance, rounding = kind
+        unit = 10.0 ** -decimals
+        # values from 2**k on are spaced wider than a decimal: written (and read back) as they are
+        exact = 2.0 ** np.ceil(np.log2(unit * 2.0 ** bits))
+        magnitude = np.abs(V)
+        small = magnitude[magnitude < exact]
+        loss = min(float(small.max(initial=0.0)), rounding * unit)
+        if loss > tolerance * scale:
+            raise MeshFileError(
+                f"{where}: pymeshlab writes {name} coordinates with {decimals} decimals (an error up to "
+                f"{rounding * unit:.1g}), which loses up to {loss / scale:.2g} of {size}; the limit is "
+                f"{tolerance:g} of it. Write {_SAFE}, or scale the mesh up.")
 
 
 def write_mesh(path, V, F, *, quality=None, overwrite=False):
@@ -182,7 +365,14 @@ def write_mesh(path, V, F, *, quality=None, overwrite=False):
     FileExistsError   ``path`` exists and ``overwrite`` is False
     MeshError         malformed ``V``, ``F`` or ``quality``
     MeshFileError     ``path`` is a folder, its folder is missing or not writable, or the format
-                      is unknown or keeps points only (.xyz, ...; see :func:`check_mesh_output`)
+                      is unknown or keeps points only (.xyz, ...; see :func:`check_mesh_output`),
+                      or it cannot hold the coordinates (before anything is written; see
+                      :func:`check_coordinates`): binary PLY writes doubles (exact); OBJ 16
+                      decimals (a mesh smaller than about 5e-8 loses more than 1e-9 of its
+                      bounding-box diagonal: refused); OFF 16 significant digits (refused more
+                      than about 2e6 diagonals from the origin); STL, 3DS, CTM, COLLADA, VRML,
+                      X3D, JSON single precision (refused where a coordinate overflows, above
+                      3.4e38, or the mesh underflows it)
 
     Examples
     --------
@@ -253,14 +443,17 @@ def save_mesh(path, mesh, *, overwrite=False, _plain=None, **save_options):
     overwrite : bool            replace an existing file (refused by default)
     **save_options              passed to ``MeshSet.save_current_mesh`` (e.g. ``binary=False``);
                                 for PLY, ``save_vertex_quality`` defaults to True when the mesh
-                                has vertex quality
+                                has vertex quality; for CTM, ``lossless`` to True
 
     Raises
     ------
     FileExistsError   ``path`` exists and ``overwrite`` is False
     MeshFileError     no extension, a folder, missing folder, a format pymeshlab does not write
-                      as a mesh, pymeshlab failed to write, or a save option that asks for a
-                      custom attribute (``__ca_...``)
+                      as a mesh, pymeshlab failed to write (or wrote nothing), a save option
+                      that asks for a custom attribute (``__ca_...``), or coordinates the format
+                      (with ``binary``, ``lossless``) cannot hold: :func:`check_coordinates`,
+                      before anything is written. For CTM ``lossless`` defaults to True
+                      (pymeshlab's default compresses the coordinates to a grid)
 
     Examples
     --------
@@ -279,9 +472,12 @@ def save_mesh(path, mesh, *, overwrite=False, _plain=None, **save_options):
                             "save it with curvdetail.filters.files.save_current_mesh.")
     check_mesh_output(path, overwrite)
     plain = _plain or {}         # options to set where the format has them (write_mesh's)
-    if os.path.splitext(os.fspath(path))[1].lower() == ".ply" and mesh.has_vertex_scalar() and \
-            "save_vertex_quality" not in plain:
+    extension = os.path.splitext(os.fsdecode(path))[1].lower()
+    if extension == ".ply" and mesh.has_vertex_scalar() and "save_vertex_quality" not in plain:
         options.setdefault("save_vertex_quality", True)
+    if extension == ".ctm":
+        options.setdefault("lossless", True)     # pymeshlab's default compresses the coordinates
+    check_coordinates(path, mesh.vertex_matrix(), **options)
     # the temporary file keeps path's extension: pymeshlab picks the format from it
     with atomic_output(path, overwrite=overwrite, error=MeshFileError) as tmp:
         ms = _meshset()
@@ -291,6 +487,9 @@ def save_mesh(path, mesh, *, overwrite=False, _plain=None, **save_options):
         except Exception as exc:
             raise MeshFileError(f"could not write {os.fspath(path)!r}: "
                                 f"{str(exc).replace(tmp, os.fspath(path))}") from None
+        if os.path.getsize(tmp) == 0:
+            raise MeshFileError(f"could not write {os.fspath(path)!r}: pymeshlab reported success but wrote "
+                                f"nothing; {_MESH_HINT}")
 
 
 def _save(ms, path, options, optional):

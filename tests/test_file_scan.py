@@ -203,3 +203,42 @@ def test_obj_faces_pymeshlab_misreads_are_refused(tmp_path, face, line, message)
     path.write_text(_OBJ_V4 + face)
     with pytest.raises(ValueError, match=f"the face on line {line} {message}"):
         check_before_loading(path)
+
+
+_OFF_OK = "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n"
+
+
+@pytest.mark.parametrize("name, text, message", [
+    # "v 1,5 2 3" and the OFF row "1,5 2 3" were both read as the vertex (1, 2, 3)
+    ("m.obj", _OBJ_V4.replace("v 1 0 0", "v 1,5 0 0") + "f 1 2 3\n", r"line 2 \('v 1,5 0 0'\) writes a number "
+                                                                      r"with a comma.*decimals with a point"),
+    ("m.obj", _OBJ_V4 + "vt 0,5 0\nf 1 2 3\n", r"line 5 \('vt 0,5 0'\) writes a number with a comma"),
+    ("m.obj", _OBJ_V4 + "f 1,2,3\n", r"line 5 \('f 1,2,3'\) writes a number with a comma"),
+    ("m.off", _OFF_OK.replace("\n1 0 0", "\n1,5 0 0"), r"line 4 \('1,5 0 0'\) writes a number with a comma.*"
+                                                         r"with a point"),
+    ("m.off", _OFF_OK.replace("3 0 2 3", "3 0 2 3 0,5 0 0"), r"line 8 \('3 0 2 3 0,5 0 0'\) writes a number"),
+    # face rows beyond the header's count were dropped
+    ("m.off", _OFF_OK + "3 1 2 3\n", r"the header declares 4 vertices and 2 faces, but 1 more rows follow the "
+                                     r"last face \(first: line 9, '3 1 2 3'\)"),
+    ("m.off", _OFF_OK.replace("4 2 0", "4 1 0"), r"declares 4 vertices and 1 faces, but 1 more rows follow"),
+])
+def test_decimal_commas_and_extra_off_faces_are_refused(tmp_path, name, text, message):
+    path = tmp_path / name
+    path.write_text(text)
+    with pytest.raises(ValueError, match=message):
+        check_before_loading(path)
+
+
+@pytest.mark.parametrize("name, text", [
+    ("m.off", _OFF_OK + "\n\n# the end, really\n  \n\r\n"),        # blank lines, comments after the faces
+    ("m.off", _OFF_OK.replace("OFF\n", "OFF\n# made by me, today\n").replace("3 0 1 2", "3 0 1 2 # a, b")),
+    ("m.obj", "# made by me, today\n" + _OBJ_V4.replace("v 0 0 0", "v 0 0 0 # x, y") + "o a,b\nf 1 2 3\nf 1 3 4\n"),
+])
+def test_commas_in_comments_and_names_and_trailing_comments_pass(tmp_path, name, text):
+    from curvdetail.io import read_mesh
+
+    path = tmp_path / name
+    path.write_text(text)
+    V, F = read_mesh(path)
+    np.testing.assert_array_equal(V, _V4 if name.endswith(".obj") else [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]])
+    assert F.shape == (2, 3)

@@ -99,3 +99,35 @@ def test_file_with_a_nan_vertex_is_refused_not_renumbered(tmp_path, capsys):
     assert main(["apply", "compute_curvature_detail", str(path), str(tmp_path / "out.ply")]) == 1
     assert "has 5 vertices but pymeshlab loaded 4" in capsys.readouterr().err
     assert sorted(os.listdir(tmp_path)) == ["bad.obj"]
+
+
+def test_filter_saves_refuse_coordinates_the_format_cannot_hold(tmp_path):
+    # the filters' save path wrote OBJ's 16 decimals of a 1e-20 mesh as zeros without a word
+    import pymeshlab
+
+    from curvdetail.curvature.testing import icosphere
+
+    V, F = icosphere(subdivisions=1)
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(V * 1e-20, F.astype(np.int32)))
+    with pytest.raises(MeshFileError, match="OBJ coordinates with 16 decimals"):
+        save_current_mesh(ms, tmp_path / "m.obj")
+    assert not os.listdir(tmp_path)
+    save_current_mesh(ms, tmp_path / "m.ply")                       # binary doubles: exact
+    loaded = load_meshset(tmp_path / "m.ply")
+    assert np.array_equal(loaded.current_mesh().vertex_matrix(), V * 1e-20)
+
+
+def test_filter_saves_write_ctm_lossless(tmp_path):
+    # pymeshlab's CTM default compresses the coordinates to a grid (2e-5 of a unit sphere lost)
+    import pymeshlab
+
+    from curvdetail.curvature.testing import icosphere
+
+    V, F = icosphere(subdivisions=2)
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(V, F.astype(np.int32)))
+    save_current_mesh(ms, tmp_path / "m.ctm")
+    loaded = load_meshset(tmp_path / "m.ctm")
+    W = loaded.current_mesh().vertex_matrix()
+    assert W.shape == V.shape and np.abs(W - V.astype(np.float32)).max() == 0.0

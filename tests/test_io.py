@@ -25,7 +25,8 @@ def nose(load_mesh, rng):
 
 @pytest.mark.parametrize("ext", ["obj", "off", "ply"])
 def test_round_trip_keeps_vertices_and_faces(tmp_path, nose, ext):
-    # OBJ and OFF are text written with 17 significant digits (error ~1 ulp); PLY is binary double
+    # OBJ is text with 16 decimals, OFF with 16 significant digits (error ~1 ulp at this scale); PLY is
+    # binary double
     V, F = nose
     path = tmp_path / f"mesh.{ext}"
     write_mesh(path, V, F)
@@ -540,3 +541,151 @@ def test_coff_rows_with_and_without_a_colour_are_read(tmp_path):
     path.write_text("COFF\n4 2 0\n0 0 0 255 0 0 255\n1 0\n0 1 0\n1 1 0\n3 0 1 2\n3 1 3 2\n")
     with pytest.raises(MeshFileError, match="1 vertex rows hold fewer than 3 values"):
         read_mesh(path)
+
+
+# What each format keeps of the coordinates (pymeshlab's writers, measured): OBJ 16 decimals
+# ("%.16f"), OFF and ASCII PLY 16 significant digits ("%.16g"), binary PLY doubles, STL and 3DS
+# float32. write_mesh and save_mesh refuse, before writing, what a format cannot hold.
+def _raw_round_trip(path, V, F, **options):
+    """What pymeshlab itself writes and reads back (no checks): the loss write_mesh guards."""
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=V, face_matrix=F.astype(np.int32)))
+    ms.save_current_mesh(str(path), **options)
+    back = pymeshlab.MeshSet()
+    back.load_new_mesh(str(path))
+    return back.current_mesh().vertex_matrix()
+
+
+def _diagonal(V):
+    return np.linalg.norm(V.max(axis=0) - V.min(axis=0))
+
+
+@pytest.mark.parametrize("scale", [1e-13, 1e-20])
+def test_obj_refuses_a_mesh_its_16_decimals_cannot_hold(tmp_path, scale):
+    V, F = icosphere(subdivisions=1)
+    V = V * scale
+    # pymeshlab alone: 1e-20 comes back as all zeros, 1e-13 with 3.5e-4 of the diagonal lost
+    lost = np.abs(_raw_round_trip(tmp_path / "raw.obj", V, F) - V).max() / _diagonal(V)
+    assert lost > 1e-4
+    with pytest.raises(MeshFileError, match=r"pymeshlab writes OBJ coordinates with 16 decimals \(an error up to "
+                                            r"5e-17\), which loses up to .* of the mesh's bounding-box diagonal "
+                                            r"\(.*\); the limit is 1e-09 of it. Write .ply \(binary"):
+        write_mesh(tmp_path / "m.obj", V, F)
+    with pytest.raises(MeshFileError, match="16 decimals"):
+        save_mesh(tmp_path / "m.obj", pymeshlab.Mesh(vertex_matrix=V, face_matrix=F.astype(np.int32)))
+    assert not (tmp_path / "m.obj").exists()
+    write_mesh(tmp_path / "m.ply", V, F)                                 # binary doubles: exact
+    assert np.array_equal(read_mesh(tmp_path / "m.ply")[0], V)
+
+
+def test_obj_keeps_a_mesh_within_the_limit_to_1e9_of_its_diagonal(tmp_path):
+    V, F = icosphere(subdivisions=1)
+    V = V * 1e-7
+    write_mesh(tmp_path / "m.obj", V, F)
+    assert np.abs(read_mesh(tmp_path / "m.obj")[0] - V).max() <= 1e-9 * _diagonal(V)
+
+
+@pytest.mark.parametrize("options", [{}, {"binary": False}])
+def test_off_and_ascii_ply_refuse_coordinates_their_16_digits_cannot_hold(tmp_path, options):
+    # a unit sphere 1e7 from the origin: 16 significant digits keep 1.6e-9 of its diagonal
+    V, F = icosphere(subdivisions=1)
+    V = V + 1e7
+    ext = "off" if not options else "ply"
+    assert np.abs(_raw_round_trip(tmp_path / f"raw.{ext}", V, F, **options) - V).max() > 1e-9 * _diagonal(V)
+    mesh = pymeshlab.Mesh(vertex_matrix=V, face_matrix=F.astype(np.int32))
+    with pytest.raises(MeshFileError, match=rf"writes {ext.upper()}.* coordinates with 16 significant digits, "
+                                            r"which loses up to .* the limit is 1e-09\) for coordinates this far "
+                                            r"from the origin \(largest 1e\+07\)"):
+        save_mesh(tmp_path / f"m.{ext}", mesh, **options)
+    save_mesh(tmp_path / "m.ply", mesh)                                  # binary: exact
+    assert np.array_equal(read_mesh(tmp_path / "m.ply")[0], V)
+    V = V - 1e7 + 1e5                                                    # nearer: within the limit
+    write_mesh(tmp_path / "near.off", V, F)
+    assert np.abs(read_mesh(tmp_path / "near.off")[0] - V).max() <= 1e-9 * _diagonal(V)
+
+
+@pytest.mark.parametrize("ext", ["stl", "3ds"])
+def test_single_precision_formats_refuse_overflow_and_underflow(tmp_path, ext):
+    V, F = icosphere(subdivisions=1)
+    # pymeshlab writes 1e39 as inf (its loader then drops every vertex), and a 1e-41 mesh loses
+    # digits to float32's subnormals
+    assert _raw_round_trip(tmp_path / f"raw.{ext}", V * 1e39, F).shape == (0, 3)
+    assert b"\x00\x00\x80\x7f" in (tmp_path / f"raw.{ext}").read_bytes()          # float32 inf
+    with pytest.raises(MeshFileError, match=rf"{ext.upper()} holds coordinates in single precision, whose largest "
+                                            r"value is 3.403e\+38; 42 vertices exceed it \(first: 0, 1, 2\) and "
+                                            r"would be written as inf"):
+        write_mesh(tmp_path / f"m.{ext}", V * 1e39, F)
+    with pytest.raises(MeshFileError, match=r"single precision, which keeps this mesh's coordinates \(largest .*\) "
+                                            r"only to .*: values below 1.18e-38 lose digits or become 0"):
+        write_mesh(tmp_path / f"m.{ext}", V * 1e-41, F)
+    assert not (tmp_path / f"m.{ext}").exists()
+    write_mesh(tmp_path / f"m.{ext}", V * 1e30, F)                       # float32 precision: accepted
+    W = read_mesh(tmp_path / f"m.{ext}")[0]
+    assert W.shape == V.shape and np.allclose(np.sort(W, axis=0), np.sort(V * 1e30, axis=0), rtol=1e-7, atol=0)
+
+
+@pytest.mark.parametrize("ext", ["stl", "3ds", "dae"])
+def test_single_precision_formats_refuse_a_small_mesh_far_from_the_origin(tmp_path, ext):
+    # a unit sphere at 1e7 lost 0.14 of its diagonal in .3ds without a word; single precision
+    # there is spaced 1 apart
+    V, F = icosphere(subdivisions=1)
+    with pytest.raises(MeshFileError, match=r"which loses up to .* of the mesh's bounding-box diagonal .*the limit "
+                                            r"is 0.0001\) for coordinates this far from the origin"):
+        write_mesh(tmp_path / f"m.{ext}", V + 1e7, F)
+    assert not (tmp_path / f"m.{ext}").exists()
+    write_mesh(tmp_path / f"n.{ext}", V + 10.0, F)                         # near the origin: accepted
+
+
+def test_single_precision_keeps_a_terrain_in_utm_coordinates(tmp_path):
+    # 15 km across, 5,000 km from the origin: float32 keeps it to 0.25 m, 1.2e-5 of its diagonal
+    V, F = icosphere(subdivisions=1)
+    V = V * 7500.0 + [5e6, 4e6, 300.0]
+    write_mesh(tmp_path / "t.stl", V, F)
+    assert np.abs(np.sort(read_mesh(tmp_path / "t.stl")[0], axis=0) - np.sort(V, axis=0)).max() <= 0.25
+
+
+def test_stl_ascii_is_single_precision_too(tmp_path):
+    V, F = icosphere(subdivisions=1)
+    mesh = pymeshlab.Mesh(vertex_matrix=V * 1e39, face_matrix=F.astype(np.int32))
+    with pytest.raises(MeshFileError, match="would be written as inf"):
+        save_mesh(tmp_path / "m.stl", mesh, binary=False)
+
+
+@pytest.mark.parametrize("ext, scale, message", [
+    ("3mf", 0.1, r"writes 3MF coordinates with 6 decimals \(an error up to 1e-06\).* the limit is 1e-06 of it"),
+    ("idtf", 0.1, r"writes IDTF coordinates with 6 decimals \(an error up to 5e-07\)"),
+    ("dae", 1e-41, r"DAE holds coordinates in single precision"),
+    ("wrl", 1e39, r"WRL holds coordinates in single precision, whose largest value"),
+    ("nxz", 1.0, r"pymeshlab's NXZ writer compresses the coordinates"),
+])
+def test_other_formats_refuse_what_they_cannot_hold(tmp_path, ext, scale, message):
+    V, F = icosphere(subdivisions=1)
+    with pytest.raises(MeshFileError, match=message):
+        write_mesh(tmp_path / f"m.{ext}", V * scale, F)
+    assert not (tmp_path / f"m.{ext}").exists()
+
+
+def test_ctm_is_written_lossless_and_its_lossy_compression_refused(tmp_path):
+    # pymeshlab's default (MG2) put a sphere's vertices 2e-5 of its diagonal off, at radius 1e-3 2e-2
+    V, F = icosphere(subdivisions=2)
+    write_mesh(tmp_path / "m.ctm", V * 1e-3, F)
+    raw = (tmp_path / "m.ctm").read_bytes()
+    assert raw[8:11] == b"MG1"                                           # lossless: float32 values
+    with pytest.raises(MeshFileError, match=r"with lossless=False pymeshlab's CTM writer compresses the coordinates"):
+        save_mesh(tmp_path / "lossy.ctm", pymeshlab.Mesh(vertex_matrix=V, face_matrix=F.astype(np.int32)),
+                  lossless=False)
+
+
+def test_u3d_is_refused_since_pymeshlab_writes_no_file(tmp_path):
+    V, F = icosphere(subdivisions=1)
+    with pytest.raises(MeshFileError, match=r"pymeshlab does not write .u3d meshes \(it reports success but writes "
+                                            r"no file\)"):
+        write_mesh(tmp_path / "m.u3d", V, F)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_save_mesh_refuses_non_finite_coordinates(tmp_path):
+    V, F = icosphere(subdivisions=1)
+    V[3, 1] = np.nan
+    with pytest.raises(MeshFileError, match=r"1 vertices have NaN or infinite coordinates \(first: 3\)"):
+        save_mesh(tmp_path / "m.obj", pymeshlab.Mesh(vertex_matrix=V, face_matrix=F.astype(np.int32)))

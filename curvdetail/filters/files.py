@@ -15,9 +15,7 @@ import os
 import numpy as np
 
 from .. import _output
-from .._file_counts import check_loaded
-from .._file_scan import check_before_loading
-from ..io import MeshFileError, check_mesh_output, input_path, load_failure
+from ..io import MeshFileError, check_coordinates, check_mesh_output, input_path, load_checked
 from .meshset import WRITTEN_ATTRIBUTES, set_vertex_attribute, vertex_attribute
 from .ply_attributes import read_ply_vertex_attributes
 
@@ -38,13 +36,7 @@ def load_meshset(path, *more):
     paths = [input_path(p) for p in (path, *more)]
     ms = pymeshlab.MeshSet()
     for p in paths:
-        check_before_loading(p, error=MeshFileError)
-        try:
-            ms.load_new_mesh(p)
-        except pymeshlab.PyMeshLabException as exc:
-            raise MeshFileError(load_failure(p, exc)) from None
-        n = ms.current_mesh().vertex_number()
-        check_loaded(p, n, ms.current_mesh().face_matrix(), error=MeshFileError)   # what pymeshlab dropped
+        n = load_checked(ms, p).vertex_number()
         for name, values in read_ply_vertex_attributes(p).items():
             if values.shape in ((n,), (n, 3)) and np.all(np.isfinite(values)):
                 set_vertex_attribute(ms, ms.current_mesh_id(), name, values)
@@ -59,8 +51,12 @@ def check_output_path(path, overwrite=False):
 
 
 def save_options(ms, path):
-    """pymeshlab ``save_current_mesh`` options that keep quality and our attributes in PLY."""
-    if os.path.splitext(os.fspath(path))[1].lower() != ".ply":
+    """pymeshlab ``save_current_mesh`` options that keep quality and our attributes in PLY, and
+    the coordinates in CTM (its default compresses them to a grid)."""
+    extension = os.path.splitext(os.fspath(path))[1].lower()
+    if extension == ".ctm":
+        return {"lossless": True}
+    if extension != ".ply":
         return {}
     mesh = ms.current_mesh()
     options = {"binary": True}
@@ -95,6 +91,7 @@ def save_current_mesh(ms, path, *, overwrite=False):
 
     check_output_path(path, overwrite)
     options = save_options(ms, path)
+    check_coordinates(path, ms.current_mesh().vertex_matrix(), **options)    # what the format cannot hold
     with _output.atomic_output(path, overwrite=overwrite, hint=_HINT, error=MeshFileError) as tmp:
         try:
             ms.save_current_mesh(tmp, **options)
