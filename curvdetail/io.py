@@ -131,14 +131,18 @@ def load_failure(path, exc):
 
 
 def input_path(path):
-    """``path`` as a str naming an existing file, or raise: MeshFileError for what is not a path
-    or is a folder, FileNotFoundError for a missing file."""
+    """``path`` as a str naming an existing file, or raise: MeshFileError for what is not a path,
+    a folder or not a regular file (a pipe: the checks read it before pymeshlab does),
+    FileNotFoundError for a missing file."""
     if not isinstance(path, (str, bytes, os.PathLike)):
         raise MeshFileError(f"a mesh path must be a str or os.PathLike; got {type(path).__name__}.")
     path = os.fsdecode(path)
     if os.path.isdir(path):
         raise MeshFileError(f"{path!r} is a folder; name a mesh file in it.")
     if not os.path.isfile(path):
+        if os.path.exists(path):      # a FIFO, a device, a socket: there, but no file to read twice
+            raise MeshFileError(f"{path!r} is not a regular file (a pipe or a device); write the mesh to a "
+                                "file and read that.")
         raise FileNotFoundError(f"mesh file not found: {path}")
     return path
 

@@ -389,6 +389,9 @@ def test_paths_that_are_not_mesh_files_are_named(tmp_path, read):
         function(tmp_path)
     with pytest.raises(FileNotFoundError, match="mesh file not found"):
         function(tmp_path / "none.obj")
+    os.mkfifo(tmp_path / "pipe.obj")          # there, not "not found"; never opened (it would block)
+    with pytest.raises(MeshFileError, match="is not a regular file"):
+        function(tmp_path / "pipe.obj")
 
 
 def test_bytes_paths_read_and_write(tmp_path):
