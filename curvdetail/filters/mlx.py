@@ -186,6 +186,7 @@ def _check_native_parameters(element, where):
     names the filter does not have (checked in lower case against pymeshlab's names; MeshLab's
     own check, case-sensitive, runs with the step)."""
     names = _native_parameter_names(element.get("name"))
+    keys = None if names is None else {_name_key(n) for n in names}
     seen = set()
     for child in element:
         if child.tag != "Param":
@@ -196,7 +197,7 @@ def _check_native_parameters(element, where):
         if name in seen:
             raise ScriptError(f"{where}: parameter {name!r} is given twice; keep one <Param name={name!r}>.")
         seen.add(name)
-        if names is not None and _name_key(name) not in {_name_key(n) for n in names}:
+        if keys is not None and _name_key(name) not in keys:
             raise ScriptError(f"{where}: this MeshLab filter has no parameter {name!r} (pymeshlab ignores it "
                               f"without a word); its parameters, in pymeshlab's lower case: "
                               f"{', '.join(sorted(names))}.")
