@@ -230,11 +230,10 @@ def _minimal_command(parser):
 
 # --- remesh (remeshing issue) ---------------------------------------------------------------
 
-def _note_a_big_target(V, F, fraction, *, evaluate=True, given=None, skip="--no-evaluate"):
+def _note_a_big_target(V, F, fraction, *, evaluate=True):
     """A line on stderr when a target edge of ``fraction`` of the bbox diagonal asks for more than
     ``BIG_TARGET`` vertices (an estimate only: on a mesh the checks will refuse, nothing is
-    said). ``given`` is how the user wrote it (default: the percentage); ``skip``, the option
-    that leaves out the measurements."""
+    said)."""
     import numpy as np
 
     from .curvature._validate import bbox_diagonal
@@ -246,9 +245,9 @@ def _note_a_big_target(V, F, fraction, *, evaluate=True, given=None, skip="--no-
     except (ValueError, IndexError, ArithmeticError):
         return
     if BIG_TARGET < count <= MAX_VERTICES:           # beyond, retriangulate refuses it at once
-        why = f" (the measurements most of it; {skip} skips them)" if evaluate else ""
-        given = given or f"a {100 * fraction:g} % target edge"
-        _say(f"note: {given} gives about {count:,.0f} target vertices; this takes minutes{why}.")
+        why = " (the measurements most of it; --no-evaluate skips them)" if evaluate else ""
+        _say(f"note: a {100 * fraction:g} % target edge gives about {count:,.0f} target vertices; this takes "
+             f"minutes{why}.")
 
 
 def _whole_number_from_one(text):
@@ -470,25 +469,8 @@ def _apply_command(parser):
         params = _filter_params(spec, args.param)
 
         def work(ms):
-            if spec.name == "generate_curvature_remeshing" and "target_edge" in params and \
-                    hasattr(params["target_edge"], "resolve"):
-                # a plain 0.01 is 0.01 model units: on a 15 km terrain that was 1.3M vertices and
-                # 7 minutes without a word
-                from .curvature._validate import bbox_diagonal
-                from .filters.meshset import mesh_arrays
-
-                V, F = mesh_arrays(ms, ms.current_mesh_id())
-                diagonal = bbox_diagonal(V)
-                if diagonal > 0:
-                    value = params["target_edge"]
-                    _note_a_big_target(V, F, value.resolve(diagonal) / diagonal,
-                                       evaluate=params.get("evaluate", True) is not False,
-                                       given=f"target_edge={value}", skip="--param evaluate=false")
-                from .remesh.retriangulate import LongRunWarning
-
-                with warnings.catch_warnings():       # the note above said it in the CLI's terms
-                    warnings.simplefilter("ignore", LongRunWarning)
-                    return apply(ms, spec.name, **params)
+            # generate_curvature_remeshing says beforehand when a target takes minutes (a plain
+            # target_edge=0.01 is 0.01 model units): its LongRunWarning, shown as a note by main()
             return apply(ms, spec.name, **params)
 
         return _run_on_file(args, work)

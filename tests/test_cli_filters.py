@@ -316,12 +316,13 @@ def test_apply_remeshing_with_a_big_target_is_announced_with_the_value_given(cap
     rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "o.ply",
                            "--param", f"target_edge={length}", "--param", "evaluate=false")
     assert rc == 0
-    assert f"note: target_edge={length} gives about " in err and "target vertices; this takes minutes." in err
+    assert f"note: target_edge={length} (3 % of the bbox diagonal) gives about " in err
+    assert "target vertices; this takes minutes." in err and "A plain number is in model units" in err
     assert "skips them" not in err                             # evaluate=false: nothing to skip
-    assert err.count("note:") == 1 and "LongRunWarning" not in err      # said once, in the CLI's terms
+    assert err.count("note:") == 1 and "LongRunWarning" not in err      # one line, no Python warning
     rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "q.ply",
                            "--param", f"target_edge={length}")
-    assert rc == 0 and "(the measurements most of it; --param evaluate=false skips them)" in err
+    assert rc == 0 and "(the measurements most of it; evaluate false skips them)" in err
     monkeypatch.setattr(importlib.import_module("curvdetail.remesh.retriangulate"), "BIG_TARGET", 1_000_000)
     rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "p.ply",
                            "--param", f"target_edge={length}", "--param", "evaluate=false")

@@ -95,7 +95,7 @@ def _warn_of_a_big_target(V, F, target_edge, fraction, evaluate):
     with np.errstate(all="ignore"):
         count = float(estimated_vertices(V, F, fraction * bbox_diagonal(V)))
     if BIG_TARGET < count <= MAX_VERTICES:              # beyond, the remesher refuses it at once
-        why = " (the measurements most of it; evaluate=False skips them)" if evaluate else ""
+        why = " (the measurements most of it; evaluate false skips them)" if evaluate else ""
         warnings.warn(f"target_edge={target_edge} ({100 * fraction:.3g} % of the bbox diagonal) gives about "
                       f"{count:,.0f} target vertices; this takes minutes{why}. A plain number is in model "
                       "units; pymeshlab.PercentageValue(1) is 1 % of the diagonal.", LongRunWarning,
