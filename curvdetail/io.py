@@ -303,7 +303,7 @@ def check_coordinates(path, V, *, binary=True, lossless=True, **save_options):
     size = f"the mesh's bounding-box diagonal ({diagonal:.3g})" if diagonal > 0 else \
         f"its largest coordinate ({largest:.3g}; all vertices coincide)"
     if kind[0] == "digits":
-        loss = 0.5 * 10.0 ** (1 - kind[1]) * largest
+        loss = _digits_loss(V, kind[1])
         if loss > DOUBLE_TOLERANCE * scale:
             raise MeshFileError(
                 f"{where}: pymeshlab writes {name} coordinates with {kind[1]} significant digits, which loses up "
@@ -321,7 +321,8 @@ def check_coordinates(path, V, *, binary=True, lossless=True, **save_options):
                 f"{where}: {name} holds coordinates in single precision, whose largest value is "
                 f"{_FLOAT32_MAX:.4g}; {bad.size} vertices exceed it (first: {first_indices(bad)}) and would be "
                 f"written as inf. Write {_SAFE}, or scale the mesh down.")
-        error = float(np.abs(single - V).max())
+        difference = single - V
+        error = float(np.abs(difference).max())
         if error > 2.0 ** -23 * largest:          # more than single precision's rounding: underflow
             raise MeshFileError(
                 f"{where}: {name} holds coordinates in single precision, which keeps this mesh's coordinates "
@@ -330,7 +331,9 @@ def check_coordinates(path, V, *, binary=True, lossless=True, **save_options):
                 f"digits or become 0. Write {_SAFE}, or scale the mesh up.")
         # far from the origin single precision keeps little of a small mesh (a unit sphere at 1e7
         # lost 0.14 of its diagonal in .3ds); the 6-digit text formats keep less still
-        loss = max(error, 5e-6 * largest) if extension in _SIX_DIGITS else error
+        loss = float(np.sqrt((difference ** 2).sum(axis=1).max()))          # a vertex's displacement
+        if extension in _SIX_DIGITS:
+            loss += _digits_loss(single, 6)
         if loss > OFFSET_TOLERANCE * scale:
             raise MeshFileError(
                 f"{where}: {name} holds coordinates in single precision{' with 6 digits' if extension in _SIX_DIGITS else ''}"
@@ -343,13 +346,22 @@ def check_coordinates(path, V, *, binary=True, lossless=True, **save_options):
         # values from 2**k on are spaced wider than a decimal: written (and read back) as they are
         exact = 2.0 ** np.ceil(np.log2(unit * 2.0 ** bits))
         magnitude = np.abs(V)
-        small = magnitude[magnitude < exact]
-        loss = min(float(small.max(initial=0.0)), rounding * unit)
+        per_axis = np.minimum(np.where(magnitude < exact, magnitude, 0.0).max(axis=0), rounding * unit)
+        loss = float(np.linalg.norm(per_axis))                             # a vertex's displacement
         if loss > tolerance * scale:
             raise MeshFileError(
                 f"{where}: pymeshlab writes {name} coordinates with {decimals} decimals (an error up to "
                 f"{rounding * unit:.1g}), which loses up to {loss / scale:.2g} of {size}; the limit is "
                 f"{tolerance:g} of it. Write {_SAFE}, or scale the mesh up.")
+
+
+def _digits_loss(V, digits):
+    """Largest displacement of a vertex written with ``digits`` significant digits: half a unit
+    in the last digit of each axis's largest coordinate (1234.5678 with 6 digits: 0.005)."""
+    largest = np.abs(V).max(axis=0).astype(np.float64)
+    places = np.floor(np.log10(largest, where=largest > 0, out=np.zeros_like(largest)))
+    unit = np.where(largest > 0, 10.0 ** (places + 1 - digits), 0.0)
+    return float(0.5 * np.linalg.norm(unit))
 
 
 def write_mesh(path, V, F, *, quality=None, overwrite=False):

@@ -692,3 +692,30 @@ def test_save_mesh_refuses_non_finite_coordinates(tmp_path):
     V[3, 1] = np.nan
     with pytest.raises(MeshFileError, match=r"1 vertices have NaN or infinite coordinates \(first: 3\)"):
         save_mesh(tmp_path / "m.obj", pymeshlab.Mesh(vertex_matrix=V, face_matrix=F.astype(np.int32)))
+
+
+@pytest.mark.parametrize("ext", [".off", ".dae", ".3ds"])
+def test_the_write_check_agrees_with_the_loss_measured_by_writing(tmp_path, ext):
+    # the check is an estimate made before writing; here the file is written by pymeshlab itself
+    # and read back: no placement losing more than the limit may pass, and none losing less than
+    # a third of it may be refused (CAD parts in mm at metres, GIS data in UTM coordinates)
+    from curvdetail.io import DOUBLE_TOLERANCE, OFFSET_TOLERANCE, check_coordinates
+
+    limit = DOUBLE_TOLERANCE if ext == ".off" else OFFSET_TOLERANCE
+    V0, F = icosphere(subdivisions=2)
+    for radius in (0.1, 20.0, 70.0, 1000.0):
+        for offset in (0.0, 1e3, 9e3, 9e6):
+            V = V0 * radius + [offset, -0.7 * offset, 0.3 * offset]
+            ms = pymeshlab.MeshSet()
+            ms.add_mesh(pymeshlab.Mesh(V, F.astype(np.int32)))
+            ms.save_current_mesh(str(tmp_path / f"m{ext}"))
+            back = pymeshlab.MeshSet()
+            back.load_new_mesh(str(tmp_path / f"m{ext}"))
+            loss = np.linalg.norm(back.current_mesh().vertex_matrix() - V, axis=1).max() / _diagonal(V)
+            try:
+                check_coordinates(f"m{ext}", V)
+                refused = False
+            except MeshFileError:
+                refused = True
+            assert not (loss > limit and not refused), (radius, offset, loss)
+            assert not (loss < limit / 3 and refused), (radius, offset, loss)
