@@ -339,10 +339,13 @@ def _off_rows_problem(path):
         return problem
     if rows.size < taken + nf or (not colours and per_row[:taken].sum() < per_vertex * nv):
         return too_short()
-    if rows.size > taken + nf:
+    after = rows[taken + nf:]
+    # after the faces nothing is read: an indented comment there is a comment too
+    after = after[chars[token_starts[np.searchsorted(token_starts, starts[after])]] != 35] if after.size else after
+    if after.size:
         # pymeshlab stops after the declared faces: the rest was dropped without a word
-        extra = rows[taken + nf]
-        return (f"the header declares {nv} vertices and {nf} faces, but {rows.size - taken - nf} more rows follow "
+        extra = after[0]
+        return (f"the header declares {nv} vertices and {nf} faces, but {after.size} more rows follow "
                 f"the last face (first: line {first_line + extra}, {text(extra)!r}), which pymeshlab's OFF reader "
                 "ignores without a word; fix the header's counts or remove those rows (comments and empty lines "
                 "may follow the faces)")

@@ -231,6 +231,7 @@ def test_decimal_commas_and_extra_off_faces_are_refused(tmp_path, name, text, me
 
 @pytest.mark.parametrize("name, text", [
     ("m.off", _OFF_OK + "\n\n# the end, really\n  \n\r\n"),        # blank lines, comments after the faces
+    ("m.off", _OFF_OK + "  # indented, after the faces\n\t# and tabbed\n"),     # read as nothing, like any
     ("m.off", _OFF_OK.replace("OFF\n", "OFF\n# made by me, today\n").replace("3 0 1 2", "3 0 1 2 # a, b")),
     ("m.obj", "# made by me, today\n" + _OBJ_V4.replace("v 0 0 0", "v 0 0 0 # x, y") + "o a,b\nf 1 2 3\nf 1 3 4\n"),
 ])
