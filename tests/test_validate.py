@@ -240,6 +240,10 @@ def test_float_indices_too_large_for_int64_are_named_not_wrapped():
     for big in (10 ** 20, -10 ** 20):
         with pytest.raises(ConstraintError, match=rf"1 indices are outside \[0, 5\) \(first: {big}\)"):
             as_index_set([1, big], 5, "fixed")
+    with pytest.raises(ConstraintError, match=r"2 indices are outside \[0, 5\) \(first: -1\)"):
+        as_index_set([-1, 2 ** 63], 5, "fixed")
+    # an object array of ints in range is read as indices (it crashed with an IndexError)
+    assert as_index_set(np.array([3, 0, 2], dtype=object), 5, "fixed").tolist() == [3, 0, 2]
 
 
 @pytest.mark.parametrize("values", [np.ones((2, 3)) + 1j, np.ones((2, 3), bool), np.full((2, 3), "1")])

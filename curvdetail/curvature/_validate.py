@@ -399,15 +399,19 @@ def as_index_set(indices, n, name):
             raise ConstraintError(f"{name} is a boolean mask of shape {arr.shape}; it must have shape ({n},).")
         return np.flatnonzero(arr)
     arr = arr.reshape(-1)
-    if arr.dtype == object and arr.size and all(isinstance(i, numbers.Integral) for i in arr):
-        big = np.flatnonzero([not -2 ** 63 <= i < 2 ** 63 for i in arr])    # beyond int64
-        raise ConstraintError(f"{name}: {big.size} indices are outside [0, {n}) (first: {arr[big[0]]}); "
-                              "indices are 0-based into V.")
+    if arr.dtype == object and arr.size and all(isinstance(i, numbers.Integral) and not isinstance(i, bool)
+                                                for i in arr):
+        # Python ints (some beyond int64, or given as an object array): checked as they are
+        out = np.flatnonzero([not 0 <= i < n for i in arr])
+        if out.size:
+            raise ConstraintError(f"{name}: {out.size} indices are outside [0, {n}) (first: "
+                                  f"{', '.join(str(i) for i in arr[out[:3]])}); indices are 0-based into V.")
+        arr = arr.astype(np.int64)
     if arr.size and not np.issubdtype(arr.dtype, np.integer):
         if not (np.issubdtype(arr.dtype, np.floating) and np.all(np.isfinite(arr)) and np.all(arr == np.round(arr))):
             raise ConstraintError(f"{name} has dtype {arr.dtype}; pass integer vertex indices.")
         if np.abs(arr).max() >= 2.0 ** 62:      # would not survive the cast to int64
-            bad = np.flatnonzero(np.abs(arr) >= 2.0 ** 62)
+            bad = np.flatnonzero((arr < 0) | (arr >= n))
             raise ConstraintError(f"{name}: {bad.size} indices are outside [0, {n}) (first: {arr[bad[0]]:.3g}); "
                                   "indices are 0-based into V.")
     elif arr.dtype == np.uint64 and arr.size and arr.max() > np.iinfo(np.int64).max:
