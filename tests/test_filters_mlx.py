@@ -268,6 +268,7 @@ def test_progress_is_called_before_each_step(tmp_path):
 @pytest.mark.parametrize("param, words", [
     ('name="Boundary" value="0" type="RichBool"', r"'Boundary' \(RichBool\) has value '0'; write 'true' or 'false'"),
     ('name="Boundary" value="False" type="RichBool"', r"has value 'False'; write 'true' or 'false'"),
+    ('name="Boundary" value="no" type="RichBool"', r"has value 'no'; write 'true' or 'false'"),
     ('name="stepSmoothNum" value="3.7" type="RichInt"', r"'stepSmoothNum' \(RichInt\) has value '3.7'; write a whole"),
     ('name="stepSmoothNum" value="abc" type="RichInt"', r"has value 'abc'"),
     ('name="stepSmoothNum" type="RichInt"', r"has value None"),
@@ -311,3 +312,17 @@ def test_a_script_pymeshlab_saved_runs_through_the_checks(tmp_path):
     scripted = meshset()
     run_script(scripted, tmp_path / "saved.mlx")
     assert np.array_equal(scripted.current_mesh().vertex_matrix(), ms.current_mesh().vertex_matrix())
+
+
+@pytest.mark.parametrize("value", ["True", "TRUE", "1", "true"])
+def test_native_bools_meshlab_reads_as_written_pass(tmp_path, value):
+    # MeshLab reads any text but "false" as true: these mean what it reads
+    body = f'<filter name="Laplacian Smooth"><Param name="Boundary" value="{value}" type="RichBool"/></filter>'
+    run_script(meshset(), write(tmp_path, body))
+
+
+def test_a_native_float_with_an_underscore_is_refused(tmp_path):
+    # Python reads 3_0 as 30, MeshLab as 0
+    body = '<filter name="Taubin Smooth"><Param name="lambda" value="0_5" type="RichFloat"/></filter>'
+    with pytest.raises(ScriptError, match=r"'lambda' \(RichFloat\) has value '0_5'"):
+        run_script(meshset(), write(tmp_path, body))

@@ -135,10 +135,13 @@ def _flush_c_streams():
 #: How MeshLab reads a ``<Param>`` value of each type it checks: a bool is false only as the
 #: exact text "false" ("0", "False" are true), an int or a float that does not parse is 0, and a
 #: ``RichAbsPerc`` without both ``min`` and ``max`` attributes is ignored (measured with pymeshlab
-#: 2023.12). So these are refused before any step runs.
+#: 2023.12). So what it would read against the writer's meaning is refused before any step runs;
+#: "True" or "1", read as true, pass.
 _INTEGER = re.compile(r"\s*[+-]?\d+\s*")
+_TRUE = ("true", "1", "yes", "on")
 _NATIVE_CHECKS = {
-    "RichBool": (lambda v: v in ("true", "false"), "'true' or 'false' (MeshLab reads any other text as true)"),
+    "RichBool": (lambda v: v == "false" or v.strip().lower() in _TRUE,
+                 "'true' or 'false' (MeshLab reads any text but 'false' as true)"),
     "RichInt": (lambda v: bool(_INTEGER.fullmatch(v)), "a whole number (MeshLab reads other text as 0)"),
     "RichEnum": (lambda v: bool(_INTEGER.fullmatch(v)), "the index of the choice, a whole number"),
     "RichMesh": (lambda v: bool(_INTEGER.fullmatch(v)), "a layer index, a whole number"),
@@ -149,6 +152,8 @@ _NATIVE_CHECKS = {
 
 
 def _finite(text):
+    if "_" in text:                     # Python's float reads 3_0 as 30, MeshLab's as 0
+        return False
     try:
         return abs(float(text)) < float("inf")
     except ValueError:
@@ -202,7 +207,7 @@ def _check_native_parameters(element, where):
                               f"without a word); its parameters, in pymeshlab's lower case: "
                               f"{', '.join(sorted(names))}.")
         check, meaning = _NATIVE_CHECKS.get(kind, (None, None))
-        if check is not None and (value is None or not check(value.strip() if kind != "RichBool" else value)):
+        if check is not None and (value is None or not check(value if kind == "RichBool" else value.strip())):
             raise ScriptError(f"{where}: parameter {name!r} ({kind}) has value {value!r}; write {meaning}.")
         if kind == "RichAbsPerc" and (child.get("min") is None or child.get("max") is None):
             raise ScriptError(f"{where}: parameter {name!r} (RichAbsPerc) needs min and max attributes, "
