@@ -185,3 +185,8 @@ def test_a_big_target_is_said_beforehand_with_the_unit_of_a_plain_number(monkeyp
         warnings.simplefilter("error", LongRunWarning)          # a smaller target: nothing said
         ms.set_current_mesh(0)
         apply(ms, "generate_curvature_remeshing", target_edge=1.3, evaluate=False)
+        # a mesh the checks refuse: the refusal alone, no "this takes minutes" before it
+        closed = pymeshlab.MeshSet()
+        closed.load_new_mesh(os.path.join(DATA, "spot.obj"))
+        with pytest.raises(NotADiskError):
+            apply(closed, "generate_curvature_remeshing", target_edge=pymeshlab.PercentageValue(0.5), evaluate=False)

@@ -65,10 +65,15 @@ def generate_curvature_remeshing(ms, *, method, target_edge, transfer, rows, loc
     V, F = mesh_arrays(ms, mid)
     label = get_mesh(ms, mid).label()
     fraction = target_edge.resolve(bbox_diagonal(V)) / bbox_diagonal(V)
-    _warn_of_a_big_target(V, F, target_edge, fraction, evaluate)
+
+    def progress(stage):            # said once the checks have passed, before the work
+        if stage == "retriangulate":
+            _warn_of_a_big_target(V, F, target_edge, fraction, evaluate)
+
     result = run_experiment(V, F, method=method, target_edge=fraction, transfer=transfer, rows=rows,
                             location=location, parameterization=planar_map(location, parameterization),
-                            backend=backend, evaluate=evaluate, source_path=label, surface_check=surface_check)
+                            backend=backend, evaluate=evaluate, source_path=label, surface_check=surface_check,
+                            progress=progress)
     Ft = result["Ft"]
     layers = {"source": mid,
               "retriangulated": add_layer(ms, result["Vt"], Ft, f"{label} retriangulated")}
@@ -99,4 +104,15 @@ def _warn_of_a_big_target(V, F, target_edge, fraction, evaluate):
         warnings.warn(f"target_edge={target_edge} ({100 * fraction:.3g} % of the bbox diagonal) gives about "
                       f"{count:,.0f} target vertices; this takes minutes{why}. A plain number is in model "
                       "units; pymeshlab.PercentageValue(1) is 1 % of the diagonal.", LongRunWarning,
-                      stacklevel=4)
+                      stacklevel=_caller_outside_the_package())
+
+
+def _caller_outside_the_package():
+    """The ``stacklevel`` of the first frame outside curvdetail: a warning names the caller's line
+    (and is shown once per such line, not once per process)."""
+    import sys
+
+    frame, level = sys._getframe(1), 1
+    while frame is not None and frame.f_globals.get("__name__", "").startswith("curvdetail"):
+        frame, level = frame.f_back, level + 1
+    return level
