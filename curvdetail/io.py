@@ -102,9 +102,11 @@ def load_checked(ms, path):
         triangles = check_before_loading(path, error=MeshFileError)
     except OSError as exc:          # unreadable: named as the file's problem, as pymeshlab's are
         raise MeshFileError(f"could not read {path!r}: {exc.strerror or exc}.") from None
+    cwd = os.getcwd()
     try:
         ms.load_new_mesh(path)
     except Exception as exc:
+        os.chdir(cwd)               # a failed load leaves the process in the file's folder
         raise MeshFileError(load_failure(path, exc)) from None
     mesh = ms.current_mesh()
     F = mesh.face_matrix()

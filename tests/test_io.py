@@ -205,6 +205,17 @@ def test_reading_garbage_raises_mesh_file_error(tmp_path):
         read_mesh(path)
 
 
+def test_a_failed_read_leaves_the_working_directory_where_it_was(tmp_path, monkeypatch):
+    # pymeshlab moves the process into the file's folder when it fails to load it: relative
+    # paths of the caller's next steps then pointed elsewhere
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "sub" / "garbage.ply").write_bytes(b"\x00\x01 this is not a ply file")
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(MeshFileError, match="could not read"):
+        read_mesh("sub/garbage.ply")
+    assert os.getcwd() == str(tmp_path)
+
+
 def test_reading_a_point_cloud_is_refused(tmp_path):
     path = tmp_path / "points.off"
     path.write_text("OFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n")
