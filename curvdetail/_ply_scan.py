@@ -318,8 +318,9 @@ def _ply_body_problem(data, offset, elements, first_line):
     came back as a triangle with the previous face's third index, one of 0 as the previous face
     again, one of 256 as no polygon at all, one of 1000 smashed the stack.
 
-    Refused: lines of an element without lists that hold values of two rows (a row split over
-    lines that hold exactly its values is read right and passes), a row of an element with lists
+    Refused: lines of an element without lists that hold values of two rows other than whole
+    rows (a row split over lines that hold exactly its values, and lines of whole rows, are read
+    right and pass), a row of an element with lists
     (the faces) not on a line of its own with exactly its values, a list count that is not a
     whole number in digits, a face with fewer than 3 or more than 255 vertex indices, a value
     that is not an integer in digits fitting 32 bits where an integer is read (``2.0`` too) or
@@ -380,7 +381,11 @@ def _ply_body_problem(data, offset, elements, first_line):
                 return too_few(element, (int(total[-1]) if total.size else 0) // k, count)
             end = int(np.searchsorted(total, need))
             before = total[:end + 1] - per_row[rp:rp + end + 1]
-            straddle = np.flatnonzero(before // k != (total[:end + 1] - 1) // k)
+            # a line within one row, or whole rows of this element from a row's start, is read
+            # as written (fscanf does not see lines); anything else would shift the values
+            within = before // k == (total[:end + 1] - 1) // k
+            whole = (before % k == 0) & (per_row[rp:rp + end + 1] % k == 0) & (total[:end + 1] <= need)
+            straddle = np.flatnonzero(~within & ~whole)
             if straddle.size:
                 # the line where the first row whose values run past a line's end starts
                 row = rp + int(np.searchsorted(total, before[straddle[0]] // k * k, side="right"))

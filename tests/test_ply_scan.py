@@ -193,3 +193,28 @@ def test_the_ply_misreads_refused_are_what_pymeshlab_does(tmp_path):
     assert load(_PLY_V4 + "3 0 1 2\n3 0 2 3\n3 1 2 3\n3 1 3 0\n")[1] == [[0, 1, 2], [0, 2, 3], [1, 2, 3]]
     assert load(_PLY_V4 + "3 0 1 2\n3 0 2 3\n3 2 3 1.9\n")[1][2] == [2, 3, 1]      # 1.9 read as 1
     assert load(_PLY_V4 + "3 0 1 2\n3 0 2 3\n2 1 2\n")[1][2] == [1, 2, 3]           # the 3 of the face before
+
+
+@pytest.mark.parametrize("vertices", ["0 0 0 1 0 0\n1 1 0 0 1 0\n", "0 0 0 1 0 0 1 1 0 0 1 0\n",
+                                      "0 0 0\n1 0 0 1 1 0\n0 1 0\n"])
+def test_ply_vertex_lines_of_whole_rows_are_read_as_pymeshlab_reads_them(tmp_path, vertices):
+    # fscanf does not see lines: whole rows on one line are read right (they were refused)
+    import pymeshlab
+
+    from curvdetail.io import read_mesh
+
+    path = _ply(tmp_path, _PLY_HEAD + vertices + "3 0 1 2\n3 0 2 3\n")
+    V, F = read_mesh(path)
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(str(path))
+    assert np.array_equal(V, ms.current_mesh().vertex_matrix()) and F.tolist() == _F2
+    assert V.tolist() == [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
+
+
+@pytest.mark.parametrize("body", [
+    "0 0 0 1 0\n0 1 1 0 0\n1 0\n3 0 1 2\n3 0 2 3\n",         # 5 + 5 + 2: rows cut across lines
+    "0 0 0\n1 0 0\n1 1 0\n0 1 0 3 0 1\n2\n3 0 2 3\n",       # the last vertex and a face on one line
+])
+def test_ply_vertex_lines_that_cut_rows_are_still_refused(tmp_path, body):
+    with pytest.raises(ValueError):
+        check_before_loading(_ply(tmp_path, _PLY_HEAD + body))
