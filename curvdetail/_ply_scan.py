@@ -40,6 +40,8 @@ _PLY_FACE_TYPES = {
                         for index in (b"short", b"int", b"uint")} | {(b"ushort", b"uint")},
     b"vertex_index": {(b"char", b"int"), (b"uchar", b"int"), (b"int", b"int")},
 }
+#: Of those, the ones its binary reader fails on ("Bad vertex index in face ... damaged").
+_PLY_FACE_TYPES_NOT_BINARY = {(b"int", b"short"), (b"int", b"uint"), (b"ushort", b"uint")}
 #: What fscanf("%f") reads whole besides decimal numbers (read as NaN or inf: pymeshlab then
 #: drops the vertex, which :func:`curvdetail._file_counts.check_loaded` reports).
 _PLY_WORDS = re.compile(rb"[+-]?(?:inf|infinity|nan)", re.IGNORECASE)
@@ -93,11 +95,12 @@ def _ply_header(f):
                 and words[4] in _PLY_FACE_TYPES:
             types = tuple(_PLY_TYPE_NAMES.get(w, w) for w in words[2:4])
             count_type, index_type = (t.decode("ascii", "replace") for t in types)
-            if types not in _PLY_FACE_TYPES[words[4]]:
+            if types not in _PLY_FACE_TYPES[words[4]] or (not ascii_ and types in _PLY_FACE_TYPES_NOT_BINARY):
+                how = "it takes the faces from whatever its memory held" if ascii_ or \
+                    types not in _PLY_FACE_TYPES_NOT_BINARY else "it calls the file damaged"
                 return (f"the header's line {here} ({piece.decode('ascii', 'replace').strip()!r}) declares face "
                         f"lists of {count_type} counts and {index_type} indices, which pymeshlab's PLY reader "
-                        "does not read (it takes the faces from whatever its memory held); write 'property "
-                        "list uchar int vertex_indices'")
+                        f"does not read ({how}); write 'property list uchar int vertex_indices'")
             vertices = max((count for name, count, _ in elements if name == b"vertex"), default=0)
             if index_type == "short" and vertices > 32767:
                 return (f"the header's line {here} declares face indices of type short, which cannot name the "

@@ -218,3 +218,36 @@ def test_ply_vertex_lines_of_whole_rows_are_read_as_pymeshlab_reads_them(tmp_pat
 def test_ply_vertex_lines_that_cut_rows_are_still_refused(tmp_path, body):
     with pytest.raises(ValueError):
         check_before_loading(_ply(tmp_path, _PLY_HEAD + body))
+
+
+@pytest.mark.parametrize("count, index, readable", [("uchar", "int", True), ("char", "uint", True),
+                                                    ("int", "short", False), ("int", "uint", False),
+                                                    ("ushort", "uint", False)])
+def test_binary_face_list_types_pymeshlab_cannot_read_are_named(tmp_path, count, index, readable):
+    # its binary reader fails on these with "Bad vertex index in face ... damaged" (ASCII reads them)
+    import struct
+
+    import pymeshlab
+
+    from curvdetail.io import MeshFileError, read_mesh
+
+    codes = {"char": "b", "uchar": "B", "short": "h", "ushort": "H", "int": "i", "uint": "I"}
+    header = ("ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+              f"property float z\nelement face 2\nproperty list {count} {index} vertex_indices\nend_header\n")
+    vertices = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], dtype="<f4").tobytes()
+    faces = b"".join(struct.pack("<" + codes[count] + codes[index] * 3, 3, *f) for f in _F2)
+    path = tmp_path / "b.ply"
+    path.write_bytes(header.encode() + vertices + faces)
+    ms = pymeshlab.MeshSet()
+    try:
+        ms.load_new_mesh(str(path))
+        read_by_pymeshlab = ms.current_mesh().face_matrix().tolist() == _F2
+    except pymeshlab.PyMeshLabException:
+        read_by_pymeshlab = False
+    assert read_by_pymeshlab == readable                     # the fact behind the refusal
+    if readable:
+        assert read_mesh(path)[1].tolist() == _F2
+    else:
+        with pytest.raises(MeshFileError, match=f"face lists of {count} counts and {index} indices.*calls the "
+                                                r"file damaged"):
+            read_mesh(path)
