@@ -671,5 +671,6 @@ def _ply_values_problem(lines, layouts, words_of, line_of, text):
     return min(found)[1] if found else None
 
 
-#: A decimal number as fscanf("%f") reads it whole.
-_PLY_REAL_WORD = re.compile(rb"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
+#: A number as fscanf("%f") reads it whole: decimal, or hexadecimal as glibc reads it (0x1p-1).
+_PLY_REAL_WORD = re.compile(rb"[+-]?(?:(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?"
+                            rb"|0[xX](?:[0-9a-fA-F]+\.?[0-9a-fA-F]*|\.[0-9a-fA-F]+)(?:[pP][+-]?[0-9]+)?)")

@@ -251,3 +251,13 @@ def test_binary_face_list_types_pymeshlab_cannot_read_are_named(tmp_path, count,
         with pytest.raises(MeshFileError, match=f"face lists of {count} counts and {index} indices.*calls the "
                                                 r"file damaged"):
             read_mesh(path)
+
+
+def test_ply_hexadecimal_reals_are_read_as_pymeshlab_reads_them(tmp_path):
+    # glibc's fscanf("%f") reads 0x1p-1 as 0.5; where an index is read, 0x1 stays refused
+    from curvdetail.io import read_mesh
+
+    V, _ = read_mesh(_ply(tmp_path, _PLY_HEAD + "0 0 0\n0x1p0 0 0\n1 0x1.0p0 0\n0 0x.8p1 0\n3 0 1 2\n3 0 2 3\n"))
+    assert V.tolist() == [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
+    with pytest.raises(ValueError, match="holds '0x1' where an integer"):
+        check_before_loading(_ply(tmp_path, _PLY_HEAD + _PLY_V4 + "3 0 0x1 2\n3 0 2 3\n"))
