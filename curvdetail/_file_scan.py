@@ -56,6 +56,10 @@ def check_before_loading(path, error=ValueError):
     polygon of k vertices k - 2; pymeshlab drops faces with a repeated index or the 'deleted'
     flag bit, which the caller finds by comparing), else None."""
     extension = os.path.splitext(os.fspath(path))[1].lower()
+    if extension in (".off", ".ply", ".obj") and _carriage_returns_only(path):
+        raise error(f"{path!r} ends its lines with carriage returns alone (classic Mac OS), which pymeshlab "
+                    "reads as one long line (it failed, or read a single vertex); convert the line ends to "
+                    "newlines (e.g. tr '\\r' '\\n' < old > new) and read the file again.")
     if extension == ".off":
         if _off_is_binary(path):
             raise error(f"{path!r} is a binary OFF file ('OFF BINARY'), which pymeshlab's OFF reader "
@@ -97,6 +101,14 @@ def _off_is_binary(path):
     with open(path, "rb") as f:
         words = f.readline(4096).split(b"#", 1)[0].upper().split()
     return len(words) >= 2 and words[0].endswith(b"OFF") and words[1] == b"BINARY"
+
+
+def _carriage_returns_only(path):
+    """Whether the file's first 64 KiB hold a carriage return but no newline: its lines end in
+    "\\r" alone. (CRLF files hold both and are read right.)"""
+    with open(path, "rb") as f:
+        head = f.read(1 << 16)
+    return b"\r" in head and b"\n" not in head
 
 
 @contextlib.contextmanager

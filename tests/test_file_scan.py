@@ -243,3 +243,20 @@ def test_commas_in_comments_and_names_and_trailing_comments_pass(tmp_path, name,
     V, F = read_mesh(path)
     np.testing.assert_array_equal(V, _V4 if name.endswith(".obj") else [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]])
     assert F.shape == (2, 3)
+
+
+@pytest.mark.parametrize("name, text", [
+    ("m.off", "OFF\r4 2 0\r0 0 0\r1 0 0\r1 1 0\r0 1 0\r3 0 1 2\r3 0 2 3\r"),
+    ("m.obj", "v 0 0 0\rv 1 0 0\rv 1 1 0\rv 0 1 0\rf 1 2 3\rf 1 3 4\r"),
+    ("m.ply", "ply\rformat ascii 1.0\relement vertex 4\rproperty float x\rproperty float y\rproperty float z\r"
+              "element face 2\rproperty list uchar int vertex_indices\rend_header\r0 0 0\r1 0 0\r1 1 0\r0 1 0\r"
+              "3 0 1 2\r3 0 2 3\r"),
+])
+def test_carriage_return_line_ends_are_named(tmp_path, name, text):
+    # pymeshlab failed ("Unable to open file", "truncated") or read the OBJ as one vertex
+    path = tmp_path / name
+    path.write_bytes(text.encode())
+    with pytest.raises(ValueError, match="ends its lines with carriage returns alone"):
+        check_before_loading(path)
+    path.write_bytes(text.replace("\r", "\r\n").encode())         # CRLF is read right
+    check_before_loading(path)
