@@ -173,7 +173,7 @@ def test_a_big_target_is_said_beforehand_with_the_unit_of_a_plain_number(monkeyp
     import importlib
     import warnings
 
-    from curvdetail.remesh.retriangulate import LongRunWarning
+    from curvdetail.remesh import LongRunWarning
 
     monkeypatch.setattr(importlib.import_module("curvdetail.remesh.retriangulate"), "BIG_TARGET", 100)
     ms = pymeshlab.MeshSet()

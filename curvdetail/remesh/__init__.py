@@ -10,11 +10,11 @@ from .evaluate import hausdorff, vertex_distance
 from .experiment import remesh_experiment
 from .locate import interpolate, locate, spread
 from .parameterize import flipped_triangles, harmonic_map, parameterize
-from .retriangulate import retriangulate
+from .retriangulate import LongRunWarning, retriangulate
 from .transfer import edge_curvature_measure, transfer_curvature
 
 __all__ = [
-    "NotADiskError", "RemeshError", "check_disk", "edge_curvature_measure", "flipped_triangles", "harmonic_map",
+    "LongRunWarning", "NotADiskError", "RemeshError", "check_disk", "edge_curvature_measure", "flipped_triangles", "harmonic_map",
     "hausdorff", "interpolate", "locate", "parameterize", "remesh_experiment", "retriangulate", "spread",
     "transfer_curvature", "vertex_distance",
 ]
