@@ -33,6 +33,19 @@ def test_rigid_translation_of_the_boundary_translates_the_patch(load_mesh):
     assert np.abs(X - (V + shift)).max() < 1e-8 * np.linalg.norm(np.ptp(V, axis=0))
 
 
+@pytest.mark.parametrize("name", ["mannequin_ear.obj", "mannequin_nose.obj"])
+@pytest.mark.parametrize("degrees, scale", [(30.0, 1.0), (90.0, 1.0), (0.0, 2.0), (30.0, 1.5)])
+def test_a_boundary_turned_or_scaled_as_a_whole_moves_the_patch_with_it(load_mesh, name, degrees, scale):
+    # SPEC: a similarity of every constraint moves the result by it. Spreading the whole move
+    # harmonically gave the trunk turned by 30 degrees 1.8 diagonals off, scaled by 2 7.9
+    V, F = load_mesh(name)
+    c, a = V.mean(0), np.radians(degrees)
+    R = np.array([[np.cos(a), -np.sin(a), 0.0], [np.sin(a), np.cos(a), 0.0], [0.0, 0.0, 1.0]])
+    X = edit_boundary(V, F, lambda s, P: scale * (P - c) @ R.T + c - P)
+    expected = scale * (V - c) @ R.T + c
+    assert np.abs(X - expected).max() < 1e-8 * scale * np.linalg.norm(V.max(0) - V.min(0))
+
+
 def test_boundary_loop_follows_the_triangles_and_covers_the_boundary():
     V, F = grid(6, 5)
     loop = boundary_loop(F)
