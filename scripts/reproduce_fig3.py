@@ -11,6 +11,7 @@ Writes (paths relative to the repository):
   docs/fig3_table.md              the markdown tables (also copied into docs/remeshing.md,
                                   between its <!-- fig3-table --> markers)
   docs/fig3.png                   the Fig. 3 patches, default configuration
+With --quick (a subset) the tables go to out/fig3/table_quick.md and docs/ is left alone.
 
 Usage: python scripts/reproduce_fig3.py [--meshes DIR] [--quick]
 (DIR defaults to $CURVDETAIL_MESHES, else ../shared/meshes beside the repository.)
@@ -75,7 +76,8 @@ def main():
     default_meshes = os.environ.get("CURVDETAIL_MESHES", os.path.join(ROOT, "..", "shared", "meshes"))
     ap.add_argument("--meshes", default=default_meshes,
                     help="folder of the public meshes (default: $CURVDETAIL_MESHES, else ../shared/meshes)")
-    ap.add_argument("--quick", action="store_true", help="default configuration only, no 100k run")
+    ap.add_argument("--quick", action="store_true",
+                    help="default configuration only, no 100k run; writes out/fig3/ only, not docs/")
     args = ap.parse_args()
     meshes = args.meshes
     if not os.path.isdir(meshes):
@@ -156,6 +158,11 @@ def main():
         table += ("\n### Planar domains for the location (conservative transfer, free rows; retriangulation time "
                   "not counted)\n\n" + HEADER.replace(" |\n|", " | flipped source / target |\n|", 1) + "---|\n"
                   + "\n".join(params) + "\n")
+    if args.quick:            # a subset: the committed tables and figure in docs/ stay as they are
+        with open(os.path.join(ROOT, "out", "fig3", "table_quick.md"), "w") as fh:
+            fh.write(table)
+        print(table)
+        return
     with open(os.path.join(ROOT, "docs", "fig3_table.md"), "w") as fh:
         fh.write(table)
     doc = os.path.join(ROOT, "docs", "remeshing.md")
