@@ -19,7 +19,7 @@ import os
 import numpy as np
 
 from ._output import atomic_output, check_output_path
-from .curvature._validate import check_transformed_values
+from .curvature._validate import affine_transform_problem, check_transformed_values, real_word
 from .curvature.curvature_coefficients import DEFAULT_RCOND
 from .curvature.curvature_editor import CurvatureEditor
 from .curvature.errors import ConstraintError, first_indices
@@ -117,19 +117,16 @@ def read_transform(path):
     for r, (no, text) in enumerate(rows):
         parts = text.replace(",", " ").split()
         try:
-            values = [float(p) for p in parts]
+            values = [real_word(p) for p in parts]
         except ValueError:
             raise DeformationFileError(f"{path}: line {no} ({text[:40]!r}) is not 4 numbers.") from None
         if len(values) != 4 or not np.all(np.isfinite(values)):
             raise DeformationFileError(f"{path}: line {no} has {len(values)} values (or NaN/inf); each "
                                        "matrix row needs 4 finite numbers.")
         T[r] = values
-    if not np.allclose(T[3], [0.0, 0.0, 0.0, 1.0], atol=1e-12):
-        raise DeformationFileError(f"{path}: last matrix row is {T[3].tolist()}; an affine handle "
-                                   "transform has (0, 0, 0, 1) there.")
-    if abs(np.linalg.det(T[:3, :3])) < 1e-12:
-        raise DeformationFileError(f"{path}: the linear part of the transform is singular; it would "
-                                   "collapse the handles.")
+    problem = affine_transform_problem(T)
+    if problem:
+        raise DeformationFileError(f"{path}: {problem}.")
     return T
 
 

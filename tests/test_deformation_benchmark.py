@@ -68,8 +68,11 @@ def test_selection_of_the_wrong_length_is_refused(tmp_path):
     ("# c\n1 0 0 0\n0 1 0 0\n0 0 1 0\n", "3 matrix rows"),
     ("1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0\n", "line 4 has 3 values"),
     ("1 0 0 0\n0 1 0 0\n0 0 1 a\n0 0 0 1\n", "not 4 numbers"),
-    ("1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0.5 1\n", "last matrix row"),
+    ("1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0.5 1\n", "the last row is"),
     ("0 0 0 1\n0 1 0 0\n0 0 1 0\n0 0 0 1\n", "singular"),
+    # scale-free: this collapses z although its determinant is 1
+    ("1e6 0 0 0\n0 1e6 0 0\n0 0 1e-12 0\n0 0 0 1\n", "singular"),
+    ("1 0 0 1_0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n", "not 4 numbers"),     # Python would read 10
 ])
 def test_malformed_transform_is_refused(tmp_path, text, message):
     p = tmp_path / "bad.def"
@@ -162,3 +165,10 @@ def test_unknown_handle_detail_mode_is_refused():
     V, F, status = _strip()
     with pytest.raises(ValueError, match="handle_detail"):
         edit_with_selection(V, F, status, np.eye(4), handle_detail="rotate")
+
+
+def test_a_small_uniform_scaling_is_no_singular_transform(tmp_path):
+    # its determinant, 1e-15, was below the absolute threshold 1e-12
+    p = tmp_path / "small.def"
+    p.write_text("1e-5 0 0 0\n0 1e-5 0 0\n0 0 1e-5 0\n0 0 0 1\n")
+    assert np.allclose(read_transform(p)[:3, :3], 1e-5 * np.eye(3))

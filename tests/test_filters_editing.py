@@ -86,6 +86,10 @@ def test_filter_is_declared_with_its_parameters():
                                                                         r"\(first: 99999999999999999999999\)"),
     (dict(handles="1 2", transform="1 0 0"), FilterParameterError, "16 finite numbers"),
     (dict(handles="1 2", detail_scale=-1.0), FilterParameterError, "greater than 0"),
+    # transforms that collapse the handles: refused here as curvdetail edit's .def files are
+    (dict(handles="1 2", transform="0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 1"), FilterParameterError, "singular"),
+    (dict(handles="1 2", transform="1 0 0 0 0 1 0 0 0 0 0 0 0 0 0 1"), FilterParameterError, "singular"),
+    (dict(handles="1 2", transform="1 0 0 1_0 0 1 0 0 0 0 1 0 0 0 0 1"), FilterParameterError, "16 numbers"),
 ])
 def test_bad_parameters_are_refused(params, error, message):
     ms, V, d, handles = _meshset_with_roi()
@@ -95,7 +99,7 @@ def test_bad_parameters_are_refused(params, error, message):
 
 @pytest.mark.parametrize("params, message", [
     (dict(detail_scale=1e300), "transform with detail_scale gives the handles values of"),
-    (dict(transform="1e300 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1"), "the transform gives the handles values of"),
+    (dict(transform="1e300 0 0 0 0 1e300 0 0 0 0 1e300 0 0 0 0 1"), "the transform gives the handles values of"),
 ])
 def test_an_overflowing_edit_is_refused_before_the_mesh_is_touched(params, message):
     # before, the positions were written and only then the quality's infinities refused

@@ -504,6 +504,28 @@ def check_transformed_values(values, what, fix, error=ConstraintError):
                     f"where the geometry overflows double precision; {fix}.")
 
 
+def real_word(word):
+    """``float(word)`` for a number written in a text file or parameter, but ValueError for
+    Python's digit separators too (``1_0`` would be read as 10)."""
+    if "_" in word:
+        raise ValueError(f"{word!r} is not a number")
+    return float(word)
+
+
+def affine_transform_problem(T):
+    """What is wrong with the (4, 4) handle transform ``T`` for an edit, or None: a last row other
+    than (0, 0, 0, 1), or a linear part that collapses a direction (smallest over largest
+    singular value below 1e-12: scale-free, so a uniform 1e-5 scaling passes and diag(1e6,
+    1e6, 1e-12) does not)."""
+    if not np.allclose(T[3], [0.0, 0.0, 0.0, 1.0], atol=1e-12):
+        return f"the last row is {T[3].tolist()}; an affine transform has (0, 0, 0, 1) there"
+    sigma = np.linalg.svd(T[:3, :3], compute_uv=False)
+    if not sigma[0] > 0 or sigma[2] < 1e-12 * sigma[0]:
+        return (f"its linear part is singular (singular values {sigma[0]:.3g} ... {sigma[2]:.3g}); it would "
+                "collapse the handles onto a plane, a line or a point")
+    return None
+
+
 def vertex_components(F, n, adjacency=None):
     """Connected-component label per vertex, shape (n,), and the number of components.
 

@@ -4,7 +4,7 @@ import time
 
 import numpy as np
 
-from ..curvature._validate import bbox_diagonal, check_transformed_values
+from ..curvature._validate import affine_transform_problem, bbox_diagonal, check_transformed_values, real_word
 from ..curvature.curvature_editor import CurvatureEditor
 from ..curvature.errors import ConstraintError, UndeterminedEditError
 from .apply_curvature_reconstruction import BACKEND_DESCRIPTION, BACKENDS
@@ -39,7 +39,7 @@ def _indices(text, n):
 
 def _matrix(text):
     try:
-        values = [float(t) for t in str(text).replace(",", " ").split()]
+        values = [real_word(t) for t in str(text).replace(",", " ").split()]
     except ValueError:
         raise FilterParameterError(f"parameter 'transform' must be 16 numbers (a 4x4 matrix, row by "
                                    f"row); got {str(text)[:40]!r}.") from None
@@ -47,8 +47,9 @@ def _matrix(text):
         raise FilterParameterError(f"parameter 'transform' has {len(values)} numbers (or NaN/inf); it "
                                    "must be 16 finite numbers, a 4x4 matrix row by row.")
     T = np.asarray(values).reshape(4, 4)
-    if not np.allclose(T[3], [0, 0, 0, 1], atol=1e-12):
-        raise FilterParameterError("parameter 'transform': the last row must be 0 0 0 1 (an affine map).")
+    problem = affine_transform_problem(T)
+    if problem:
+        raise FilterParameterError(f"parameter 'transform': {problem}.")
     return T
 
 
