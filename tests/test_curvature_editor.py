@@ -87,6 +87,23 @@ def test_changing_the_callers_arrays_afterwards_does_not_change_the_editor(load_
     assert np.abs(rest - V_before).max() < 1e-8 * _diag(V_before)
     with pytest.raises(ValueError):    # and the editor's own copies are read-only
         ed.V[0] = 0.0
+    # so is the state its solves read again (zeroing ed.detail moved the rest shape 0.19 off)
+    for state in (ed.detail, ed.coefficients.data, ed.laplacian.data, ed.position_constrained,
+                  ed.detail_constrained):
+        with pytest.raises(ValueError):
+            state[0] = 0
+    assert np.array_equal(ed.solve(), rest)
+
+
+def test_precomputed_handles_with_every_vertex_constrained_respond_like_the_full_solve(plane_grid):
+    # nothing left to solve for: the response was numpy's "cannot reshape array of size 0"
+    V, F = plane_grid
+    n = V.shape[0]
+    ed = CurvatureEditor(V, F, np.arange(n), [0, 1, 2])
+    P = V.copy()
+    P[0] += [0.0, 0.0, 0.1]
+    full = ed.solve(positions=P)
+    assert np.array_equal(ed.precompute_handles([0]).solve(positions=P), full)
 
 
 @pytest.mark.parametrize("rows", ["all", "free"])

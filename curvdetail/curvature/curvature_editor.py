@@ -212,6 +212,8 @@ class CurvatureEditor:
         C, rank, _ = _coefficients(D, A, rows, cols, n, rcond, size)
         cvals = C.data if C.nnz == rows.size else np.asarray(C[rows, cols]).ravel()  # (rows, cols) order
         self.detail, self.coefficients, self.laplacian = D, C, L
+        for state in (D, C.data, L.data, pc, dc):      # read-only: solves read them again
+            state.flags.writeable = False
         self.rank_deficient = int(np.count_nonzero(rank < 3))
         t1 = time.perf_counter()
 
@@ -555,7 +557,7 @@ class CurvatureEditor:
         keep_d = np.ones(self._dc.size, dtype=bool)
         keep_d[jd] = False
         G = np.zeros((self.n, jp.size + jd.size))           # response of every vertex
-        G[self._fp] = np.hstack([Gp.reshape(f, -1), Gd.reshape(f, -1)])
+        G[self._fp] = np.hstack([Gp.reshape(f, jp.size), Gd.reshape(f, jd.size)])    # f may be 0
         self._response = {"X": base, "Xk": Xk.copy(), "Dk": Dk.copy(), "jp": jp, "jd": jd,
                           "G": G, "keep_p": keep_p, "keep_d": keep_d}
         return self
