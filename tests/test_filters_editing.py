@@ -47,6 +47,14 @@ def test_handles_follow_the_transform_and_unselected_vertices_stay():
     assert figures["amplification"] == pytest.approx(1.0, abs=0.05)   # nothing outruns a translation
 
 
+def test_amplification_is_none_where_the_handles_do_not_move():
+    # a pure detail edit moves the region but not the handles: the ratio was reported as 1.0, and
+    # rounding noise with move_handles=false as 3.4 (above the CLI's warning threshold)
+    ms, V, d, handles = _meshset_with_roi()
+    figures = apply(ms, "apply_curvature_editing", handles=" ".join(map(str, handles)), detail_scale=0.5)
+    assert figures["amplification"] is None and figures["max_displacement"] > 1e-3
+
+
 def test_python_callers_may_pass_handles_and_transform_as_arrays():
     # as pymeshlab takes a matrix parameter: the same edit as from the texts, digit for digit
     T = np.eye(4)

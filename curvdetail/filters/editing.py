@@ -144,8 +144,10 @@ def apply_curvature_editing(ms, *, handles, region_radius, transform, detail_sca
     set_vertex_quality(ms, mid, moved)
     return {
         "max_displacement": float(moved.max() / bbox_diagonal(V)),
-        # far above 1: the curvature stage amplified the handle details (see docs/editing.md)
-        "amplification": float(moved.max() / max(moved[h].max(), 1e-300)) if moved[h].max() > 0 else 1.0,
+        # far above 1: the curvature stage amplified the handle details (see docs/editing.md);
+        # None where the handles do not move (a ratio of rounding, or of a pure detail edit)
+        "amplification": (float(moved.max() / moved[h].max())
+                          if moved[h].max() > 1e-12 * bbox_diagonal(V) else None),
         "roi_vertices": int(roi.size),
         "handle_vertices": int(h.size),
         "rank_deficient_vertices": int(editor.rank_deficient),
