@@ -130,3 +130,23 @@ def test_a_selection_that_does_not_determine_the_edit_is_refused_with_what_to_ch
     assert "Add handles (status 2) or fixed vertices (status 0) in" in err and "q.sel" in err
     assert "roi" not in err and "--handle-detail" not in err
     assert not (tmp_path / "o.ply").exists()
+
+
+def test_a_free_piece_no_constraint_reaches_is_refused_in_the_selections_terms(tmp_path, capsys):
+    # two separate grids, the second all free: the message named the library's detail_constrained
+    # and roi, not the .sel file
+    V, F = grid(10, 10)
+    V2, F2 = np.vstack([V, V + [2.0, 0.0, 0.0]]), np.vstack([F, F + V.shape[0]])
+    status = np.ones(V2.shape[0], dtype=int)
+    status[:10] = 0
+    status[55] = 2
+    write_mesh(tmp_path / "two.obj", V2, F2)
+    write_selection(tmp_path / "q.sel", status)
+    write_transform(tmp_path / "p.def", np.eye(4))
+    rc = main(["edit", str(tmp_path / "two.obj"), "--sel", str(tmp_path / "q.sel"), "--def",
+               str(tmp_path / "p.def"), str(tmp_path / "o.ply")])
+    err = capsys.readouterr().err
+    assert rc == 1 and "1 connected free region touches no" in err
+    assert "Add handles (status 2) or fixed vertices (status 0) in" in err and "q.sel" in err
+    assert "roi" not in err and "detail_constrained" not in err
+    assert not (tmp_path / "o.ply").exists()

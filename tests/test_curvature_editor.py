@@ -5,7 +5,7 @@ import pytest
 
 from curvdetail import CurvatureEditor, boundary_vertices, curvature_detail, reconstruct
 from curvdetail.curvature import sparse_solver
-from curvdetail.curvature.errors import ConstraintError
+from curvdetail.curvature.errors import ConstraintError, UndeterminedEditError
 from curvdetail.curvature.testing import grid
 
 
@@ -169,10 +169,12 @@ def test_a_free_piece_without_any_constraint_is_refused(plane_grid):
     V2 = np.vstack([V, V + [2.0, 0.0, 0.0]])
     F2 = np.vstack([F, F + V.shape[0]])
     b = boundary_vertices(F)                               # constraints on the first piece only
-    with pytest.raises(ConstraintError, match="touch no position constraint"):
+    # an UndeterminedEditError (a ConstraintError), whose advice callers word in their own terms
+    with pytest.raises(UndeterminedEditError, match="1 connected free region touches no position constraint"):
         CurvatureEditor(V2, F2, b, np.arange(V2.shape[0]))
-    with pytest.raises(ConstraintError, match="touch no detail constraint"):
+    with pytest.raises(UndeterminedEditError, match="touches no detail constraint") as error:
         CurvatureEditor(V2, F2, np.arange(V2.shape[0]), b)
+    assert error.value.advice.startswith("Add a vertex of each region to detail_constrained")
 
 
 def test_unknown_row_mode_or_relations_are_refused(plane_grid):

@@ -643,7 +643,8 @@ def _check_reached(rows, cols, free, n, what, name):
         _, labels = connected_components(G, directed=False)
         regions = np.unique(labels[lost])
         example = [int(lost[np.flatnonzero(labels[lost] == c)[0]]) for c in regions[:3]]
-        raise ConstraintError(
-            f"{regions.size} connected free regions touch no {what} constraint (e.g. the regions "
-            f"containing vertex {', '.join(map(str, example))}); their {what}s are undetermined. "
+        raise UndeterminedEditError(
+            f"{regions.size} connected free {'region touches' if regions.size == 1 else 'regions touch'} no "
+            f"{what} constraint (e.g. the {'region' if regions.size == 1 else 'regions'} containing vertex "
+            f"{', '.join(map(str, example))}); their {what}s are undetermined.",
             f"Add a vertex of each region to {name}, or shrink the roi.")

@@ -16,7 +16,8 @@ class ConstraintError(ValueError):
 
 
 class UndeterminedEditError(ConstraintError):
-    """The constraints of an edit leave the curvature stage singular to working precision (see
+    """The constraints of an edit leave part of it undetermined: a connected free region that no
+    constraint reaches, or a curvature stage singular to working precision (see
     ``CurvatureEditor.rest_error``). ``problem`` is what was found and ``advice`` what to change
     in the editor's terms; callers with their own way of giving constraints (a selection file, a
     filter's parameters) raise it again with their own advice."""
