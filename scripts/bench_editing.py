@@ -25,7 +25,8 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
-from reproduce_table1 import MESHES, PAPER, table1_meshes, time_edit  # noqa: E402
+from _meshes import MESHES, at_least_one, require  # noqa: E402
+from reproduce_table1 import PAPER, table1_meshes, time_edit  # noqa: E402
 
 from curvdetail import CurvatureEditor, boundary_vertices, read_mesh  # noqa: E402
 from curvdetail.deformation_benchmark import (edit_with_selection, read_selection,  # noqa: E402
@@ -110,9 +111,11 @@ def bench_cases(repeat):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="out/bench_editing.json")
-    ap.add_argument("--repeat", type=int, default=7)
+    ap.add_argument("--repeat", type=at_least_one, default=7)
     ap.add_argument("--skip-100k", action="store_true")
     args = ap.parse_args(argv)
+    require("mannequin_nose.obj", "mannequin.off", "mannequin_ear.obj", "cat_tosca.off", "deformation",
+            *(() if args.skip_100k else ("terrainA_100k.ply",)))
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
     report = {"machine": {"platform": platform.platform(), "cpus": os.cpu_count(),
                           "load_average_before": os.getloadavg()}}

@@ -19,13 +19,14 @@ import time
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from _meshes import MESHES, require  # noqa: E402
+
 from curvdetail import read_mesh
 from curvdetail.curvature._validate import bbox_diagonal
 from curvdetail.deformation_benchmark import (edit_with_selection, read_selection, read_transform,
                                               render_panels)
 
-MESHES = os.environ.get("CURVDETAIL_MESHES", os.path.join(os.path.dirname(__file__), "..", "..",
-                                                          "shared", "meshes"))
 CASES = ("bar", "cactus", "cylinder", "plane")
 #: (handle details, curvature-stage relations): the paper, the steadier stacked relations, free
 VARIANTS = (("transform", "one-ring"), ("transform", "one+two-ring"), ("free", "one-ring"))
@@ -73,6 +74,7 @@ def main(argv=None):
     ap.add_argument("--out", default="out/compare")
     ap.add_argument("--docs", default=None, help="also write small pictures docs/editing_NAME.png here")
     args = ap.parse_args(argv)
+    require("deformation")
     os.makedirs(args.out, exist_ok=True)
     folder = os.path.join(MESHES, "deformation")
     rows = []

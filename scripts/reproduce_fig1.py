@@ -24,12 +24,13 @@ import time
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from _meshes import MESHES, require  # noqa: E402
+
 from curvdetail import CurvatureEditor, boundary_vertices, mean_curvature_normal, read_mesh
 from curvdetail.curvature._validate import bbox_diagonal
 from curvdetail.deformation_benchmark import render_panels
 
-MESHES = os.environ.get("CURVDETAIL_MESHES", os.path.join(os.path.dirname(__file__), "..", "..",
-                                                          "shared", "meshes"))
 Y_UP = np.array([[1.0, 0, 0], [0, 0, -1.0], [0, 1.0, 0]])   # display y-up models with z up
 
 
@@ -120,6 +121,7 @@ def main(argv=None):
     ap.add_argument("--out", default="out/fig1")
     ap.add_argument("--docs", default=None)
     args = ap.parse_args(argv)
+    require("elephant.obj", "cactus.off", "mannequin_devil.off")
     os.makedirs(args.out, exist_ok=True)
     report, docs_panels = [], []
     views = {"fig1a": (10, 0), "fig1b": (10, -90), "fig1c": (10, -30)}

@@ -23,12 +23,13 @@ import time
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from _meshes import MESHES, require  # noqa: E402
+
 from curvdetail import edit_boundary, read_mesh, sine_displacement
 from curvdetail.curvature._validate import bbox_diagonal
 from curvdetail.deformation_benchmark import edit_with_selection, render_panels, view_direction
 
-MESHES = os.environ.get("CURVDETAIL_MESHES", os.path.join(os.path.dirname(__file__), "..", "..",
-                                                          "shared", "meshes"))
 Y_UP = np.array([[1.0, 0, 0], [0, 0, -1.0], [0, 1.0, 0]])   # display y-up models with z up
 COW_VIEW = (15, 30)
 
@@ -94,6 +95,7 @@ def main(argv=None):
     ap.add_argument("--out", default="out/fig2")
     ap.add_argument("--docs", default=None)
     args = ap.parse_args(argv)
+    require("cow.off", "terrainA_10k.obj")
     os.makedirs(args.out, exist_ok=True)
     V, F, status, meshes, info_a = cow()
     print(json.dumps(info_a))

@@ -23,12 +23,13 @@ import time
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from _meshes import MESHES, at_least_one, require  # noqa: E402
+
 from curvdetail import CurvatureEditor, boundary_vertices, read_mesh
 from curvdetail.curvature._validate import bbox_diagonal, check_mesh, vertex_components
 from curvdetail.deformation_benchmark import render_panels
 
-MESHES = os.environ.get("CURVDETAIL_MESHES", os.path.join(os.path.dirname(__file__), "..", "..",
-                                                          "shared", "meshes"))
 
 #: (model, vertices, facets, optimization time in s) as printed in the paper's Table 1
 PAPER = [("Cat", 135, 257, 0.5), ("Nose2", 383, 732, 2.6), ("Nose1", 601, 1135, 7.4),
@@ -152,8 +153,9 @@ def time_edit(V, F, repeat):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="out/table1")
-    ap.add_argument("--repeat", type=int, default=7)
+    ap.add_argument("--repeat", type=at_least_one, default=7)
     args = ap.parse_args(argv)
+    require("mannequin_nose.obj", "mannequin.off", "mannequin_ear.obj", "cat_tosca.off")
     os.makedirs(args.out, exist_ok=True)
     meshes = table1_meshes()
     results, panels = [], []
