@@ -34,13 +34,17 @@ class DeformationFileError(ValueError):
 
 def _data_lines(path, what):
     path = os.fspath(path)
+    if os.path.isdir(path):
+        raise DeformationFileError(f"{path} is a folder; name a {what} file.")
     if not os.path.isfile(path):
         raise FileNotFoundError(f"{what} file not found: {path}")
     try:
-        with open(path, encoding="utf-8") as fh:
+        # utf-8-sig: a byte-order mark (Windows editors write one) is no part of the first line
+        with open(path, encoding="utf-8-sig") as fh:
             lines = fh.read().splitlines()
-    except UnicodeDecodeError:
-        raise DeformationFileError(f"{path}: not a text file; a {what} file is plain text.") from None
+    except UnicodeDecodeError as exc:
+        raise DeformationFileError(f"{path}: byte {exc.start} is not UTF-8 text; a {what} file is plain "
+                                   "text (save it as UTF-8 or ASCII).") from None
     return [(k + 1, line.strip()) for k, line in enumerate(lines)
             if line.strip() and not line.lstrip().startswith("#")]
 

@@ -172,3 +172,21 @@ def test_a_small_uniform_scaling_is_no_singular_transform(tmp_path):
     p = tmp_path / "small.def"
     p.write_text("1e-5 0 0 0\n0 1e-5 0 0\n0 0 1e-5 0\n0 0 0 1\n")
     assert np.allclose(read_transform(p)[:3, :3], 1e-5 * np.eye(3))
+
+
+def test_files_with_a_byte_order_mark_are_read(tmp_path):
+    # "1 lines are not a vertex status (line 1: '\ufeff# per vertex status')" before
+    sel, d = tmp_path / "a.sel", tmp_path / "a.def"
+    sel.write_bytes("\ufeff# per vertex status\n0\n1\n2\n".encode("utf-8"))
+    d.write_bytes("\ufeff# transform\n1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n".encode("utf-8"))
+    assert read_selection(sel, 3).tolist() == [0, 1, 2]
+    assert np.array_equal(read_transform(d), np.eye(4))
+
+
+def test_a_folder_or_latin1_text_is_named_as_such(tmp_path):
+    with pytest.raises(DeformationFileError, match="is a folder"):
+        read_selection(tmp_path, 3)
+    p = tmp_path / "b.sel"
+    p.write_bytes("# caf\xe9\n0\n".encode("latin-1"))
+    with pytest.raises(DeformationFileError, match=r"byte 5 is not UTF-8 text.*save it as UTF-8"):
+        read_selection(p, 1)
