@@ -1,9 +1,10 @@
 """Where the reproduction and benchmark scripts find the public meshes: $CURVDETAIL_MESHES, else
 ../shared/meshes beside the repository (see ../shared/meshes/README.md for their sources)."""
 
-import argparse
 import os
 import sys
+
+from curvdetail.cli import _whole_number_from_one as at_least_one  # noqa: F401 (--repeat)
 
 MESHES = os.environ.get("CURVDETAIL_MESHES",
                         os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "shared", "meshes"))
@@ -17,14 +18,3 @@ def require(*names):
         sys.exit(f"{os.path.basename(sys.argv[0])}: {MESHES!r} does not hold {', '.join(missing)}; set "
                  "CURVDETAIL_MESHES to the folder of the public meshes (../shared/meshes beside the "
                  "repository).")
-
-
-def at_least_one(text):
-    """An argparse type: a whole number of at least 1 (``--repeat``)."""
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number of at least 1")
-    return value
