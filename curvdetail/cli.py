@@ -234,17 +234,11 @@ def _note_a_big_target(V, F, fraction, *, evaluate=True):
     """A line on stderr when a target edge of ``fraction`` of the bbox diagonal asks for more than
     ``BIG_TARGET`` vertices (an estimate only: on a mesh the checks will refuse, nothing is
     said)."""
-    import numpy as np
-
     from .curvature._validate import bbox_diagonal
-    from .remesh.retriangulate import BIG_TARGET, MAX_VERTICES, estimated_vertices
+    from .remesh.retriangulate import long_run_vertices
 
-    try:
-        with np.errstate(all="ignore"):
-            count = float(estimated_vertices(V, F, fraction * bbox_diagonal(V)))
-    except (ValueError, IndexError, ArithmeticError):
-        return
-    if BIG_TARGET < count <= MAX_VERTICES:           # beyond, retriangulate refuses it at once
+    count = long_run_vertices(V, F, fraction * bbox_diagonal(V))
+    if count is not None:
         why = " (the measurements most of it; --no-evaluate skips them)" if evaluate else ""
         _say(f"note: a {100 * fraction:g} % target edge gives about {count:,.0f} target vertices; this takes "
              f"minutes{why}.")

@@ -37,6 +37,19 @@ def estimated_vertices(V, F, target_edge):
         return 2.0 * area / np.sqrt(3.0) / float(target_edge) / float(target_edge)
 
 
+def long_run_vertices(V, F, target_edge):
+    """The estimated target vertex count (:func:`estimated_vertices`) where a retriangulation
+    with edges ``target_edge`` (absolute) takes minutes: above ``BIG_TARGET``, up to the
+    ``MAX_VERTICES`` the remesher accepts; else None (also where the mesh is too malformed to
+    estimate: its checks will say why)."""
+    try:
+        with np.errstate(all="ignore"):
+            count = float(estimated_vertices(V, F, target_edge))
+    except (ValueError, IndexError, ArithmeticError):
+        return None
+    return count if BIG_TARGET < count <= MAX_VERTICES else None
+
+
 def edge_for_vertices(V, F, count):
     """The absolute edge length whose equilateral triangulation of the surface has ``count``
     vertices (the inverse of :func:`estimated_vertices`)."""
