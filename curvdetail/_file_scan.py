@@ -86,9 +86,9 @@ def check_before_loading(path, error=ValueError):
                         "the leading whitespace and read the file again.")
         odd = _obj_odd_face(path)
         if odd is not None and odd[1] == ".":
-            raise error(f"{path!r}: the face on line {odd[0]} has a fractional vertex index, which "
-                        "pymeshlab's OBJ loader truncates without a word (1.5 becomes 1); OBJ indices are "
-                        "whole numbers. Fix the face and read the file again.")
+            raise error(f"{path!r}: the face on line {odd[0]} has a fractional index (of a vertex, texture "
+                        "coordinate or normal), which pymeshlab's OBJ loader truncates without a word (1.5 "
+                        "becomes 1); OBJ indices are whole numbers. Fix the face and read the file again.")
         if odd is not None:
             raise error(f"{path!r}: the face on line {odd[0]} ends in a comment, whose words pymeshlab's OBJ "
                         "loader reads as further corners (a vertex index past the file's vertices, which "

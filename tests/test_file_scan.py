@@ -194,9 +194,10 @@ def test_off_index_shorter_than_the_vertex_count_is_read_as_written(tmp_path, in
     ("f 1/1 2/1 3/1#x\t7\n", 5, "ends in a comment"),
     ("f 1 2 3/#x\n", 5, "ends in a comment"),
     ("f 1 2 3\nf 1 3 4#face. 2\n", 6, "ends in a comment"),
-    ("f 1 2 3.5#x\n", 5, "has a fractional vertex index"),
-    ("f 1 2 3#x\nf 1 3.5 4\n", 6, "has a fractional vertex index"),
-    ("f 1 2/1.5 3\n", 5, "has a fractional vertex index"),
+    ("f 1 2 3.5#x\n", 5, "has a fractional index"),
+    ("f 1 2 3#x\nf 1 3.5 4\n", 6, "has a fractional index"),
+    # 1.5 is the texture coordinate's index here: the message must not call it a vertex's
+    ("f 1 2/1.5 3\n", 5, r"has a fractional index \(of a vertex, texture coordinate or normal\)"),
 ])
 def test_obj_faces_pymeshlab_misreads_are_refused(tmp_path, face, line, message):
     path = tmp_path / "m.obj"

@@ -527,7 +527,7 @@ def test_a_file_pymeshlab_reads_as_nothing_is_not_called_a_mesh_without_triangle
 
 
 @pytest.mark.parametrize("faces, message", [
-    ("f 1 2 3\nf 2.5 4 3\n", "the face on line 8 has a fractional vertex index"),
+    ("f 1 2 3\nf 2.5 4 3\n", "the face on line 8 has a fractional index"),
     ("f 1 2 3\n# a comment line. fine\nf 2 4 3 # second\n", "the face on line 9 ends in a comment"),
 ])
 def test_obj_faces_the_loader_would_misread_are_refused_before_loading(tmp_path, faces, message):
