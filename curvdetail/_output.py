@@ -53,8 +53,11 @@ PENDING = set()
 #: (the old files kept aside would be left in hidden folders, and the outputs a mix).
 COMMIT_LOCK = threading.Lock()
 
+#: how a refusal of an existing output says to replace it: the CLI's option and Python's argument
+OVERWRITE_FLAG = "--overwrite (overwrite=True)"
 
-def check_output_path(path, overwrite=False, *, hint=_FORMATS_HINT, error=MeshError):
+
+def check_output_path(path, overwrite=False, *, hint=_FORMATS_HINT, error=MeshError, flag=OVERWRITE_FLAG):
     """Return ``os.fspath(path)`` or raise before any work if it cannot be written.
 
     Raises
@@ -68,6 +71,9 @@ def check_output_path(path, overwrite=False, *, hint=_FORMATS_HINT, error=MeshEr
                       pass their ``MeshFileError``) ``path`` is a folder, its folder does not
                       exist, or ``path`` has no extension to pick the format (``hint`` says
                       which to use; ``hint=None``: any name will do)
+
+    ``flag`` is how the refusal of an existing file says to replace it (the scripts under
+    scripts/ name their own option).
     """
     if not isinstance(path, (str, bytes, os.PathLike)):
         raise ValueError(f"an output path must be a str or os.PathLike; got {type(path).__name__}.")
@@ -78,7 +84,7 @@ def check_output_path(path, overwrite=False, *, hint=_FORMATS_HINT, error=MeshEr
         raise kind(f"cannot write {path!r}: it is a folder; name a file (in it, or elsewhere).")
     if os.path.lexists(path) and not overwrite:     # a dangling link exists too
         what = "is a link to a missing file" if not os.path.exists(path) else "exists"
-        raise FileExistsError(f"{path} {what}; pass --overwrite (overwrite=True) to replace it.")
+        raise FileExistsError(f"{path} {what}; pass {flag} to replace it.")
     folder = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(folder):
         raise error(f"cannot write {path!r}: folder {folder!r} does not exist.")
@@ -97,16 +103,17 @@ def _umask():
 
 
 class Output(typing.NamedTuple):
-    """One output of :func:`atomic_outputs`: its path, and ``hint`` and ``error`` for
+    """One output of :func:`atomic_outputs`: its path, and ``hint``, ``error`` and ``flag`` for
     :func:`check_output_path`."""
 
     path: typing.Any
     hint: typing.Optional[str] = _FORMATS_HINT
     error: type = MeshError
+    flag: str = OVERWRITE_FLAG
 
 
 @contextlib.contextmanager
-def atomic_output(path, *, overwrite=False, hint=_FORMATS_HINT, error=MeshError):
+def atomic_output(path, *, overwrite=False, hint=_FORMATS_HINT, error=MeshError, flag=OVERWRITE_FLAG):
     """Context manager yielding a temporary path to write ``path``'s content to.
 
     The destination is checked first (:func:`check_output_path`). The temporary file exists
@@ -123,7 +130,7 @@ def atomic_output(path, *, overwrite=False, hint=_FORMATS_HINT, error=MeshError)
     >>> open(path).read()
     'done'
     """
-    with atomic_outputs([Output(path, hint, error)], overwrite=overwrite) as (tmp,):
+    with atomic_outputs([Output(path, hint, error, flag)], overwrite=overwrite) as (tmp,):
         yield tmp
 
 
@@ -156,7 +163,8 @@ def atomic_outputs(outputs, *, overwrite=False):
     ('one', 'two', None)
     """
     outputs = list(outputs)
-    paths = [None if out is None else check_output_path(out.path, overwrite, hint=out.hint, error=out.error)
+    paths = [None if out is None else
+             check_output_path(out.path, overwrite, hint=out.hint, error=out.error, flag=out.flag)
              for out in outputs]
     _check_distinct([p for p in paths if p is not None])
     temps = []
@@ -167,7 +175,7 @@ def atomic_outputs(outputs, *, overwrite=False):
         with COMMIT_LOCK:
             for path, out in zip(paths, outputs):       # what changed during the work
                 if out is not None:
-                    check_output_path(path, overwrite, hint=out.hint, error=out.error)
+                    check_output_path(path, overwrite, hint=out.hint, error=out.error, flag=out.flag)
             mode = 0o666 & ~_umask()
             for tmp in temps:
                 if tmp is not None:

@@ -10,12 +10,12 @@ Targets:
   * each of the four Botsch-Sorkine benchmark cases under 2 s including setup (reading the
     mesh, .sel and .def, building and factoring, solving).
 
-Usage: python scripts/bench_editing.py [--out out/bench_editing.json] [--skip-100k]
+Usage: python scripts/bench_editing.py [--out out/bench_editing.json] [--skip-100k] [--force]
 Times are medians; the machine's load average is recorded beside them (the machine is shared).
+OUT is written atomically; an existing OUT is refused before any work unless --force is given.
 """
 
 import argparse
-import json
 import os
 import platform
 import sys
@@ -25,6 +25,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
+import _outputs  # noqa: E402
 from _meshes import MESHES, at_least_one, require  # noqa: E402
 from reproduce_table1 import PAPER, table1_meshes, time_edit  # noqa: E402
 
@@ -113,7 +114,9 @@ def main(argv=None):
     ap.add_argument("--out", default="out/bench_editing.json")
     ap.add_argument("--repeat", type=at_least_one, default=7)
     ap.add_argument("--skip-100k", action="store_true")
+    ap.add_argument("--force", action="store_true", help="replace OUT if it exists")
     args = ap.parse_args(argv)
+    _outputs.refuse_existing(ap, [args.out], args.force)
     require("mannequin_nose.obj", "mannequin.off", "mannequin_ear.obj", "cat_tosca.off", "deformation",
             *(() if args.skip_100k else ("terrainA_100k.ply",)))
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
@@ -137,8 +140,7 @@ def main(argv=None):
                   f"{1e3 * r['handle_resolve_s']:.2f} ms = {r['handle_resolves_per_second']:.0f}/s "
                   "(target 20/s)")
     report["machine"]["load_average_after"] = os.getloadavg()
-    with open(args.out, "w") as fh:
-        json.dump(report, fh, indent=2)
+    _outputs.write_json(args.out, report, args.force, indent=2)
     print(f"wrote {args.out}")
     return 0
 

@@ -19,7 +19,8 @@ Usage::
     python scripts/bench_operations.py --sizes 100k --out out/bench_operations.json
     python scripts/bench_operations.py --sizes 100k,1M --out out/bench_operations.json --force
 
-The machine's load average is recorded beside the times (the machine is shared).
+The machine's load average is recorded beside the times (the machine is shared). OUT is written
+atomically; an existing OUT is refused before any case runs unless --force is given.
 """
 
 import argparse
@@ -32,6 +33,9 @@ import sys
 import time
 
 import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import _outputs  # noqa: E402
 
 SIDES = {"10k": 100, "100k": 316, "1M": 1000}
 CASES = {
@@ -133,8 +137,7 @@ def main(argv=None):
     unknown = [s for s in sizes if s not in SIDES] + [c for c in cases if c not in CASES]
     if unknown:
         ap.error(f"unknown size or case: {', '.join(unknown)}")
-    if os.path.exists(args.out) and not args.force:
-        ap.error(f"{args.out} exists; pass --force to replace it")
+    _outputs.refuse_existing(ap, [args.out], args.force)
     results = []
     for size in sizes:
         for case in cases:
@@ -148,11 +151,7 @@ def main(argv=None):
     report = {"machine": {"cpu": platform.processor() or platform.machine(), "cores": os.cpu_count()},
               "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "results": results}
     os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
-    tmp = args.out + ".tmp"
-    with open(tmp, "w", encoding="utf-8") as fh:
-        json.dump(report, fh, indent=2)
-        fh.write("\n")
-    os.replace(tmp, args.out)
+    _outputs.write_json(args.out, report, args.force, indent=2, end="\n")
     return 0
 
 

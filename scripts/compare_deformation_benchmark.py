@@ -7,12 +7,13 @@ distance of every vertex to the survey's ``NAME-laplacian_editing.off`` (same co
 vertex-to-vertex; mean and max as fractions of the rest mesh's bounding-box diagonal), the
 first-solve time (setup + solve) and the re-solve time, and save pictures side by side.
 
-Usage: python scripts/compare_deformation_benchmark.py [--out out/compare] [--docs docs]
-Writes OUT/compare.json, OUT/compare.md and OUT/NAME.png (and docs/editing_NAME.png with --docs).
+Usage: python scripts/compare_deformation_benchmark.py [--out out/compare] [--docs docs] [--force]
+Writes OUT/compare.json, OUT/compare.md and OUT/NAME.png (and docs/editing_NAME.png with --docs),
+each atomically; an existing one is refused before any work unless --force is given (the
+pictures in docs/ are in the repository: refreshing them is ``--docs docs --force``).
 """
 
 import argparse
-import json
 import os
 import sys
 import time
@@ -20,12 +21,12 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import _outputs  # noqa: E402
 from _meshes import MESHES, require  # noqa: E402
 
 from curvdetail import read_mesh
 from curvdetail.curvature._validate import bbox_diagonal
-from curvdetail.deformation_benchmark import (edit_with_selection, read_selection, read_transform,
-                                              render_panels)
+from curvdetail.deformation_benchmark import edit_with_selection, read_selection, read_transform
 
 CASES = ("bar", "cactus", "cylinder", "plane")
 #: (handle details, curvature-stage relations): the paper, the steadier stacked relations, free
@@ -73,7 +74,12 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="out/compare")
     ap.add_argument("--docs", default=None, help="also write small pictures docs/editing_NAME.png here")
+    ap.add_argument("--force", action="store_true", help="replace output files that exist")
     args = ap.parse_args(argv)
+    _outputs.refuse_existing(ap, [os.path.join(args.out, name) for name in ("compare.json", "compare.md")]
+                             + [os.path.join(args.out, name + ".png") for name in CASES]
+                             + [os.path.join(args.docs, f"editing_{name}.png") for name in CASES if args.docs],
+                             args.force)
     require("deformation")
     os.makedirs(args.out, exist_ok=True)
     folder = os.path.join(MESHES, "deformation")
@@ -95,8 +101,8 @@ def main(argv=None):
         for target in [os.path.join(args.out, name + ".png")] + (
                 [os.path.join(args.docs, f"editing_{name}.png")] if args.docs else []):
             small = target.startswith(args.docs) if args.docs else False
-            render_panels(target, panels, elev=elev, azim=azim, overwrite=True,
-                          panel_size=2.4 if small else 3.5)
+            _outputs.render_panels(target, panels, args.force, elev=elev, azim=azim,
+                                   panel_size=2.4 if small else 3.5)
         print(name, {m: (round(row[m]["mean"], 4), round(row[m]["max"], 4)) for m in LABELS})
     lines = ["| case | vertices (fixed/free/handle) | survey result moved from rest (mean / max) | "
              + " | ".join(f"{LABELS[m]}: distance to survey (mean / max)" for m in LABELS)
@@ -111,10 +117,9 @@ def main(argv=None):
                      + " / ".join(f"{1e3 * r[m]['resolve_s']:.1f}" for m in LABELS) + " |")
     table = "\n".join(lines)
     print(table)
-    with open(os.path.join(args.out, "compare.json"), "w") as fh:
-        json.dump({"load_average": os.getloadavg(), "rows": rows}, fh, indent=2)
-    with open(os.path.join(args.out, "compare.md"), "w") as fh:
-        fh.write(table + "\n")
+    _outputs.write_json(os.path.join(args.out, "compare.json"),
+                        {"load_average": os.getloadavg(), "rows": rows}, args.force, indent=2)
+    _outputs.write_text(os.path.join(args.out, "compare.md"), table + "\n", args.force)
     return 0
 
 

@@ -12,8 +12,10 @@
 
 Feature points are found from the geometry (extreme vertices), the regions of interest by
 Euclidean distance. Every edit is one CurvatureEditor (constructor = all factoring) and one
-solve. Usage: python scripts/reproduce_fig1.py [--out out/fig1] [--docs docs]
-Writes OUT/fig1.json, OUT/fig1a.png, OUT/fig1b.png, OUT/fig1c.png (docs/editing_fig1.png with --docs).
+solve. Usage: python scripts/reproduce_fig1.py [--out out/fig1] [--docs docs] [--force]
+Writes OUT/fig1.json, OUT/fig1a.png, OUT/fig1b.png, OUT/fig1c.png (docs/editing_fig1.png with --docs),
+each atomically; an existing one is refused before any work unless --force is given (the
+picture in docs/ is in the repository: refreshing it is ``--docs docs --force``).
 """
 
 import argparse
@@ -25,11 +27,11 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import _outputs  # noqa: E402
 from _meshes import MESHES, require  # noqa: E402
 
 from curvdetail import CurvatureEditor, boundary_vertices, mean_curvature_normal, read_mesh
 from curvdetail.curvature._validate import bbox_diagonal
-from curvdetail.deformation_benchmark import render_panels
 
 Y_UP = np.array([[1.0, 0, 0], [0, 0, -1.0], [0, 1.0, 0]])   # display y-up models with z up
 
@@ -120,11 +122,16 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="out/fig1")
     ap.add_argument("--docs", default=None)
+    ap.add_argument("--force", action="store_true", help="replace output files that exist")
     args = ap.parse_args(argv)
+    views = {"fig1a": (10, 0), "fig1b": (10, -90), "fig1c": (10, -30)}
+    _outputs.refuse_existing(ap, [os.path.join(args.out, key + ".png") for key in views]
+                             + [os.path.join(args.out, "fig1.json"),
+                                os.path.join(args.docs, "editing_fig1.png") if args.docs else None],
+                             args.force)
     require("elephant.obj", "cactus.off", "mannequin_devil.off")
     os.makedirs(args.out, exist_ok=True)
     report, docs_panels = [], []
-    views = {"fig1a": (10, 0), "fig1b": (10, -90), "fig1c": (10, -30)}
     for key, make in (("fig1a", elephant), ("fig1b", cactus), ("fig1c", devil)):
         V, F, X, info, y_up = make()
         extra = info.pop("extra_panel", None)
@@ -137,7 +144,7 @@ def main(argv=None):
         if extra is not None:
             panels.append((show(extra[0]), F, extra[1], np.linalg.norm(extra[0] - V, axis=1)))
         panels.append((show(X), F, label, moved))
-        render_panels(os.path.join(args.out, key + ".png"), panels, elev=elev, azim=azim, overwrite=True)
+        _outputs.render_panels(os.path.join(args.out, key + ".png"), panels, args.force, elev=elev, azim=azim)
         docs_panels += [(show(V), F, f"({key[-1]}) rest"), (show(X), F, f"({key[-1]}) edited", moved)]
         print(json.dumps(info))
     if args.docs:
@@ -153,10 +160,11 @@ def main(argv=None):
             ax.imshow(mpimg.imread(os.path.join(args.out, key + ".png")))
             ax.set_axis_off()
         fig.tight_layout()
-        fig.savefig(os.path.join(args.docs, "editing_fig1.png"), dpi=80)
-        plt.close(fig)
-    with open(os.path.join(args.out, "fig1.json"), "w") as fh:
-        json.dump(report, fh, indent=2)
+        try:
+            _outputs.save_figure(fig, os.path.join(args.docs, "editing_fig1.png"), args.force, dpi=80)
+        finally:
+            plt.close(fig)
+    _outputs.write_json(os.path.join(args.out, "fig1.json"), report, args.force, indent=2)
     return 0
 
 

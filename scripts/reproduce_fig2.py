@@ -11,8 +11,10 @@
     coefficients (``edit_boundary``), with the paper's one-ring relations and with one- plus
     two-ring relations. Folded triangles (normals pointing down) are counted.
 
-Usage: python scripts/reproduce_fig2.py [--out out/fig2] [--docs docs]
-Writes OUT/fig2.json, OUT/fig2a.png, OUT/fig2b.png (docs/editing_fig2.png with --docs).
+Usage: python scripts/reproduce_fig2.py [--out out/fig2] [--docs docs] [--force]
+Writes OUT/fig2.json, OUT/fig2a.png, OUT/fig2b.png (docs/editing_fig2.png with --docs), each
+atomically; an existing one is refused before any work unless --force is given (the picture in
+docs/ is in the repository: refreshing it is ``--docs docs --force``).
 """
 
 import argparse
@@ -24,11 +26,12 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import _outputs  # noqa: E402
 from _meshes import MESHES, require  # noqa: E402
 
 from curvdetail import edit_boundary, read_mesh, sine_displacement
 from curvdetail.curvature._validate import bbox_diagonal
-from curvdetail.deformation_benchmark import edit_with_selection, render_panels, view_direction
+from curvdetail.deformation_benchmark import edit_with_selection, view_direction
 
 Y_UP = np.array([[1.0, 0, 0], [0, 0, -1.0], [0, 1.0, 0]])   # display y-up models with z up
 COW_VIEW = (15, 30)
@@ -94,7 +97,12 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="out/fig2")
     ap.add_argument("--docs", default=None)
+    ap.add_argument("--force", action="store_true", help="replace output files that exist")
     args = ap.parse_args(argv)
+    _outputs.refuse_existing(ap, [os.path.join(args.out, name)
+                                  for name in ("fig2a.png", "fig2b.png", "fig2.json")]
+                             + [os.path.join(args.docs, "editing_fig2.png") if args.docs else None],
+                             args.force)
     require("cow.off", "terrainA_10k.obj")
     os.makedirs(args.out, exist_ok=True)
     V, F, status, meshes, info_a = cow()
@@ -105,8 +113,8 @@ def main(argv=None):
                         ("free/one-ring", "handle details free")):
         X = meshes[mode]
         panels.append((X @ Y_UP.T, F, label, np.linalg.norm(X - V, axis=1)))
-    render_panels(os.path.join(args.out, "fig2a.png"), panels, elev=COW_VIEW[0], azim=COW_VIEW[1],
-                  overwrite=True)
+    _outputs.render_panels(os.path.join(args.out, "fig2a.png"), panels, args.force, elev=COW_VIEW[0],
+                           azim=COW_VIEW[1])
     Vt, Ft, tmeshes, info_b = terrain()
     print(json.dumps(info_b))
     panels = [(Vt, Ft, "terrain: rest", Vt[:, 2])]
@@ -115,10 +123,10 @@ def main(argv=None):
             X = tmeshes[f"{key}_{mode}"]
             folds = info_b[key + "_" + mode]["folded_triangles"]
             panels.append((X, Ft, f"{label} {short}\n{folds} folded triangles", X[:, 2]))
-    render_panels(os.path.join(args.out, "fig2b.png"), panels, elev=35, azim=-60, overwrite=True,
-                  panel_size=3.0)
-    with open(os.path.join(args.out, "fig2.json"), "w") as fh:
-        json.dump({"cow": info_a, "terrain": info_b}, fh, indent=2)
+    _outputs.render_panels(os.path.join(args.out, "fig2b.png"), panels, args.force, elev=35, azim=-60,
+                           panel_size=3.0)
+    _outputs.write_json(os.path.join(args.out, "fig2.json"), {"cow": info_a, "terrain": info_b}, args.force,
+                        indent=2)
     if args.docs:
         import matplotlib
 
@@ -131,8 +139,10 @@ def main(argv=None):
             ax.imshow(mpimg.imread(os.path.join(args.out, key + ".png")))
             ax.set_axis_off()
         fig.tight_layout()
-        fig.savefig(os.path.join(args.docs, "editing_fig2.png"), dpi=75)
-        plt.close(fig)
+        try:
+            _outputs.save_figure(fig, os.path.join(args.docs, "editing_fig2.png"), args.force, dpi=75)
+        finally:
+            plt.close(fig)
     return 0
 
 

@@ -12,24 +12,31 @@ Writes (paths relative to the repository):
                                   between its <!-- fig3-table --> markers)
   docs/fig3.png                   the Fig. 3 patches, default configuration
 With --quick (a subset) the tables go to out/fig3/table_quick.md and docs/ is left alone.
+Every file is written atomically; one that exists is refused before any work unless --force is
+given. The files in docs/ are in the repository, so a full run (which refreshes them) takes
+--force.
 
-Usage: python scripts/reproduce_fig3.py [--meshes DIR] [--quick]
+Usage: python scripts/reproduce_fig3.py [--meshes DIR] [--quick] [--force]
 (DIR defaults to $CURVDETAIL_MESHES, else ../shared/meshes beside the repository.)
 """
 
 import argparse
-import json
 import os
 import sys
 import time
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import _outputs  # noqa: E402
+
 from curvdetail import read_mesh
 from curvdetail.remesh import retriangulate
 from curvdetail.remesh.experiment import run_experiment
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+#: where docs/remeshing.md holds its copy of the tables
+TABLE_BEGIN, TABLE_END = "<!-- fig3-table -->\n", "<!-- /fig3-table -->"
 PATCHES = ["mannequin_nose.obj", "mannequin_ear.obj", "elephant_trunk.obj", "terrainA_10k.obj",
            "camelhead.off", "mannequin_disk_1k.obj"]
 CONFIGS = [  # (transfer, rows, location)
@@ -71,15 +78,39 @@ HEADER = ("| patch | source V | target V | retriangulation | transfer | rows | l
           "|---|---:|---:|---|---|---|---|---:|---:|---:|---:|---:|---|---|")
 
 
-def main():
+def _with_table(doc, table):
+    """The text of ``doc`` with ``table`` between its markers, or None where there is no such
+    file or it has no markers (then it is not written)."""
+    if not os.path.exists(doc):
+        return None
+    with open(doc, encoding="utf-8") as fh:
+        text = fh.read()
+    if TABLE_BEGIN not in text or TABLE_END not in text:
+        return None
+    return text[:text.index(TABLE_BEGIN) + len(TABLE_BEGIN)] + table + text[text.index(TABLE_END):]
+
+
+def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     default_meshes = os.environ.get("CURVDETAIL_MESHES", os.path.join(ROOT, "..", "shared", "meshes"))
     ap.add_argument("--meshes", default=default_meshes,
                     help="folder of the public meshes (default: $CURVDETAIL_MESHES, else ../shared/meshes)")
     ap.add_argument("--quick", action="store_true",
                     help="default configuration only, no 100k run; writes out/fig3/ only, not docs/")
-    args = ap.parse_args()
+    ap.add_argument("--force", action="store_true",
+                    help="replace output files that exist (a full run refreshes the committed docs/ files)")
+    args = ap.parse_args(argv)
     meshes = args.meshes
+    results_json = os.path.join(ROOT, "out", "fig3", "results.json")
+    if args.quick:
+        table_file, doc, figure = os.path.join(ROOT, "out", "fig3", "table_quick.md"), None, None
+    else:
+        table_file = os.path.join(ROOT, "docs", "fig3_table.md")
+        doc = os.path.join(ROOT, "docs", "remeshing.md")     # the copy between its markers, if it has them
+        if _with_table(doc, "") is None:
+            doc = None
+        figure = os.path.join(ROOT, "docs", "fig3.png")
+    _outputs.refuse_existing(ap, [results_json, table_file, doc, figure], args.force)
     if not os.path.isdir(meshes):
         ap.error(f"mesh folder {meshes!r} does not exist; pass --meshes DIR or set CURVDETAIL_MESHES")
     os.makedirs(os.path.join(ROOT, "out", "fig3"), exist_ok=True)
@@ -147,8 +178,7 @@ def main():
         line = row(name.rsplit(".", 1)[0] + (f" ({100 * target_edge:g} %)" if target_edge != 0.01 else ""), rep)
         extra.append(line)
         print(line, flush=True)
-    with open(os.path.join(ROOT, "out", "fig3", "results.json"), "w") as fh:
-        json.dump(results, fh, indent=1)
+    _outputs.write_json(results_json, results, args.force, indent=1)
     table = ("### Default configuration (isotropic 1 %, conservative transfer, free rows, closest-point location)\n\n"
              f"{HEADER}\n" + "\n".join(lines_main) +
              "\n\n### Every transfer configuration on the same targets\n\n" + f"{HEADER}\n" + "\n".join(lines_all) +
@@ -158,27 +188,17 @@ def main():
         table += ("\n### Planar domains for the location (conservative transfer, free rows; retriangulation time "
                   "not counted)\n\n" + HEADER.replace(" |\n|", " | flipped source / target |\n|", 1) + "---|\n"
                   + "\n".join(params) + "\n")
-    if args.quick:            # a subset: the committed tables and figure in docs/ stay as they are
-        with open(os.path.join(ROOT, "out", "fig3", "table_quick.md"), "w") as fh:
-            fh.write(table)
-        print(table)
-        return
-    with open(os.path.join(ROOT, "docs", "fig3_table.md"), "w") as fh:
-        fh.write(table)
-    doc = os.path.join(ROOT, "docs", "remeshing.md")
-    if os.path.exists(doc):   # refresh the copy between the markers in docs/remeshing.md
-        text = open(doc).read()
-        a, b = "<!-- fig3-table -->\n", "<!-- /fig3-table -->"
-        if a in text and b in text:
-            text = text[:text.index(a) + len(a)] + table + text[text.index(b):]
-            with open(doc, "w") as fh:
-                fh.write(text)
-    if figure_inputs:
-        _figure(figure_inputs, os.path.join(ROOT, "docs", "fig3.png"))
+    # --quick: a subset; the committed tables and figure in docs/ stay as they are
+    _outputs.write_text(table_file, table, args.force)
+    text = _with_table(doc, table) if doc else None
+    if text is not None:      # refresh the copy between the markers in docs/remeshing.md
+        _outputs.write_text(doc, text, args.force)
+    if figure is not None and figure_inputs:
+        _figure(figure_inputs, figure, args.force)
     print(table)
 
 
-def _figure(inputs, path):
+def _figure(inputs, path, force=False):
     import matplotlib
 
     matplotlib.use("Agg")
@@ -206,8 +226,10 @@ def _figure(inputs, path):
                   vmax=None if val is None else float(val.max()), title=title)
     fig.suptitle("Fig. 3 patches rebuilt from transferred curvature detail (colour: distance to the source, "
                  "0 to its max)\n% of the source bbox diagonal", fontsize=9)
-    fig.savefig(path, dpi=70, bbox_inches="tight")
-    plt.close(fig)
+    try:
+        _outputs.save_figure(fig, path, force, dpi=70, bbox_inches="tight")
+    finally:
+        plt.close(fig)
 
 
 if __name__ == "__main__":

@@ -11,12 +11,12 @@ constrained). Times are medians of repeated runs, split into coefficients, curva
 (factor + solve), embedding (factor + solve) and the constructor's rest check (one
 back-substitution per stage).
 
-Usage: python scripts/reproduce_table1.py [--out out/table1] [--repeat 7]
-Writes OUT/table1.json, OUT/table1.md and OUT/table1.png.
+Usage: python scripts/reproduce_table1.py [--out out/table1] [--repeat 7] [--force]
+Writes OUT/table1.json, OUT/table1.md and OUT/table1.png, each atomically; an existing one is
+refused before any work unless --force is given.
 """
 
 import argparse
-import json
 import os
 import sys
 import time
@@ -24,11 +24,11 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import _outputs  # noqa: E402
 from _meshes import MESHES, at_least_one, require  # noqa: E402
 
 from curvdetail import CurvatureEditor, boundary_vertices, read_mesh
 from curvdetail.curvature._validate import bbox_diagonal, check_mesh, vertex_components
-from curvdetail.deformation_benchmark import render_panels
 
 
 #: (model, vertices, facets, optimization time in s) as printed in the paper's Table 1
@@ -154,7 +154,10 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="out/table1")
     ap.add_argument("--repeat", type=at_least_one, default=7)
+    ap.add_argument("--force", action="store_true", help="replace output files that exist")
     args = ap.parse_args(argv)
+    _outputs.refuse_existing(ap, [os.path.join(args.out, "table1" + ext) for ext in (".json", ".md", ".png")],
+                             args.force)
     require("mannequin_nose.obj", "mannequin.off", "mannequin_ear.obj", "cat_tosca.off")
     os.makedirs(args.out, exist_ok=True)
     meshes = table1_meshes()
@@ -175,12 +178,11 @@ def main(argv=None):
                      f"{1e3 * r['embedding']:.1f} | {1e3 * r['rest_check']:.2f} | {1e3 * r['resolve']:.2f} |")
     table = "\n".join(lines)
     print(table)
-    with open(os.path.join(args.out, "table1.json"), "w") as fh:
-        json.dump({"repeat": args.repeat, "rows": results}, fh, indent=2)
-    with open(os.path.join(args.out, "table1.md"), "w") as fh:
-        fh.write(table + "\n")
-    render_panels(os.path.join(args.out, "table1.png"), panels, overwrite=True, elev=10, azim=-80,
-                  panel_size=2.6)
+    _outputs.write_json(os.path.join(args.out, "table1.json"), {"repeat": args.repeat, "rows": results},
+                        args.force, indent=2)
+    _outputs.write_text(os.path.join(args.out, "table1.md"), table + "\n", args.force)
+    _outputs.render_panels(os.path.join(args.out, "table1.png"), panels, args.force, elev=10, azim=-80,
+                           panel_size=2.6)
     return 0
 
 

@@ -62,6 +62,21 @@ def test_atomic_output_refuses_an_existing_file_before_the_block(tmp_path):
     assert os.listdir(tmp_path) == ["a.txt"]
 
 
+def test_a_refusal_names_the_callers_way_to_replace(tmp_path):
+    # the CLI and Python say --overwrite (overwrite=True); the scripts under scripts/ name their own flag
+    path = tmp_path / "old.json"
+    path.write_text("kept")
+    with pytest.raises(FileExistsError, match=r"exists; pass --overwrite \(overwrite=True\) to replace it"):
+        check_output_path(path)
+    with pytest.raises(FileExistsError, match=r"exists; pass --force to replace it\.$"):
+        with atomic_output(path, hint=None, flag="--force"):
+            pass
+    with pytest.raises(FileExistsError, match="pass --redo to replace it"):
+        with atomic_outputs([Output(path, hint=None, flag="--redo")]):
+            pass
+    assert path.read_text() == "kept"
+
+
 def test_a_dangling_link_is_not_replaced_without_overwrite(tmp_path):
     link = tmp_path / "a.txt"
     os.symlink(tmp_path / "missing.txt", link)
