@@ -178,7 +178,10 @@ def test_a_big_target_is_said_beforehand_with_the_unit_of_a_plain_number(monkeyp
     monkeypatch.setattr(importlib.import_module("curvdetail.remesh.retriangulate"), "BIG_TARGET", 100)
     ms = pymeshlab.MeshSet()
     ms.load_new_mesh(os.path.join(DATA, "terrainA_1k.obj"))
-    with pytest.warns(LongRunWarning, match=r"target_edge=1\.0 \(6\.55 % of the bbox diagonal\) gives about "
+    # 1.0 model units on a terrain 15.3 units across: 6.55 % of its diagonal
+    percent = 100.0 / bbox_diagonal(ms.current_mesh().vertex_matrix())
+    assert round(percent, 2) == 6.55
+    with pytest.warns(LongRunWarning, match=rf"target_edge=1\.0 \({percent:.3g} % of the bbox diagonal\) gives about "
                                             r"\d+ target vertices; this takes minutes\. A plain number is in model units"):
         apply(ms, "generate_curvature_remeshing", target_edge=1.0, evaluate=False)
     with warnings.catch_warnings():
