@@ -225,3 +225,72 @@ def test_two_closed_pieces_are_named_as_closed_not_as_pieces_with_boundaries():
     V, F = icosphere(subdivisions=1)
     with pytest.raises(MeshError, match=r"the mesh is closed \(no boundary loop\)"):
         boundary_loop(np.vstack([F, F + V.shape[0]]))
+
+
+def _onto_first_neighbour(s, P):
+    d = np.zeros_like(P)
+    d[1] = P[0] - P[1]                       # the loop's second vertex onto its first
+    return d
+
+
+@pytest.mark.filterwarnings("error")        # the refusal comes without numpy's RuntimeWarnings
+@pytest.mark.parametrize("displacement, message", [
+    (lambda s, P: -P, "moves all 36 boundary vertices onto one point"),
+    (lambda s, P: P.mean(axis=0) - P, "moves all 36 boundary vertices onto one point"),
+    (lambda s, P: -P * [1.0, 1.0, 0.0], "moves the boundary loop onto a line"),
+    (_onto_first_neighbour, r"collapses part of the boundary loop \(e\.g\. a vertex onto its neighbour\)"),
+])
+def test_a_displacement_that_collapses_the_boundary_is_refused_without_warnings(displacement, message):
+    # divide-by-zero and invalid-value warnings from the provisional surface's cotangents came
+    # first, then "details: 36 rows are NaN or infinite", naming values the caller never passed
+    V, F = grid(10, 10)
+    V[:, 2] = 0.1 * np.sin(3 * V[:, 0])
+    with pytest.raises(ConstraintError, match=rf"the displacement {message}: \d+ triangles of the provisional "
+                                              r"surface .* have zero area .*boundary_detail='rest'"):
+        edit_boundary(V, F, displacement)
+    X = edit_boundary(V, F, displacement, boundary_detail="rest")      # the advice: defined, no warnings
+    assert np.all(np.isfinite(X))
+
+
+@pytest.mark.filterwarnings("error")
+def test_a_displaced_boundary_beyond_1e75_is_refused_before_any_algebra():
+    # the callable's result was only checked for NaN: overflow warnings, then the editor's "positions"
+    V, F = grid(10, 10)
+    with pytest.raises(ConstraintError, match=r"the displaced boundary \(its positions plus the displacement\): "
+                                              r"36 rows reach 1e\+80 .*use a smaller displacement"):
+        edit_boundary(V, F, lambda s, P: np.full(P.shape, 1e80))
+
+
+@pytest.mark.filterwarnings("error")
+def test_a_boundary_of_one_point_is_a_mesh_error_without_warnings():
+    # the arc length divided by a loop length of 0 first (invalid-value warning)
+    V, F = grid(6, 6)
+    with pytest.raises(MeshError, match="the mesh is 0 across"):
+        edit_boundary(np.zeros_like(V), F, sine_displacement(0.1))
+
+
+def test_a_displacement_callable_with_non_finite_values_is_named_as_such():
+    V, F = grid(6, 6)
+
+    def nan_at_the_start(s, P):
+        d = np.zeros_like(P)
+        d[0, 2] = np.nan
+        return d
+
+    # it was "returned shape (20, 3) (or non-finite values)", for a shape that was right
+    with pytest.raises(ValueError, match=r"the displacement callable returned NaN or infinite values in 1 rows "
+                                         r"\(first: 0\)"):
+        edit_boundary(V, F, nan_at_the_start)
+
+
+@pytest.mark.parametrize("kwargs, error, message", [
+    (dict(boundary_detail=np.array(["rest", "deformed"])), ValueError,
+     r"boundary_detail=array\(.*\(ndarray, not a single str\); use 'deformed' or 'rest'"),
+    (dict(relations=np.array(["one-ring", "one+two-ring"])), ValueError, r"relations=array\(.*not a single str"),
+    (dict(backend=np.array(["auto", "splu"])), ValueError, r"backend=array\(.* is not a solver backend"),
+])
+def test_options_given_as_arrays_are_refused_before_the_displacement_runs(kwargs, error, message):
+    # numpy's "truth value of an array ... is ambiguous" before
+    V, F = grid(6, 6)
+    with pytest.raises(error, match=message):
+        edit_boundary(V, F, lambda s, P: pytest.fail("the displacement ran"), **kwargs)

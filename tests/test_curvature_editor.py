@@ -441,3 +441,46 @@ def test_a_curvature_stage_that_cannot_be_factored_is_an_undetermined_edit(monke
     with pytest.raises(UndeterminedEditError, match="curvature stage could not be factored.*error -4") as exc:
         CurvatureEditor(V, F, b, b[:5], relations="one+two-ring")
     assert "relations='one-ring'" in exc.value.advice
+
+
+@pytest.mark.parametrize("kwargs, error, message", [
+    # np.array(["all"]) passed `in ("all", "free")` element-wise and was kept as the row mode
+    (dict(rows=np.array(["all"])), ValueError, r"rows=array\(\['all'\].*\(ndarray, not a single str\) is not a "
+                                               r"row mode; use 'all'"),
+    # two elements: numpy's "truth value of an array ... is ambiguous"
+    (dict(relations=np.array(["one-ring", "one+two-ring"])), ValueError,
+     r"relations=array\(.*\(ndarray, not a single str\); use 'one-ring' .* or 'one\+two-ring'"),
+    (dict(backend=np.array(["auto", "splu"])), sparse_solver.SolverError,
+     r"backend=array\(.*\(ndarray\) is not a solver backend; pass a single str: one of .*splu.* or 'auto'"),
+])
+def test_options_given_as_arrays_or_lists_are_refused_naming_the_option(plane_grid, kwargs, error, message):
+    V, F = plane_grid
+    b = boundary_vertices(F)
+    with pytest.raises(error, match=message):
+        CurvatureEditor(V, F, b, b, **kwargs)
+
+
+@pytest.mark.parametrize("flag", ["no", 0, np.array([True, False])])
+def test_return_details_must_be_a_bool(plane_grid, flag):
+    # "no" and 0 returned the (X, D) pair as if True was meant; an array reached numpy's truth value
+    V, F = plane_grid
+    b = boundary_vertices(F)
+    ed = CurvatureEditor(V, F, b, b)
+    with pytest.raises(ValueError, match=r"return_details=.* must be True or False"):
+        ed.solve(return_details=flag)
+    assert isinstance(ed.solve(return_details=np.False_), np.ndarray)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(position_constrained=None, detail_constrained=[0, 1, 2]),
+     r"position_constrained is None; pass vertex indices \(\[\] for none\) or an \(441,\) boolean mask"),
+    (dict(position_constrained=[0, 1, 2], detail_constrained={0, 1, 2}),
+     r"detail_constrained is a set, which has no order; pass a list or array of vertex indices \(row r of the "
+     r"details belongs to detail_constrained\[r\]\)"),
+    (dict(position_constrained=[0], detail_constrained=[0], roi=frozenset(range(40))), r"roi is a frozenset"),
+])
+def test_constraint_sets_given_as_none_or_a_set_are_named_as_such(plane_grid, kwargs, message):
+    # both were "has dtype object; pass integer vertex indices", about the type
+    V, F = plane_grid
+    with pytest.raises(ConstraintError, match=message):
+        CurvatureEditor(V, F, **kwargs)

@@ -163,3 +163,57 @@ def test_an_edit_the_handles_do_not_determine_is_refused_with_the_filter_s_optio
     report = apply(ms, "apply_curvature_editing", handles="450 451 480", handle_detail="transform",
                    region_radius=pymeshlab.PercentageValue(45.0))
     assert report["max_displacement"] < 1e-12
+
+
+@pytest.mark.parametrize("shape", [(2, 8), (16, 1), (1, 16)])
+def test_a_transform_array_of_another_shape_than_4x4_is_refused(shape):
+    # every array was flattened: a 2x8 array (or 16x1, 1x16) passed and was read as a 4x4 matrix
+    ms, V, d, handles = _meshset_with_roi()
+    T = np.eye(4)
+    T[:3, 3] = [0.0, 0.0, 0.02]
+    dims = "x".join(map(str, shape))
+    with pytest.raises(FilterParameterError, match=rf"parameter 'transform' is a {dims} array; it must be a "
+                                                   r"4x4 matrix"):
+        apply(ms, "apply_curvature_editing", handles=handles, transform=T.reshape(shape))
+    assert np.array_equal(ms.current_mesh().vertex_matrix(), V)
+    # the documented forms stay: 16 numbers as a flat list, as in the text
+    apply(ms, "apply_curvature_editing", handles=handles, transform=T.ravel().tolist())
+    assert np.abs(ms.current_mesh().vertex_matrix()[handles] - (V[handles] + [0, 0, 0.02])).max() < 1e-12
+
+
+@pytest.mark.parametrize("handles", [[], np.array([], dtype=np.int64)])
+def test_handles_given_as_an_empty_list_are_named_as_no_handle(handles):
+    # it was "parameter 'handles' expects a str; got [] (list)", about the type
+    ms, *_ = _meshset_with_roi()
+    with pytest.raises(FilterParameterError, match=r"parameter 'handles' is empty; name the handle vertices"):
+        apply(ms, "apply_curvature_editing", handles=handles)
+
+
+def test_handles_given_as_a_boolean_mask_are_refused_with_the_conversion():
+    ms, V, d, handles = _meshset_with_roi()
+    mask = np.zeros(V.shape[0], dtype=bool)
+    mask[handles] = True
+    with pytest.raises(FilterParameterError, match=rf"parameter 'handles' is a boolean mask \({V.shape[0]} "
+                                                   r"True/False values\); .*np\.flatnonzero\(mask\)"):
+        apply(ms, "apply_curvature_editing", handles=mask)
+    apply(ms, "apply_curvature_editing", handles=np.flatnonzero(mask))      # the conversion it names
+
+
+@pytest.mark.parametrize("radius, given", [(BBoxLength(1e-300, percent=False), r"region_radius=1e-300 of"),
+                                           (BBoxLength(1e-300, percent=True), r"region_radius=1e-300% of a "
+                                                                              r"handle \(\d.*e-30\d on this mesh\)"),
+                                           (BBoxLength(1e-9, percent=False), r"region_radius=1e-09 of")])
+def test_a_positive_region_radius_that_reaches_no_vertex_is_named_as_given(radius, given):
+    # 1e-300 was called "region_radius is 0"; 1e-9 made a region of the handles alone, moved them
+    # and rebuilt nothing around them
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(os.path.join(DATA, "mannequin_ear.obj"))
+    V = ms.current_mesh().vertex_matrix().copy()
+    with pytest.raises(ConstraintError, match=r"no selected vertices and no vertex but the handles lies within "
+                                              + given) as error:
+        apply(ms, "apply_curvature_editing", handles="1 2 3", region_radius=radius,
+              transform="1 0 0 0 0 1 0 0 0 0 1 0.01 0 0 0 1")
+    assert "is 0" not in str(error.value)
+    assert np.array_equal(ms.current_mesh().vertex_matrix(), V)
+    with pytest.raises(ConstraintError, match="no selected vertices and region_radius is 0: the region"):
+        apply(ms, "apply_curvature_editing", handles="1 2 3", region_radius=0.0)

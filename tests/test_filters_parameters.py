@@ -162,3 +162,59 @@ def test_text_parameter_takes_a_sequence_of_numbers_digit_for_digit():
     for bad in ([True, 2], [[1, 2], [3]], ["1", 2], object()):
         with pytest.raises(FilterParameterError, match="'transform' expects a str"):
             p.check(bad)
+
+
+@pytest.mark.parametrize("shape", [(2, 8), (16, 1), (1, 16), (4, 4, 1)])
+def test_a_matrix_parameter_refuses_arrays_of_another_shape(shape):
+    # every array was flattened: a 2x8 array passed and was read row by row as a 4x4 matrix
+    p = Parameter("transform", "str", "", "4x4 matrix", shape=(4, 4))
+    dims = "x".join(map(str, shape))
+    with pytest.raises(FilterParameterError, match=rf"'transform' is a {dims} array; it must be a 4x4 matrix"):
+        p.check(np.arange(16.0).reshape(shape))
+    text = " ".join(repr(float(x)) for x in range(16))
+    for good in (np.arange(16.0).reshape(4, 4), np.arange(16.0), np.arange(16.0).reshape(4, 4).tolist()):
+        assert p.check(good) == text                  # the matrix, or its 16 numbers row by row
+
+
+def test_a_shape_is_declared_for_a_str_of_numbers_only():
+    with pytest.raises(TypeError, match="a shape applies to a str of numbers only"):
+        Parameter("rows", "str", "all", "d", choices=("all", "free"), shape=(2,))
+
+
+def test_an_index_parameter_takes_any_array_of_indices():
+    # no shape declared: an index set, whose order does not matter (np.argwhere gives (k, 1))
+    p = Parameter("handles", "str", "", "indices")
+    assert p.check(np.argwhere(np.array([0, 1, 1, 0]))) == "1 2"
+
+
+@pytest.mark.parametrize("empty", [[], (), np.array([], dtype=np.int64), np.zeros((0, 2))])
+def test_an_empty_sequence_of_numbers_is_the_empty_text(empty):
+    # it was "expects a str; got [] (list)": the filter now names the empty value as empty
+    assert Parameter("handles", "str", "", "indices").check(empty) == ""
+
+
+@pytest.mark.parametrize("mask", [np.array([False, True, True, False]), [False, True, True, False]])
+def test_a_boolean_mask_is_refused_with_the_indices_it_means(mask):
+    # it was "expects a str; got array([False, True, ...]) (ndarray)", about the type
+    p = Parameter("handles", "str", "", "indices")
+    with pytest.raises(FilterParameterError, match=r"'handles' is a boolean mask \(4 True/False values\); it "
+                                                   r"takes numbers, not a mask: .*np\.flatnonzero\(mask\)"):
+        p.check(mask)
+
+
+def test_masked_entries_are_refused_not_read_as_numbers():
+    # np.ma.array([1, 2], mask=[0, 1]) was read as "1 2", the masked entry included
+    p = Parameter("handles", "str", "", "indices")
+    with pytest.raises(FilterParameterError, match="'handles' has 1 masked entries"):
+        p.check(np.ma.array([1, 2], mask=[False, True]))
+    assert p.check(np.ma.array([1, 2], mask=[False, False])) == "1 2"
+
+
+@pytest.mark.parametrize("value", [np.array(["all"]), np.array(["all", "free"]), ["all"], ("free",),
+                                   np.array("all")])
+def test_an_enum_given_as_an_array_or_a_list_names_the_parameter_and_the_choices(value):
+    # not numpy's "truth value of an array ... is ambiguous", and not the first element taken
+    p = Parameter("rows", "str", "all", "rows", choices=("all", "free"))
+    with pytest.raises(FilterParameterError, match=r"'rows' expects a str \(one of all, free, or its index\); "
+                                                   r"got .*all|free"):
+        p.check(value)

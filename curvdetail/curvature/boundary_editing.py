@@ -5,12 +5,13 @@ import numbers
 
 import numpy as np
 
-from ._validate import (_compact_ids, as_faces, as_values, as_vertices, boundary_edges, check_bool,
-                        check_mesh, check_oriented, vertex_components)
+from ._validate import (MIN_DIAGONAL, ZERO_AREA_RELATIVE, _check_magnitude, _compact_ids, as_faces, as_values,
+                        as_vertices, bbox_diagonal, boundary_edges, check_bool, check_mesh, check_oriented,
+                        face_double_areas, vertex_components)
 from .cotan_laplacian import _cotan_laplacian_unchecked, laplacian_product
-from .curvature_coefficients import DEFAULT_RCOND
-from .curvature_editor import CurvatureEditor
-from .errors import MeshError
+from .curvature_coefficients import DEFAULT_RCOND, check_rcond
+from .curvature_editor import CurvatureEditor, _check_backend, _check_relations, _one_of
+from .errors import ConstraintError, MeshError, first_indices
 from .sparse_solver import factorize
 
 
@@ -62,9 +63,12 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
     Raises
     ------
     MeshError         malformed mesh, or not exactly one boundary loop
-    ConstraintError   displacement array of the wrong shape or with NaN / inf
+    ConstraintError   displacement array of the wrong shape or with NaN / inf; a displaced boundary
+                      beyond 1e75; with ``"deformed"``, a displacement that collapses the loop
+                      (onto a point or a line: the provisional surface has zero-area triangles)
     ValueError        the displacement callable returned the wrong shape or non-finite values,
-                      or ``return_info`` is not a bool
+                      ``return_info`` is not a bool, or an option is not one of its values (or
+                      not a single str); SolverError for an unknown ``backend``
 
     Examples
     --------
@@ -76,8 +80,12 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
     >>> bool(np.allclose(X[b, 2] - V[b, 2], 0.1 * np.sin(2 * np.pi * 2 * info["arc_length"])))
     True
     """
-    if boundary_detail not in ("deformed", "rest"):
-        raise ValueError(f"boundary_detail={boundary_detail!r}; use 'deformed' or 'rest'.")
+    # the options before the mesh and the displacement callable (the editor checks them again)
+    boundary_detail = _one_of(boundary_detail, "boundary_detail", ("deformed", "rest"),
+                              "; use 'deformed' or 'rest'.")
+    _check_relations(relations)
+    check_rcond(rcond)
+    _check_backend(backend)
     check_bool(return_info, "return_info")
     V = as_vertices(V)
     F = as_faces(F, V.shape[0])        # shapes and indices; the editor below runs every mesh check
@@ -88,6 +96,9 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
         raise
     P = V[loop]
     seg = np.linalg.norm(np.roll(P, -1, axis=0) - P, axis=1)
+    if not seg.sum() > 0:               # a loop of one point: its triangles have zero area
+        check_mesh(V, F)
+        raise MeshError("the boundary loop has length 0 (all its vertices coincide); repair the mesh.")
     s = np.concatenate([[0.0], np.cumsum(seg)[:-1]]) / seg.sum()
     if callable(displacement):
         try:
@@ -99,16 +110,25 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
             raise ValueError(f"the displacement callable returned dtype {d.dtype}; it must return a "
                              f"({loop.size}, 3) array of real numbers.")
         d = d.astype(np.float64)
-        if d.shape != (loop.size, 3) or not np.all(np.isfinite(d)):
-            raise ValueError(f"the displacement callable returned shape {d.shape} (or non-finite "
-                             f"values); it must return a finite ({loop.size}, 3) array.")
+        if d.shape != (loop.size, 3):
+            raise ValueError(f"the displacement callable returned shape {d.shape}; it must return a "
+                             f"({loop.size}, 3) array, one row per boundary vertex.")
+        if not np.all(np.isfinite(d)):
+            bad = np.flatnonzero(~np.isfinite(d).all(axis=1))
+            raise ValueError(f"the displacement callable returned NaN or infinite values in {bad.size} rows "
+                             f"(first: {first_indices(bad)}); it must return finite displacements.")
     else:
         d = as_values(displacement, loop.size, "displacement")
+    Q = P + d                                   # the boundary's new positions
+    # before any algebra: beyond 1e75 the provisional surface's areas overflow (warnings, then a
+    # refusal of the editor's "positions", which the caller never passed)
+    _check_magnitude(Q, "the displaced boundary (its positions plus the displacement)", ConstraintError,
+                     "use a smaller displacement")
     n = V.shape[0]
     editor = CurvatureEditor(V, F, loop, loop, relations=relations, rcond=rcond, backend=backend)
     L = editor.laplacian                        # of the rest shape
     if boundary_detail == "rest":
-        X = editor.solve(positions=P + d, details=editor.detail[loop])
+        X = editor.solve(positions=Q, details=editor.detail[loop])
         if not return_info:
             return X
         return X, {"boundary": loop, "arc_length": s, "boundary_detail": editor.detail[loop],
@@ -120,19 +140,47 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
     # is spread harmonically: a rotated or scaled boundary then gives the details s R D_b exactly
     # (the cotangent weights are similarity-invariant), where spreading all of it bent a curved
     # patch (trunk turned by 30 degrees: 1.8 diagonals off)
-    s_, R, t = _similarity(P, P + d)
+    s_, R, t = _similarity(P, Q)
     Vp = s_ * V @ R.T + t
     U = np.zeros((n, 3))
-    U[loop] = P + d - Vp[loop]
+    U[loop] = Q - Vp[loop]
     if inner.size:
         Lf = L[inner][:, inner]
         U[inner] = factorize(Lf, symmetric=True, backend=backend).solve(-(L[inner][:, loop] @ U[loop]))
     Vp += U
+    _check_provisional_surface(Vp, F, P, Q)
     Db = laplacian_product(_cotan_laplacian_unchecked(Vp, F), Vp)[loop]
-    X = editor.solve(positions=P + d, details=Db)
+    X = editor.solve(positions=Q, details=Db)
     if not return_info:
         return X
     return X, {"boundary": loop, "arc_length": s, "boundary_detail": Db, "editor": editor}
+
+
+def _check_provisional_surface(Vp, F, P, Q):
+    """ConstraintError if the provisional surface ``Vp`` (whose detail gives the boundary's; the
+    loop moved from ``P`` to ``Q``) has triangles of zero area, as check_mesh counts them: a
+    displacement that collapses the boundary loop (onto a point or a line, or scales it to
+    nothing) collapses the harmonic inside with it, and its cotangent weights divided by zero
+    (numpy warnings, then NaN details refused as the caller's "details")."""
+    diag = bbox_diagonal(Vp)
+    dbl = face_double_areas(Vp, F)
+    zero = np.flatnonzero(~(dbl > 2.0 * ZERO_AREA_RELATIVE * diag ** 2))      # NaN included
+    if not zero.size:
+        return
+    extent = np.sort(np.ptp(Q, axis=0))[::-1]
+    if not extent[0] > 1e-12 * np.ptp(P, axis=0).max():     # the rest loop's extent: rounding of P - P
+        what = f"moves all {Q.shape[0]} boundary vertices onto one point"
+    elif diag < MIN_DIAGONAL:
+        what = f"shrinks the patch to {diag:.3g} across, where triangle areas underflow double precision"
+    elif not extent[1] > 1e-12 * extent[0]:
+        what = "moves the boundary loop onto a line"
+    else:
+        what = "collapses part of the boundary loop (e.g. a vertex onto its neighbour)"
+    raise ConstraintError(
+        f"the displacement {what}: {zero.size} triangles of the provisional surface whose detail gives the "
+        f"boundary's (boundary_detail='deformed') have zero area (first: {first_indices(zero)}), so the "
+        "boundary's new curvature detail is undefined. Use a displacement that keeps the loop open, or "
+        "boundary_detail='rest' (the boundary keeps its rest detail).")
 
 
 def _similarity(P, Q):

@@ -6,13 +6,13 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from ._validate import as_index_set, as_values, bbox_centre, bbox_diagonal, centroid_diameter
+from ._validate import as_index_set, as_values, bbox_centre, bbox_diagonal, centroid_diameter, check_bool
 from .cotan_laplacian import checked_cotan_laplacian, laplacian_product
 from .curvature_coefficients import DEFAULT_RCOND, _coefficients, _one_ring_pairs, check_rcond
 from .errors import ConstraintError, UndeterminedEditError, first_indices
 from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
 from .reconstruct import refine_least_squares
-from .sparse_solver import SolverError, _chosen_automatically, factorize, resolve_backend
+from .sparse_solver import BACKENDS, SolverError, _chosen_automatically, factorize, resolve_backend
 
 
 RELATIONS = ("one-ring", "one+two-ring")
@@ -126,14 +126,15 @@ class CurvatureEditor:
     Raises
     ------
     MeshError         malformed mesh
-    ConstraintError   indices out of range or repeated; a constraint outside ``roi``; an empty
+    ConstraintError   indices out of range or repeated, None, or a set (which has no order); a
+                      constraint outside ``roi``; an empty
                       ``roi``; no position constraint (or fewer than three detail constraints)
                       while ``roi`` is the whole mesh; a connected free region that touches no position (or no
                       detail) constraint; constraints that do not determine the edit
                       (UndeterminedEditError: the rest values give back a shape more than
                       :data:`MAX_REST_ERROR` of the diagonal off ``V``, or the curvature stage
                       could not be factored)
-    ValueError        unknown ``rows`` or ``relations``; ``rcond`` outside (0, 1)
+    ValueError        unknown ``rows`` or ``relations`` (or not a single str); ``rcond`` outside (0, 1)
     SolverError       unknown or uninstalled ``backend`` (before any work); the embedding could
                       not be factored
 
@@ -160,14 +161,12 @@ class CurvatureEditor:
 
     def __init__(self, V, F, position_constrained, detail_constrained, *, roi=None,
                  rows="all", relations="one-ring", rcond=DEFAULT_RCOND, backend="auto"):
-        V, F, L = checked_cotan_laplacian(V, F)       # every mesh check, and L in the same pass
-        if rows not in ("all", "free"):
-            raise ValueError(f"rows={rows!r} is not a row mode; use 'all' (the paper's E_Q) or 'free'.")
-        if relations not in RELATIONS:
-            raise ValueError(f"relations={relations!r}; use 'one-ring' (the paper's relations) or "
-                             "'one+two-ring'.")
+        rows = _one_of(rows, "rows", ("all", "free"),
+                       " is not a row mode; use 'all' (the paper's E_Q) or 'free'.")
+        relations = _check_relations(relations)
         rcond = check_rcond(rcond)
-        resolve_backend(backend)           # an unknown or missing backend fails before the work
+        _check_backend(backend)            # an unknown or missing backend fails before the work
+        V, F, L = checked_cotan_laplacian(V, F)       # every mesh check, and L in the same pass
         self.relations = relations
         n = V.shape[0]
         # own read-only copies: the checks pass a contiguous caller array through, and an edit of
@@ -175,11 +174,11 @@ class CurvatureEditor:
         V, F = V.copy(), F.copy()
         V.flags.writeable = F.flags.writeable = False
         self.n, self.V, self.F, self.rows = n, V, F, rows
-        pc = as_index_set(position_constrained, n, "position_constrained")
-        dc = as_index_set(detail_constrained, n, "detail_constrained")
+        pc = _index_set(position_constrained, n, "position_constrained", "positions")
+        dc = _index_set(detail_constrained, n, "detail_constrained", "details")
         in_roi = np.ones(n, dtype=bool)
         if roi is not None:
-            r = as_index_set(roi, n, "roi")
+            r = _index_set(roi, n, "roi")
             if r.size == 0:
                 raise ConstraintError("roi is empty: nothing would be edited. Pass the vertices to "
                                       "edit, or roi=None for the whole mesh.")
@@ -433,7 +432,8 @@ class CurvatureEditor:
                                                  ``detail_constrained``; None = rest values. Under a
                                                  similarity with linear part ``s R`` a detail
                                                  becomes ``s R D``
-        return_details : bool                    also return the curvature stage's details
+        return_details : bool                    also return the curvature stage's details (True or
+                                                 False; ValueError otherwise)
 
         Returns
         -------
@@ -441,6 +441,8 @@ class CurvatureEditor:
                                  the roi keep their rest positions exactly
         D : (n, 3) float array   only with ``return_details=True``
         """
+        # "no" or 0 would otherwise count as an answer, and an array as numpy's ambiguous truth value
+        return_details = check_bool(return_details, "return_details")
         return self._solve(self._positions(positions), self._details(details), return_details)
 
     def _solve(self, Xk, Dk, return_details=False):
@@ -521,7 +523,7 @@ class CurvatureEditor:
         -------
         self
         """
-        h = as_index_set(handles, self.n, "handles")
+        h = _index_set(handles, self.n, "handles")
         is_p = np.zeros(self.n, dtype=bool)
         is_p[self._pc] = True
         is_d = np.zeros(self.n, dtype=bool)
@@ -585,6 +587,44 @@ class CurvatureEditor:
         if self._dc.size == self._user_dc:
             return given
         return np.concatenate([given, self.detail[self._dc[self._user_dc:]]])
+
+
+def _one_of(value, name, choices, advice):
+    """``value`` as a str if it is one of the strings ``choices``, else ValueError
+    ``f"{name}={value!r}{advice}"``. A str first: ``in`` compares an array element-wise, which
+    took np.array(["all"]) as "all" and raised numpy's "truth value ... is ambiguous" for two."""
+    if isinstance(value, str) and value in choices:
+        return str(value)
+    given = repr(value) if isinstance(value, str) else f"{value!r} ({type(value).__name__}, not a single str)"
+    raise ValueError(f"{name}={given}{advice}")
+
+
+def _check_relations(relations):
+    """``relations`` as one of :data:`RELATIONS`, or ValueError naming them."""
+    return _one_of(relations, "relations", RELATIONS,
+                   "; use 'one-ring' (the paper's relations) or 'one+two-ring'.")
+
+
+def _check_backend(backend):
+    """SolverError for an unknown or uninstalled backend (see :func:`resolve_backend`), and for
+    a backend that is no str: resolve_backend compares it with ``in``, which an array answers
+    with numpy's "truth value ... is ambiguous"."""
+    if backend is not None and not isinstance(backend, str):
+        raise SolverError(f"backend={backend!r} ({type(backend).__name__}) is not a solver backend; pass a "
+                          f"single str: one of {', '.join(BACKENDS)} or 'auto'.")
+    resolve_backend(backend)
+
+
+def _index_set(indices, n, name, values=None):
+    """:func:`as_index_set`, with None and a set named as such (both were "dtype object"); a
+    set has no order, and row r of the ``values`` given to solve belongs to ``name[r]``."""
+    if indices is None:
+        raise ConstraintError(f"{name} is None; pass vertex indices ([] for none) or an ({n},) boolean mask.")
+    if isinstance(indices, (set, frozenset)):
+        order = f" (row r of the {values} belongs to {name}[r])" if values else ""
+        raise ConstraintError(f"{name} is a {type(indices).__name__}, which has no order; pass a list or "
+                              f"array of vertex indices{order}, e.g. sorted({name}).")
+    return as_index_set(indices, n, name)
 
 
 def _two_ring_pairs(rows, cols, n):

@@ -77,7 +77,7 @@ def _matrix(text):
                   min=0.0),
         Parameter("transform", "str", IDENTITY,
                   "4x4 handle transform, 16 numbers row by row, applied to homogeneous positions "
-                  "(from Python also a 4x4 array)"),
+                  "(from Python also a 4x4 array)", shape=(4, 4)),
         Parameter("detail_scale", "float", 1.0,
                   "factor on the handles' curvature normals after the transform (1 keeps them)",
                   positive=True),
@@ -109,12 +109,18 @@ def apply_curvature_editing(ms, *, handles, region_radius, transform, detail_sca
         from scipy.spatial import cKDTree
 
         near = np.flatnonzero(cKDTree(V[h]).query(V, distance_upper_bound=radius)[0] <= radius)
-        selected = np.union1d(selected, near)
+        # the handles are in the region anyway (and a radius below ~1e-154 misses even them: the
+        # tree compares squared distances); the radius has to bring in a vertex to rebuild
+        selected = np.union1d(selected, np.setdiff1d(near, h))
     if selected.size == 0:
+        # a positive radius is named as given: 1e-300 was called 0
+        within = ("region_radius is 0" if region_radius.value == 0 else
+                  f"no vertex but the handles lies within region_radius={region_radius} of a handle"
+                  + ("" if radius == region_radius.value else f" ({radius:.3g} on this mesh)"))
         raise ConstraintError(
-            f"layer {mid} ({get_mesh(ms, mid).label()!r}) has no selected vertices and "
-            "region_radius is 0: the region of interest to rebuild is empty. Select it first (e.g. "
-            "with compute_selection_by_condition_per_vertex) or set region_radius (e.g. 20%).")
+            f"layer {mid} ({get_mesh(ms, mid).label()!r}) has no selected vertices and {within}: the "
+            "region of interest to rebuild is empty. Select it first (e.g. with "
+            "compute_selection_by_condition_per_vertex) or set a larger region_radius (e.g. 20%).")
     roi = np.union1d(selected, h)
     if roi.size == V.shape[0]:
         raise ConstraintError("every vertex is in the region of interest (selection plus handles), so "

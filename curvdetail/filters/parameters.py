@@ -7,7 +7,10 @@ A :class:`Parameter` has a ``name``, a ``type`` (one of :data:`TYPES`), a ``defa
 Types, as pymeshlab names them:
 
 ``bool``, ``int``, ``float``, ``str``
-    plain values; a ``str`` with ``choices`` is an enumeration (pymeshlab's RichEnum).
+    plain values; a ``str`` with ``choices`` is an enumeration (pymeshlab's RichEnum). A ``str``
+    without choices also takes a list, tuple or array of numbers from Python, as the text of
+    those numbers; ``shape`` (e.g. ``(4, 4)`` for a matrix) is the one multi-dimensional shape
+    such an array may have, where the order of its axes matters.
 ``PercentageValue``
     a length given either as a percentage of the bounding-box diagonal
     (``pymeshlab.PercentageValue(1.0)``, ``"1%"`` on the command line) or as an absolute value
@@ -52,15 +55,29 @@ class BBoxLength:
 
 def _numbers_as_text(value):
     """A list, tuple or array of real numbers (``handles=[1, 2, 3]``, ``transform=np.eye(4)``)
-    as the space-separated text the str parameters take (row by row, every digit kept);
-    anything else unchanged."""
+    as the space-separated text the str parameters take (row by row, every digit kept); an
+    empty one as the empty text; anything else unchanged."""
     if isinstance(value, (list, tuple, np.ndarray)):
-        arr = np.asarray(value, dtype=object).ravel()
-        if arr.size and all(isinstance(x, numbers.Real) and not isinstance(x, (bool, np.bool_)) for x in arr.tolist()):
+        arr = _object_array(value)
+        if arr is None:
+            return value
+        if arr.size == 0:               # no numbers: the filter names an empty value as such
+            return ""
+        arr = arr.ravel()
+        if all(isinstance(x, numbers.Real) and not isinstance(x, (bool, np.bool_)) for x in arr.tolist()):
             # numbers as Python writes them: numpy 2's repr of np.float64(1.0) is "np.float64(1.0)"
             return " ".join(str(int(x)) if isinstance(x, numbers.Integral) else repr(float(x))
                             for x in arr.tolist())
     return value
+
+
+def _object_array(value):
+    """``value`` as an object array with its nesting as shape, or None where numpy cannot make
+    one (lists of arrays of different shapes)."""
+    try:
+        return np.asarray(value, dtype=object)
+    except ValueError:
+        return None
 
 
 @dataclass(frozen=True)
@@ -72,6 +89,8 @@ class Parameter:
     >>> p = Parameter("rows", "str", "all", "residual rows in E_Q", choices=("all", "free"))
     >>> p.check("free")
     'free'
+    >>> Parameter("scale", "str", "", "2x2 matrix", shape=(2, 2)).check(np.eye(2))
+    '1.0 0.0 0.0 1.0'
     """
 
     name: str
@@ -82,6 +101,10 @@ class Parameter:
     min: float = None
     max: float = None
     positive: bool = False
+    #: a ``str`` of numbers only: the shape an array from Python must have where it has more than
+    #: one axis, e.g. (4, 4) for a matrix read row by row (a flat sequence is counted by the
+    #: filter); None flattens any array (an index set, where the order does not matter)
+    shape: tuple = None
 
     def __post_init__(self):
         if self.type not in TYPES:
@@ -90,6 +113,10 @@ class Parameter:
             raise TypeError(f"parameter {self.name!r} needs a description.")
         if self.choices is not None:
             object.__setattr__(self, "choices", tuple(self.choices))
+        if self.shape is not None:
+            if self.type != "str" or self.choices is not None:
+                raise TypeError(f"parameter {self.name!r}: a shape applies to a str of numbers only.")
+            object.__setattr__(self, "shape", tuple(int(k) for k in self.shape))
         if self.default is not None or self.type != "mesh":
             object.__setattr__(self, "default", self.check(self.default))
 
@@ -145,10 +172,10 @@ class Parameter:
                     and not isinstance(value, (bool, np.bool_)) and 0 <= value < len(self.choices):
                 return self.choices[int(value)]           # an enum index, as pymeshlab takes it
             if self.choices is None:
-                value = _numbers_as_text(value)
+                value = _numbers_as_text(self._check_numbers(value))
             if not isinstance(value, str):
-                raise self._fail(value, "a str" + (f" (one of {', '.join(self.choices)}, or its index)"
-                                                   if self.choices else ""))
+                raise self._fail(value, f"a str (one of {', '.join(self.choices)}, or its index)"
+                                 if self.choices else "a str (from Python also a list or array of numbers)")
             if self.choices is not None:
                 for c in self.choices:
                     if value.lower() == c.lower():
@@ -173,6 +200,34 @@ class Parameter:
         self._finite(length.value)
         self._range(length.value)
         return length
+
+    def _check_numbers(self, value):
+        """``value`` unchanged, or FilterParameterError where a list, tuple or array would be read
+        wrongly as numbers: a boolean mask (True/False are no indices), masked entries, or an
+        array of another shape than ``shape`` (a 2x8 array was read as a 4x4 matrix)."""
+        if not isinstance(value, (list, tuple, np.ndarray)):
+            return value
+        arr = _object_array(value)
+        if arr is None or arr.size == 0:
+            return value
+        items = arr.ravel().tolist()
+        if all(isinstance(x, (bool, np.bool_)) for x in items):
+            fix = (f"pass a {self.shape} array of numbers" if self.shape is not None else
+                   "pass the indices where the mask is true, np.flatnonzero(mask)")
+            raise FilterParameterError(f"parameter {self.name!r} is a boolean mask ({arr.size} True/False "
+                                       f"values); it takes numbers, not a mask: {fix}.")
+        if np.ma.isMaskedArray(value) and np.ma.getmaskarray(value).any():
+            raise FilterParameterError(
+                f"parameter {self.name!r} has {int(np.ma.getmaskarray(value).sum())} masked entries, which "
+                "would be read as numbers; pass the entries you mean, e.g. value.compressed().")
+        if self.shape is not None and arr.ndim > 1 and arr.shape != self.shape and \
+                all(isinstance(x, numbers.Real) for x in items):
+            dims = "x".join(map(str, self.shape))
+            raise FilterParameterError(
+                f"parameter {self.name!r} is a {'x'.join(map(str, arr.shape))} array; it must be a {dims} "
+                f"matrix: a {self.shape} array, or its {math.prod(self.shape)} numbers row by row as a "
+                "flat list or as text.")
+        return value
 
     def _finite(self, x):
         if not math.isfinite(x):
