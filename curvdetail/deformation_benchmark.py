@@ -19,7 +19,7 @@ import os
 import numpy as np
 
 from ._output import atomic_output, check_output_path
-from .curvature._validate import affine_transform_problem, check_transformed_values, real_word
+from .curvature._validate import affine_transform_problem, check_choice, check_transformed_values, real_word
 from .curvature.curvature_coefficients import DEFAULT_RCOND
 from .curvature.curvature_editor import CurvatureEditor
 from .curvature.errors import ConstraintError, first_indices
@@ -207,8 +207,7 @@ def edit_with_selection(V, F, status, T, *, handle_detail="transform", relations
     >>> bool(np.all(X[status == 2, 2] == 0.3) and np.all(X[status == 0] == V[status == 0]))
     True
     """
-    if handle_detail not in HANDLE_DETAIL_MODES:
-        raise ValueError(f"handle_detail={handle_detail!r}; use 'transform' or 'free'.")
+    handle_detail = check_choice(handle_detail, "handle_detail", HANDLE_DETAIL_MODES, "; use 'transform' or 'free'.")
     V = np.asarray(V, dtype=np.float64)
     status = np.asarray(status).reshape(-1)
     if status.size != V.shape[0]:

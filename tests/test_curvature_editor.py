@@ -451,7 +451,7 @@ def test_a_curvature_stage_that_cannot_be_factored_is_an_undetermined_edit(monke
     (dict(relations=np.array(["one-ring", "one+two-ring"])), ValueError,
      r"relations=array\(.*\(ndarray, not a single str\); use 'one-ring' .* or 'one\+two-ring'"),
     (dict(backend=np.array(["auto", "splu"])), sparse_solver.SolverError,
-     r"backend=array\(.*\(ndarray\) is not a solver backend; pass a single str: one of .*splu.* or 'auto'"),
+     r"backend=array\(.*\(ndarray, not a single str\) is not a solver backend; choose one of .*splu.* or 'auto'"),
 ])
 def test_options_given_as_arrays_or_lists_are_refused_naming_the_option(plane_grid, kwargs, error, message):
     V, F = plane_grid

@@ -165,6 +165,9 @@ def test_unknown_handle_detail_mode_is_refused():
     V, F, status = _strip()
     with pytest.raises(ValueError, match="handle_detail"):
         edit_with_selection(V, F, status, np.eye(4), handle_detail="rotate")
+    # an array was compared element-wise: numpy's "truth value ... is ambiguous" for two entries
+    with pytest.raises(ValueError, match=r"handle_detail=.*\(ndarray, not a single str\); use 'transform' or 'free'"):
+        edit_with_selection(V, F, status, np.eye(4), handle_detail=np.array(["transform", "free"]))
 
 
 def test_a_small_uniform_scaling_is_no_singular_transform(tmp_path):

@@ -14,6 +14,14 @@ def _points_on_faces(V, F, rng, k=2000):
     return face, bary, interpolate(V, F, face, bary)
 
 
+@pytest.mark.parametrize("engine", [np.array(["numpy"]), np.array(["auto", "numpy"]), ("auto",)])
+def test_an_engine_that_is_not_one_str_is_refused_as_such(flat_disk, engine):
+    # ``in`` compared an array element-wise: one entry passed, two raised numpy's "truth value"
+    V, F = flat_disk
+    with pytest.raises(ValueError, match=r"engine=.* \((ndarray|tuple), not a single str\); use 'auto' or 'numpy'"):
+        locate(V[:3], V, F, engine=engine)
+
+
 @pytest.mark.parametrize("engine", ["auto", "numpy"])
 def test_located_barycentrics_reproduce_points_on_the_surface(load_mesh, rng, engine):
     V, F = load_mesh("mannequin_nose.obj")

@@ -115,3 +115,12 @@ def test_source_boundary_is_placed_on_the_circle_by_arc_length(load_mesh):
     if turn[1] > 0.5:                   # the loop runs clockwise on the circle
         turn = np.mod(-turn, 1.0)
     assert np.abs(turn - s).max() < 1e-12
+
+
+@pytest.mark.parametrize("method", ["conformal", np.array(["harmonic"]), ["lscm"]])
+def test_a_method_that_is_not_a_parameterization_is_refused(method):
+    # an array or list was compared with ``in`` element-wise (numpy's "truth value ... is ambiguous")
+    V, F = disk(3)
+    shown = "'conformal'" if isinstance(method, str) else r".* \((ndarray|list), not a single str\)"
+    with pytest.raises(ValueError, match=rf"method={shown} is not a parameterization; use one of harmonic"):
+        parameterize(V, F, method=method)

@@ -122,6 +122,15 @@ def test_unknown_method_is_refused(load_mesh):
         retriangulate(V, F, method="loop")
 
 
+@pytest.mark.parametrize("method", [np.array(["isotropic"]), np.array(["isotropic", "decimate"]), ["decimate"]])
+def test_a_method_that_is_not_one_str_is_refused_as_such(load_mesh, method):
+    # ``in`` compared an array element-wise: one entry passed as the method, two raised numpy's
+    # "truth value ... is ambiguous"
+    V, F = load_mesh("mannequin_nose.obj")
+    with pytest.raises(RemeshError, match=r"method=.* \((ndarray|list), not a single str\) is not a retriangulation"):
+        retriangulate(V, F, method=method)
+
+
 @pytest.mark.parametrize("kwargs, words", [
     ({"iterations": 0}, "at least 1"),
     ({"iterations": "ten"}, "must be a whole number"),

@@ -504,6 +504,26 @@ def check_transformed_values(values, what, fix, error=ConstraintError):
                     f"where the geometry overflows double precision; {fix}.")
 
 
+def shown_choice(value):
+    """How an option value that is not one of its choices is shown in a refusal: a str as its
+    repr, anything else with its type, as not a single str (an array compared with ``in`` is
+    compared element-wise: np.array(["all"]) passed as "all", two entries raised numpy's "truth
+    value ... is ambiguous")."""
+    return repr(value) if isinstance(value, str) else f"{value!r} ({type(value).__name__}, not a single str)"
+
+
+def is_choice(value, choices):
+    """Whether ``value`` is a str among ``choices`` (see :func:`shown_choice`)."""
+    return isinstance(value, str) and value in choices
+
+
+def check_choice(value, name, choices, advice, error=ValueError):
+    """``value`` if it is a str among ``choices``, else ``error(f"{name}={shown}{advice}")``."""
+    if is_choice(value, choices):
+        return str(value)
+    raise error(f"{name}={shown_choice(value)}{advice}")
+
+
 def real_word(word):
     """``float(word)`` for a number written in a text file or parameter, but ValueError for
     Python's digit separators too (``1_0`` would be read as 10)."""

@@ -6,13 +6,13 @@ import numbers
 import numpy as np
 
 from ._validate import (MIN_DIAGONAL, ZERO_AREA_RELATIVE, _check_magnitude, _compact_ids, as_faces, as_values,
-                        as_vertices, bbox_diagonal, boundary_edges, check_bool, check_mesh, check_oriented,
-                        face_double_areas, vertex_components)
+                        as_vertices, bbox_diagonal, boundary_edges, check_bool, check_choice, check_mesh,
+                        check_oriented, face_double_areas, vertex_components)
 from .cotan_laplacian import _cotan_laplacian_unchecked, laplacian_product
 from .curvature_coefficients import DEFAULT_RCOND, check_rcond
-from .curvature_editor import CurvatureEditor, _check_backend, _check_relations, _one_of
+from .curvature_editor import CurvatureEditor, _check_relations
 from .errors import ConstraintError, MeshError, first_indices
-from .sparse_solver import factorize
+from .sparse_solver import factorize, resolve_backend
 
 
 def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="one-ring",
@@ -81,11 +81,11 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
     True
     """
     # the options before the mesh and the displacement callable (the editor checks them again)
-    boundary_detail = _one_of(boundary_detail, "boundary_detail", ("deformed", "rest"),
+    boundary_detail = check_choice(boundary_detail, "boundary_detail", ("deformed", "rest"),
                               "; use 'deformed' or 'rest'.")
     _check_relations(relations)
     check_rcond(rcond)
-    _check_backend(backend)
+    resolve_backend(backend)
     check_bool(return_info, "return_info")
     V = as_vertices(V)
     F = as_faces(F, V.shape[0])        # shapes and indices; the editor below runs every mesh check

@@ -6,13 +6,14 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from ._validate import as_index_set, as_values, bbox_centre, bbox_diagonal, centroid_diameter, check_bool
+from ._validate import (as_index_set, as_values, bbox_centre, bbox_diagonal, centroid_diameter, check_bool,
+                        check_choice)
 from .cotan_laplacian import checked_cotan_laplacian, laplacian_product
 from .curvature_coefficients import DEFAULT_RCOND, _coefficients, _one_ring_pairs, check_rcond
 from .errors import ConstraintError, UndeterminedEditError, first_indices
 from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
 from .reconstruct import refine_least_squares
-from .sparse_solver import BACKENDS, SolverError, _chosen_automatically, factorize, resolve_backend
+from .sparse_solver import SolverError, _chosen_automatically, factorize, resolve_backend
 
 
 RELATIONS = ("one-ring", "one+two-ring")
@@ -161,11 +162,11 @@ class CurvatureEditor:
 
     def __init__(self, V, F, position_constrained, detail_constrained, *, roi=None,
                  rows="all", relations="one-ring", rcond=DEFAULT_RCOND, backend="auto"):
-        rows = _one_of(rows, "rows", ("all", "free"),
-                       " is not a row mode; use 'all' (the paper's E_Q) or 'free'.")
+        rows = check_choice(rows, "rows", ("all", "free"),
+                            " is not a row mode; use 'all' (the paper's E_Q) or 'free'.")
         relations = _check_relations(relations)
         rcond = check_rcond(rcond)
-        _check_backend(backend)            # an unknown or missing backend fails before the work
+        resolve_backend(backend)           # an unknown or missing backend fails before the work
         V, F, L = checked_cotan_laplacian(V, F)       # every mesh check, and L in the same pass
         self.relations = relations
         n = V.shape[0]
@@ -589,30 +590,10 @@ class CurvatureEditor:
         return np.concatenate([given, self.detail[self._dc[self._user_dc:]]])
 
 
-def _one_of(value, name, choices, advice):
-    """``value`` as a str if it is one of the strings ``choices``, else ValueError
-    ``f"{name}={value!r}{advice}"``. A str first: ``in`` compares an array element-wise, which
-    took np.array(["all"]) as "all" and raised numpy's "truth value ... is ambiguous" for two."""
-    if isinstance(value, str) and value in choices:
-        return str(value)
-    given = repr(value) if isinstance(value, str) else f"{value!r} ({type(value).__name__}, not a single str)"
-    raise ValueError(f"{name}={given}{advice}")
-
-
 def _check_relations(relations):
     """``relations`` as one of :data:`RELATIONS`, or ValueError naming them."""
-    return _one_of(relations, "relations", RELATIONS,
-                   "; use 'one-ring' (the paper's relations) or 'one+two-ring'.")
-
-
-def _check_backend(backend):
-    """SolverError for an unknown or uninstalled backend (see :func:`resolve_backend`), and for
-    a backend that is no str: resolve_backend compares it with ``in``, which an array answers
-    with numpy's "truth value ... is ambiguous"."""
-    if backend is not None and not isinstance(backend, str):
-        raise SolverError(f"backend={backend!r} ({type(backend).__name__}) is not a solver backend; pass a "
-                          f"single str: one of {', '.join(BACKENDS)} or 'auto'.")
-    resolve_backend(backend)
+    return check_choice(relations, "relations", RELATIONS,
+                        "; use 'one-ring' (the paper's relations) or 'one+two-ring'.")
 
 
 def _index_set(indices, n, name, values=None):

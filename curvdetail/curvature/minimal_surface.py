@@ -3,7 +3,7 @@
 import numpy as np
 
 from ._geometry import corner_cotangents
-from ._validate import (ZERO_AREA_RELATIVE, as_count, as_index_set, as_positive_number, bbox_centre,
+from ._validate import (check_choice, ZERO_AREA_RELATIVE, as_count, as_index_set, as_positive_number, bbox_centre,
                         bbox_diagonal, check_every_component_fixed, misoriented_edges, vertex_components)
 from .cotan_laplacian import _assemble_upper, checked_cotan_triangle
 from .errors import ConstraintError, MeshError, first_indices
@@ -132,9 +132,8 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, step="n
     """
     max_iterations = as_count(max_iterations, "max_iterations")
     tol = as_positive_number(tol, "tol", " (relative to the bbox diagonal)")
-    if step not in ("normal", "full"):
-        raise ValueError(f"step={step!r}; use 'normal' (the step across the surface) or 'full' (the "
-                         "whole vertex displacement).")
+    step = check_choice(step, "step", ("normal", "full"), "; use 'normal' (the step across the surface) "
+                        "or 'full' (the whole vertex displacement).")
     if callback is not None and not callable(callback):
         raise ValueError(f"callback={callback!r} is not callable; pass a function (iteration, step) or None.")
     V, F, U, diagonal = checked_cotan_triangle(V, F)     # every mesh check; L of the first step

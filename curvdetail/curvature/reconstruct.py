@@ -3,7 +3,7 @@
 import numpy as np
 import scipy.sparse as sp
 
-from ._validate import (as_count, as_faces, as_index_set, as_values, as_vertices, bbox_centre,
+from ._validate import (check_choice, as_count, as_faces, as_index_set, as_values, as_vertices, bbox_centre,
                         check_every_component_fixed)
 from .cotan_laplacian import _edge_pattern, _symmetric_from_upper, checked_cotan_triangle
 from .errors import ConstraintError
@@ -82,8 +82,7 @@ class Reconstructor:
     refinement_steps = 1
 
     def __init__(self, V_ref, F, fixed, *, rows="all", backend="auto", refinement_steps=None):
-        if rows not in ROW_MODES:
-            raise ValueError(f"rows={rows!r} is not a row mode; use 'all' (the paper's E_Q) or 'free'.")
+        rows = check_choice(rows, "rows", ROW_MODES, " is not a row mode; use 'all' (the paper's E_Q) or 'free'.")
         if refinement_steps is not None:
             try:
                 self.refinement_steps = as_count(refinement_steps, "refinement_steps", minimum=0)

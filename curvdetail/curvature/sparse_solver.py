@@ -28,6 +28,8 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ._validate import shown_choice
+
 BACKENDS = ("pardiso", "cholmod", "splu", "banded")
 
 #: Number of numeric factorizations performed in this process (a solver that promises
@@ -121,6 +123,9 @@ def resolve_backend(backend="auto", *, symmetric=True, size=None, nnz=None):
     """Turn ``"auto"`` (or the ``CURVDETAIL_SOLVER`` setting) into an installed backend name."""
     if isinstance(backend, str):
         backend = backend.strip().lower()         # "PARDISO" too, as the filters' choices are taken
+    elif backend is not None:                     # an array would meet ``in`` below element-wise
+        raise SolverError(f"backend={shown_choice(backend)} is not a solver backend; choose one of "
+                          f"{', '.join(BACKENDS)} or 'auto'.")
     source = ""
     if backend in (None, "auto"):
         backend = (os.environ.get("CURVDETAIL_SOLVER", "auto") or "auto").strip().lower()

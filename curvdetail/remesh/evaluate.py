@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ..curvature._validate import as_count, as_faces, bbox_diagonal, check_bool, check_mesh, face_double_areas
+from ..curvature._validate import as_count, check_choice, as_faces, bbox_diagonal, check_bool, check_mesh, face_double_areas
 from ..curvature.errors import MeshError
 from .locate import FAR_POINTS, _locate, _unit_frame, check_points_and_mesh
 
@@ -73,8 +73,7 @@ def hausdorff(Va, Fa, Vb, Fb, *, samples=None, engine="meshlab", seed=0):
     _, both, scale = _unit_frame(both[:0], both)
     Va, Fa = check_mesh(both[:Va.shape[0]], Fa)
     Vb, Fb = check_mesh(both[Va.shape[0]:], Fb)
-    if engine not in ("meshlab", "kdtree"):
-        raise ValueError(f"engine={engine!r}; use 'meshlab' or 'kdtree'.")
+    engine = check_choice(engine, "engine", ("meshlab", "kdtree"), "; use 'meshlab' or 'kdtree'.")
     samples = _check_samples(samples)
     seed = None if seed is None else as_count(seed, "seed", minimum=0)
     engine = "kdtree" if engine == "kdtree" or _apart(Va, Vb) else "meshlab"

@@ -4,7 +4,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
-from ..curvature._validate import (ZERO_AREA_ADVICE, ZERO_AREA_RELATIVE, as_count, as_faces, as_vertices, bbox_diagonal,
+from ..curvature._validate import (check_choice, ZERO_AREA_ADVICE, ZERO_AREA_RELATIVE, as_count, as_faces, as_vertices, bbox_diagonal,
                                    face_double_areas)
 from ..curvature.errors import MeshError, first_indices
 
@@ -79,8 +79,7 @@ def locate(points, V, F, *, engine="auto", candidates=8, chunk=20_000):
     ([0, 1], [[0.5, 0.25, 0.25], [0.2, 0.7, 0.1]])
     """
     P, V, F = check_points_and_mesh(points, V, F)
-    if engine not in ("auto", "numpy"):
-        raise ValueError(f"engine={engine!r}; use 'auto' or 'numpy'.")
+    engine = check_choice(engine, "engine", ("auto", "numpy"), "; use 'auto' or 'numpy'.")
     return _locate(P, V, F, engine, as_count(candidates, "candidates"), as_count(chunk, "chunk"))
 
 

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ..curvature._validate import (as_faces, as_index_set, as_values, as_vertices, check_every_component_fixed,
+from ..curvature._validate import (check_choice, as_faces, as_index_set, as_values, as_vertices, check_every_component_fixed,
                                   check_mesh)
 from ..curvature.cotan_laplacian import _cotan_laplacian_unchecked
 from ..curvature.errors import ConstraintError, MeshError
@@ -167,8 +167,7 @@ def parameterize(Vs, Fs, Vt=None, Ft=None, *, method="harmonic", backend="auto")
     >>> bool(abs(np.linalg.norm(UV, axis=1).max() - 1.0) < 1e-12), info["flipped_source"]
     (True, 0)
     """
-    if method not in METHODS:
-        raise ValueError(f"method={method!r} is not a parameterization; use one of {', '.join(METHODS)}.")
+    method = check_choice(method, "method", METHODS, f" is not a parameterization; use one of {', '.join(METHODS)}.")
     if (Vt is None) != (Ft is None):
         given, missing = ("Ft", "Vt") if Vt is None else ("Vt", "Ft")
         raise ValueError(f"{given} was given without {missing}: pass both (the target mesh) or neither "

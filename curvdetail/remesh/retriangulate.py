@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ..curvature._validate import (as_count, as_float, as_positive_number, bbox_diagonal, check_bool,
+from ..curvature._validate import (check_choice, as_count, as_float, as_positive_number, bbox_diagonal, check_bool,
                                    face_double_areas)
 from ._disk import NotADiskError, Polyline, RemeshError, check_disk
 
@@ -136,8 +136,8 @@ def retriangulate(V, F, *, method="isotropic", target_edge=0.01, iterations=10, 
     >>> 50 < Vt.shape[0] < 5000
     True
     """
-    if method not in METHODS:
-        raise RemeshError(f"method={method!r} is not a retriangulation method; use 'isotropic' or 'decimate'.")
+    method = check_choice(method, "method", METHODS, " is not a retriangulation method; use 'isotropic' or "
+                          "'decimate'.", RemeshError)
     V, F, loop = check_disk(V, F, "the source")
     d = bbox_diagonal(V)
     target_edge = check_target_edge(target_edge)

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ..curvature._validate import _edge_keys, as_count, bbox_diagonal, check_mesh
+from ..curvature._validate import _edge_keys, as_count, check_choice, bbox_diagonal, check_mesh
 from ..curvature.errors import MeshError
 from ..curvature.mean_curvature_normal import mean_curvature_normal
 from ..curvature.mixed_voronoi_area import mixed_voronoi_area
@@ -122,10 +122,9 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     >>> bool(np.allclose(D, curvature_detail(V, F), atol=1e-12))
     True
     """
-    if method not in METHODS:
-        raise ValueError(f"method={method!r} is not a transfer; use 'conservative' or 'pointwise'.")
-    if location not in LOCATIONS:
-        raise ValueError(f"location={location!r}; use 'closest' (3D closest point) or 'uv' (shared domain).")
+    method = check_choice(method, "method", METHODS, " is not a transfer; use 'conservative' or 'pointwise'.")
+    location = check_choice(location, "location", LOCATIONS, "; use 'closest' (3D closest point) or 'uv' "
+                            "(shared domain).")
     if samples_per_edge is not None:
         if method != "conservative":
             raise ValueError("samples_per_edge is used by method='conservative' only; drop it for 'pointwise'.")
