@@ -73,3 +73,27 @@ def test_missing_detail_attribute_says_what_to_run():
     with pytest.raises(FilterError, match="no per-vertex point attribute 'curvature_detail'; run "
                                           "compute_curvature_detail"):
         apply(meshset("mannequin_nose.obj"), "apply_curvature_reconstruction")
+
+
+@pytest.mark.parametrize("rows", ["all", "free"])
+def test_bumped_flat_grid_is_rebuilt_flat_from_its_stored_detail(rows):
+    # known answer: the detail of a flat grid has no z component (interior: 0; boundary: the
+    # in-plane conormal), so with the boundary fixed at z = 0 the z rows of both systems are
+    # homogeneous and the rebuilt surface is the plane again, whatever L of the bumped geometry
+    from curvdetail.curvature.testing import grid
+
+    V, F = grid(12, 12)
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=V, face_matrix=F))
+    apply(ms, "compute_curvature_detail")
+    b = boundary_vertices(F)
+    interior = np.setdiff1d(np.arange(V.shape[0]), b)
+    bumped = V.copy()
+    bumped[interior, 2] = 0.05 * np.sin(3 * V[interior, 0])
+    set_vertex_positions(ms, 0, bumped)        # the stored detail is still the flat one
+    assert np.abs(ms.current_mesh().vertex_matrix()[interior, 2]).max() > 0.01
+    figures = apply(ms, "apply_curvature_reconstruction", rows=rows)
+    X = ms.current_mesh().vertex_matrix()
+    assert np.abs(X[:, 2]).max() < 1e-12                   # measured 0.0 for both rows
+    assert np.array_equal(X[b], V[b])
+    assert figures["max_displacement"] > 0.01

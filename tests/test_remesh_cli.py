@@ -22,6 +22,8 @@ def test_remesh_writes_mesh_with_distance_quality_report_and_image(tmp_path, cap
     report = json.loads(rep.read_text())
     assert report["target"]["vertices"] == read_mesh(str(out))[0].shape[0]
     assert report["options"]["target_edge"] == pytest.approx(0.03)
+    # the detail was carried over: far closer to the source than the zero-detail surface
+    assert report["error"]["hausdorff_rms"] < report["baseline_zero_detail"]["hausdorff_rms"] / 10
     assert img.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     import pymeshlab
 

@@ -217,7 +217,12 @@ def test_a_target_with_one_boundary_vertex_slightly_off_names_it():
     with pytest.raises(RemeshError, match=r"^1 of \d+ target boundary vertices are off .*up to 3\.5\de-05"):
         remesh_experiment(V, F, target=(Vt, F), evaluate=False)
     Vt[boundary_loop(F)[3], 2] = V[boundary_loop(F)[3], 2] + 1e-8     # rounding-sized: taken
-    remesh_experiment(V, F, target=(Vt, F), evaluate=False)
+    (X, Ft), _ = remesh_experiment(V, F, target=(Vt, F), evaluate=False)
+    # and rebuilt as given: its triangles, its boundary where it put it, and the source disk
+    # (its own triangulation, so its own detail) back up to the nudge (measured 1e-8)
+    b = boundary_loop(F)
+    assert np.array_equal(Ft, F) and np.array_equal(X[b], Vt[b])
+    assert np.abs(X - V).max() < 2e-8
     # the exact search, in chunks smaller than one row of segments, agrees with a direct one
     P, X = V[boundary_loop(F)], np.random.default_rng(1).normal(size=(7, 3))
     A, B = P, np.roll(P, -1, axis=0)
@@ -235,6 +240,8 @@ def test_a_float32_target_far_from_the_origin_is_taken():
     Vt = Vt.astype(np.float32).astype(np.float64)
     (X, _), report = remesh_experiment(V, F, target=(Vt, Ft), evaluate=False)
     assert report["target"]["vertices"] == Vt.shape[0]
+    # the source is the flat z = 0 disk: so is the rebuilt surface (measured |z| = 0.0)
+    assert np.abs(X[:, 2]).max() < 1e-9 * report["source"]["bbox_diagonal"]
 
 
 def test_the_zero_detail_baseline_is_the_harmonic_surface_for_both_row_modes(height_field):

@@ -155,7 +155,11 @@ def test_a_target_that_is_not_the_same_surface_is_refused(load_mesh, method):
     with pytest.raises(MeshError, match=r"source and target lie up to .* % of the source's bbox diagonal apart"):
         transfer_curvature(V, F, V + [0.0, 0.0, 1000.0], F, method=method)
     D = transfer_curvature(V, F, V + [0.0, 0.0, 1e-3], F, method=method)       # a slight offset is fine
-    assert np.all(np.isfinite(D))
+    # and gives the target the detail of the same surface: that of the identity transfer, up to
+    # the sampling's sensitivity to the 0.11 %-of-the-diagonal shift (measured 4.9 % and 4.8 %
+    # of max |D| for conservative and pointwise)
+    same = transfer_curvature(V, F, V, F, method=method)
+    assert np.abs(D - same).max() < 0.1 * np.abs(same).max()
 
 
 def _located_on_grid():
