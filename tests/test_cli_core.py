@@ -23,14 +23,42 @@ def _error_line(capsys):
     return err[0]
 
 
+def _spy_on_solve(monkeypatch):
+    """Every ``Reconstructor.solve`` call as ``(detail, fixed_positions, result, reconstructor)``
+    (a spy that still solves)."""
+    from curvdetail import Reconstructor
+
+    calls, real = [], Reconstructor.solve
+
+    def spy(self, detail, fixed_positions):
+        X = real(self, detail, fixed_positions)
+        calls.append((np.array(detail), np.array(fixed_positions), np.array(X), self))
+        return X
+
+    monkeypatch.setattr(Reconstructor, "solve", spy)
+    return calls
+
+
 @pytest.mark.parametrize("rows", ["all", "free"])
-def test_reconstruct_rebuilds_the_input(tmp_path, capsys, rows):
+def test_reconstruct_rebuilds_the_input(tmp_path, capsys, monkeypatch, rows):
+    # the answer is the input itself, which a copy of it also gives: so the solver's run is
+    # checked too, with the input's own detail and boundary, and the file holds what it returned
+    from curvdetail import curvature_detail, reconstruct
+
+    calls = _spy_on_solve(monkeypatch)
     out = tmp_path / "nose.ply"
     assert main(["reconstruct", NOSE, str(out), "--rows", rows]) == 0
     V, F = read_mesh(NOSE)
     X, G = read_mesh(out)
     assert np.array_equal(G, F)
     assert np.abs(X - V).max() <= 1e-9 * bbox_diagonal(V)
+    (detail, positions, solved, rec), = calls
+    b = boundary_vertices(F)
+    assert np.array_equal(detail, curvature_detail(V, F)) and np.array_equal(rec.fixed, b)
+    assert np.array_equal(positions, V[b]) and rec.rows == rows
+    assert np.array_equal(X, solved)                  # binary PLY: doubles, exact
+    expected = reconstruct(V, F, curvature_detail(V, F), b, V[b], rows=rows)
+    assert np.abs(X - expected).max() <= 1e-12 * bbox_diagonal(V)
     printed = capsys.readouterr().out
     assert "max vertex error" in printed and f"rows={rows}" in printed
     assert float(printed.split("max vertex error ")[1].split()[0]) <= 1e-9
@@ -45,11 +73,15 @@ def test_reconstruct_shows_its_stages_on_a_terminal_only(tmp_path, capsys, monke
     assert stages == ["[1/4] read", "[2/4] factor", "[3/4] solve", "[4/4] write"]
 
 
-def test_reconstruct_closed_mesh_with_fixed_vertices(tmp_path):
+def test_reconstruct_closed_mesh_with_fixed_vertices(tmp_path, monkeypatch):
+    calls = _spy_on_solve(monkeypatch)
     out = tmp_path / "spot.off"
     assert main(["reconstruct", SPOT, str(out), "--fix", "0", "1000", "2000"]) == 0
     V, _ = read_mesh(SPOT)
     assert np.abs(read_mesh(out)[0] - V).max() <= 1e-9 * bbox_diagonal(V)
+    (detail, positions, solved, rec), = calls            # solved with the three named vertices fixed
+    assert np.array_equal(rec.fixed, [0, 1000, 2000]) and np.array_equal(positions, V[[0, 1000, 2000]])
+    assert np.abs(read_mesh(out)[0] - solved).max() <= 1e-12 * bbox_diagonal(V)
 
 
 def test_reconstruct_example(tmp_path, capsys):
@@ -58,6 +90,13 @@ def test_reconstruct_example(tmp_path, capsys):
     printed = capsys.readouterr().out
     # the issue's default: E_Q over all rows
     assert out.exists() and "1089 vertices" in printed and "rows=all" in printed
+    # the bundled terrain, rebuilt from its own detail: itself
+    from curvdetail.data import example_path
+
+    V, F = read_mesh(example_path())
+    X, G = read_mesh(out)
+    assert np.array_equal(G, F) and V.shape == (1089, 3)
+    assert np.abs(X - V).max() <= 1e-9 * bbox_diagonal(V)
 
 
 def test_minimal_example_converges(tmp_path, capsys):
@@ -74,6 +113,15 @@ def test_minimal_not_converged_exits_3_and_says_so(tmp_path, capsys):
     out = tmp_path / "minimal.ply"
     assert main(["minimal", NOSE, str(out), "--max-iterations", "1", "--tol", "1e-12"]) == 3
     assert "not converged" in capsys.readouterr().out and out.exists()
+    # one step, as the library takes it with the same options
+    from curvdetail import minimal_surface
+
+    V, F = read_mesh(NOSE)
+    expected = minimal_surface(V, F, boundary_vertices(F), max_iterations=1, tol=1e-12)
+    assert expected.iterations == 1 and not expected.converged
+    X, G = read_mesh(out)
+    assert np.array_equal(G, F)
+    assert np.abs(X - expected).max() <= 1e-12 * bbox_diagonal(V)
 
 
 @pytest.mark.parametrize("command", ["reconstruct", "minimal"])
@@ -131,7 +179,10 @@ def test_overwrite_replaces_output(tmp_path):
     out = tmp_path / "keep.ply"
     out.write_text("old")
     assert main(["reconstruct", NOSE, str(out), "--overwrite"]) == 0
-    assert read_mesh(out)[0].shape == (640, 3)
+    V, F = read_mesh(NOSE)
+    X, G = read_mesh(out)
+    assert X.shape == (640, 3) and np.array_equal(G, F)
+    assert np.abs(X - V).max() <= 1e-9 * bbox_diagonal(V)
 
 
 def test_minimal_on_a_closed_mesh_fails_cleanly(tmp_path, capsys):

@@ -51,6 +51,14 @@ def test_handle_detail_and_relations_options_change_only_the_interior(tmp_path):
     for other in (B, C):                      # constrained vertices: the same in all three
         assert np.array_equal(A[status != 1], other[status != 1])
     assert np.abs(A - B)[status == 1].max() > 1e-3
+    # --relations reaches the editor: the free vertices move, to where the library puts them
+    assert np.abs(A - C)[status == 1].max() > 1e-2             # 0.063
+    from curvdetail.curvature._validate import bbox_diagonal
+    from curvdetail.deformation_benchmark import edit_with_selection
+
+    expected = edit_with_selection(V, F, status, T, relations="one+two-ring")
+    assert np.abs(C - expected).max() <= 1e-6 * bbox_diagonal(V)
+    assert np.abs(A - edit_with_selection(V, F, status, T)).max() <= 1e-6 * bbox_diagonal(V)
 
 
 def test_existing_output_is_refused_without_overwrite(tmp_path, capsys):

@@ -73,4 +73,5 @@ def test_is_extensive_under_refinement():
 
 
 def test_docstring_example_runs():
-    assert doctest.testmod(importlib.import_module("curvdetail.curvature.curvature_detail")).failed == 0
+    result = doctest.testmod(importlib.import_module("curvdetail.curvature.curvature_detail"))
+    assert result.attempted > 0 and result.failed == 0, result

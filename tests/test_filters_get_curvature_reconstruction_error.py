@@ -77,6 +77,30 @@ def test_rebuilt_copy_of_itself_has_no_error():
     assert figures["hausdorff_max"] < 1e-6
 
 
+def test_rebuild_of_a_moved_plane_from_its_stored_detail_has_no_error():
+    # the copy above is rebuilt into itself, which leaving it alone does too. Here the known
+    # answer is not the input: a flat square's detail is stored, then its interior is lifted into
+    # a bump 0.1 high (moving vertices keeps the stored detail). The detail's z parts are all 0,
+    # so the rebuild (boundary fixed) puts every vertex back into z = 0 within the square: the
+    # same surface as the source, error 0, while the lifted layer is 0.1 off
+    V, F = grid(21, 21)
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(V, F.astype(np.int32)), "plane")
+    ms.generate_copy_of_current_mesh()
+    apply(ms, "compute_curvature_detail")
+    ms.compute_coord_by_function(x="x", y="y", z="1.6*x*(1-x)*y*(1-y)")      # 0 on the boundary
+    assert ms.current_mesh().vertex_matrix()[:, 2].max() == pytest.approx(0.1, rel=1e-12)
+    lifted = apply(ms, "get_curvature_reconstruction_error", samplenum=5000)
+    assert lifted["sampled_to_target_max"] == pytest.approx(0.1 / np.sqrt(2.0), rel=0.02)
+    apply(ms, "apply_curvature_reconstruction")
+    X = ms.mesh(1).vertex_matrix()
+    assert np.abs(X[:, 2]).max() < 1e-12
+    assert X[:, :2].min() >= -1e-12 and X[:, :2].max() <= 1 + 1e-12
+    figures = apply(ms, "get_curvature_reconstruction_error", samplenum=5000)
+    assert figures["hausdorff_max"] < 1e-9 and figures["hausdorff_rms"] < 1e-9
+    assert np.abs(ms.mesh(1).vertex_scalar_array()).max() < 1e-9    # quality: distance to the source
+
+
 def test_same_layer_twice_is_refused():
     ms = pymeshlab.MeshSet()
     ms.load_new_mesh(os.path.join(DATA, "mannequin_nose.obj"))

@@ -53,8 +53,19 @@ def test_quality_is_set_exactly(ms, rng):
 
 def test_write_on_another_layer_keeps_the_current_one(ms, rng):
     ms.load_new_mesh(os.path.join(DATA, "terrainA_1k.obj"))
-    set_vertex_quality(ms, 0, rng.normal(size=640))
+    terrain = ms.mesh(1)
+    V1, F1, q1 = terrain.vertex_matrix().copy(), terrain.face_matrix().copy(), terrain.vertex_scalar_array().copy()
+    V0 = ms.mesh(0).vertex_matrix().copy()
+    q = rng.normal(size=640)
+    set_vertex_quality(ms, 0, q)
     assert ms.current_mesh_id() == 1
+    # layer 0 got the values (and kept its positions), layer 1 is as loaded
+    assert np.array_equal(ms.mesh(0).vertex_scalar_array(), q)
+    assert np.array_equal(ms.mesh(0).vertex_matrix(), V0)
+    assert ms.current_mesh().vertex_number() == 1089
+    assert np.array_equal(ms.current_mesh().vertex_matrix(), V1)
+    assert np.array_equal(ms.current_mesh().face_matrix(), F1)
+    assert np.array_equal(ms.current_mesh().vertex_scalar_array(), q1)
 
 
 def test_wrong_shape_and_nan_are_refused(ms):

@@ -144,8 +144,23 @@ def test_misnamed_meshlab_step_says_what_meshlab_calls_it(tmp_path, name, words)
     path = write(tmp_path, f'<filter name="{name}"/>')
     with pytest.raises(ScriptError, match=words + r".*as MeshLab writes it \(Filters > Show current filter script\)"):
         run_script(meshset(), path)
-    # the name MeshLab writes runs
-    run_script(meshset(), write(tmp_path, '<filter name="Remove Duplicate Vertices"/>'))
+    # the name MeshLab writes runs, and does what it says: a grid whose vertex 5 is also stored
+    # as vertex 16 (used by one triangle) gets its 16 distinct vertices back
+    from curvdetail.curvature.testing import grid
+
+    V, F = grid(4, 4)
+    F = F.copy()
+    row = int(np.flatnonzero((F == 5).any(axis=1))[0])
+    F[row][F[row] == 5] = 16
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(np.vstack([V, V[5]]), F.astype(np.int32)))
+    assert ms.current_mesh().vertex_number() == 17
+    run_script(ms, write(tmp_path, '<filter name="Remove Duplicate Vertices"/>'))
+    assert ms.current_mesh().vertex_number() == 16
+    assert np.array_equal(ms.current_mesh().vertex_matrix(), V)
+    def triangles(T):
+        return sorted(tuple(np.roll(t, -int(np.argmin(t)))) for t in T.tolist())
+    assert triangles(ms.current_mesh().face_matrix()) == triangles(grid(4, 4)[1])
 
 
 @pytest.mark.parametrize("body", [NATIVE_BORDER,
@@ -317,8 +332,15 @@ def test_a_script_pymeshlab_saved_runs_through_the_checks(tmp_path):
 @pytest.mark.parametrize("value", ["True", "TRUE", "1", "true"])
 def test_native_bools_meshlab_reads_as_written_pass(tmp_path, value):
     # MeshLab reads any text but "false" as true: these mean what it reads
-    body = f'<filter name="Laplacian Smooth"><Param name="Boundary" value="{value}" type="RichBool"/></filter>'
-    run_script(meshset(), write(tmp_path, body))
+    def smoothed(text):
+        body = f'<filter name="Laplacian Smooth"><Param name="Boundary" value="{text}" type="RichBool"/></filter>'
+        ms = meshset()
+        run_script(ms, write(tmp_path, body, name=f"{text}.mlx"))
+        return ms.current_mesh().vertex_matrix()
+
+    # the mesh MeshLab's own "true" gives, which differs from "false" (the boundary is smoothed)
+    assert np.array_equal(smoothed(value), smoothed("true"))
+    assert np.abs(smoothed(value) - smoothed("false")).max() > 1e-6
 
 
 def test_a_native_float_with_an_underscore_is_refused(tmp_path):

@@ -74,7 +74,9 @@ def test_overwrite_replaces_the_file(tmp_path, nose):
     path = tmp_path / "replace.off"
     path.write_text("old")
     write_mesh(path, V, F, overwrite=True)
-    assert read_mesh(path)[0].shape == V.shape
+    W, G = read_mesh(path)                  # the new mesh, to OFF's 16 digits (as the round trip)
+    assert np.array_equal(G, F)
+    assert np.abs(W - V).max() <= 4 * np.finfo(float).eps * np.abs(V).max()
 
 
 @pytest.mark.parametrize("umask", [0o022, 0o027, 0o002], ids=["022", "027", "002"])
@@ -370,6 +372,13 @@ def test_polygons_are_triangulated_not_reported(tmp_path):
     path.write_text("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n")
     V, F = read_mesh(path)
     assert V.shape == (4, 3) and F.shape == (2, 3)
+    assert V.tolist() == [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
+    # the unit square split along one diagonal, both triangles facing +z as the quad does
+    up = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+    assert np.allclose(up[:, :2], 0.0) and np.array_equal(up[:, 2], [1.0, 1.0])     # doubled areas
+    assert 0.5 * up[:, 2].sum() == 1.0
+    assert {frozenset(f) for f in F.tolist()} in ({frozenset({0, 1, 2}), frozenset({0, 2, 3})},
+                                                  {frozenset({0, 1, 3}), frozenset({1, 2, 3})})
 
 
 def test_reads_the_shipped_meshes_in_file_order():
@@ -452,7 +461,8 @@ def test_docstring_examples_run():
     import doctest
     import importlib
 
-    assert doctest.testmod(importlib.import_module("curvdetail.io"), optionflags=doctest.ELLIPSIS).failed == 0
+    result = doctest.testmod(importlib.import_module("curvdetail.io"), optionflags=doctest.ELLIPSIS)
+    assert result.attempted > 0 and result.failed == 0, result
 
 
 def test_written_off_is_plain_geometry_that_other_readers_take(tmp_path):
@@ -648,6 +658,17 @@ def test_single_precision_formats_refuse_a_small_mesh_far_from_the_origin(tmp_pa
         write_mesh(tmp_path / f"m.{ext}", V + 1e7, F)
     assert not (tmp_path / f"m.{ext}").exists()
     write_mesh(tmp_path / f"n.{ext}", V + 10.0, F)                         # near the origin: accepted
+    # and read back as written, within the 1e-4 of the diagonal the check allows (STL merges and
+    # renumbers the vertices: each is matched to the nearest one written)
+    W, G = read_mesh(tmp_path / f"n.{ext}")
+    assert W.shape == V.shape and G.shape == F.shape
+    gap = np.linalg.norm(W[:, None, :] - (V + 10.0)[None, :, :], axis=2)
+    match = gap.argmin(axis=1)
+    assert np.array_equal(np.sort(match), np.arange(V.shape[0]))          # one to one
+    assert gap.min(axis=1).max() <= 1e-4 * np.linalg.norm(np.ptp(V, axis=0))
+    def canonical(T):                                                     # each triangle from its least corner
+        return sorted(tuple(np.roll(t, -int(np.argmin(t)))) for t in T.tolist())
+    assert canonical(match[G]) == canonical(F)
 
 
 def test_single_precision_keeps_a_terrain_in_utm_coordinates(tmp_path):

@@ -82,4 +82,5 @@ def test_flat_grid_interior_is_exactly_zero_at_regular_vertices():
 
 
 def test_docstring_example_runs():
-    assert doctest.testmod(importlib.import_module("curvdetail.curvature.mean_curvature_normal")).failed == 0
+    result = doctest.testmod(importlib.import_module("curvdetail.curvature.mean_curvature_normal"))
+    assert result.attempted > 0 and result.failed == 0, result

@@ -159,7 +159,8 @@ def test_order_of_the_fixed_vertices_does_not_matter(load_mesh):
 
 
 def test_docstring_example_runs():
-    assert doctest.testmod(importlib.import_module("curvdetail.curvature.minimal_surface")).failed == 0
+    result = doctest.testmod(importlib.import_module("curvdetail.curvature.minimal_surface"))
+    assert result.attempted > 0 and result.failed == 0, result
 
 
 @pytest.mark.parametrize("backend", available_backends())

@@ -81,4 +81,5 @@ def test_areas_scale_with_the_square_of_the_scale():
 def test_docstring_example_runs():
     mod = importlib.import_module("curvdetail.curvature.mixed_voronoi_area")
 
-    assert doctest.testmod(mod).failed == 0
+    result = doctest.testmod(mod)
+    assert result.attempted > 0 and result.failed == 0, result

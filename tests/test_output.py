@@ -132,7 +132,8 @@ def test_a_folder_that_refuses_files_is_named_not_the_temporary_file(tmp_path):
 
 
 def test_doctests():
-    assert doctest.testmod(importlib.import_module("curvdetail._output")).failed == 0
+    result = doctest.testmod(importlib.import_module("curvdetail._output"))
+    assert result.attempted > 0 and result.failed == 0, result
 
 
 def test_filter_output_mesh_has_normal_permissions(tmp_path, umask_022):

@@ -211,13 +211,17 @@ def test_ply_vertex_lines_of_whole_rows_are_read_as_pymeshlab_reads_them(tmp_pat
     assert V.tolist() == [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
 
 
-@pytest.mark.parametrize("body", [
-    "0 0 0 1 0\n0 1 1 0 0\n1 0\n3 0 1 2\n3 0 2 3\n",         # 5 + 5 + 2: rows cut across lines
-    "0 0 0\n1 0 0\n1 1 0\n0 1 0 3 0 1\n2\n3 0 2 3\n",       # the last vertex and a face on one line
+@pytest.mark.parametrize("body, where", [
+    ("0 0 0 1 0\n0 1 1 0 0\n1 0\n3 0 1 2\n3 0 2 3\n",        # 5 + 5 + 2: rows cut across lines
+     r"3 lines hold .* \(first: line 11, '0 0 0 1 0', 5 values\)"),
+    ("0 0 0\n1 0 0\n1 1 0\n0 1 0 3 0 1\n2\n3 0 2 3\n",      # the last vertex and a face on one line
+     r"1 lines hold .* \(first: line 14, '0 1 0 3 0 1', 6 values\)"),
 ])
-def test_ply_vertex_lines_that_cut_rows_are_still_refused(tmp_path, body):
-    with pytest.raises(ValueError):
+def test_ply_vertex_lines_that_cut_rows_are_still_refused(tmp_path, body, where):
+    with pytest.raises(ValueError, match=r"lines hold a number of values other than the 3 of a vertex row "
+                                         r"\(x y z\)") as info:
         check_before_loading(_ply(tmp_path, _PLY_HEAD + body))
+    assert info.match(where) and "write each row on a line of its own" in str(info.value)
 
 
 @pytest.mark.parametrize("count, index, readable", [("uchar", "int", True), ("char", "uint", True),

@@ -310,7 +310,8 @@ def test_docstring_examples_run():
     import doctest
     import importlib
 
-    assert doctest.testmod(importlib.import_module("curvdetail.curvature._validate"), optionflags=doctest.ELLIPSIS).failed == 0
+    result = doctest.testmod(importlib.import_module("curvdetail.curvature._validate"), optionflags=doctest.ELLIPSIS)
+    assert result.attempted > 0 and result.failed == 0, result
 
 
 def test_boundary_functions_take_sparse_huge_indices_without_allocating_or_overflowing():
