@@ -276,3 +276,12 @@ def test_aligned_normals_take_the_largest_triangle_as_reference():
     for F in (np.array(fan + [[0, 1, 5]]), np.array([[0, 1, 5]] + fan)):
         n0 = _vertex_normals(V, F, aligned=True)[0]
         assert abs(abs(n0[2]) - 1.0) < 0.05, F.tolist()
+
+
+@pytest.mark.parametrize("step", ["half", np.array(["full"]), ["normal", "full"]])
+def test_a_step_that_is_not_normal_or_full_is_refused(step):
+    # an array was compared with ``in`` element-wise: np.array(["full"]) passed as the step
+    V, F = grid(4, 4)
+    shown = "'half'" if isinstance(step, str) else r".* \((ndarray|list), not a single str\)"
+    with pytest.raises(ValueError, match=rf"step={shown}; use 'normal' \(the step across the surface\) or 'full'"):
+        minimal_surface(V, F, boundary_vertices(F), step=step)

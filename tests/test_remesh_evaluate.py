@@ -141,6 +141,15 @@ def test_bool_huge_or_fractional_counts_are_refused(kwargs, words):
         hausdorff(V, F, V, F, engine="kdtree", **kwargs)
 
 
+@pytest.mark.parametrize("engine", ["octree", np.array(["kdtree"]), ["meshlab", "kdtree"]])
+def test_an_engine_that_is_not_one_of_the_two_is_refused(engine):
+    # an array was compared with ``in`` element-wise: np.array(["kdtree"]) passed as the engine
+    V, F = grid(5, 5)
+    shown = "'octree'" if isinstance(engine, str) else r".* \((ndarray|list), not a single str\)"
+    with pytest.raises(ValueError, match=rf"engine={shown}; use 'meshlab' or 'kdtree'"):
+        hausdorff(V, F, V, F, engine=engine)
+
+
 def test_kdtree_seed_none_draws_fresh_samples():
     # surfaces whose distances vary over the samples: a new draw gives another RMS, while a
     # fixed seed repeats its figures bit for bit

@@ -83,6 +83,12 @@ def test_bad_options_are_refused(load_mesh):
         transfer_curvature(V, F, V, F, method="nearest")
     with pytest.raises(ValueError, match="needs uv="):
         transfer_curvature(V, F, V, F, location="uv")
+    # an array was compared with ``in`` element-wise: one entry passed as the option, two raised
+    # numpy's "truth value ... is ambiguous"
+    with pytest.raises(ValueError, match=r"method=array\(.*\(ndarray, not a single str\) is not a transfer"):
+        transfer_curvature(V, F, V, F, method=np.array(["pointwise", "conservative"]))
+    with pytest.raises(ValueError, match=r"location=\('closest',\) \(tuple, not a single str\); use 'closest'"):
+        transfer_curvature(V, F, V, F, location=("closest",))
 
 
 def _bad_mesh(kind):

@@ -189,6 +189,14 @@ def test_environment_variable_overrides_auto(monkeypatch):
     assert factorize(_normal_equations(20)[0]).backend == "banded"   # "auto" spelled out is auto
 
 
+@pytest.mark.parametrize("backend", [np.array(["splu"]), np.array(["splu", "pardiso"]), ["splu"], 3])
+def test_a_backend_that_is_not_one_str_is_refused_as_such(backend):
+    # ``in`` compared an array element-wise: numpy's "truth value ... is ambiguous" for two entries
+    with pytest.raises(SolverError, match=r"backend=.* \((ndarray|list|int), not a single str\) is not a solver "
+                                          r"backend; choose one of pardiso, cholmod, splu, banded or 'auto'"):
+        resolve_backend(backend)
+
+
 def test_unknown_backend_is_refused_with_the_choices():
     with pytest.raises(SolverError, match="unknown solver backend 'umfpack'.*pardiso, cholmod, splu, banded"):
         resolve_backend("umfpack")

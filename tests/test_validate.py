@@ -348,3 +348,18 @@ def test_an_integer_0_1_mask_is_named_as_such_with_both_fixes():
         as_index_set(mask, 25, "fixed")
     with pytest.raises(ConstraintError, match=r"repeated \(first: 3\); list each vertex once\.$"):
         as_index_set([3, 3], 25, "fixed")                  # a plain repeat gets no mask hint
+
+
+def test_check_choice_takes_one_str_of_the_choices_and_names_anything_else():
+    from curvdetail.curvature._validate import check_choice
+
+    assert check_choice("free", "rows", ("all", "free"), "; use 'all' or 'free'.") == "free"
+    assert type(check_choice(np.str_("all"), "rows", ("all", "free"), ".")) is str
+    with pytest.raises(ValueError, match=r"^rows='some'; use 'all' or 'free'\.$"):
+        check_choice("some", "rows", ("all", "free"), "; use 'all' or 'free'.")
+    # ``value in choices`` compares an array element-wise: one entry passed, two raised numpy's
+    # "truth value ... is ambiguous"; neither is an option value
+    for value, kind in ((np.array(["all"]), "ndarray"), (np.array(["all", "free"]), "ndarray"),
+                        (["all"], "list"), (None, "NoneType")):
+        with pytest.raises(ConstraintError, match=rf"^rows=.* \({kind}, not a single str\); use"):
+            check_choice(value, "rows", ("all", "free"), "; use 'all' or 'free'.", ConstraintError)
