@@ -10,12 +10,24 @@ from curvdetail.curvature.testing import cylinder, disk, grid, icosphere
 
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
 
-#: Real disk-topology patches shipped in tests/data (source and terms in tests/data/README.md).
-DISK_PATCHES = ("mannequin_nose.obj", "mannequin_ear.obj", "terrainA_1k.obj")
-
 
 def data_path(name):
     return os.path.join(DATA, name)
+
+
+def jittered_grid(nx, ny, seed, *, jitter=0.2, heights=0.0):
+    """A grid triangulation of the unit square whose interior vertices are moved by up to
+    ``jitter`` of the spacing in x and y (at most 0.2: an affine image of a square grid jittered
+    that much, so no triangle folds; about half the triangles come out obtuse), lifted by
+    ``heights`` times a random smooth height field (0: flat). Returns ``(V, F, interior)``."""
+    rng = np.random.default_rng(seed)
+    V, F = grid(nx, ny)
+    interior = np.flatnonzero((V[:, 0] > 0) & (V[:, 0] < 1) & (V[:, 1] > 0) & (V[:, 1] < 1))
+    spacing = np.array([1.0 / (nx - 1), 1.0 / (ny - 1)])
+    V[interior, :2] += rng.uniform(-jitter, jitter, (interior.size, 2)) * spacing
+    a, b, c = rng.uniform(-1.0, 1.0, 3)
+    V[:, 2] = heights * (a * np.sin(2.0 * V[:, 0] + b) + c * V[:, 0] * V[:, 1] ** 2)
+    return V, F, interior
 
 
 @pytest.fixture(scope="session")

@@ -6,11 +6,16 @@ import importlib
 import numpy as np
 import pytest
 import scipy.sparse as sp
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.spatial.transform import Rotation
 
 from curvdetail import MeshError, cotan_laplacian
 from curvdetail.curvature import _geometry
 from curvdetail.curvature import cotan_laplacian as module_function
 from curvdetail.curvature.testing import grid, icosphere
+
+from conftest import jittered_grid
 
 S3 = np.sqrt(3.0)
 
@@ -131,3 +136,35 @@ def test_threaded_check_refuses_a_zero_area_triangle_without_warnings(monkeypatc
         warnings.simplefilter("error")
         with pytest.raises(MeshError, match="zero area"):
             cotan_laplacian(V, F)
+
+
+# -- properties on random meshes (hypothesis, derandomized: the same examples on every run) -----
+
+_RANDOM_MESHES = dict(nx=st.integers(3, 9), ny=st.integers(3, 9), seed=st.integers(0, 2**32 - 1))
+
+
+@settings(max_examples=60, derandomize=True, deadline=None)
+@given(**_RANDOM_MESHES, rotation=st.tuples(*[st.floats(-3.0, 3.0)] * 3),
+       scale=st.floats(1e-3, 1e3), shift=st.tuples(*[st.floats(-1e3, 1e3)] * 3))
+def test_linear_functions_are_harmonic_on_any_planar_triangulation(nx, ny, seed, rotation, scale, shift):
+    # linear precision: on a flat mesh, sum_j w_ij (x_i - x_j) = 0 at every interior vertex for
+    # cotangent weights w_ij, whatever the triangles (obtuse ones included), placed anywhere in space
+    V, F, interior = jittered_grid(nx, ny, seed)
+    W = scale * V @ Rotation.from_rotvec(rotation).as_matrix().T + shift
+    L = cotan_laplacian(W, F)
+    assert np.abs(L @ (W - shift))[interior].max() <= 1e-12 * scale * np.abs(L).max()
+    # and the boundary rows do not vanish: the flat patch's boundary curvature
+    assert np.abs(L @ (W - shift)).max() > 1e-3 * scale * np.abs(L).max()
+
+
+@settings(max_examples=60, derandomize=True, deadline=None)
+@given(**_RANDOM_MESHES, heights=st.floats(0.0, 2.0))
+def test_is_symmetric_positive_semidefinite_with_zero_row_sums_on_random_surfaces(nx, ny, seed, heights):
+    V, F, _ = jittered_grid(nx, ny, seed, heights=heights)
+    L = cotan_laplacian(V, F).toarray()
+    size = np.abs(L).max()
+    assert np.array_equal(L, L.T)
+    assert np.abs(L.sum(axis=1)).max() <= 1e-14 * size * L.shape[0]
+    # the Dirichlet energy x^T L x is a sum of w_ij (x_i - x_j)^2 with w_ij possibly negative
+    # across obtuse corners, yet never negative: its smallest eigenvalue is 0 (the constants)
+    assert np.linalg.eigvalsh(L)[0] >= -1e-12 * size
