@@ -15,6 +15,19 @@ def data_path(name):
     return os.path.join(DATA, name)
 
 
+def every_backend(exclude=()):
+    """Every solver backend as a pytest parameter, skipped with a reason where it is not
+    installed (CHOLMOD needs scikit-sparse, which CI does not install), so the report counts
+    what did not run instead of leaving it out without a word."""
+    from curvdetail import available_backends
+    from curvdetail.curvature.sparse_solver import BACKENDS
+
+    installed = available_backends()
+    return [pytest.param(name, marks=pytest.mark.skipif(name not in installed, reason=f"solver backend {name!r} "
+                                                        "not installed (pip install -e '.[cholmod]' for CHOLMOD)"))
+            for name in BACKENDS if name not in exclude]
+
+
 def jittered_grid(nx, ny, seed, *, jitter=0.2, heights=0.0):
     """A grid triangulation of the unit square whose interior vertices are moved by up to
     ``jitter`` of the spacing in x and y (at most 0.2: an affine image of a square grid jittered

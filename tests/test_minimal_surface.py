@@ -12,6 +12,8 @@ from curvdetail import (ConstraintError, MeshError, available_backends, boundary
 from curvdetail.curvature._validate import bbox_diagonal, face_double_areas
 from curvdetail.curvature.testing import cylinder, grid
 
+from conftest import every_backend
+
 
 def _catenoid_parameter():
     # a cosh(0.5 / a) = 1 has two roots; the stable (outer) catenoid is the larger, a ~ 0.848
@@ -163,7 +165,7 @@ def test_docstring_example_runs():
     assert result.attempted > 0 and result.failed == 0, result
 
 
-@pytest.mark.parametrize("backend", available_backends())
+@pytest.mark.parametrize("backend", every_backend())
 def test_steps_are_the_textbook_iteration_with_one_symbolic_analysis(load_mesh, backend):
     # three Pinkall-Polthier steps written out with scipy's spsolve, against minimal_surface,
     # which factors once and then only refactors the numeric values on the same pattern
