@@ -19,6 +19,24 @@ def _diag(V):
     return np.linalg.norm(V.max(0) - V.min(0))
 
 
+class _InexactSolves:
+    """A factorization whose every solve comes back 1e-8 (relative) off: a stand-in for normal
+    equations that lose cond^2 * eps, with an error that rounding on no machine can hide. The
+    plain solve is then ~1e-8 off, and each corrected semi-normal step contracts the error by
+    ~1e-8. (Asserting that the exact solves' plain error is large depended on the machine's
+    rounding; "refined <= plain" does not hold by construction either: refine_least_squares
+    does not keep the better iterate, and at the rounding floor a step may add rounding.)"""
+
+    def __init__(self, factor):
+        self.factor = factor
+
+    def __getattr__(self, name):
+        return getattr(self.factor, name)
+
+    def solve(self, b):
+        return self.factor.solve(b) * (1 + 1e-8)
+
+
 @pytest.mark.parametrize("relations", ["one-ring", "one+two-ring"])
 def test_rest_constraints_reproduce_the_patch(load_mesh, relations):
     V, F = load_mesh("mannequin_nose.obj")
@@ -67,9 +85,16 @@ def test_constraints_are_kept_exactly_and_outside_roi_is_untouched(load_mesh):
     assert np.array_equal(X[handle], P)
     assert np.array_equal(X[outside], V[outside])
     assert np.all(np.isfinite(X))
-    # the region moved with the handle, decaying towards its border
-    moved = np.linalg.norm(X - V, axis=1)
-    assert moved[roi].max() > 0.5 * 0.05 * _diag(V)
+    # the free part of the region moved with the handle, decaying towards the region's border.
+    # (Over all of roi this held with the free vertices left at rest: the handles are in it.)
+    # Measured, in units of the handle's move: free max 1.0; median 0.64 over the free vertices
+    # nearer the centre than their median distance, 0.12 over the farther ones.
+    lift = np.linalg.norm(X - V, axis=1) / (0.05 * _diag(V))
+    free = np.setdiff1d(roi, handle)
+    near = dist[free] <= np.median(dist[free])
+    assert lift[free].max() > 0.5
+    assert np.median(lift[free][near]) > 0.3
+    assert np.median(lift[free][near]) > 2 * np.median(lift[free][~near])
 
 
 def test_changing_the_callers_arrays_afterwards_does_not_change_the_editor(load_mesh):
@@ -124,8 +149,12 @@ def test_the_normal_equation_embedding_is_refined_to_solver_precision(load_mesh)
     b = boundary_vertices(F)
     ed = CurvatureEditor(V, F, b, np.arange(V.shape[0]), rows="all")
     assert np.abs(ed.solve() - V).max() < 1e-14 * _diag(V)
+    # the step is what does it: with solves 1e-8 off (see _InexactSolves) the plain embedding
+    # comes back ~4e-9 of the diagonal off (measured 3.8e-9), refined 2e-16 (measured)
+    ed._embed = _InexactSolves(ed._embed)
+    assert np.abs(ed.solve() - V).max() < 1e-14 * _diag(V)
     ed.refinement_steps = 0
-    assert np.abs(ed.solve() - V).max() > 1e-14 * _diag(V)          # the step is what does it
+    assert np.abs(ed.solve() - V).max() > 1e-10 * _diag(V)
 
 
 def test_bump_in_a_plane_is_a_detail_island_and_keeps_its_shape():
@@ -388,15 +417,21 @@ def test_one_plus_two_ring_normal_equations_are_refined_to_the_rest_shape(load_m
     # the stacked normal equations square the coefficients' condition number: without
     # refinement fandisk with 3 handles came back 7e-3 ... 3e-2 of the diagonal off and was
     # refused, where one-ring gives 2e-6; refined, 1e-11 and better. Here: the ear, whose
-    # unrefined rest shape came back 1.5e-10 ... 1.6e-9 of the diagonal off (1e-15 refined)
+    # unrefined rest shape came back 1.5e-10 ... 1.6e-9 of the diagonal off (1e-15 refined;
+    # the unrefined figures are rounding, which another machine may make smaller)
     V, F = load_mesh("mannequin_ear.obj")
     for seed in range(3):
         h = np.random.default_rng(seed).choice(V.shape[0], 3, replace=False)
         ed = CurvatureEditor(V, F, h, h, relations="one+two-ring")
         assert ed.rest_error < 1e-13
         assert np.linalg.norm(ed.solve() - V, axis=1).max() < 1e-13 * _diag(V)
-    ed.refinement_steps = 0                   # the plain normal equations, as before
-    assert np.linalg.norm(ed.solve() - V, axis=1).max() > 1e-12 * _diag(V)
+        # the refinement is what does it: with both stages' solves 1e-8 off (see _InexactSolves)
+        # the plain normal equations come back ~8e-9 of the diagonal off (measured 7.7e-9 ...
+        # 8.7e-9), refined 1.5e-15 at most (measured)
+        ed._curv, ed._embed = _InexactSolves(ed._curv), _InexactSolves(ed._embed)
+        assert np.linalg.norm(ed.solve() - V, axis=1).max() < 1e-13 * _diag(V)
+        ed.refinement_steps = 0                   # the plain normal equations, as before
+        assert np.linalg.norm(ed.solve() - V, axis=1).max() > 1e-10 * _diag(V)
 
 
 def test_rest_error_is_rounding_where_the_constraints_determine_the_edit(load_mesh):
@@ -408,7 +443,11 @@ def test_rest_error_is_rounding_where_the_constraints_determine_the_edit(load_me
     h = np.random.default_rng(0).choice(V.shape[0], 8, replace=False)
     ed = CurvatureEditor(V, F, h, h)
     error = np.linalg.norm(ed.solve() - V, axis=1).max() / _diag(V)
-    assert 1e-11 < ed.rest_error < 1e-9 and ed.rest_error == pytest.approx(error, rel=1e-2)
+    # measured: rest_error 1.45e-10, the solve's error the same to 4e-7. Both are rounding, so
+    # no lower bound (another machine may round better); the agreement allows the embedding's
+    # own rounding (abs: ~1e-16 measured, 1e-13 allowed), so a rest_error of 0 fails here
+    assert ed.rest_error < 1e-9
+    assert ed.rest_error == pytest.approx(error, rel=1e-2, abs=1e-13)
 
 
 def test_one_plus_two_ring_refusals_name_the_one_ring_relations_that_determine_them():

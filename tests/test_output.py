@@ -116,19 +116,28 @@ def test_output_path_that_is_not_a_path_is_named(tmp_path):
     assert (tmp_path / "b.txt").exists()
 
 
-def test_a_folder_that_refuses_files_is_named_not_the_temporary_file(tmp_path):
-    folder = tmp_path / "ro"
+def test_a_folder_that_refuses_files_is_named_not_the_temporary_file(tmp_path, monkeypatch):
+    # a folder that passes the permission check (os.access) but refuses the temporary file, as
+    # /proc does for root: os.open refuses it here, as the OS would, whoever runs the test (root
+    # ignores a chmod, and the test used /proc itself), so mkstemp's own error, naming the
+    # temporary file, is what must come back naming the output
+    import errno
+
+    folder = tmp_path / "refuses"
     folder.mkdir()
-    os.chmod(folder, 0o500)
-    try:
-        if os.access(folder, os.W_OK):                  # root ignores permissions: use /proc
-            folder = "/proc"
-        with pytest.raises(OSError, match=r"cannot write '.*m\.ply': ") as info:    # its own type
-            with atomic_output(os.path.join(folder, "m.ply")):
-                pass
-        assert ".curvdetail-" not in str(info.value) and not isinstance(info.value, ValueError)
-    finally:
-        os.chmod(tmp_path / "ro", 0o700)
+    real_open = os.open
+
+    def refusing_open(path, flags, *args, **kwargs):
+        if os.path.dirname(os.fsdecode(path)) == str(folder):
+            raise PermissionError(errno.EACCES, os.strerror(errno.EACCES), os.fsdecode(path))
+        return real_open(path, flags, *args, **kwargs)
+
+    monkeypatch.setattr(os, "open", refusing_open)
+    with pytest.raises(PermissionError, match=r"cannot write '.*m\.ply': Permission denied$") as info:
+        with atomic_output(folder / "m.ply"):
+            pytest.fail("the block must not run")
+    assert ".curvdetail-" not in str(info.value)
+    assert os.listdir(folder) == []
 
 
 def test_doctests():
@@ -392,32 +401,52 @@ def test_edit_failed_mesh_rename_keeps_the_old_picture_and_mesh(tmp_path, capsys
 
 def test_sigterm_during_a_commit_lets_it_finish(tmp_path):
     # the watcher removed the temporary files at once: outputs renamed before the signal were
-    # new, the others old (one possibly missing), and the old files were left in hidden folders
+    # new, the others old (one possibly missing), and the old files were left in hidden folders.
+    # Handshakes, not sleeps: the commit goes on only once the watcher has asked for the commit
+    # lock (it was a 1 s sleep), and the main thread then waits for the watcher's thread, which
+    # only the watcher's exit ends (it was a 10 s sleep)
     script = tmp_path / "killed.py"
     script.write_text(
-        "import os, signal, sys, time\n"
-        "from curvdetail import cli\n"
+        "import os, signal, sys, threading\n"
+        "from curvdetail import _output, cli\n"
         "from curvdetail._output import Output, atomic_outputs\n"
+        "asked = threading.Event()\n"
+        "class Lock:                                  # the commit lock, telling when the watcher asks\n"
+        "    def __init__(self, lock):\n"
+        "        self.lock = lock\n"
+        "    def acquire(self, *args, **kwargs):\n"
+        "        if threading.current_thread() is not threading.main_thread():\n"
+        "            asked.set()\n"
+        "        return self.lock.acquire(*args, **kwargs)\n"
+        "    def release(self):\n"
+        "        self.lock.release()\n"
+        "    def __enter__(self):\n"
+        "        self.lock.acquire()\n"
+        "    def __exit__(self, *exc):\n"
+        "        self.lock.release()\n"
+        "_output.COMMIT_LOCK = Lock(_output.COMMIT_LOCK)\n"
         "real = os.replace\n"
         "def replace(src, dst):\n"
         "    real(src, dst)\n"
         "    if dst.endswith('a.txt'):\n"
         "        os.kill(os.getpid(), signal.SIGTERM)   # between the renames of a.txt and b.txt\n"
-        "        time.sleep(1)                          # (the GIL released: the watcher runs)\n"
+        "        asked.wait()                           # until the watcher asks for the lock\n"
         "os.replace = replace\n"
+        "before = set(threading.enumerate())\n"
         "cli._watch_sigterm()\n"
+        "(watcher,) = set(threading.enumerate()) - before\n"
         "a, b = sys.argv[1:]\n"
         "with atomic_outputs([Output(a, hint=None), Output(b, hint=None)], overwrite=True) as temps:\n"
         "    for tmp, text in zip(temps, ('new a', 'new b')):\n"
         "        open(tmp, 'w').write(text)\n"
-        "time.sleep(10)\n"
+        "watcher.join()                                 # the watcher ends the process, or returns\n"
         "print('not ended', flush=True)\n")
     out = tmp_path / "out"
     out.mkdir()
     (out / "a.txt").write_text("old a")
     (out / "b.txt").write_text("old b")
     done = subprocess.run([sys.executable, str(script), str(out / "a.txt"), str(out / "b.txt")],
-                          capture_output=True, text=True, timeout=120)
-    assert done.returncode == 128 + 15 and "not ended" not in done.stdout, done.stderr
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 128 + 15 and done.stdout == "", (done.stdout, done.stderr)
     assert ((out / "a.txt").read_text(), (out / "b.txt").read_text()) == ("new a", "new b")
     assert sorted(os.listdir(out)) == ["a.txt", "b.txt"]

@@ -182,35 +182,66 @@ def test_an_output_format_that_cannot_hold_the_mesh_is_refused_before_the_work(t
 
 def test_sigterm_ends_the_run_during_native_work_and_removes_the_temporary_files(tmp_path):
     # `timeout` and `kill` send SIGTERM: it left .curvdetail-*.png/.ply behind, and a Python
-    # handler alone would wait for the native call in progress (10 s and more on big meshes)
+    # handler alone would wait for the native call in progress (10 s and more on big meshes).
+    # The native call is os.system: its shell sends the SIGTERM (so the signal comes while the
+    # call is in progress), says so on a pipe, and waits on another that only this test writes
+    # to, so the call cannot end before the watcher acts, however slow the machine. (It was
+    # eigvalsh on 2000 x 2000, ~1 s, raced against the watcher's wake-up, after a kill that a
+    # Python handler could take before the call even began; and as a Python handler runs
+    # before the next line after the call, only the test's own release tells "after" apart.)
+    import select
     import subprocess
     import sys
 
     script = tmp_path / "killed.py"
     script.write_text(
-        "import os, signal, sys\n"
-        "import numpy as np\n"
+        "import os, sys\n"
         "import curvdetail.io\n"
         "from curvdetail.cli import main\n"
         "real = curvdetail.io.write_mesh\n"
+        "hold, killed = map(int, os.environ['CURVDETAIL_TEST_FDS'].split())\n"
         "def write_then_killed(path, *args, **kwargs):\n"
         "    real(path, *args, **kwargs)                  # the temporary file is written ...\n"
-        "    os.kill(os.getpid(), signal.SIGTERM)         # ... and the run is killed before the rename\n"
-        "    A = np.random.default_rng(0).random((2000, 2000))\n"
-        "    try:\n"
-        "        np.linalg.eigvalsh(A + A.T)              # native work, ~1 s\n"
-        "    finally:\n"
-        "        print('the native call ended', flush=True)\n"
+        "    os.system(f'exec >/dev/null 2>&1; kill -TERM {os.getpid()}; '   # ... and the run is killed\n"
+        "              f'echo >/dev/fd/{killed}; read x </dev/fd/{hold}')      # before the rename\n"
         "curvdetail.io.write_mesh = write_then_killed\n"
         "sys.exit(main(sys.argv[1:]))\n")
     out = tmp_path / "out"
     out.mkdir()
-    done = subprocess.run([sys.executable, str(script), "remesh", os.path.join(DATA, "mannequin_nose.obj"),
-                           str(out / "o.ply"), "--report", str(out / "r.json"), "--quiet"],
-                          capture_output=True, text=True, timeout=300)
-    assert done.returncode == 128 + 15, done.stderr
-    assert "curvdetail: terminated" in done.stderr
-    assert "the native call ended" not in done.stdout          # ended during it, not after it
+    hold, release = os.pipe()           # the shell waits on this one: only the test writes to it
+    reached, killed = os.pipe()         # the shell writes to this one once the SIGTERM is sent
+    child, released = None, False
+    try:
+        with open(tmp_path / "stderr", "w") as stderr:
+            child = subprocess.Popen(
+                [sys.executable, str(script), "remesh", os.path.join(DATA, "mannequin_nose.obj"),
+                 str(out / "o.ply"), "--report", str(out / "r.json"), "--quiet"],
+                stderr=stderr, pass_fds=(hold, killed),
+                env={**os.environ, "CURVDETAIL_TEST_FDS": f"{hold} {killed}"})
+        os.close(killed)
+        killed = None
+        # readable once the shell has sent the SIGTERM (or at EOF: the child ended before)
+        assert select.select([reached], [], [], 300)[0], "the run did not reach the kill"
+        assert os.read(reached, 1) == b"\n", (tmp_path / "stderr").read_text()
+        try:
+            # the watcher ends the run in milliseconds; the bound only keeps a broken one from
+            # hanging the test: the native call is then let end, and the test fails below
+            child.wait(timeout=60)
+        except subprocess.TimeoutExpired:
+            released = True
+            os.write(release, b"\n")
+            child.wait(timeout=60)
+    finally:
+        if child is not None and child.poll() is None:
+            child.kill()
+            child.wait()
+        for fd in (hold, release, reached, killed):     # the shell, left waiting on the pipe, ends
+            if fd is not None:
+                os.close(fd)
+    stderr = (tmp_path / "stderr").read_text()
+    assert not released, "the run waited for the native call to end"   # ended during it
+    assert child.returncode == 128 + 15, stderr
+    assert "curvdetail: terminated" in stderr
     assert os.listdir(out) == []
 
 
