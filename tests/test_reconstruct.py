@@ -5,12 +5,16 @@ import importlib
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from curvdetail import (ConstraintError, MeshError, Reconstructor, SolverError, available_backends,
                         boundary_vertices, cotan_laplacian, curvature_detail, reconstruct)
 from curvdetail.curvature import sparse_solver
 from curvdetail.curvature._validate import bbox_diagonal
 from curvdetail.curvature.testing import grid, icosphere
+
+from conftest import every_backend, jittered_grid
 
 ROWS = ("all", "free")
 
@@ -206,7 +210,7 @@ def _dense_reference(V, F, D, fixed, rows):
     return _DENSE_REFERENCE[key]
 
 
-@pytest.mark.parametrize("backend", available_backends())
+@pytest.mark.parametrize("backend", every_backend())
 @pytest.mark.parametrize("rows", ROWS)
 def test_backends_agree(load_mesh, backend, rows, rng):
     # every backend, splu included, against a dense solution (not against one of them)
@@ -416,3 +420,35 @@ def test_a_stalled_refinement_raises_or_returns_its_last_iterate_as_asked():
         refine_least_squares(np.ones((4, 3)), stalled, 1)
     X = refine_least_squares(np.ones((4, 3)), stalled, 1, stall="return")
     assert np.allclose(X, 1.002, rtol=0, atol=1e-12)           # two steps: the stall is seen
+
+
+# -- properties on random surfaces (hypothesis, derandomized: the same examples on every run) ---
+
+@settings(max_examples=30, derandomize=True, deadline=None)
+@given(nx=st.integers(4, 10), ny=st.integers(4, 10), seed=st.integers(0, 2**32 - 1),
+       heights=st.floats(0.0, 2.0), rows=st.sampled_from(["all", "free"]))
+def test_round_trip_and_linearity_on_random_surfaces(nx, ny, seed, heights, rows):
+    # a surface is rebuilt exactly from its own detail with its boundary fixed, and the solve is
+    # linear in (detail, fixed positions): the answer for a D1 + b D2 is a X1 + b X2
+    V, F, _ = jittered_grid(nx, ny, seed, heights=heights)
+    b = boundary_vertices(F)
+    diag = bbox_diagonal(V)
+    rec = Reconstructor(V, F, b, rows=rows)
+    X1 = rec.solve(curvature_detail(V, F), V[b])
+    assert np.abs(X1 - V).max() <= 1e-9 * diag
+    rng = np.random.default_rng(seed)
+    D2, P2 = rng.normal(size=V.shape), rng.normal(size=(b.size, 3))
+    X2 = rec.solve(D2, P2)
+    X = rec.solve(0.5 * curvature_detail(V, F) - 2.0 * D2, 0.5 * V[b] - 2.0 * P2)
+    assert np.abs(X - (0.5 * X1 - 2.0 * X2)).max() <= 1e-9 * max(np.abs(X).max(), diag)
+    assert np.array_equal(X[b], 0.5 * V[b] - 2.0 * P2)
+
+
+@pytest.mark.parametrize("rows", ["some", np.array(["all"]), ["free"]])
+def test_a_row_mode_that_is_not_all_or_free_is_refused(rows):
+    # an array was compared with ``in`` element-wise: np.array(["all"]) passed as the row mode
+    V, F = grid(4, 4)
+    b = boundary_vertices(F)
+    shown = "'some'" if isinstance(rows, str) else r".* \((ndarray|list), not a single str\)"
+    with pytest.raises(ValueError, match=rf"rows={shown} is not a row mode; use 'all'"):
+        Reconstructor(V, F, b, rows=rows)
