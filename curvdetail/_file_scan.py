@@ -8,8 +8,11 @@ read as numbers, a vertex split over lines is read right), missing OFF rows are 
 what follows, a line of blanks among the faces repeats the face before it, OFF and OBJ indices
 and counts are read with atoi (2.5 -> 2, 2.0 -> 2) and a comment after an OBJ face becomes
 further corners; OFF face rows beyond the header's count are dropped, and a decimal comma ends
-an OFF or OBJ number (``1,5`` -> 1). PLY files are scanned by :mod:`._ply_scan`. The scans
-read the file once more, vectorized over its bytes.
+an OFF or OBJ number (``1,5`` -> 1). Its OFF and OBJ coordinates are read with atof, which takes
+any text for a number without a word: up to the first character that does not fit (``0.3abc`` ->
+0.3, ``abc`` and ``-`` -> 0, ``1d3`` -> 1), and C's hexadecimal floats too (``0x10`` -> 16).
+PLY files are scanned by :mod:`._ply_scan`. The scans read the file once more, vectorized over
+its bytes.
 """
 
 import contextlib
@@ -39,9 +42,17 @@ def check_before_loading(path, error=ValueError):
     refuses with only "Invalid file", is named as such. OBJ: indented vertex lines (the loader
     counts them in one pass and not in the other; reading one aborted the process), a fractional
     face index (truncated; 2.0 passes) and a comment after a face (read as corners out of range;
-    a one-word comment glued to the last index, ``f 1 2 3#note``, passes). OFF and OBJ: a comma
-    in a number (``v 1,5 2 3`` was read as the vertex (1, 2, 3); commas in comments and names
-    pass); OFF: rows after the header's faces (dropped; empty lines and comments pass).
+    a one-word comment glued to the last index, ``f 1 2 3#note``, passes), and a comment before a
+    vertex's z (``v 1 0#c 5`` was read as (1, 0, 5); one glued to the z, ``v 1 0 5#c``, or after
+    it passes). OFF and OBJ: a comma in a number (``v 1,5 2 3`` was read as the vertex (1, 2, 3);
+    commas in comments and names pass), and an x, y or z that is not a decimal number
+    (``[+-](digits[.digits] | .digits)[(e|E)[+-]digits]``), inf, infinity or nan (any case; the
+    loader drops such vertices, which :func:`check_loaded` reports): ``0.3abc``, ``abc``, ``-``,
+    ``1.2.3``, ``1d3``, ``0x10`` were read as 0.3, 0, 0, 1.2, 1 and 16 (the vertex colours,
+    normals and texture coordinates after them, which the mesh we keep lacks, and a comment
+    glued to a value pass); OFF: a control character on a vertex row that changes its words (the
+    reader splits them at spaces and tabs only; one that atof stops at, ``1\\x01``, passes), and
+    rows after the header's faces (dropped; empty lines and comments pass).
 
     PLY, ASCII or binary: a header pymeshlab misparses (an element count that is not a whole
     number, or none: that crashed it) and face lists of types its importer does not read (it
@@ -84,6 +95,9 @@ def check_before_loading(path, error=ValueError):
             raise error(f"{path!r}: {count} vertex lines start with spaces or tabs (first: line {line}), "
                         "which pymeshlab's OBJ loader miscounts (it crashed reading such a file); remove "
                         "the leading whitespace and read the file again.")
+        bad = _obj_bad_coordinate(path)
+        if bad is not None:
+            raise error(f"{path!r}: line {bad[0]} ({bad[1]!r}) {bad[2]}; fix the file and read it again.")
         odd = _obj_odd_face(path)
         if odd is not None and odd[1] == ".":
             raise error(f"{path!r}: the face on line {odd[0]} has a fractional index (of a vertex, texture "
@@ -252,6 +266,356 @@ def _obj_misread_dots_and_comments(chars, odd, line, ends):
     return bad_dot, bad_hash
 
 
+# The coordinate check (:func:`_obj_bad_coordinate`, :func:`_off_bad_coordinate`). pymeshlab reads
+# each coordinate with atof, which stops at the first character that does not fit and reads what
+# it has so far without a word ("0.3abc" is 0.3, "abc", "-" and "." are 0, "1e" and "1d3" are 1,
+# "1.2.3" is 1.2) and also reads C's hexadecimal floats ("0x10" is 16, "0x1p3" is 8). A decimal
+# number, [+-](digits[.digits] | .digits)[(e|E)[+-]digits], is read right (to the nearest double),
+# and so are inf, infinity and nan in any case (pymeshlab drops such vertices, which
+# _file_counts.check_loaded reports). The bytes are classed as below; digits are no class: only
+# the other bytes are looked at, each with the class of the one before and after it and whether
+# digits lie between them, which decides a number's grammar (the table _NUMBER_STEP_OK).
+_NL, _SEP, _POINT, _SIGN, _EXP, _HASH, _V, _OTHER = range(8)
+_OFF_CLASS = np.full(256, _OTHER, dtype=np.uint8)
+_OFF_CLASS[10] = _NL
+_OFF_CLASS[[9, 13, 32]] = _SEP                 # tab, carriage return, space: the words' separators
+_OFF_CLASS[46] = _POINT
+_OFF_CLASS[[43, 45]] = _SIGN
+_OFF_CLASS[[69, 101]] = _EXP                   # "E", "e"
+_OFF_CLASS[35] = _HASH
+_OBJ_CLASS = _OFF_CLASS.copy()
+_OBJ_CLASS[118] = _V                           # "v": the keyword, at a line's start only
+
+
+def _number_step_ok(before, digits_before, this, digits_after, after):
+    """Whether the non-digit byte of class ``this``, with ``before`` the class of the non-digit
+    byte before it and ``after`` of the one after it (``digits_before`` / ``digits_after``:
+    whether digits lie between), fits in a decimal number or between words. A ``"#"`` ends a
+    number (what follows in its word is no number's), an other byte in a number fails it."""
+    separator = (_NL, _SEP)
+    if this in separator:                      # the byte after a word's start
+        return {_POINT: True, _SIGN: not digits_after, _EXP: digits_after, _HASH: digits_after,
+                _OTHER: False}.get(after, True)
+    if this == _POINT:                         # a digit on one side; at most once, before an exponent
+        return (digits_before or digits_after) and after in separator + (_EXP, _HASH)
+    if this == _SIGN:                          # first in the word, or first in the exponent
+        in_exponent = before == _EXP and not digits_before
+        if after in separator + (_HASH,):
+            return digits_after
+        return not in_exponent and (after == _POINT or (after == _EXP and digits_after))
+    if this == _EXP:
+        return not digits_after if after == _SIGN else digits_after and after in separator + (_HASH,)
+    if this == _V:                             # "v" then a blank, first on its line
+        return before == _NL and not digits_before and after == _SEP and not digits_after
+    return True                                # "#" and others: judged by the bytes before them
+
+
+#: :func:`_number_step_ok` for ``((before * 2 + digits_before) * 16 + this * 2 + digits_after) * 8
+#: + after``.
+_NUMBER_STEP_OK = np.array([_number_step_ok(b // 2, b % 2, t // 2, t % 2, a)
+                            for b in range(16) for t in range(16) for a in range(8)], dtype=bool)
+_ATOF = re.compile(rb"[\x0b\x0c]*([+-]?(?:0[xX](?:[0-9a-fA-F]+\.?[0-9a-fA-F]*|\.[0-9a-fA-F]+)(?:[pP][+-]?[0-9]+)?"
+                   rb"|(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|[iI][nN][fF](?:[iI][nN][iI][tT][yY])?"
+                   rb"|[nN][aA][nN](?:\([0-9A-Za-z_]*\))?))")
+_ATOF_EXAMPLES = ("it reads a value up to the first character that does not fit: '0.3abc' is 0.3, 'abc' and '-' "
+                  "are 0, '1.2.3' is 1.2, '1d3' is 1; '0x10' is hexadecimal, 16")
+
+
+def _atof(word):
+    """What C's atof (glibc) reads from the bytes ``word``, as a string ("0.3", "16", "0")."""
+    match = _ATOF.match(word)
+    if not match:
+        return "0"
+    number = match.group(1)
+    unsigned = number.lstrip(b"+-")
+    if unsigned[:2] in (b"0x", b"0X"):
+        value = float.fromhex(number.decode())
+    elif unsigned[:1] in (b"n", b"N"):
+        value = float("nan")
+    else:
+        value = float(number.split(b"(")[0])
+    return f"{value:.15g}"
+
+
+def _number_failures(chars, classes):
+    """The non-digit bytes of ``chars`` (a uint8 array of whole lines, mostly digits) and where a
+    word breaks a decimal number's grammar (:func:`_number_step_ok`). Returns ``(at, kind, digits,
+    failed)``: the non-digit bytes' positions in ``chars`` (with two newlines put before, at -2
+    and -1, and one after, at ``chars.size``), their classes (``classes`` maps bytes to them),
+    whether digits follow each before the next, and the indices (into those) of a byte in each
+    failing word, in order."""
+    inner = np.flatnonzero((chars - np.uint8(48)) > 9)
+    at = np.empty(inner.size + 3, dtype=np.int64)
+    at[:2] = -2, -1
+    at[2:-1] = inner
+    at[-1] = chars.size
+    kind = np.empty(at.size, dtype=np.uint8)
+    kind[:2] = kind[-1] = _NL
+    np.take(classes, chars[inner], out=kind[2:-1])
+    del inner
+    digits = np.subtract(at[1:], at[:-1]) > 1
+    step = kind[:-1] << np.uint8(1)                                # class and "digits after", < 16
+    step |= digits
+    code = step[:-1].astype(np.uint16)
+    code <<= 4
+    code |= step[1:]
+    code <<= 3
+    code |= kind[2:]
+    failed = np.flatnonzero(~_NUMBER_STEP_OK[code]) + 1
+    failed += (kind[failed] == _NL) | (kind[failed] == _SEP)      # a separator's: the word after it
+    return at, kind, digits, failed
+
+
+def _failing_pieces(chars, classes, hashes_fail=False, size=1 << 18):
+    """The pieces of ``chars`` (whole lines) that hold a word :func:`_number_failures` fails (or,
+    with ``hashes_fail``, a ``"#"``), in order: ``(start, piece, at, kind, digits, failed)`` with
+    ``piece`` the bytes ``chars[start:...]`` and the rest what :func:`_number_failures` returns
+    for it. The lines are looked at in pieces of about ``size`` bytes, which keeps the arrays in
+    the processor's cache (~0.1-0.15 s for the 40-60 MB of a million vertex lines, against ~0.25 s
+    at once)."""
+    start = 0
+    while start < chars.size:
+        end = start + size
+        while end < chars.size:                                    # cut after a line
+            newline = np.flatnonzero(chars[end:end + 4096] == 10)
+            if newline.size:
+                end += int(newline[0])
+                break
+            end += 4096
+        end = min(end, chars.size)
+        piece = chars[start:end]
+        at, kind, digits, failed = _number_failures(piece, classes)
+        if failed.size or (hashes_fail and (kind == _HASH).any()):
+            yield start, piece, at, kind, digits, failed
+        start = end + 1
+
+
+def _word_bounds(kind, at, where):
+    """``(first, end)``: the indices of the separators around the non-digit bytes ``where``
+    (each in a word) among the bytes of :func:`_number_failures`."""
+    separators = np.flatnonzero((kind == _NL) | (kind == _SEP))
+    after = np.searchsorted(separators, where)
+    return separators[after - 1], separators[after]
+
+
+def _after_hash(kind, where, word_start):
+    """Which of the non-digit bytes ``where`` follow a ``"#"`` in their word (that starts after
+    the separator ``word_start``): no part of its number."""
+    hashes = np.flatnonzero(kind == _HASH)
+    if not hashes.size:
+        return np.zeros(where.size, dtype=bool)
+    last = hashes[np.maximum(np.searchsorted(hashes, where) - 1, 0)]
+    return (last < where) & (last > word_start)
+
+
+def _special_words(chars, start, end):
+    """Which of the words ``chars[start:end]`` are inf, infinity or nan (any case, signed or not):
+    read right (pymeshlab then drops the vertex, which check_loaded reports)."""
+    start = start + ((chars[start] == 43) | (chars[start] == 45))
+    length = end - start
+    special = np.zeros(start.size, dtype=bool)
+    for word in (b"inf", b"infinity", b"nan"):
+        match = length == len(word)
+        for j, letter in enumerate(word):
+            some = np.flatnonzero(match)
+            match[some] = (chars[start[some] + j] | np.uint8(32)) == letter
+        special |= match
+    return special
+
+
+_CONTROL = re.compile(rb"[\x00-\x08\x0b\x0c\x0e-\x1f]")
+_CONTROLLED_WORD = re.compile(rb"([\x00-\x08\x0b\x0c\x0e-\x1f]*)([^\x00-\x20]+)[\x00-\x08\x0b\x0c\x0e-\x1f\r]*")
+_NUMBER = re.compile(rb"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|[+-]?(?:inf|infinity|nan)", re.IGNORECASE)
+
+
+def _control_word_read_right(word, coordinate):
+    """Whether pymeshlab reads the word ``word``, which holds control characters (a byte below 32
+    other than a tab, newline or carriage return), as the scan's words have it: one run of other
+    characters, which they end (atof stops at them) or begin (for a coordinate only vertical tabs
+    and form feeds, which atof skips) and, for a ``coordinate``, a decimal number before any
+    ``"#"`` (see :func:`_number_step_ok`). Control characters are no part of a mesh file; this
+    keeps the few that pymeshlab reads past from being refused."""
+    match = _CONTROLLED_WORD.fullmatch(word)
+    if match is None:
+        return False
+    return not coordinate or (not match.group(1).strip(b"\x0b\x0c") and
+                              _NUMBER.fullmatch(match.group(2).split(b"#", 1)[0]) is not None)
+
+
+def _number_end(chars, kind, at, first, end):
+    """The end (in ``chars``) of the number part of the words between the separators ``first``
+    and ``end`` (indices of :func:`_number_failures`' bytes): its first ``"#"``, else its end."""
+    hashes = np.flatnonzero(kind == _HASH)
+    stop = at[end]
+    if hashes.size:
+        hash_ = hashes[np.minimum(np.searchsorted(hashes, first), hashes.size - 1)]
+        stop = np.where((hash_ > first) & (hash_ < end), at[hash_], stop)
+    return stop
+
+
+def _obj_bad_coordinate(path):
+    """``(1-based line, its text, message)`` for the first ``v`` line of an OBJ file whose x, y or
+    z pymeshlab's loader would misread (not a decimal number, inf or nan; a ``"#"`` before the z:
+    the comment's words are read as coordinates), or None. Only the bytes from the first ``v``
+    line to the last are looked at, and of those the ones that are not digits; the words that
+    fail (normally none) are then placed on their lines, keeping those in a ``v`` line's first
+    three values (not its colours or comment). Indented ``v`` lines must have been refused."""
+    with _mapped(path) as data:
+        if data is None:
+            return None
+        heads = (b"\nv ", b"\nv\t") if data.find(b"\t") >= 0 else (b"\nv ",)
+        first = 0 if data[:2] in (b"v ", b"v\t") else min(
+            (k + 1 for k in (data.find(head) for head in heads) if k >= 0), default=-1)
+        if first < 0:
+            return None
+        end = data.find(b"\n", max([first] + [data.rfind(head) + 1 for head in heads]))   # the last v line's
+        end = len(data) if end < 0 else end
+        chars = np.frombuffer(data, dtype=np.uint8)
+        pieces = _failing_pieces(chars[first:end], _OBJ_CLASS, hashes_fail=True)
+        found = numbers = None
+        try:
+            for piece, *numbers in pieces:
+                found = _obj_bad_coordinate_in(*numbers)
+                if found is not None:
+                    break
+            if found is None:
+                return None
+            start, stop, rank, comment, lines_before = found
+            start, stop = first + piece + start, first + piece + stop
+            line = int(np.count_nonzero(chars[:first + piece] == 10)) + lines_before + 1
+            text = bytes(data[start:stop])
+        finally:                                               # the map closes: no array may view it
+            pieces.close()
+            del chars, pieces, numbers
+    words = re.split(rb"[ \t\r]+", text.strip(b" \t\r"))
+    shown = text.decode("utf-8", "replace").strip()
+    shown = shown if len(shown) <= 80 else shown[:77] + "..."
+    read = "(" + ", ".join(_atof(word) for word in words[1:4]) + ")"
+    if comment:
+        return line, shown, (f"has a comment among its coordinates, whose words (the '#' too, as 0) pymeshlab's OBJ "
+                             f"loader reads as coordinates (the line was read as the vertex {read}); move the "
+                             "comment after the third coordinate or to a line of its own")
+    word = words[rank].decode("utf-8", "replace")
+    return line, shown, (f"has the {'xyz'[rank - 1]} coordinate {word!r}, which is not a decimal number: "
+                         f"pymeshlab's OBJ loader reads it as {_atof(words[rank])} without a word (the line was "
+                         f"read as the vertex {read}; {_ATOF_EXAMPLES}); write the coordinates as decimal "
+                         "numbers (e.g. -1.5e-3)")
+
+
+def _obj_bad_coordinate_in(chars, at, kind, digits, failed):
+    """:func:`_obj_bad_coordinate` on the bytes ``chars`` (whole lines; the rest: what
+    :func:`_number_failures` returns for them): ``(start, end, value, comment, line)`` of the
+    first bad ``v`` line: its bounds in ``chars``, the bad value's rank (1: x, 2: y, 3: z),
+    whether it is a comment, and the number of lines before it; or None."""
+    hashes = np.flatnonzero(kind == _HASH)
+    if not failed.size and not hashes.size:
+        return None
+    separator = (kind == _NL) | (kind == _SEP)
+    begins = separator[:-1] & (digits | ~separator[1:])     # a word starts after the byte
+    words_before = np.zeros(kind.size, dtype=np.int64)
+    np.cumsum(begins, out=words_before[1:])
+    newlines = np.flatnonzero(kind == _NL)
+
+    def placed(where):
+        # the line's newline, and the rank of the word holding each byte (0: the "v")
+        newline = newlines[np.searchsorted(newlines, where) - 1]
+        rank = words_before[where] - words_before[newline] - 1
+        vertex = (kind[newline + 1] == _V) & ~digits[newline] & ~digits[newline + 1] & \
+            (kind[newline + 2] == _SEP) & (chars[at[newline + 2]] != 13)
+        return newline, rank, vertex
+
+    newline, rank, vertex = placed(failed)
+    keep = vertex & (rank >= 1) & (rank <= 3)
+    failed, newline, rank = failed[keep], newline[keep], rank[keep]
+    if failed.size:
+        first, end = _word_bounds(kind, at, failed)
+        keep = ~_after_hash(kind, failed, first)
+        failed, newline, rank, first, end = failed[keep], newline[keep], rank[keep], first[keep], end[keep]
+        keep = ~_special_words(chars, at[first] + 1, _number_end(chars, kind, at, first, end))
+        failed, newline, rank, first, end = failed[keep], newline[keep], rank[keep], first[keep], end[keep]
+    hash_line, hash_rank, hash_vertex = placed(hashes)
+    keep = hash_vertex & (hash_rank >= 1) & (hash_rank <= 2)   # a comment before the z
+    hashes, hash_line = hashes[keep], hash_line[keep]
+    for k in range(failed.size):                               # the few words that fail, in order
+        if hashes.size and hashes[0] < failed[k]:
+            break
+        word = bytes(chars[at[first[k]] + 1:at[end[k]]])
+        if _CONTROL.search(word) and _control_word_read_right(word, True):
+            continue
+        line_end = newlines[np.searchsorted(newlines, failed[k])]
+        return (int(at[newline[k]]) + 1, int(at[line_end]), int(rank[k]), word.startswith(b"#"),
+                int(np.searchsorted(newlines, newline[k])) - 1)
+    if not hashes.size:
+        return None
+    line_end = newlines[np.searchsorted(newlines, hashes[0])]
+    return int(at[hash_line[0]]) + 1, int(at[line_end]), 0, True, int(np.searchsorted(newlines, hash_line[0])) - 1
+
+
+def _off_bad_coordinate(chars, token_starts, token_ends, starts, ends, rows, per_vertex, colours, first_line,
+                        text):
+    """What is wrong with the x, y and z values of an ASCII OFF file's vertex rows ``rows`` (the
+    body's line numbers; whole vertices each, or in a plain file a stream of them), or None: a
+    value that is not a decimal number, inf or nan (pymeshlab reads each with atof: see
+    :func:`_number_failures`), or a control character on a row (the reader splits words at spaces
+    and tabs only, so it is part of a word to it, which the scan's words are not). The normals,
+    texture coordinates and colours after them are not looked at (not read into the mesh we keep).
+    Only the rows' bytes that are not digits are looked at, and of those only the failing words'."""
+    if not rows.size:
+        return None
+    low = int(starts[rows[0]])
+    for piece, region, at, kind, _, failed in _failing_pieces(chars[low:int(ends[rows[-1]])], _OFF_CLASS):
+        problem = _off_bad_coordinate_in(chars, low + piece, region, at, kind, failed, token_starts, token_ends,
+                                         starts, rows, per_vertex, colours, first_line, text)
+        if problem:
+            return problem
+    return None
+
+
+def _off_bad_coordinate_in(chars, low, region, at, kind, failed, token_starts, token_ends, starts, rows,
+                           per_vertex, colours, first_line, text):
+    """:func:`_off_bad_coordinate` on the bytes ``region``, ``chars[low:...]`` (whole lines;
+    ``at``, ``kind``, ``failed``: what :func:`_number_failures` returns for them)."""
+    first, end = _word_bounds(kind, at, failed)
+    where = at[failed] + low                                   # in the body
+    line = np.searchsorted(starts, where, side="right") - 1
+    token = np.searchsorted(token_starts, where, side="right") - 1
+    inside = (token >= 0) & (where < token_ends[np.maximum(token, 0)])
+    # the scan's word in each failing one (a control character is none of them)
+    token = np.where(inside, token, np.searchsorted(token_starts, at[first] + 1 + low))
+
+    def value(token):
+        # (which value of its vertex, which vertex) the scan's word ``token`` is
+        if colours:                                            # one vertex a row: x y z first
+            row = np.searchsorted(starts, token_starts[token], side="right") - 1
+            return token - np.searchsorted(token_starts, starts[row]), np.searchsorted(rows, row)
+        stream = token - np.searchsorted(token_starts, starts[rows[0]])    # a stream of per_vertex each
+        return stream % per_vertex, stream // per_vertex
+
+    special = _special_words(region, at[first] + 1, _number_end(region, kind, at, first, end))
+    coordinate = inside & (value(np.minimum(token, token_starts.size - 1))[0] < 3) & ~special & \
+        ~_after_hash(kind, failed, first)
+    control = (chars[where] < 32) & np.isin(line, rows)       # on a vertex row
+    for k in np.flatnonzero(coordinate | control):             # the few words that fail, in order
+        word = bytes(region[at[first[k]] + 1:at[end[k]]])
+        start = low + at[first[k]] + 1
+        scan_word = np.searchsorted(token_starts, start)       # the scan's first word in it, if any
+        which, vertex = value(min(scan_word, token_starts.size - 1))
+        row = f"line {first_line + line[k]} ({text(line[k])!r})"
+        if _CONTROL.search(word):
+            if colours and which >= 3:                         # a colour: the row is one vertex anyway
+                continue
+            if scan_word < token_starts.size and token_starts[scan_word] < start + len(word) and \
+                    _control_word_read_right(word, which < 3):
+                continue
+            return (f"{row} holds the control character {bytes(chars[where[k]:where[k] + 1])!r}, which "
+                    "pymeshlab's OFF reader takes for part of a value (it splits the values at spaces and tabs "
+                    "only), shifting or misreading them; remove it")
+        return (f"{row} holds the {'xyz'[which]} coordinate {word.decode('utf-8', 'replace')!r} of vertex "
+                f"{vertex}, which is not a decimal number: pymeshlab's OFF reader reads it as {_atof(word)} "
+                f"without a word ({_ATOF_EXAMPLES}); write the coordinates as decimal numbers (e.g. -1.5e-3)")
+    return None
+
+
 def _off_rows_problem(path):
     """What is wrong with the rows of an ASCII OFF file, or None (also where it cannot tell: the
     loader and :func:`check_loaded` then judge): counts in the header that are not whole numbers,
@@ -310,7 +674,7 @@ def _off_rows_problem(path):
     per_row = per_line[rows]
 
     def text(line):
-        return bytes(body[starts[line]:ends[line]]).decode("ascii", "replace").strip()
+        return bytes(body[starts[line]:ends[line]]).decode("utf-8", "replace").strip()
 
     def too_short():
         # pymeshlab fills the missing rows from what follows: a triangle came back twice
@@ -351,6 +715,10 @@ def _off_rows_problem(path):
         return problem
     if rows.size < taken + nf or (not colours and per_row[:taken].sum() < per_vertex * nv):
         return too_short()
+    problem = _off_bad_coordinate(chars, token_starts, token_ends, starts, ends, rows[:taken], per_vertex, colours,
+                                  first_line, text)
+    if problem:
+        return problem
     after = rows[taken + nf:]
     # after the faces nothing is read: an indented comment there is a comment too
     after = after[chars[token_starts[np.searchsorted(token_starts, starts[after])]] != 35] if after.size else after
