@@ -90,6 +90,12 @@ def check_before_loading(path, error=ValueError):
                         "pymeshlab's OBJ loader reads only up to the comma without a word ('v 1,5 2 3' was "
                         "read as the vertex (1, 2, 3)); write decimals with a point (and separate values with "
                         "spaces) and read the file again.")
+        continued = _obj_continued_line(path)
+        if continued is not None:
+            raise error(f"{path!r}: line {continued[0]} ({continued[1]!r}) ends in a backslash, which "
+                        "pymeshlab's OBJ loader reads as a line continued on the next one, and then loses "
+                        "that line's vertex without a word (a vertex (0, 0, 0) took its place); remove the "
+                        "backslash and read the file again.")
         count, line = _obj_indented_vertices(path)
         if count:
             raise error(f"{path!r}: {count} vertex lines start with spaces or tabs (first: line {line}), "
@@ -159,6 +165,33 @@ def _obj_comma(path):
                 return line, text if len(text) <= 80 else text[:77] + "..."
             at = data.find(b",", end)
     return None
+
+
+def _obj_continued_line(path):
+    """``(1-based line, its text)`` of the first line of an OBJ file that ends in a backslash and
+    is not a face line, or None. pymeshlab's loader joins such a line with the next one and loses
+    what that line held: a vertex line so continued, or a comment line before a vertex, cost the
+    next vertex, and a vertex (0, 0, 0) was appended in its place, without a word (measured). A
+    continued face line is read right. Found through a memory map; only such lines are looked at."""
+    found = []
+    with _mapped(path) as data:
+        if data is None:
+            return None
+        for ending in (b"\\\n", b"\\\r\n"):           # LF and CRLF line ends
+            at = data.find(ending)
+            while at >= 0:
+                start = data.rfind(b"\n", 0, at) + 1
+                words = data[start:at + 1].split()
+                if not words or words[0] != b"f":
+                    found.append((start, at + 1))
+                    break
+                at = data.find(ending, at + len(ending))
+        if not found:
+            return None
+        start, end = min(found)
+        text = data[start:end].decode("utf-8", "replace").strip()
+        number = int(np.count_nonzero(np.frombuffer(data, dtype=np.uint8, count=start) == 10)) + 1
+    return number, text if len(text) <= 80 else text[:77] + "..."
 
 
 def _obj_indented_vertices(path):

@@ -61,7 +61,8 @@ def read_mesh(path):
                         passes); decimal commas (OFF, OBJ, ASCII PLY); vertex coordinates
                         that are not decimal numbers, which it reads as 0 or as their first
                         digits (OFF, OBJ: ``abc``, ``0.3abc``, ``0x1p3``, ``1d3``, a comment
-                        among the coordinates); a PLY header pymeshlab
+                        among the coordinates); lines other than faces ending in a backslash
+                        (OBJ: the next line's vertex is lost); a PLY header pymeshlab
                         misparses or crashes on, or face lists of types it does not read;
                         ASCII PLY values it would not read whole as their type, faces of
                         fewer than 3 or more than 255 vertices, a face row not on a line of

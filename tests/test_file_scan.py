@@ -110,7 +110,6 @@ def test_off_rows_pymeshlab_reads_right_are_read(tmp_path, name, text):
 
 def _read_as_the_two_triangles(path, text):
     from curvdetail.io import read_mesh
-
     path.write_bytes(text.encode())
     V, F = read_mesh(path)
     np.testing.assert_array_equal(V, _V4)
@@ -238,7 +237,6 @@ def test_decimal_commas_and_extra_off_faces_are_refused(tmp_path, name, text, me
 ])
 def test_commas_in_comments_and_names_and_trailing_comments_pass(tmp_path, name, text):
     from curvdetail.io import read_mesh
-
     path = tmp_path / name
     path.write_text(text)
     V, F = read_mesh(path)
@@ -379,7 +377,6 @@ def test_off_vertex_rows_pymeshlab_misreads_are_refused(tmp_path, text, message)
 @pytest.mark.parametrize("line_end", ["\n", "\r\n"])
 def test_decimal_coordinates_are_read_right(tmp_path, name, row, expected, line_end):
     from curvdetail.io import read_mesh
-
     path = tmp_path / name
     rows = _coordinate_files("1")[name].split("\n")
     rows[1 if name == "m.obj" else 3] = row
@@ -395,7 +392,6 @@ def test_decimal_coordinates_are_read_right(tmp_path, name, row, expected, line_
 ])
 def test_off_values_after_the_coordinates_are_not_judged(tmp_path, text):
     from curvdetail.io import read_mesh
-
     path = tmp_path / "m.off"
     path.write_text(text)
     V, _ = read_mesh(path)
@@ -532,3 +528,31 @@ def test_fuzzed_coordinates_the_scan_passes_are_read_right(tmp_path, extension):
         assert strict is not None, (text, V.tolist())
         np.testing.assert_array_equal(V, strict[np.isfinite(strict).all(axis=1)], err_msg=repr(text))
     assert passed >= 25 and refused >= 25                             # both kinds were tried (45+ each)
+
+
+@pytest.mark.parametrize("text, line", [
+    # pymeshlab joined the line with the next and lost that vertex: (0, 1, 0) was gone and a
+    # vertex (0, 0, 0) appended (measured with pymeshlab 2025.7)
+    ("v 0 0 0\nv 1 0 0 \\\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\n", 2),
+    ("v 0 0 0\r\nv 1 0 0 \\\r\nv 0 1 0\r\nv 0 0 1\r\nf 1 2 3\r\n", 2),
+    ("# made by hand \\\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", 1),
+])
+def test_obj_lines_continued_by_a_backslash_are_refused(tmp_path, text, line):
+    path = tmp_path / "m.obj"
+    path.write_bytes(text.encode())
+    with pytest.raises(ValueError, match=rf"line {line} \(.*\) ends in a backslash, which pymeshlab's OBJ loader "
+                                         "reads as a line continued"):
+        check_before_loading(path)
+
+
+@pytest.mark.parametrize("text, triangles", [
+    ("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 \\\n3\nf 1 3 4\n", [[0, 1, 2], [0, 2, 3]]),   # a continued face
+    ("v 0 0 0\nv 1 0 0 \\ \nv 0 1 0\nf 1 2 3\n", [[0, 1, 2]]),                                # not at the line's end
+])
+def test_obj_backslashes_pymeshlab_reads_right_pass(tmp_path, text, triangles):
+    from curvdetail.io import read_mesh
+    path = tmp_path / "m.obj"
+    path.write_bytes(text.encode())
+    V, F = read_mesh(path)
+    assert F.tolist() == triangles
+    assert V[:3].tolist() == [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
