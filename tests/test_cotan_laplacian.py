@@ -143,7 +143,7 @@ def test_threaded_check_refuses_a_zero_area_triangle_without_warnings(monkeypatc
 _RANDOM_MESHES = dict(nx=st.integers(3, 9), ny=st.integers(3, 9), seed=st.integers(0, 2**32 - 1))
 
 
-@settings(max_examples=60, derandomize=True, deadline=None)
+@settings(max_examples=60, derandomize=True, database=None, deadline=None)
 @given(**_RANDOM_MESHES, rotation=st.tuples(*[st.floats(-3.0, 3.0)] * 3),
        scale=st.floats(1e-3, 1e3), shift=st.tuples(*[st.floats(-1e3, 1e3)] * 3))
 def test_linear_functions_are_harmonic_on_any_planar_triangulation(nx, ny, seed, rotation, scale, shift):
@@ -152,12 +152,16 @@ def test_linear_functions_are_harmonic_on_any_planar_triangulation(nx, ny, seed,
     V, F, interior = jittered_grid(nx, ny, seed)
     W = scale * V @ Rotation.from_rotvec(rotation).as_matrix().T + shift
     L = cotan_laplacian(W, F)
-    assert np.abs(L @ (W - shift))[interior].max() <= 1e-12 * scale * np.abs(L).max()
+    # the mesh is flat up to the rounding of its coordinates (eps |shift|, which for a 1e-3 patch
+    # 1e3 away is 1e-10 of its size: measured residuals up to 9e-11 there), a bound 100x above
+    # the residuals measured over 200 such placements
+    flat = 1e-12 + 1e-14 * max(map(abs, shift)) / scale
+    assert np.abs(L @ (W - shift))[interior].max() <= flat * scale * np.abs(L).max()
     # and the boundary rows do not vanish: the flat patch's boundary curvature
     assert np.abs(L @ (W - shift)).max() > 1e-3 * scale * np.abs(L).max()
 
 
-@settings(max_examples=60, derandomize=True, deadline=None)
+@settings(max_examples=60, derandomize=True, database=None, deadline=None)
 @given(**_RANDOM_MESHES, heights=st.floats(0.0, 2.0))
 def test_is_symmetric_positive_semidefinite_with_zero_row_sums_on_random_surfaces(nx, ny, seed, heights):
     V, F, _ = jittered_grid(nx, ny, seed, heights=heights)

@@ -424,7 +424,7 @@ def test_a_stalled_refinement_raises_or_returns_its_last_iterate_as_asked():
 
 # -- properties on random surfaces (hypothesis, derandomized: the same examples on every run) ---
 
-@settings(max_examples=30, derandomize=True, deadline=None)
+@settings(max_examples=30, derandomize=True, database=None, deadline=None)
 @given(nx=st.integers(4, 10), ny=st.integers(4, 10), seed=st.integers(0, 2**32 - 1),
        heights=st.floats(0.0, 2.0), rows=st.sampled_from(["all", "free"]))
 def test_round_trip_and_linearity_on_random_surfaces(nx, ny, seed, heights, rows):
