@@ -28,9 +28,11 @@ What POSIX does not allow: the renames are one system call each, not one for all
   neither: move a file back, or delete them. (The ``.curvdetail-*`` temporary files of a
   killed run are left the same way.)
 - Where taking an output back fails too, the error names it and where its old file is kept.
-- SIGTERM (the CLI's watcher, which takes :data:`COMMIT_LOCK`) waits for a commit in progress,
-  so it ends a run before the commit (nothing written) or after it (everything written, though
-  the exit status says terminated).
+- SIGTERM and SIGINT (Ctrl-C) end a CLI run through its watcher thread, which takes
+  :data:`COMMIT_LOCK` and so waits for a commit in progress: a run ends before the commit
+  (nothing written) or after it (everything written, though the exit status, 143 or 130, says
+  terminated or interrupted). In Python, a KeyboardInterrupt during a commit takes back the
+  renames done (none written).
 """
 
 import contextlib
@@ -44,16 +46,17 @@ from .curvature.errors import MeshError
 
 _FORMATS_HINT = "use .ply, .obj, .off, .stl, ..."
 
-#: Temporary files of the :func:`atomic_outputs` blocks in progress, for the CLI's SIGTERM
-#: watcher, which removes them before it ends the process.
+#: Temporary files of the :func:`atomic_outputs` blocks in progress, for the CLI's SIGTERM /
+#: SIGINT watcher, which removes them before it ends the process.
 PENDING = set()
 
-#: Held while :func:`atomic_outputs` renames its files into place. The SIGTERM watcher takes it
-#: before it removes :data:`PENDING` and ends the process, so that a commit is never cut short
+#: Held while :func:`atomic_outputs` renames its files into place. The SIGTERM / SIGINT watcher
+#: takes it before it removes :data:`PENDING` and ends the process, so that a commit is never cut short
 #: (the old files kept aside would be left in hidden folders, and the outputs a mix).
 COMMIT_LOCK = threading.Lock()
 
-#: how a refusal of an existing output says to replace it: the CLI's option and Python's argument
+#: how a refusal of an existing output says to replace it by default: the CLI's option and
+#: Python's argument (the CLI passes ``flag="--overwrite"``, the scripts their own option)
 OVERWRITE_FLAG = "--overwrite (overwrite=True)"
 
 
@@ -185,7 +188,7 @@ def atomic_outputs(outputs, *, overwrite=False):
         for tmp in temps:
             if tmp is not None:
                 PENDING.discard(tmp)
-                with contextlib.suppress(FileNotFoundError):    # renamed, or the SIGTERM watcher took it
+                with contextlib.suppress(FileNotFoundError):    # renamed, or the signal watcher took it
                     os.remove(tmp)
 
 

@@ -2,8 +2,8 @@
 
 Every subcommand is declared with :func:`command` next to the code that runs it. A failure
 anywhere exits non-zero with a ``curvdetail: error: ...`` message on stderr and leaves no output
-file behind (outputs are written atomically, last; Ctrl-C and SIGTERM remove the temporary
-files too).
+file behind (outputs are written atomically, last). Ctrl-C (SIGINT) and SIGTERM end a run at
+once, even during a long native call, removing the temporary files: exit status 130 or 143.
 """
 
 import argparse
@@ -27,17 +27,28 @@ def command(name, help):
     return register
 
 
-def _say(text, stream=None, end="\n"):
+#: The stream whose last line is still open (a stage's "[1/5] retriangulate ..." waiting for its
+#: seconds), or None: a note, error or "interrupted" said meanwhile starts a line of its own.
+_open_line = None
+
+
+def _say(text, stream=None, end="\n", *, continues=False):
     """Write a progress line, note or warning to stderr; False (and nothing raised) when the
     reader has gone away: such lines must not end a run whose outputs are still to be written
-    (`curvdetail remesh ... 2>&1 | head` would otherwise stop half-way with status 0)."""
+    (`curvdetail remesh ... 2>&1 | head` would otherwise stop half-way with status 0).
+    ``continues``: the text goes on the line left open (a stage's seconds); otherwise an open
+    line is ended first."""
+    global _open_line
     stream = stream or sys.stderr
+    if not continues and _open_line is stream:
+        text = "\n" + text
     try:
         stream.write(text + end)
         stream.flush()
-        return True
     except (BrokenPipeError, ValueError):       # ValueError: the stream was closed
         return False
+    _open_line = None if end.endswith("\n") else stream
+    return True
 
 
 class Progress:
@@ -46,18 +57,23 @@ class Progress:
     def __init__(self, total, enabled=True, stream=None):
         self.total, self.done, self.enabled = total, 0, enabled
         self.stream = stream or sys.stderr
-        self._t = None
+        self._t, self._label = None, None
 
     def stage(self, name):
         self._finish()
         self.done += 1
         self._t = time.perf_counter()
+        self._label = f"[{self.done}/{self.total}] {name} ..."
         if self.enabled:
-            self.enabled = _say(f"[{self.done}/{self.total}] {name} ...", self.stream, end="")
+            self.enabled = _say(self._label, self.stream, end="")
 
     def _finish(self):
         if self._t is not None and self.enabled:
-            self.enabled = _say(f" {time.perf_counter() - self._t:.2f} s", self.stream)
+            seconds = f" {time.perf_counter() - self._t:.2f} s"
+            if _open_line is self.stream:
+                self.enabled = _say(seconds, self.stream, continues=True)
+            else:           # a note came in between: the stage again, on a line of its own
+                self.enabled = _say(self._label + seconds, self.stream)
         self._t = None
 
     def close(self):
@@ -66,6 +82,20 @@ class Progress:
 
 def add_output_arguments(parser):
     parser.add_argument("--overwrite", action="store_true", help="replace OUTPUT if it exists")
+
+
+#: how a refusal of an existing output says to replace it, on the command line
+OVERWRITE = "--overwrite"
+
+
+def check_mesh_output(path, overwrite):
+    """:func:`curvdetail.io.check_mesh_output`, an existing file refused in the command line's
+    words ("pass --overwrite", not Python's overwrite=True)."""
+    from ._output import check_output_path
+    from .io import MeshFileError, check_mesh_output as check
+
+    check_output_path(path, overwrite, hint=None, error=MeshFileError, flag=OVERWRITE)
+    return check(path, overwrite)
 
 
 def add_backend_argument(parser):
@@ -95,8 +125,6 @@ def resolve_input_output(args):
         args.input, args.output = example_path(), args.input
     if args.input is None or args.output is None:
         raise ValueError("missing INPUT or OUTPUT (or use --example OUTPUT).")
-    from .io import check_mesh_output
-
     check_mesh_output(args.output, args.overwrite)
 
 
@@ -202,7 +230,7 @@ def _minimal_command(parser):
 
         from . import minimal_surface, read_mesh, write_mesh
         from .curvature._validate import check_mesh
-        from .curvature.errors import ConstraintError
+        from .curvature.errors import ConstraintError, counted
 
         resolve_input_output(args)
         V, F = check_mesh(*read_mesh(args.input))
@@ -222,7 +250,7 @@ def _minimal_command(parser):
                     f"({X.last_full_step:.2e} with tangential sliding)")
         else:
             last = f"last step {X.last_full_step:.2e} of the bbox diagonal (tangential sliding included)"
-        print(f"{state} after {X.iterations} steps, {last}")
+        print(f"{state} after {counted(X.iterations, 'step')}, {last}")
         return 0 if X.converged else 3
 
     return run
@@ -230,18 +258,18 @@ def _minimal_command(parser):
 
 # --- remesh (remeshing issue) ---------------------------------------------------------------
 
-def _note_a_big_target(V, F, fraction, *, evaluate=True):
-    """A line on stderr when a target edge of ``fraction`` of the bbox diagonal asks for more than
-    ``BIG_TARGET`` vertices (an estimate only: on a mesh the checks will refuse, nothing is
-    said)."""
+def _note_a_big_target(V, F, fraction, *, method="isotropic", evaluate=True):
+    """A line on stderr when a target edge of ``fraction`` of the bbox diagonal makes a run of
+    minutes (:func:`curvdetail.remesh.retriangulate.long_run_vertices`: more than ``BIG_TARGET``
+    vertices), saying what takes the time (an estimate only: on a mesh the checks will refuse,
+    or a decimation that will be refused, nothing is said)."""
     from .curvature._validate import bbox_diagonal
-    from .remesh.retriangulate import long_run_vertices
+    from .remesh.retriangulate import long_run_reason, long_run_vertices
 
-    count = long_run_vertices(V, F, fraction * bbox_diagonal(V))
+    count = long_run_vertices(V, F, fraction * bbox_diagonal(V), method=method, evaluate=evaluate)
     if count is not None:
-        why = " (the measurements most of it; --no-evaluate skips them)" if evaluate else ""
         _say(f"note: a {100 * fraction:g} % target edge gives about {count:,.0f} target vertices; this takes "
-             f"minutes{why}.")
+             f"minutes. {long_run_reason(method, evaluate=evaluate, cli=True)}")
 
 
 def _whole_number_from_one(text):
@@ -313,7 +341,7 @@ def _remesh_command(parser):
 
         from ._output import Output, atomic_outputs, check_output_path
         from .io import MeshFileError, read_mesh, write_mesh
-        from .remesh.experiment import run_experiment
+        from .remesh.experiment import WorseThanZeroDetailWarning, run_experiment, worse_than_zero_detail
 
         resolve_input_output(args)      # checks OUTPUT
         if args.parameterization is not None and args.location != "uv":
@@ -328,24 +356,27 @@ def _remesh_command(parser):
         _check_image_and_distinct(args.image, args.output, args.report, inputs=[args.input])
         for extra in (args.report, args.image):
             if extra is not None:
-                check_output_path(extra, args.overwrite, hint=None, error=FileNotFoundError)
+                check_output_path(extra, args.overwrite, hint=None, error=FileNotFoundError, flag=OVERWRITE)
         if args.no_evaluate and args.image is not None:
             raise ValueError("--image shows the measured distances; leave out --no-evaluate or --image.")
         V, F = read_mesh(args.input)
         if not args.quiet:
-            _note_a_big_target(V, F, args.target_edge / 100.0, evaluate=not args.no_evaluate)
+            _note_a_big_target(V, F, args.target_edge / 100.0, method=args.method, evaluate=not args.no_evaluate)
         stages = 3 + (not args.no_evaluate) + (args.location == "uv") + (args.image is not None)
         progress = Progress(stages, enabled=not args.quiet)
         try:
-            result = run_experiment(V, F, method=args.method, target_edge=args.target_edge / 100.0,
-                                    transfer=args.transfer, rows=args.rows, location=args.location,
-                                    parameterization=args.parameterization, backend=args.backend,
-                                    evaluate=not args.no_evaluate, source_path=os.path.abspath(args.input),
-                                    progress=progress.stage, surface_check=not args.no_surface_check)
+            with warnings.catch_warnings():
+                # said below, after the figures, in the command line's options
+                warnings.simplefilter("ignore", WorseThanZeroDetailWarning)
+                result = run_experiment(V, F, method=args.method, target_edge=args.target_edge / 100.0,
+                                        transfer=args.transfer, rows=args.rows, location=args.location,
+                                        parameterization=args.parameterization, backend=args.backend,
+                                        evaluate=not args.no_evaluate, source_path=os.path.abspath(args.input),
+                                        progress=progress.stage, surface_check=not args.no_surface_check)
             report = result["report"]
             # all outputs appear together, only once every one of them is written
             outputs = [_extra_output(args.image), _extra_output(args.report),
-                       Output(args.output, error=MeshFileError)]
+                       Output(args.output, error=MeshFileError, flag=OVERWRITE)]
             with atomic_outputs(outputs, overwrite=args.overwrite) as (image_tmp, report_tmp, mesh_tmp):
                 if image_tmp is not None:
                     progress.stage("image")
@@ -370,6 +401,9 @@ def _remesh_command(parser):
               f"diagonal (zero detail {100 * b['hausdorff_rms']:.3f} % / {100 * b['hausdorff_max']:.2f} %, "
               f"floor {100 * fl['hausdorff_rms']:.4f} % / {100 * fl['hausdorff_max']:.3f} %); "
               f"{report['seconds']['total']:.2f} s")
+        worse = worse_than_zero_detail(report, cli=True)
+        if worse is not None:           # the run did what was asked: a finding, not an error
+            _say(f"note: {worse}")
         return 0
 
     return run
@@ -428,9 +462,13 @@ def _run_on_file(args, work):
     as JSON, save the current mesh (quality and curvature attributes kept in PLY)."""
     import json
 
+    from . import _output
     from .filters.files import attributes_lost_in, check_output_path, load_meshset, save_current_mesh
+    from .io import MeshFileError
 
     _check_image_and_distinct(None, args.output, inputs=[args.input], other_inputs=args.add)
+    # an existing file refused in the command line's words, then the filters' checks (format hint)
+    _output.check_output_path(args.output, args.overwrite, hint=None, error=MeshFileError, flag=OVERWRITE)
     check_output_path(args.output, args.overwrite)
     ms = load_meshset(args.input, *args.add)
     figures = work(ms)
@@ -539,14 +577,14 @@ def _edit_command(parser):
         from .curvature._validate import bbox_diagonal, check_mesh
         from .deformation_benchmark import (edit_with_selection, read_selection, read_transform,
                                             render_panels)
-        from .curvature.errors import UndeterminedEditError
-        from .io import MeshFileError, check_mesh_output
+        from .curvature.errors import UndeterminedEditError, counted
+        from .io import MeshFileError
 
         _check_image_and_distinct(args.image, args.output, inputs=[args.mesh],
                                   other_inputs=[args.sel, args.transform])
         check_mesh_output(args.output, args.overwrite)
         if args.image:
-            check_output_path(args.image, args.overwrite, hint=None, error=FileNotFoundError)
+            check_output_path(args.image, args.overwrite, hint=None, error=FileNotFoundError, flag=OVERWRITE)
         progress = Progress(3, enabled=sys.stderr.isatty())
         progress.stage("read")
         V, F = check_mesh(*read_mesh(args.mesh))
@@ -567,7 +605,7 @@ def _edit_command(parser):
         progress.stage("write")
         moved = np.linalg.norm(X - V, axis=1)
         # the picture and the mesh appear together, only once both are written
-        outputs = [_extra_output(args.image or None), Output(args.output, error=MeshFileError)]
+        outputs = [_extra_output(args.image or None), Output(args.output, error=MeshFileError, flag=OVERWRITE)]
         with atomic_outputs(outputs, overwrite=args.overwrite) as (image_tmp, mesh_tmp):
             if image_tmp is not None:
                 render_panels(image_tmp, [(V, F, "rest (status 0/1/2)", status),
@@ -576,10 +614,10 @@ def _edit_command(parser):
             write_mesh(mesh_tmp, X, F, quality=moved, overwrite=True)
         progress.close()
         counts = np.bincount(status, minlength=3)
-        print(f"{V.shape[0]} vertices ({counts[0]} fixed, {counts[1]} free, {counts[2]} handles); "
+        print(f"{V.shape[0]} vertices ({counts[0]} fixed, {counts[1]} free, {counted(counts[2], 'handle')}); "
               f"largest move {moved.max() / bbox_diagonal(V):.3e} of the bbox diagonal; "
-              f"{editor.rank_deficient} rank-deficient rings, {editor.detail_islands} island "
-              f"vertices; {seconds:.3f} s")
+              f"{counted(editor.rank_deficient, 'rank-deficient ring')}, "
+              f"{counted(editor.detail_islands, 'island vertex', 'island vertices')}; {seconds:.3f} s")
         handle_move = moved[status == 2].max()
         if moved.max() > 3.0 * handle_move + 1e-12 * bbox_diagonal(V):
             _say(f"curvdetail: warning: vertices moved up to {moved.max() / max(handle_move, 1e-300):.1f} "
@@ -600,7 +638,7 @@ def _extra_output(path):
     before the work), or None where it is not asked for."""
     from ._output import Output
 
-    return None if path is None else Output(path, hint=None, error=FileNotFoundError)
+    return None if path is None else Output(path, hint=None, error=FileNotFoundError, flag=OVERWRITE)
 
 
 def _check_image_and_distinct(image, output, *extras, inputs=(), other_inputs=()):
@@ -641,16 +679,25 @@ def build_parser():
     return parser
 
 
+#: The signals that end a run at once, cleanly, with the word said for each: SIGTERM (``timeout``,
+#: ``kill``) and SIGINT (Ctrl-C).
+_ENDING_SIGNALS = {signal.SIGTERM: "terminated", signal.SIGINT: "interrupted"}
+
+
 def _watch_sigterm():
-    """End the process promptly and cleanly on SIGTERM (``timeout``, ``kill``): Python runs its
-    signal handlers only between bytecodes, so a handler alone waited for the native call in
-    progress (a factorization, pymeshlab's sampling: 10 s and more). Python's C-level handler
+    """End the process promptly and cleanly on SIGTERM (``timeout``, ``kill``) and SIGINT
+    (Ctrl-C): Python runs its signal handlers (KeyboardInterrupt included) only between bytecodes
+    of the main thread, so a handler alone waited for the native call in progress (a
+    factorization, pymeshlab's sampling or remeshing: 10 s to minutes). Python's C-level handler
     writes the signal number to a wakeup pipe at once, from any thread; a watcher thread blocked
-    on it removes the temporary files of the outputs in progress and exits with 128 + SIGTERM
-    (as soon as it gets the GIL, which numerical code mostly releases; after the renames of a
-    commit in progress, see :mod:`curvdetail._output`). Returns the function
-    that stops the watcher and puts everything back; None where this cannot be set up (not the
-    main thread, or no wakeup fd)."""
+    on it removes the temporary files of the outputs in progress, says ``curvdetail: terminated``
+    or ``curvdetail: interrupted`` and exits with 128 + the signal's number (143, 130), as soon
+    as it gets the GIL, which numerical code mostly releases; after the renames of a commit in
+    progress, see :mod:`curvdetail._output`. The Python handlers meanwhile do nothing (so no
+    KeyboardInterrupt unwinds the main thread as well). A SIGINT that was ignored (a command
+    started in the background by a shell) stays ignored. Returns the function that stops the
+    watcher and puts everything back; None where this cannot be set up (not the main thread,
+    or no wakeup fd): SIGINT then raises KeyboardInterrupt, as before."""
     from . import _output
 
     if threading.current_thread() is not threading.main_thread():
@@ -663,30 +710,36 @@ def _watch_sigterm():
         os.close(read_fd)
         os.close(write_fd)
         return None
-    # a handler that does nothing: the watcher does the work (the default would kill at once,
-    # leaving the temporary files)
-    previous = signal.signal(signal.SIGTERM, lambda signum, frame: None)
+    # handlers that do nothing: the watcher does the work (SIGTERM's default would kill at once,
+    # leaving the temporary files; SIGINT's KeyboardInterrupt would come after the native call)
+    previous = {}
+    for signum in _ENDING_SIGNALS:
+        if signum == signal.SIGINT and signal.getsignal(signum) is signal.SIG_IGN:
+            continue
+        previous[signum] = signal.signal(signum, lambda signum, frame: None)
 
     def watch():
         while True:
             got = os.read(read_fd, 64)
             if not got or 0 in got:                     # closed, or stop() asked
                 return
-            if signal.SIGTERM in got:
+            ending = [signum for signum in previous if signum in got]
+            if ending:
                 # a commit in progress is let finish (milliseconds), so that its outputs are all
                 # written or none, and no old file is left in its hidden folder
                 _output.COMMIT_LOCK.acquire(timeout=10)
                 for path in list(_output.PENDING):
                     with contextlib.suppress(OSError):
                         os.remove(path)
-                _say("curvdetail: terminated")
-                os._exit(128 + signal.SIGTERM)
+                _say(f"curvdetail: {_ENDING_SIGNALS[ending[0]]}")
+                os._exit(128 + ending[0])
 
-    watcher = threading.Thread(target=watch, name="curvdetail-sigterm", daemon=True)
+    watcher = threading.Thread(target=watch, name="curvdetail-signals", daemon=True)
     watcher.start()
 
     def stop():
-        signal.signal(signal.SIGTERM, previous if previous is not None else signal.SIG_DFL)
+        for signum, handler in previous.items():
+            signal.signal(signum, handler if handler is not None else signal.SIG_DFL)
         signal.set_wakeup_fd(previous_fd)
         os.write(write_fd, b"\0")
         watcher.join()
@@ -697,10 +750,11 @@ def _watch_sigterm():
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None):
-    """A LongRunWarning (a filter in a script about to take minutes) as a note line."""
-    from .remesh.retriangulate import LongRunWarning
+    """A LongRunWarning (a filter in a script about to take minutes) or a
+    WorseThanZeroDetailWarning (a remeshing that failed) as a note line."""
+    from .remesh import LongRunWarning, WorseThanZeroDetailWarning
 
-    if issubclass(category, LongRunWarning):
+    if issubclass(category, (LongRunWarning, WorseThanZeroDetailWarning)):
         _say(f"note: {message}")
     else:
         _default_showwarning(message, category, filename, lineno, file, line)

@@ -345,7 +345,14 @@ def test_apply_remeshing_with_a_big_target_is_announced_with_the_value_given(cap
     assert err.count("note:") == 1 and "LongRunWarning" not in err      # one line, no Python warning
     rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "q.ply",
                            "--param", f"target_edge={length}")
-    assert rc == 0 and "(the measurements most of it; evaluate false skips them)" in err
+    # what takes the time: the remeshing half or more (alone 554 s at 2.25M vertices), not
+    # "the measurements most of it"
+    assert rc == 0 and "Half of it or more is pymeshlab's isotropic remeshing" in err, err
+    assert "the measurements (evaluate false skips them)" in err and "measurements most of it" not in err
+    # a decimation that will be refused (finer than the source) is refused without the note
+    rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "r.ply",
+                           "--param", "method=decimate", "--param", f"target_edge={length}")
+    assert rc == 1 and "decimation can only coarsen" in err and "note:" not in err
     monkeypatch.setattr(importlib.import_module("curvdetail.remesh.retriangulate"), "BIG_TARGET", 1_000_000)
     rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "p.ply",
                            "--param", f"target_edge={length}", "--param", "evaluate=false")
@@ -374,3 +381,20 @@ def test_apply_refuses_to_write_over_an_added_layer_even_with_overwrite(capsys, 
     rc, out, err = run_cli(capsys, "apply", "compute_curvature_detail", NOSE, added, "--add", added, "--overwrite")
     assert rc == 1 and "b.obj is an input of this run" in err
     assert added.read_bytes() == before
+
+
+def test_apply_remeshing_says_a_rebuild_worse_than_zero_detail_as_a_note(capsys, tmp_path):
+    from curvdetail import boundary_vertices, write_mesh
+    from curvdetail.curvature.testing import disk
+
+    V, F = disk(n_rings=8)                      # noise on a flat disk, see test_remesh_experiment.noisy_disk
+    z = 0.02 * np.random.default_rng(1).standard_normal(V.shape[0])
+    z[boundary_vertices(F)] = 0.0
+    V[:, 2] = z
+    write_mesh(tmp_path / "noisy.ply", V, F)
+    rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", tmp_path / "noisy.ply", tmp_path / "o.ply",
+                           "--param", "transfer=pointwise", "--param", "target_edge=8%")
+    assert rc == 0 and json.loads(out)["improvement_over_zero_detail"] < 0.5
+    notes = [line for line in err.splitlines() if line.startswith("note: ")]
+    assert len(notes) == 1 and "farther from the source than the zero-detail surface" in notes[0], err
+    assert "WorseThanZeroDetailWarning" not in err

@@ -182,7 +182,9 @@ def test_a_big_target_is_said_beforehand_with_the_unit_of_a_plain_number(monkeyp
     percent = 100.0 / bbox_diagonal(ms.current_mesh().vertex_matrix())
     assert round(percent, 2) == 6.55
     with pytest.warns(LongRunWarning, match=rf"target_edge=1\.0 \({percent:.3g} % of the bbox diagonal\) gives about "
-                                            r"\d+ target vertices; this takes minutes\. A plain number is in model units"):
+                                            r"\d+ target vertices; this takes minutes\. Most of it is pymeshlab's "
+                                            r"isotropic remeshing \(surface_check false makes it 25-50 % faster\)\. "
+                                            r"A plain number is in model units"):
         apply(ms, "generate_curvature_remeshing", target_edge=1.0, evaluate=False)
     with warnings.catch_warnings():
         warnings.simplefilter("error", LongRunWarning)          # a smaller target: nothing said
@@ -193,3 +195,49 @@ def test_a_big_target_is_said_beforehand_with_the_unit_of_a_plain_number(monkeyp
         closed.load_new_mesh(os.path.join(DATA, "spot.obj"))
         with pytest.raises(NotADiskError):
             apply(closed, "generate_curvature_remeshing", target_edge=pymeshlab.PercentageValue(0.5), evaluate=False)
+
+
+def test_without_evaluation_the_rebuilt_layer_has_no_quality(tmp_path):
+    # evaluate=false left pymeshlab's quality 0 on the rebuilt layer, and its PLY carried it as if
+    # measured (the CLI's --no-evaluate writes none; the docs say quality = distance)
+    from curvdetail.filters.files import load_meshset, save_current_mesh
+    from curvdetail.remesh.experiment import run_experiment
+
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(os.path.join(DATA, "mannequin_nose.obj"))
+    report = apply(ms, "generate_curvature_remeshing", target_edge=pymeshlab.PercentageValue(3), evaluate=False,
+                   add_baseline=True)
+    rebuilt, zero = ms.mesh(report["layers"]["rebuilt"]), ms.mesh(report["layers"]["zero_detail"])
+    assert ms.current_mesh_id() == report["layers"]["rebuilt"]
+    assert not rebuilt.has_vertex_scalar() and not zero.has_vertex_scalar()
+    assert rebuilt.label() == "mannequin_nose.obj rebuilt" and zero.label() == "mannequin_nose.obj zero detail"
+    # the layers are the experiment's arrays exactly (they went through a binary PLY: doubles)
+    result = run_experiment(ms.mesh(0).vertex_matrix(), ms.mesh(0).face_matrix(), target_edge=0.03, evaluate=False)
+    assert np.array_equal(rebuilt.vertex_matrix(), result["X"]) and np.array_equal(zero.vertex_matrix(), result["Z"])
+    assert np.array_equal(rebuilt.face_matrix(), result["Ft"]) and np.array_equal(zero.face_matrix(), result["Ft"])
+    assert np.array_equal(vertex_attribute(ms, report["layers"]["rebuilt"], "curvature_detail", "point"),
+                          result["Dt"])
+    save_current_mesh(ms, tmp_path / "rebuilt.ply")
+    assert b"property double quality" not in (tmp_path / "rebuilt.ply").read_bytes().split(b"end_header")[0]
+    again = load_meshset(tmp_path / "rebuilt.ply")
+    assert not again.current_mesh().has_vertex_scalar()
+    assert np.array_equal(vertex_attribute(again, 0, "curvature_detail", "point"), result["Dt"])
+
+
+def test_a_rebuild_worse_than_zero_detail_is_said_by_the_filter():
+    from curvdetail.curvature.testing import disk
+    from curvdetail.remesh import WorseThanZeroDetailWarning
+
+    V, F = disk(n_rings=8)                      # noise on a flat disk, see test_remesh_experiment.noisy_disk
+    z = 0.02 * np.random.default_rng(1).standard_normal(V.shape[0])
+    z[boundary_vertices(F)] = 0.0
+    V[:, 2] = z
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(V, F.astype(np.int32)), "noisy")
+    with pytest.warns(WorseThanZeroDetailWarning, match=r"^the rebuilt surface is farther from the source than the "
+                                                        r"zero-detail surface .* Try the conservative transfer "
+                                                        r"\(transfer='conservative', the default") as caught:
+        report = apply(ms, "generate_curvature_remeshing", target_edge=pymeshlab.PercentageValue(8),
+                       transfer="pointwise")
+    assert report["improvement_over_zero_detail"] < 0.5
+    assert caught[0].filename == __file__

@@ -188,7 +188,7 @@ def test_malformed_arrays_are_refused_before_writing(tmp_path, nose):
     V, F = nose
     bad = V.copy()
     bad[3] = np.nan
-    with pytest.raises(MeshError, match=r"1 vertices have NaN .*first: 3"):
+    with pytest.raises(MeshError, match=r"1 vertex has NaN .*first: 3"):
         write_mesh(tmp_path / "bad.ply", bad, F)
     with pytest.raises(MeshError, match="quality has 2 values for 640 vertices"):
         write_mesh(tmp_path / "bad.ply", V, F, quality=[1.0, 2.0])

@@ -99,7 +99,7 @@ def test_no_fixed_vertex_is_refused():
 
 def test_fixed_out_of_range_is_refused_with_the_index():
     V, F = grid(4, 4)
-    with pytest.raises(ConstraintError, match=r"1 indices are outside \[0, 16\) \(first: 99\)"):
+    with pytest.raises(ConstraintError, match=r"1 index is outside \[0, 16\) \(first: 99\)"):
         minimal_surface(V, F, [0, 99])
 
 

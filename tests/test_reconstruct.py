@@ -294,7 +294,7 @@ def test_unknown_row_mode_is_refused():
 def test_malformed_mesh_is_refused_before_solving():
     V, F = icosphere(subdivisions=1)
     V[3] = np.nan
-    with pytest.raises(MeshError, match=r"1 vertices have NaN .*first: 3"):
+    with pytest.raises(MeshError, match=r"1 vertex has NaN .*first: 3"):
         reconstruct(V, F, np.zeros_like(V), [0], V[[0]])
 
 
@@ -361,7 +361,7 @@ def test_a_check_failing_after_the_early_analysis_still_reports_its_error(monkey
     fin = np.vstack([V, (V[a] + V[b]) / 2 + [0.0, 0.0, 1.0]])               # and a third triangle on it
     laplacian_module = importlib.import_module("curvdetail.curvature.cotan_laplacian")
     monkeypatch.setattr(laplacian_module, "_edge_pattern", None)           # the checks may not count again
-    with pytest.raises(MeshError, match=rf"1 edges are shared by more than two triangles \(first: \({a}, {b}\)\)"):
+    with pytest.raises(MeshError, match=rf"1 edge is shared by more than two triangles \(first: \({a}, {b}\)\)"):
         Reconstructor(fin, np.vstack([F, [a, b, V.shape[0]]]), [0], rows="free",
                       backend="pardiso")                                    # counted by the analysis' pattern
     V[F[3]] = V[F[3, 0]]                                                    # collapse a triangle

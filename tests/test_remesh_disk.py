@@ -43,7 +43,7 @@ def test_non_manifold_edge_is_refused_as_not_manifold():
     a, b = F[0, 0], F[0, 1]
     V2 = np.vstack([V, [[0.0, 0.0, 1.0]]])
     F2 = np.vstack([F, [[a, b, V.shape[0]]]])
-    with pytest.raises(NotADiskError, match="not manifold: 1 edges"):
+    with pytest.raises(NotADiskError, match="not manifold: 1 edge is"):
         check_disk(V2, F2)
 
 
@@ -68,7 +68,7 @@ def test_patch_with_a_handle_is_refused_with_the_handle_count():
     c = (i * m + (j + 1) % m).ravel()
     d = (((i + 1) % n) * m + (j + 1) % m).ravel()
     F = np.concatenate([np.column_stack([a, b, d]), np.column_stack([a, d, c])])[1:]
-    with pytest.raises(NotADiskError, match="Euler characteristic -1 .1 handles"):
+    with pytest.raises(NotADiskError, match="Euler characteristic -1 .1 handle\\)"):
         check_disk(V, F)
 
 

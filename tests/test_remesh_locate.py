@@ -80,7 +80,7 @@ def test_nan_points_are_refused_naming_them_not_a_crash(flat_disk, engine, dim):
     V, F = flat_disk
     P = V[:4, :dim].copy()
     P[2, 0] = np.nan
-    with pytest.raises(MeshError, match=r"points: 1 vertices have NaN or infinite coordinates \(first: 2\)"):
+    with pytest.raises(MeshError, match=r"points: 1 vertex has NaN or infinite coordinates \(first: 2\)"):
         locate(P, V[:, :dim], F, engine=engine)
 
 
@@ -88,7 +88,7 @@ def test_triangle_indices_outside_v_are_refused(flat_disk):
     V, F = flat_disk
     G = F.copy()
     G[5, 1] = V.shape[0]
-    with pytest.raises(MeshError, match=r"1 triangles have vertex indices outside .*first: 5"):
+    with pytest.raises(MeshError, match=r"1 triangle has vertex indices outside .*first: 5"):
         locate(V[:3], V, G)
 
 

@@ -65,7 +65,7 @@ def test_flipped_triangles_refuses_nan_uv_instead_of_reporting_none_flipped():
     V, F = disk(n_rings=4)
     UV = V[:, :2].copy()
     UV[5] = np.nan                       # NaN <= 0 is False: every triangle passed as unflipped
-    with pytest.raises(MeshError, match=r"UV: 1 vertices have NaN or infinite coordinates \(first: 5\)"):
+    with pytest.raises(MeshError, match=r"UV: 1 vertex has NaN or infinite coordinates \(first: 5\)"):
         flipped_triangles(UV, F)
 
 
@@ -87,7 +87,7 @@ def test_harmonic_map_without_pinned_vertices_is_refused_not_zeros():
         harmonic_map(V, F, [], np.zeros((0, 2)))
     with pytest.raises(ConstraintError, match=r"boundary_uv has shape \(2, 3\); expected \(2, 2\)"):
         harmonic_map(V, F, [0, 1], np.zeros((2, 3)))
-    with pytest.raises(ConstraintError, match=r"boundary_uv: 1 rows are NaN or infinite \(first: 1\)"):
+    with pytest.raises(ConstraintError, match=r"boundary_uv: 1 row is NaN or infinite \(first: 1\)"):
         harmonic_map(V, F, [0, 1], [[0.0, 0.0], [np.nan, 1.0]])
 
 

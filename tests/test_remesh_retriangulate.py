@@ -95,8 +95,56 @@ _USE_ISOTROPIC = r'use method "isotropic" \(--method isotropic on the command li
 
 def test_decimation_refuses_to_refine(load_mesh):
     V, F = load_mesh("mannequin_nose.obj")
-    with pytest.raises(RemeshError, match="decimation can only coarsen.*longer target edge or " + _USE_ISOTROPIC):
+    with pytest.raises(RemeshError, match=r"decimation can only coarsen.*decimation takes target edges from 3\.06 % "
+                                          r"to 10\.6 % of the bbox diagonal .*; choose one there or " + _USE_ISOTROPIC):
         retriangulate(V, F, method="decimate", target_edge=0.005)
+
+
+def _percents(message):
+    """The two percentages of a range given in ``message`` ("... from A % ... to B % ...")."""
+    import re
+
+    return [float(x) / 100 for x in re.findall(r"(\d+(?:\.\d+)?) %", message)[-2:]]
+
+
+@pytest.mark.parametrize("target_edge", [0.4, 1e-300])
+def test_a_decimation_out_of_range_is_given_decimations_own_range(load_mesh, target_edge):
+    # --method decimate --target-edge 40 advised "between 0.0335 % and 10.6 %", the isotropic
+    # range, and every target below ~3.1 % of it was then refused ("can only coarsen"). Both
+    # ends of the range given must now be accepted (rounded inwards to 3 digits), 1 % below it refused.
+    V, F = load_mesh("mannequin_nose.obj")                 # 640 vertices, 1,206 triangles
+    with pytest.raises(RemeshError) as refused:
+        retriangulate(V, F, method="decimate", target_edge=target_edge)
+    message = str(refused.value)
+    assert "decimation takes target edges from " in message and "own edge length" in message, message
+    assert "0.0335 %" not in message and "0.0336 %" not in message
+    shortest, longest = _percents(message)
+    assert shortest == pytest.approx(0.0306) and longest == pytest.approx(0.106)
+    for edge in (shortest, longest):
+        Vt, Ft = retriangulate(V, F, method="decimate", target_edge=edge)
+        assert 50 <= Vt.shape[0] and Ft.shape[0] < F.shape[0]
+    with pytest.raises(RemeshError, match="decimation can only coarsen"):
+        retriangulate(V, F, method="decimate", target_edge=0.99 * shortest)     # below 3.054 %
+
+
+def test_the_isotropic_range_given_is_admissible_at_both_ends(load_mesh):
+    from curvdetail.remesh.retriangulate import estimated_vertices
+
+    V, F = load_mesh("mannequin_nose.obj")
+    with pytest.raises(RemeshError) as refused:
+        retriangulate(V, F, target_edge=0.9)
+    shortest, longest = _percents(str(refused.value))
+    d = bbox_diagonal(V)
+    assert 50 <= estimated_vertices(V, F, longest * d) and estimated_vertices(V, F, shortest * d) <= 5_000_000
+
+
+def test_a_patch_too_small_to_decimate_says_so(load_mesh):
+    from curvdetail.curvature.testing import disk
+
+    V, F = disk(n_rings=4)                                  # 61 vertices, 96 triangles
+    with pytest.raises(RemeshError, match=r"this 61-vertex patch is too small to decimate to 50 vertices or more "
+                                          r"\(96 triangles\); " + _USE_ISOTROPIC):
+        retriangulate(V, F, method="decimate", target_edge=0.3)
 
 
 def test_failed_decimation_points_to_isotropic_for_api_and_command_line(load_mesh, monkeypatch):
@@ -223,3 +271,85 @@ def test_a_smooth_patch_gives_a_disk_near_the_target_edge_either_way():
         assert _boundary_distance(V, F, Vt, Ft) <= 1e-9
         E = np.linalg.norm(Vt[Ft[:, [1, 2, 0]]] - Vt[Ft], axis=2)
         assert np.median(E) / (0.04 * bbox_diagonal(V)) == pytest.approx(1.0, abs=0.2)
+
+
+def test_a_long_run_is_not_announced_for_a_decimation_that_will_be_refused(load_mesh, monkeypatch):
+    # `--method decimate --target-edge 0.1` said "this takes minutes" and failed in 0.01 s
+    import sys
+
+    module = sys.modules["curvdetail.remesh.retriangulate"]
+    monkeypatch.setattr(module, "BIG_TARGET", 100)
+    V, F = load_mesh("mannequin_nose.obj")                 # 1,206 triangles
+    d = bbox_diagonal(V)
+    finer, coarser = 0.02 * d, 0.04 * d                   # more and fewer triangles than the source has
+    assert module.estimated_vertices(V, F, finer) > 100 and module.estimated_vertices(V, F, coarser) > 100
+    assert module.long_run_vertices(V, F, finer, method="isotropic") is not None
+    assert module.long_run_vertices(V, F, finer, method="decimate") is None             # refused: refines
+    with pytest.raises(RemeshError, match="decimation can only coarsen"):
+        retriangulate(V, F, method="decimate", target_edge=0.02)
+    assert module.long_run_vertices(V, F, coarser, method="decimate") is not None
+    # without the measurements a decimation takes seconds (490k -> 251k vertices: 18 s)
+    assert module.long_run_vertices(V, F, coarser, method="decimate", evaluate=False) is None
+
+
+@pytest.mark.parametrize("method, evaluate, cli, says, not_says", [
+    # at 2.25M target vertices pymeshlab's remeshing alone took 554 s: "the measurements most
+    # of it" was wrong for isotropic runs
+    ("isotropic", True, True, ["isotropic remeshing", "--no-surface-check", "--no-evaluate skips them"],
+     ["Most of it is the measurements"]),
+    ("isotropic", False, True, ["Most of it is pymeshlab's isotropic remeshing", "--no-surface-check"],
+     ["evaluate", "measurements"]),
+    ("isotropic", True, False, ["surface_check false", "evaluate false skips them"], ["--no"]),
+    ("decimate", True, True, ["Most of it is the measurements (--no-evaluate skips them)"], ["isotropic"]),
+])
+def test_a_long_run_says_what_takes_the_time(method, evaluate, cli, says, not_says):
+    from curvdetail.remesh.retriangulate import long_run_reason
+
+    reason = long_run_reason(method, evaluate=evaluate, cli=cli)
+    assert all(words in reason for words in says), reason
+    assert not any(words in reason for words in not_says), reason
+
+
+# --- messages about the source's topology (curvdetail.remesh._disk) --------------------------
+
+def test_a_non_manifold_edge_in_the_source_is_given_a_repair_not_a_cut():
+    # it said "1 edges are shared ..." and "cut a disk out, e.g. with ... selection": a fin is
+    # repaired, not cut away
+    import pymeshlab
+
+    from curvdetail.curvature.testing import disk
+    from curvdetail.remesh import NotADiskError
+
+    V, F = disk(n_rings=3)
+    a, b = F[0, 0], F[0, 1]
+    V2 = np.vstack([V, [[0.0, 0.0, 0.05]]])                  # a small fin on the edge (a, b)
+    F2 = np.vstack([F, [[a, b, V.shape[0]]]])
+    with pytest.raises(NotADiskError, match=rf"^the source is not manifold: 1 edge is shared by more than two "
+                                            rf"triangles \(first: \({min(a, b)}, {max(a, b)}\)\); repair the mesh, "
+                                            r"e\.g\. with pymeshlab's meshing_repair_non_manifold_edges") as refused:
+        retriangulate(V2, F2, target_edge=0.1)
+    assert "cut one out" not in str(refused.value)
+    # and the repair named does it
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(V2, F2.astype(np.int32)))
+    ms.meshing_repair_non_manifold_edges(method="Remove Faces")
+    ms.meshing_remove_unreferenced_vertices()
+    repaired = ms.current_mesh()
+    check_disk(repaired.vertex_matrix(), repaired.face_matrix())
+
+
+def test_one_pinched_boundary_vertex_and_one_handle_are_counted_in_the_singular():
+    from curvdetail.remesh import NotADiskError
+
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0]], dtype=float)
+    with pytest.raises(NotADiskError, match=r"the boundary passes 1 vertex more than once \(first: 0\); a disk"):
+        check_disk(V, [[0, 1, 2], [0, 3, 4]])                # two triangles touching at vertex 0
+    n, m = 12, 8                                             # a torus with one triangle taken out
+    i, j = np.meshgrid(np.arange(n), np.arange(m), indexing="ij")
+    u, v = 2 * np.pi * i.ravel() / n, 2 * np.pi * j.ravel() / m
+    V = np.column_stack([(2 + np.cos(v)) * np.cos(u), (2 + np.cos(v)) * np.sin(u), np.sin(v)])
+    a, b = (i * m + j).ravel(), (((i + 1) % n) * m + j).ravel()
+    c, d = (i * m + (j + 1) % m).ravel(), (((i + 1) % n) * m + (j + 1) % m).ravel()
+    F = np.concatenate([np.column_stack([a, b, d]), np.column_stack([a, d, c])])[1:]
+    with pytest.raises(NotADiskError, match=r"Euler characteristic -1 \(1 handle\);"):
+        check_disk(V, F)

@@ -103,7 +103,7 @@ def _bad_mesh(kind):
 
 
 @pytest.mark.parametrize("kind, words", [
-    ("nan vertex", r"V: 1 vertices have NaN or infinite coordinates \(first: 3\)"),
+    ("nan vertex", r"V: 1 vertex has NaN or infinite coordinates \(first: 3\)"),
     ("zero area", r"triangles have zero area \(first: .*7"),
     ("(m, 4) F", r"F has shape \(32, 4\)"),
     ("negative index", "vertex indices outside"),
@@ -148,7 +148,7 @@ def test_malformed_uv_is_named_as_uv():
         transfer_curvature(V, F, V, F, location="uv", uv=5)
     UV = V[:, :2].copy()
     UV[4, 1] = np.nan
-    with pytest.raises(MeshError, match=r"uv\[0\] \(UVs\): 1 vertices have NaN .*\(first: 4\)"):
+    with pytest.raises(MeshError, match=r"uv\[0\] \(UVs\): 1 vertex has NaN .*\(first: 4\)"):
         transfer_curvature(V, F, V, F, location="uv", uv=(UV, V[:, :2]))
     with pytest.raises(MeshError, match=r"uv\[1\] \(UVt\) has dtype <U"):
         transfer_curvature(V, F, V, F, location="uv", uv=(V[:, :2], V[:, :2].astype(str)))

@@ -86,7 +86,7 @@ def test_out_of_range_face_indices_are_refused_with_the_faces():
 def test_repeated_index_in_a_face_is_refused_with_the_face():
     V, F = _square()
     F[4] = [3, 4, 3]
-    with pytest.raises(MeshError, match=r"1 triangles repeat a vertex index \(first: 4\)"):
+    with pytest.raises(MeshError, match=r"F: 1 triangle repeats a vertex index \(first: 4\); remove it, "):
         mixed_voronoi_area(V, F)
 
 
@@ -115,8 +115,8 @@ def test_zero_area_faces_are_refused_with_the_faces():
     V, F = _square()
     V[4] = V[0] + 0.5 * (V[1] - V[0])         # centre vertex onto the bottom edge, between 0 and 1
     bad = np.flatnonzero(np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1) == 0)
-    assert bad.size >= 1
-    with pytest.raises(MeshError, match=rf"{bad.size} triangles have zero area \(first: {bad[0]}"):
+    assert bad.size == 1                        # one: the message says "1 triangle has", not "1 triangles have"
+    with pytest.raises(MeshError, match=rf"^1 triangle has zero area \(first: {bad[0]}.*; flip or collapse it away"):
         cotan_laplacian(V, F)
 
 
@@ -124,7 +124,7 @@ def test_non_manifold_edge_is_refused_with_the_edge():
     V, F = _square()
     V = np.vstack([V, [0.25, 0.25, 1.0]])     # a fin on the interior diagonal (0, 4)
     F = np.vstack([F, [0, 4, 9]])
-    with pytest.raises(MeshError, match=r"1 edges are shared by more than two triangles \(first: \(0, 4\)\)"):
+    with pytest.raises(MeshError, match=r"^1 edge is shared by more than two triangles \(first: \(0, 4\)\)"):
         cotan_laplacian(V, F)
 
 
@@ -144,8 +144,33 @@ def test_non_manifold_edges_are_counted_and_listed_in_order_by_every_entry_point
 def test_unreferenced_vertices_are_refused_with_the_vertices():
     V, F = _square()
     V = np.vstack([V, [[5.0, 5, 5], [6.0, 6, 6]]])
-    with pytest.raises(MeshError, match=r"2 vertices are not used by any triangle \(first: 9, 10\)"):
+    with pytest.raises(MeshError, match=r"2 vertices are not used by any triangle \(first: 9, 10\); remove them"):
         curvature_detail(V, F)
+    # one is one: "1 vertices are not used" before
+    with pytest.raises(MeshError, match=r"^1 vertex is not used by any triangle \(first: 9\); remove it, e\.g\."):
+        curvature_detail(V[:10], F)
+
+
+def test_one_bad_vertex_is_named_in_the_singular():
+    V, F = _square()
+    V[2, 1] = np.nan
+    with pytest.raises(MeshError, match=r"^V: 1 vertex has NaN or infinite coordinates \(first: 2\); remove or "
+                                        r"repair it before"):
+        check_mesh(V, F)
+    V[3, 0] = np.inf
+    with pytest.raises(MeshError, match=r"^V: 2 vertices have NaN or infinite coordinates \(first: 2, 3\); remove "
+                                        r"or repair them before"):
+        check_mesh(V, F)
+
+
+@pytest.mark.parametrize("count, words", [(0, "0 edges are"), (1, "1 edge is"), (2, "2 edges are")])
+def test_counted_puts_noun_and_verb_in_the_number_of_the_count(count, words):
+    from curvdetail.curvature.errors import counted, them
+
+    assert counted(count, "edge", verb="are") == words
+    assert counted(count, "vertex", "vertices").endswith("vertex" if count == 1 else "vertices")
+    assert counted(count, "triangle", verb="repeat").endswith("repeats" if count == 1 else "repeat")
+    assert them(count) == ("it" if count == 1 else "them")
 
 
 def test_component_without_fixed_vertex_is_refused():
@@ -161,7 +186,7 @@ def test_component_without_fixed_vertex_is_refused():
 def test_fixed_indices_out_of_range_and_repeated_are_named():
     with pytest.raises(ConstraintError, match=r"2 indices are outside \[0, 9\) \(first: 9, -3\)"):
         as_index_set([0, 9, -3], 9, "fixed")
-    with pytest.raises(ConstraintError, match=r"1 indices are repeated \(first: 4\)"):
+    with pytest.raises(ConstraintError, match=r"1 index is repeated \(first: 4\)"):
         as_index_set([4, 1, 4], 9, "fixed")
     with pytest.raises(ConstraintError, match=r"dtype float64; pass integer"):
         as_index_set([0.5], 9, "fixed")
@@ -179,7 +204,7 @@ def test_values_of_the_wrong_shape_or_non_finite_are_named():
         as_values(np.zeros((4, 2)), 4, "detail")
     bad = np.zeros((4, 3))
     bad[3, 0] = np.nan
-    with pytest.raises(ConstraintError, match=r"1 rows are NaN or infinite \(first: 3\)"):
+    with pytest.raises(ConstraintError, match=r"1 row is NaN or infinite \(first: 3\)"):
         as_values(bad, 4, "detail")
 
 
@@ -220,7 +245,7 @@ def test_components_are_labelled():
 
 @pytest.mark.parametrize("F, message", [
     ([[0, 1]], r"shape \(1, 2\)"), (None, r"shape \(\)"), (np.zeros((0, 3), int), "is empty"),
-    ([[0, 1, -2]], "1 triangles have negative vertex indices"), ([[0, 1, 1]], "repeat a vertex index"),
+    ([[0, 1, -2]], "1 triangle has negative vertex indices"), ([[0, 1, 1]], "1 triangle repeats a vertex index"),
     ([[0, 1, 2.5]], "non-integer"), (np.ones((1, 3), bool), "dtype bool"),
 ])
 def test_boundary_functions_check_their_triangles(F, message):
@@ -230,7 +255,7 @@ def test_boundary_functions_check_their_triangles(F, message):
 
 
 def test_float_indices_too_large_for_int64_are_named_not_wrapped():
-    with pytest.raises(ConstraintError, match=r"1 indices are outside \[0, 5\) \(first: 1e\+20\)"):
+    with pytest.raises(ConstraintError, match=r"1 index is outside \[0, 5\) \(first: 1e\+20\)"):
         as_index_set([1e20], 5, "fixed")
     with pytest.raises(ConstraintError, match=r"outside \[0, 5\)"):
         as_index_set(np.array([2 ** 64 - 1], dtype=np.uint64), 5, "fixed")
@@ -238,7 +263,7 @@ def test_float_indices_too_large_for_int64_are_named_not_wrapped():
         check_mesh(np.eye(3), [[0, 1, 1e20]])
     # Python ints beyond int64 make an object array: still "outside", not "dtype object"
     for big in (10 ** 20, -10 ** 20):
-        with pytest.raises(ConstraintError, match=rf"1 indices are outside \[0, 5\) \(first: {big}\)"):
+        with pytest.raises(ConstraintError, match=rf"1 index is outside \[0, 5\) \(first: {big}\)"):
             as_index_set([1, big], 5, "fixed")
     with pytest.raises(ConstraintError, match=r"2 indices are outside \[0, 5\) \(first: -1\)"):
         as_index_set([-1, 2 ** 63], 5, "fixed")
@@ -264,7 +289,7 @@ def test_coordinates_whose_products_overflow_are_named(scale):
         check_mesh(V * scale, F)
     with pytest.raises(MeshError, match="overflows double precision"):
         mean_curvature_normal(V * scale, F)
-    with pytest.raises(ConstraintError, match=r"positions: 1 rows reach 1e\+200"):
+    with pytest.raises(ConstraintError, match=r"positions: 1 row reaches 1e\+200"):
         as_values([[1e200, 0, 0]], 1, "positions")
 
 

@@ -13,7 +13,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from ._geometry import corner_cotangents
-from .errors import ConstraintError, MeshError, first_indices
+from .errors import ConstraintError, MeshError, counted, first_indices, them
 
 #: Largest coordinate magnitude taken: triangle areas square the cross products of edge vectors
 #: (coordinates squared), which overflow double precision from ~1e77 (mean_curvature_normal then
@@ -49,8 +49,9 @@ def as_vertices(V, name="V", dim=3, max_coordinate=MAX_COORDINATE):
     if not np.isfinite(arr).all():      # one flat pass; the per-row search below only on failure
         bad = np.flatnonzero(~np.isfinite(arr).all(axis=1))
         raise MeshError(
-            f"{name}: {bad.size} vertices have NaN or infinite coordinates (first: {first_indices(bad)}); "
-            "remove or repair them before computing curvature."
+            f"{name}: {counted(bad.size, 'vertex', 'vertices', verb='have')} NaN or infinite coordinates "
+            f"(first: {first_indices(bad)}); "
+            f"remove or repair {them(bad.size)} before computing curvature."
         )
     _check_magnitude(arr, name, MeshError, "scale the mesh down", max_coordinate)
     return arr
@@ -60,7 +61,8 @@ def _check_magnitude(arr, name, error, fix, limit=MAX_COORDINATE):
     """Refuse values beyond ``limit``, where the geometry's products overflow."""
     if arr.size and np.abs(arr).max() > limit:
         bad = np.flatnonzero((np.abs(arr) > limit).any(axis=1))
-        raise error(f"{name}: {bad.size} rows reach {np.abs(arr).max():.3g} (first: {first_indices(bad)}); "
+        raise error(f"{name}: {counted(bad.size, 'row', verb='reach')} {np.abs(arr).max():.3g} "
+                    f"(first: {first_indices(bad)}); "
                     f"beyond {limit:.0e} the geometry overflows double precision: {fix}.")
 
 
@@ -96,14 +98,14 @@ def as_faces(F, n_vertices, name="F"):
         where = "negative vertex indices" if n_vertices is None else \
             f"vertex indices outside [0, {n_vertices})"
         raise MeshError(
-            f"{name}: {bad.size} triangles have {where} "
+            f"{name}: {counted(bad.size, 'triangle', verb='have')} {where} "
             f"(first: {first_indices(bad)}); indices are 0-based into V."
         )
     rep = np.flatnonzero((arr[:, 0] == arr[:, 1]) | (arr[:, 1] == arr[:, 2]) | (arr[:, 0] == arr[:, 2]))
     if rep.size:
         raise MeshError(
-            f"{name}: {rep.size} triangles repeat a vertex index (first: {first_indices(rep)}); "
-            "remove them, e.g. with pymeshlab's meshing_remove_null_faces."
+            f"{name}: {counted(rep.size, 'triangle', verb='repeat')} a vertex index (first: {first_indices(rep)}); "
+            f"remove {them(rep.size)}, e.g. with pymeshlab's meshing_remove_null_faces."
         )
     return arr
 
@@ -180,7 +182,7 @@ def check_mesh(V, F, *, check_manifold=True, check_unreferenced=True):
     >>> check_mesh(V, [[0, 1, 2]])
     Traceback (most recent call last):
     ...
-    curvdetail.curvature.errors.MeshError: 1 vertices are not used by any triangle (first: 3); remove them, e.g. with pymeshlab's meshing_remove_unreferenced_vertices.
+    curvdetail.curvature.errors.MeshError: 1 vertex is not used by any triangle (first: 3); remove it, e.g. with pymeshlab's meshing_remove_unreferenced_vertices.
     >>> V, F = check_mesh(V[:3], [[0, 1, 2]])
     >>> V.dtype, F.dtype
     (dtype('float64'), dtype('int64'))
@@ -201,10 +203,12 @@ def _check_mesh(V, F, check_manifold, check_unreferenced, cotangents=False):
     zero = np.flatnonzero(dbl <= 2.0 * ZERO_AREA_RELATIVE * max(diag, np.finfo(float).tiny) ** 2)
     if zero.size and diag < MIN_DIAGONAL:
         raise MeshError(f"the mesh is {diag:.3g} across (bbox diagonal): its triangle areas underflow double "
-                        f"precision ({zero.size} come out as zero); scale it up, e.g. to unit size.")
+                        f"precision ({counted(zero.size, 'triangle', verb='come')} out as zero); scale it up, e.g. to "
+                        "unit size.")
     if zero.size:
-        raise MeshError(f"{zero.size} triangles have zero area (first: {first_indices(zero)}; areas up to "
-                        f"{ZERO_AREA_RELATIVE:g} of the bbox diagonal squared count); {ZERO_AREA_ADVICE}, "
+        raise MeshError(f"{counted(zero.size, 'triangle', verb='have')} zero area (first: {first_indices(zero)}; "
+                        f"areas up to {ZERO_AREA_RELATIVE:g} of the bbox diagonal squared count); "
+                        f"{ZERO_AREA_ADVICE.replace('them', them(zero.size), 1)}, "
                         "before computing curvature.")
     if check_manifold:
         bad = non_manifold_edges(F)
@@ -216,8 +220,9 @@ def _check_mesh(V, F, check_manifold, check_unreferenced, cotangents=False):
         unused = np.flatnonzero(~used)
         if unused.size:
             raise MeshError(
-                f"{unused.size} vertices are not used by any triangle (first: {first_indices(unused)}); "
-                "remove them, e.g. with pymeshlab's meshing_remove_unreferenced_vertices."
+                f"{counted(unused.size, 'vertex', 'vertices', verb='are')} not used by any triangle "
+                f"(first: {first_indices(unused)}); "
+                f"remove {them(unused.size)}, e.g. with pymeshlab's meshing_remove_unreferenced_vertices."
             )
     return V, F, cot
 
@@ -226,7 +231,7 @@ def non_manifold_error(count, first):
     """The MeshError for ``count`` edges on three or more triangles, ``first``: a few (a, b)."""
     pairs = ", ".join(f"({a}, {b})" for a, b in first)
     return MeshError(
-        f"{count} edges are shared by more than two triangles (first: {pairs}); "
+        f"{counted(count, 'edge', verb='are')} shared by more than two triangles (first: {pairs}); "
         "the mesh is not manifold. Repair it, e.g. with pymeshlab's meshing_repair_non_manifold_edges."
     )
 
@@ -404,7 +409,8 @@ def as_index_set(indices, n, name):
         # Python ints (some beyond int64, or given as an object array): checked as they are
         out = np.flatnonzero([not 0 <= i < n for i in arr])
         if out.size:
-            raise ConstraintError(f"{name}: {out.size} indices are outside [0, {n}) (first: "
+            raise ConstraintError(f"{name}: {counted(out.size, 'index', 'indices', verb='are')} outside "
+                                  f"[0, {n}) (first: "
                                   f"{', '.join(str(i) for i in arr[out[:3]])}); indices are 0-based into V.")
         arr = arr.astype(np.int64)
     if arr.size and not np.issubdtype(arr.dtype, np.integer):
@@ -412,7 +418,8 @@ def as_index_set(indices, n, name):
             raise ConstraintError(f"{name} has dtype {arr.dtype}; pass integer vertex indices.")
         if np.abs(arr).max() >= 2.0 ** 62:      # would not survive the cast to int64
             bad = np.flatnonzero((arr < 0) | (arr >= n))
-            raise ConstraintError(f"{name}: {bad.size} indices are outside [0, {n}) (first: {arr[bad[0]]:.3g}); "
+            raise ConstraintError(f"{name}: {counted(bad.size, 'index', 'indices', verb='are')} outside "
+                                  f"[0, {n}) (first: {arr[bad[0]]:.3g}); "
                                   "indices are 0-based into V.")
     elif arr.dtype == np.uint64 and arr.size and arr.max() > np.iinfo(np.int64).max:
         raise ConstraintError(f"{name}: indices up to {arr.max()} are outside [0, {n}); indices are 0-based into V.")
@@ -420,7 +427,8 @@ def as_index_set(indices, n, name):
     out = np.flatnonzero((arr < 0) | (arr >= n))
     if out.size:
         raise ConstraintError(
-            f"{name}: {out.size} indices are outside [0, {n}) (first: {first_indices(arr[out])}); "
+            f"{name}: {counted(out.size, 'index', 'indices', verb='are')} outside [0, {n}) "
+            f"(first: {first_indices(arr[out])}); "
             "indices are 0-based into V."
         )
     uniq, counts = np.unique(arr, return_counts=True)
@@ -430,7 +438,8 @@ def as_index_set(indices, n, name):
         hint = (f" It looks like a 0/1 mask of all {n} vertices: pass it as booleans "
                 f"({name}=mask.astype(bool)) or as indices (np.flatnonzero(mask)).") if mask else ""
         raise ConstraintError(
-            f"{name}: {arr.size - uniq.size} indices are repeated (first: {first_indices(uniq[counts > 1])}); "
+            f"{name}: {counted(arr.size - uniq.size, 'index', 'indices', verb='are')} repeated "
+            f"(first: {first_indices(uniq[counts > 1])}); "
             f"list each vertex once.{hint}"
         )
     return arr
@@ -491,7 +500,8 @@ def as_values(values, count, name, dim=3):
         raise ConstraintError(f"{name} has shape {arr.shape}; expected ({count}, {dim}), one row per vertex.")
     if not np.isfinite(arr).all():      # one flat pass; the per-row search below only on failure
         bad = np.flatnonzero(~np.isfinite(arr).all(axis=1))
-        raise ConstraintError(f"{name}: {bad.size} rows are NaN or infinite (first: {first_indices(bad)}).")
+        raise ConstraintError(f"{name}: {counted(bad.size, 'row', verb='are')} NaN or infinite "
+                              f"(first: {first_indices(bad)}).")
     _check_magnitude(arr, name, ConstraintError, "scale the problem down")
     return np.ascontiguousarray(arr)
 

@@ -31,3 +31,32 @@ def first_indices(indices, count=3):
     """Format the first few offending indices for an error message: ``'17, 402, 9311'``."""
     indices = [int(i) for i in list(indices)[:count]]
     return ", ".join(str(i) for i in indices)
+
+
+#: The singular of the verbs the messages put after a count (the rest take an "s").
+_SINGULAR_VERBS = {"are": "is", "have": "has", "were": "was", "reach": "reaches", "pass": "passes"}
+
+
+def counted(count, noun, plural=None, verb=None):
+    """A count with its noun (and the verb after it) in the right number, for a message:
+    ``counted(1, "edge", verb="are")`` is ``'1 edge is'``, ``counted(3, "vertex", "vertices")``
+    ``'3 vertices'``. ``plural`` defaults to ``noun + "s"``; ``verb`` is given in the plural
+    (``"are"``, ``"have"``, ``"lie"``, ...).
+
+    Examples
+    --------
+    >>> counted(1, "triangle", verb="have"), counted(2, "triangle", verb="have")
+    ('1 triangle has', '2 triangles have')
+    >>> counted(1, "vertex", "vertices", verb="lie")
+    '1 vertex lies'
+    """
+    one = int(count) == 1
+    text = f"{count} {noun if one else (plural or noun + 's')}"
+    if verb is not None:
+        text += " " + (_SINGULAR_VERBS.get(verb, verb + "s") if one else verb)
+    return text
+
+
+def them(count):
+    """The pronoun for ``count`` things in a message: ``'it'`` for one, else ``'them'``."""
+    return "it" if int(count) == 1 else "them"

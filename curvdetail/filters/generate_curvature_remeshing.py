@@ -1,9 +1,11 @@
 """Filter ``generate_curvature_remeshing``: the paper's remeshing experiment on the current mesh."""
 
+import os
+
 from ..curvature._validate import bbox_diagonal
 from .apply_curvature_reconstruction import BACKEND_DESCRIPTION, BACKENDS
 from .detail_attributes import DETAIL, stamp
-from .meshset import add_layer, get_mesh, layer_id, mesh_arrays
+from .meshset import add_layer, get_mesh, layer_id, mesh_arrays, set_vertex_attribute
 from .parameters import BBoxLength, Parameter
 from .registry import PAPER, filter
 from .transfer_curvature_detail import planar_map
@@ -20,10 +22,12 @@ from .transfer_curvature_detail import planar_map
         measure the two-sided Hausdorff distance to the source next to two baselines (the
         zero-detail surface with the same boundary and the retriangulated surface itself, the
         floor). Adds the retriangulated layer and the rebuilt layer (current; quality = distance
-        to the source, attribute 'curvature_detail' = the transferred detail) and, on request, the
-        zero-detail baseline. Returns the report of curvdetail.remesh.remesh_experiment (error and
-        baselines as fractions of the source's bbox diagonal, sizes, options, seconds per stage)
-        with the new layer ids. {PAPER}, section "Remeshing", Fig. 3.
+        to the source, none without evaluate; attribute 'curvature_detail' = the transferred
+        detail) and, on request, the zero-detail baseline. Returns the report of
+        curvdetail.remesh.remesh_experiment (error and baselines as fractions of the source's bbox
+        diagonal, sizes, options, seconds per stage) with the new layer ids; a rebuild farther
+        from the source than the zero-detail surface is said with a
+        curvdetail.remesh.WorseThanZeroDetailWarning. {PAPER}, section "Remeshing", Fig. 3.
     """,
     parameters=[
         Parameter("method", "str", "isotropic",
@@ -50,7 +54,9 @@ from .transfer_curvature_detail import planar_map
                   "100k-400k target vertices, and the retriangulation may differ where the "
                   "remesher's smoothing would leave the surface"),
         Parameter("evaluate", "bool", True,
-                  "measure the distances to the source (the costly part on big meshes)"),
+                  "measure the distances to the source (half or more of the time on big meshes with "
+                  "decimation, up to half with isotropic remeshing); false leaves the rebuilt and "
+                  "zero-detail layers without a vertex quality, so a PLY of them holds none"),
         Parameter("add_baseline", "bool", False, "also add the zero-detail baseline as a layer"),
     ],
 )
@@ -68,7 +74,7 @@ def generate_curvature_remeshing(ms, *, method, target_edge, transfer, rows, loc
 
     def progress(stage):            # said once the checks have passed, before the work
         if stage == "retriangulate":
-            _warn_of_a_big_target(V, F, target_edge, length, fraction, evaluate)
+            _warn_of_a_big_target(V, F, target_edge, length, fraction, method, evaluate)
 
     result = run_experiment(V, F, method=method, target_edge=fraction, transfer=transfer, rows=rows,
                             location=location, parameterization=planar_map(location, parameterization),
@@ -77,41 +83,54 @@ def generate_curvature_remeshing(ms, *, method, target_edge, transfer, rows, loc
     Ft = result["Ft"]
     layers = {"source": mid,
               "retriangulated": add_layer(ms, result["Vt"], Ft, f"{label} retriangulated")}
+    # without evaluation the measured layers get no quality at all, not pymeshlab's zeros
+    measured_layer = add_layer if evaluate else _add_layer_without_quality
     if add_baseline:
         # per-vertex distances of the baseline only here, where they colour its layer (the
         # experiment itself needs the Hausdorff figures only: 2-3 % of its time at 100k)
         zero_distance = vertex_distance(result["Z"], V, F, far=True) if evaluate else None
-        layers["zero_detail"] = add_layer(ms, result["Z"], Ft, f"{label} zero detail", quality=zero_distance)
-    layers["rebuilt"] = add_layer(ms, result["X"], Ft, f"{label} rebuilt", quality=result["distance"],
-                                  attributes={DETAIL: result["Dt"], **stamp(Ft, result["X"].shape[0])})
+        layers["zero_detail"] = measured_layer(ms, result["Z"], Ft, f"{label} zero detail", quality=zero_distance)
+    layers["rebuilt"] = measured_layer(ms, result["X"], Ft, f"{label} rebuilt", quality=result["distance"],
+                                       attributes={DETAIL: result["Dt"], **stamp(Ft, result["X"].shape[0])})
     report = dict(result["report"])
     report["layers"] = layers
     return report
 
 
-def _warn_of_a_big_target(V, F, target_edge, length, fraction, evaluate):
-    """A LongRunWarning before a retriangulation of more than BIG_TARGET vertices (edges of
-    ``length``, ``fraction`` of the diagonal): a plain target_edge=0.01 is 0.01 model units (on
-    a 15 km terrain 1.3M vertices, 10 minutes without a word), not 1 %."""
+def _add_layer_without_quality(ms, V, F, label, *, quality=None, attributes=None):
+    """:func:`~curvdetail.filters.meshset.add_layer` of a layer that has no vertex quality
+    (``quality`` must be None). A ``pymeshlab.Mesh`` made from arrays always has one, all 0,
+    which a PLY of the layer would carry as if it were measured; a layer loaded from a file
+    without one has none. So the layer is loaded from a temporary binary PLY (doubles: exact)."""
+    import tempfile
+
+    from ..io import write_mesh
+
+    assert quality is None
+    with tempfile.TemporaryDirectory(prefix="curvdetail-layer-") as folder:
+        path = os.path.join(folder, "layer.ply")
+        write_mesh(path, V, F)
+        ms.load_new_mesh(path)
+    mid = int(ms.current_mesh_id())
+    ms.current_mesh().set_label(label)
+    for name, values in (attributes or {}).items():
+        set_vertex_attribute(ms, mid, name, values)
+    return mid
+
+
+def _warn_of_a_big_target(V, F, target_edge, length, fraction, method, evaluate):
+    """A LongRunWarning before a run of minutes (a retriangulation of more than BIG_TARGET
+    vertices, edges of ``length``, ``fraction`` of the diagonal; not for a decimation that will
+    be refused), saying what takes the time: a plain target_edge=0.01 is 0.01 model units (on a
+    15 km terrain 1.3M vertices, 10 minutes without a word), not 1 %."""
     import warnings
 
-    from ..remesh.retriangulate import LongRunWarning, long_run_vertices
+    from ..remesh.experiment import _caller_outside_the_package
+    from ..remesh.retriangulate import LongRunWarning, long_run_reason, long_run_vertices
 
-    count = long_run_vertices(V, F, length)
+    count = long_run_vertices(V, F, length, method=method, evaluate=evaluate)
     if count is not None:
-        why = " (the measurements most of it; evaluate false skips them)" if evaluate else ""
         warnings.warn(f"target_edge={target_edge} ({100 * fraction:.3g} % of the bbox diagonal) gives about "
-                      f"{count:,.0f} target vertices; this takes minutes{why}. A plain number is in model "
-                      "units; pymeshlab.PercentageValue(1) is 1 % of the diagonal.", LongRunWarning,
-                      stacklevel=_caller_outside_the_package())
-
-
-def _caller_outside_the_package():
-    """The ``stacklevel`` of the first frame outside curvdetail: a warning names the caller's line
-    (and is shown once per such line, not once per process)."""
-    import sys
-
-    frame, level = sys._getframe(1), 1
-    while frame is not None and frame.f_globals.get("__name__", "").startswith("curvdetail"):
-        frame, level = frame.f_back, level + 1
-    return level
+                      f"{count:,.0f} target vertices; this takes minutes. {long_run_reason(method, evaluate)} "
+                      "A plain number is in model units; pymeshlab.PercentageValue(1) is 1 % of the diagonal.",
+                      LongRunWarning, stacklevel=_caller_outside_the_package())

@@ -7,14 +7,14 @@ closest-face grid, Hausdorff distance) and fast-simplification (decimation).
 
 from ._disk import NotADiskError, RemeshError, check_disk
 from .evaluate import hausdorff, vertex_distance
-from .experiment import remesh_experiment
+from .experiment import WorseThanZeroDetailWarning, remesh_experiment
 from .locate import interpolate, locate, spread
 from .parameterize import flipped_triangles, harmonic_map, parameterize
 from .retriangulate import LongRunWarning, retriangulate
 from .transfer import edge_curvature_measure, transfer_curvature
 
 __all__ = [
-    "LongRunWarning", "NotADiskError", "RemeshError", "check_disk", "edge_curvature_measure", "flipped_triangles", "harmonic_map",
-    "hausdorff", "interpolate", "locate", "parameterize", "remesh_experiment", "retriangulate", "spread",
-    "transfer_curvature", "vertex_distance",
+    "LongRunWarning", "NotADiskError", "RemeshError", "WorseThanZeroDetailWarning", "check_disk",
+    "edge_curvature_measure", "flipped_triangles", "harmonic_map", "hausdorff", "interpolate", "locate",
+    "parameterize", "remesh_experiment", "retriangulate", "spread", "transfer_curvature", "vertex_distance",
 ]

@@ -14,7 +14,7 @@ from scipy.spatial import cKDTree
 from ..curvature._validate import (as_faces, boundary_edges, check_mesh, check_oriented, non_manifold_edges,
                                    vertex_components)
 from ..curvature.boundary_editing import loop_of_boundary_edges
-from ..curvature.errors import MeshError, first_indices
+from ..curvature.errors import MeshError, counted, first_indices
 
 
 class NotADiskError(MeshError):
@@ -78,23 +78,29 @@ def check_disk(V, F, what="the source"):
             nm = None
         if nm is not None and nm.shape[0]:
             pairs = ", ".join(f"({a}, {b})" for a, b in nm[:3])
-            raise NotADiskError(f"{what} is not manifold: {nm.shape[0]} edges are shared by more than "
-                                f"two triangles (first: {pairs}); {need}.") from None
+            # a repair, not a cut: such edges are mostly a few stray triangles (a fin, a doubled face)
+            raise _refuse(f"{what} is not manifold: {counted(nm.shape[0], 'edge', verb='are')} shared by more "
+                          f"than two triangles (first: {pairs})",
+                          "repair the mesh, e.g. with pymeshlab's meshing_repair_non_manifold_edges (it deletes "
+                          "the smallest triangles on each such edge until two are left) and "
+                          "meshing_remove_unreferenced_vertices; the result must be a disk-topology patch: one "
+                          "connected piece with exactly one boundary loop and no handles") from None
         raise
     n = V.shape[0]
     _, pieces = vertex_components(F, n)
     if pieces > 1:
-        raise NotADiskError(f"{what} has {pieces} separate pieces; {need}.")
+        raise _refuse(f"{what} has {pieces} separate pieces", need)
     B = boundary_edges(F)
     if B.shape[0] == 0:
-        raise NotADiskError(f"{what} is closed (0 boundary loops); {need}.")
+        raise _refuse(f"{what} is closed (0 boundary loops)", need)
     out_deg = np.bincount(B[:, 0], minlength=n)
     in_deg = np.bincount(B[:, 1], minlength=n)
     pinched = np.flatnonzero((out_deg > 1) | (in_deg > 1))
     if pinched.size:
         check_oriented(F, what, error=NotADiskError)
-        raise NotADiskError(f"{what} is not vertex-manifold: the boundary passes {pinched.size} vertices "
-                            f"more than once (first: {first_indices(pinched)}); {need}.")
+        raise _refuse(f"{what} is not vertex-manifold: the boundary passes "
+                      f"{counted(pinched.size, 'vertex', 'vertices')} more than once "
+                      f"(first: {first_indices(pinched)})", need)
     G = sp.coo_matrix((np.ones(B.shape[0]), (B[:, 0], B[:, 1])), shape=(n, n))
     on_boundary = np.zeros(n, dtype=bool)
     on_boundary[B.ravel()] = True
@@ -102,19 +108,27 @@ def check_disk(V, F, what="the source"):
     loops = np.unique(labels[on_boundary]).size
     if loops != 1:
         check_oriented(F, what, error=NotADiskError)
-        raise NotADiskError(f"{what} has {loops} boundary loops (holes); {need}.")
+        raise _refuse(f"{what} has {loops} boundary loops (holes)", need)
     # check_mesh refused edges in more than two triangles: every interior edge is two of the 3m
     # half-edges, every boundary edge one (np.unique over the edge rows took 1.6 s at 200k faces)
     n_edges = (3 * F.shape[0] + B.shape[0]) // 2
     chi = n - n_edges + F.shape[0]
     if chi != 1:
-        raise NotADiskError(f"{what} has one boundary loop but Euler characteristic {chi} "
-                            f"({(1 - chi) // 2} handles); {need}.")
+        raise _refuse(f"{what} has one boundary loop but Euler characteristic {chi} "
+                      f"({counted((1 - chi) // 2, 'handle')})", need)
     try:
         return V, F, loop_of_boundary_edges(B)
     except MeshError:
         check_oriented(F, what, error=NotADiskError)
         raise
+
+
+def _refuse(problem, advice):
+    """The NotADiskError ``problem; advice.``, with ``problem`` kept as its attribute ``problem``
+    (where the mesh is a remesher's result, the advice to the user is another)."""
+    exc = NotADiskError(f"{problem}; {advice}.")
+    exc.problem = problem
+    return exc
 
 
 class Polyline:

@@ -1,6 +1,8 @@
 """The remeshing experiment of the paper's Fig. 3, end to end, with a JSON-ready report."""
 
+import sys
 import time
+import warnings
 
 import numpy as np
 
@@ -39,6 +41,61 @@ STAGES = ("retriangulate", "parameterize", "transfer", "reconstruct", "evaluate"
 
 DEFAULTS = {"method": "isotropic", "target_edge": 0.01, "transfer": "conservative", "rows": "free",
             "location": "closest", "parameterization": None, "backend": "auto", "surface_check": True}
+
+
+class WorseThanZeroDetailWarning(UserWarning):
+    """Said by :func:`remesh_experiment` (and so by the ``generate_curvature_remeshing`` filter;
+    ``curvdetail remesh`` says it as a note) when the rebuilt surface is farther from the source
+    than the zero-detail surface (two-sided Hausdorff RMS): the transferred detail made the
+    rebuild worse than no detail at all, so the configuration failed on this patch (the paper's
+    pointwise transfer does on camelhead, 36 % RMS against 21 %). The message says what to try
+    (:func:`worse_than_zero_detail`); the figures are in the report. Turn it into an error with
+    ``warnings.simplefilter("error", WorseThanZeroDetailWarning)``."""
+
+
+def _option(name, value, cli):
+    """An option as the user gives it: ``transfer='conservative'`` or ``--transfer conservative``."""
+    return f"--{name.replace('_', '-')} {value}" if cli else f"{name}={value!r}"
+
+
+def worse_than_zero_detail(report, cli=False):
+    """The message of a :class:`WorseThanZeroDetailWarning` for an evaluated ``report`` of
+    :func:`remesh_experiment`, or None where the rebuild is no farther from the source than the
+    zero-detail surface (RMS) or was not measured. ``cli``: naming the options of ``curvdetail
+    remesh`` instead of the function's parameters."""
+    if "error" not in report or "baseline_zero_detail" not in report:
+        return None
+    rms, zero = report["error"]["hausdorff_rms"], report["baseline_zero_detail"]["hausdorff_rms"]
+    if not rms > zero:
+        return None
+    options = report.get("options", {})
+    tries = []
+    if options.get("transfer") == "pointwise":
+        tries.append(f"the conservative transfer ({_option('transfer', 'conservative', cli)}, the default; the "
+                     "pointwise one interpolates K = D / A, which spikes where the source has small vertex "
+                     "areas, e.g. sliver triangles)")
+    if options.get("location") == "uv":
+        tries.append(f"closest-point location ({_option('location', 'closest', cli)}, the default; a planar "
+                     "map squeezes elongated parts of the patch)")
+    if options.get("rows") == "all":
+        tries.append(f"free rows ({_option('rows', 'free', cli)}, the default)")
+    if not tries:       # the defaults: measured well below zero detail on every public patch
+        edge = "--target-edge" if cli else "target_edge"
+        tries.append(f"a shorter target edge ({edge}: a coarse target cannot carry the source's detail), or "
+                     f"{_option('method', 'decimate', cli)}, and check the source for noise or sliver triangles")
+    return (f"the rebuilt surface is farther from the source than the zero-detail surface (RMS "
+            f"{100 * rms:.4g} % against {100 * zero:.4g} % of the bbox diagonal): the transferred detail made it "
+            f"worse than no detail at all, so this configuration failed on this patch. Try "
+            f"{'; and '.join(tries)}. docs/remeshing.md has what was measured.")
+
+
+def _caller_outside_the_package():
+    """The ``stacklevel`` of the first frame outside curvdetail: a warning names the caller's line
+    (and is shown once per such line, not once per process)."""
+    frame, level = sys._getframe(1), 1
+    while frame is not None and frame.f_globals.get("__name__", "").startswith("curvdetail"):
+        frame, level = frame.f_back, level + 1
+    return level
 
 
 def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="conservative", rows="free",
@@ -115,6 +172,12 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="c
                                callable; ``evaluate`` or ``surface_check`` not a bool
     SolverError                unknown or uninstalled ``backend`` (before any work)
 
+    Warns
+    -----
+    WorseThanZeroDetailWarning   the rebuild is farther from the source than the zero-detail
+                                 surface (RMS; ``improvement_over_zero_detail`` below 1): the
+                                 configuration failed on this patch; the message says what to try
+
     Examples
     --------
     >>> from curvdetail.curvature.testing import disk
@@ -148,7 +211,8 @@ def _check_target_boundary(P, X, d):
     off = np.flatnonzero(dist > TARGET_BOUNDARY_TOLERANCE)
     if off.size:
         raise RemeshError(
-            f"{off.size} of {X.shape[0]} target boundary vertices are off the source's boundary polyline "
+            f"{off.size} of {X.shape[0]} target boundary vertices {'is' if off.size == 1 else 'are'} off the "
+            "source's boundary polyline "
             f"(up to {dist.max():.3g} of the larger of the source's bbox diagonal and its largest "
             f"coordinate; allowed {TARGET_BOUNDARY_TOLERANCE:g}): the target must be a retriangulation of "
             "the source with its boundary vertices on the source's boundary. Pass one made by "
@@ -266,6 +330,9 @@ def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="cons
         report["improvement_over_zero_detail"] = report["baseline_zero_detail"]["hausdorff_rms"] / max(rms, 1e-300)
         report["ratio_to_floor"] = rms / max(report["floor_retriangulated"]["hausdorff_rms"], 1e-300)
         seconds["evaluate"] = time.perf_counter() - t
+        worse = worse_than_zero_detail(report)
+        if worse is not None:
+            warnings.warn(worse, WorseThanZeroDetailWarning, stacklevel=_caller_outside_the_package())
     seconds["total"] = time.perf_counter() - t_all
     report["seconds"] = {k: round(v, 4) for k, v in seconds.items()}
     out["report"] = report

@@ -1,9 +1,12 @@
 """Retriangulate a disk-topology patch, keeping its boundary curve (paper Fig. 3, step 1)."""
 
+import math
+
 import numpy as np
 
 from ..curvature._validate import (check_choice, as_count, as_float, as_positive_number, bbox_diagonal, check_bool,
                                    face_double_areas)
+from ..curvature.errors import counted
 from ._disk import NotADiskError, Polyline, RemeshError, check_disk
 
 METHODS = ("isotropic", "decimate")
@@ -11,13 +14,16 @@ METHODS = ("isotropic", "decimate")
 #: The target edge length is refused when it would give fewer / more target vertices than this.
 MIN_VERTICES, MAX_VERTICES = 50, 5_000_000
 #: From this many estimated target vertices the experiment takes minutes and says so beforehand
-#: (measured: 88k vertices 65 s, 547k ~10 min, most of it the evaluation).
+#: (measured: 199k-263k target vertices 61-104 s, about half of it or more the isotropic
+#: remeshing; 2.25M vertices: the remeshing alone 554 s; see :func:`long_run_reason`).
 BIG_TARGET = 200_000
 
 
 class LongRunWarning(UserWarning):
-    """Said before a run that will take minutes (a retriangulation of more than ``BIG_TARGET``
-    vertices); silence it with ``warnings.simplefilter("ignore", LongRunWarning)``."""
+    """Said by the ``generate_curvature_remeshing`` filter before a run that will take minutes
+    (a retriangulation of more than ``BIG_TARGET`` estimated vertices, see
+    :func:`long_run_vertices`), with what takes the time; silence it with
+    ``warnings.simplefilter("ignore", LongRunWarning)``."""
 
 #: A boundary vertex of the remesher's result further than this (x the target edge length) from
 #: the source boundary polyline is an error; closer ones are projected onto the polyline. The
@@ -37,23 +43,98 @@ def estimated_vertices(V, F, target_edge):
         return 2.0 * area / np.sqrt(3.0) / float(target_edge) / float(target_edge)
 
 
-def long_run_vertices(V, F, target_edge):
-    """The estimated target vertex count (:func:`estimated_vertices`) where a retriangulation
-    with edges ``target_edge`` (absolute) takes minutes: above ``BIG_TARGET``, up to the
-    ``MAX_VERTICES`` the remesher accepts; else None (also where the mesh is too malformed to
-    estimate: its checks will say why)."""
+def long_run_vertices(V, F, target_edge, method="isotropic", evaluate=True):
+    """The estimated target vertex count (:func:`estimated_vertices`) where a run of the
+    experiment with target edges ``target_edge`` (absolute) takes minutes; else None.
+
+    That is above ``BIG_TARGET``, up to the ``MAX_VERTICES`` the remesher accepts; for
+    ``method="decimate"`` only a target coarser than the source (a finer one is refused at
+    once) and with ``evaluate`` (the decimation, transfer and rebuild alone took 18 s for 490k
+    -> 251k vertices). None also where the mesh is too malformed to estimate: its checks will
+    say why."""
+    if method == "decimate" and not evaluate:
+        return None
     try:
         with np.errstate(all="ignore"):
             count = float(estimated_vertices(V, F, target_edge))
-    except (ValueError, IndexError, ArithmeticError):
+            refused = method == "decimate" and _decimation_refines(count, np.shape(F)[0])
+    except (ValueError, IndexError, ArithmeticError, TypeError):
         return None
-    return count if BIG_TARGET < count <= MAX_VERTICES else None
+    return count if BIG_TARGET < count <= MAX_VERTICES and not refused else None
+
+
+def long_run_reason(method="isotropic", evaluate=True, cli=False):
+    """What takes the time of a run that :func:`long_run_vertices` announces and what shortens
+    it: a sentence for the note said beforehand (``cli``: naming the command line's options,
+    else the filter's parameters).
+
+    Measured on the 2-core development machine (2026-12-01): isotropic remeshing to 263k
+    vertices (terrainA_1k) 61 s, of which the remeshing 47 s and the measurements 10 s; to 199k
+    (mannequin_nose) 104 s, remeshing 48 s and measurements 52 s (its zero-detail surface lies
+    far from the source); to 2.25M the remeshing alone 554 s (it grows faster than the
+    vertices, the measurements about with them). Decimation of a 490k-vertex grid to 251k: 92 s,
+    of which the measurements 75 s, the transfer 13 s and the decimation 3 s."""
+    no_evaluate = "--no-evaluate" if cli else "evaluate false"
+    no_check = "--no-surface-check" if cli else "surface_check false"
+    if method == "decimate":
+        return f"Most of it is the measurements ({no_evaluate} skips them); the decimation itself takes seconds."
+    remeshing = f"pymeshlab's isotropic remeshing ({no_check} makes it 25-50 % faster)"
+    if not evaluate:
+        return f"Most of it is {remeshing}."
+    return (f"Half of it or more is {remeshing}, the more so the bigger the target, and most of the rest "
+            f"the measurements ({no_evaluate} skips them).")
 
 
 def edge_for_vertices(V, F, count):
     """The absolute edge length whose equilateral triangulation of the surface has ``count``
     vertices (the inverse of :func:`estimated_vertices`)."""
     return float(np.sqrt(2.0 * 0.5 * face_double_areas(V, F).sum() / (np.sqrt(3.0) * count)))
+
+
+def _decimation_refines(count, faces):
+    """Whether a decimation to an estimated ``count`` vertices (2 ``count`` triangles) of a
+    source with ``faces`` triangles asks for as many triangles as it has, or more (refused)."""
+    return round(2.0 * count) >= faces
+
+
+def target_edge_range(V, F, method="isotropic"):
+    """``(shortest, longest)`` target edge, as fractions of the bbox diagonal, that
+    :func:`retriangulate` accepts for the patch ``(V, F)`` with ``method``: from
+    ``MAX_VERTICES`` to ``MIN_VERTICES`` estimated vertices; decimation, which only coarsens,
+    from about the source's own edge length (fewer triangles than the source has) up. For a
+    patch too small to decimate the shortest is longer than the longest."""
+    d = bbox_diagonal(V)
+    shortest = edge_for_vertices(V, F, MAX_VERTICES) / d
+    if method == "decimate":
+        # round(2 n) < faces from 2 n < faces - 1/2 on
+        shortest = max(shortest, edge_for_vertices(V, F, (np.shape(F)[0] - 0.5) / 2.0) / d)
+    return shortest, edge_for_vertices(V, F, MIN_VERTICES) / d
+
+
+def _percent(fraction, up):
+    """``100 fraction`` to 3 significant digits, rounded up (``up``) or down, so that a bound
+    of an admissible range given in a message is admissible itself."""
+    value = 100.0 * fraction
+    if not (np.isfinite(value) and value > 0):
+        return f"{value:.3g}"
+    unit = 10.0 ** (math.floor(math.log10(value)) - 2)
+    steps = math.ceil(value / unit) if up else math.floor(value / unit)
+    return f"{steps * unit:.3g}"
+
+
+def _range_advice(V, F, method, why=True):
+    """How a refusal of the target edge says what to choose instead, for ``method`` (``why``:
+    say why decimation's range starts where it does)."""
+    shortest, longest = target_edge_range(V, F, method)
+    patch = f"this {V.shape[0]:,}-vertex patch"
+    if method != "decimate":
+        return f"choose a target edge between {_percent(shortest, True)} % and {_percent(longest, False)} % for {patch}"
+    if shortest >= longest:
+        return (f"{patch} is too small to decimate to {MIN_VERTICES} vertices or more "
+                f"({counted(np.shape(F)[0], 'triangle')}); {_USE_ISOTROPIC}")
+    own = " (about the source's own edge length: it only coarsens)" if why else ""
+    return (f"decimation takes target edges from {_percent(shortest, True)} %{own} to "
+            f"{_percent(longest, False)} % of the bbox diagonal for {patch}; choose one there or {_USE_ISOTROPIC}")
 
 
 def check_target_edge(target_edge):
@@ -155,10 +236,7 @@ def retriangulate(V, F, *, method="isotropic", target_edge=0.01, iterations=10, 
         side, limit = ("fewer than", MIN_VERTICES) if n_est < MIN_VERTICES else ("more than", MAX_VERTICES)
         raise RemeshError(
             f"target edge {100 * target_edge:.4g} % of the bbox diagonal ({h:.4g}) would give about "
-            f"{n_est:,.0f} target vertices, {side} {limit:,}; choose a target edge between "
-            f"{100 * edge_for_vertices(V, F, MAX_VERTICES) / d:.3g} % and "
-            f"{100 * edge_for_vertices(V, F, MIN_VERTICES) / d:.3g} % for this "
-            f"{V.shape[0]:,}-vertex patch.")
+            f"{n_est:,.0f} target vertices, {side} {limit:,}; {_range_advice(V, F, method)}.")
     # Both remeshers work in a unit frame (bbox centre at the origin, diagonal 1): their
     # tolerances are absolute (fast-simplification's collapse thresholds are, so a patch 1e12
     # across came back undecimated), and the result must not depend on where the patch sits
@@ -171,7 +249,8 @@ def retriangulate(V, F, *, method="isotropic", target_edge=0.01, iterations=10, 
         try:
             Ut, Ft, loop_t = check_disk(Ut, Ft, "the isotropic remesher's result")
         except NotADiskError as exc:
-            raise RemeshError(f"{exc} Try another target edge.") from None
+            # what was found, not the advice to the owner of a mesh (repair it, cut a disk out)
+            raise RemeshError(f"{getattr(exc, 'problem', exc)}; try another target edge.") from None
     else:
         Ut, Ft, loop_t = _decimate(unit, F, target_edge, aggressiveness)
     Vt = Ut * d + center
@@ -245,7 +324,7 @@ def _decimate(V, F, h, agg):
     if target_faces >= F.shape[0]:
         raise RemeshError(
             f"decimation can only coarsen: the target edge asks for about {target_faces:,} triangles "
-            f"but the source has {F.shape[0]:,}; give a longer target edge or {_USE_ISOTROPIC}.")
+            f"but the source has {F.shape[0]:,}; {_range_advice(V, F, 'decimate', why=False)}.")
     last = None
     for a in (agg, min(agg, 3.0), 1.0):
         scale = _decimation_scale(a)
@@ -262,7 +341,7 @@ def _decimate(V, F, h, agg):
             return check_disk(P, T, "the decimated mesh")
         except ValueError as exc:  # a non-manifold edge or a zero-area triangle at high agg
             last = exc
-    raise RemeshError(f"{last} (decimation with agg={agg}, 3 and 1); {_USE_ISOTROPIC}.")
+    raise RemeshError(f"{getattr(last, 'problem', last)} (decimation with agg={agg}, 3 and 1); {_USE_ISOTROPIC}.")
 
 
 def _snap_boundary(V, loop, Vt, Ft, loop_t, d, h):
@@ -271,9 +350,9 @@ def _snap_boundary(V, loop, Vt, Ft, loop_t, d, h):
     far = np.flatnonzero(dist > BOUNDARY_SNAP * h)
     if far.size:
         raise RemeshError(
-            f"the remesher moved {far.size} boundary vertices off the source boundary (largest "
-            f"{dist.max() / d:.2e} of the bbox diagonal, first: {', '.join(map(str, loop_t[far[:3]]))}); "
-            "try another target edge.")
+            f"the remesher moved {counted(far.size, 'boundary vertex', 'boundary vertices')} off the "
+            f"source boundary (largest {dist.max() / d:.2e} of the bbox diagonal, first: "
+            f"{', '.join(map(str, loop_t[far[:3]]))}); try another target edge.")
     _, s, _ = poly.project(Y)
     step = np.mod(np.diff(np.append(s, s[0])), poly.total)
     if abs(step.sum() - poly.total) > 1e-6 * poly.total:
