@@ -113,3 +113,18 @@ def test_filter_functions_get_a_docstring_from_their_declaration():
         assert doc and spec.description.split()[0] in doc, spec.name
         for p in spec.parameters:
             assert f"{p.name} : {p.type_label}" in doc, (spec.name, p.name)
+
+
+def test_a_choice_index_means_the_same_value_in_every_filter():
+    # pymeshlab and .mlx scripts may give an enumeration by index: rows=1 was "all" in
+    # generate_curvature_remeshing and "free" in apply_curvature_reconstruction
+    from curvdetail.filters import list_filters
+
+    seen = {}
+    for spec in list_filters():
+        for p in spec.parameters:
+            if p.choices is not None:
+                seen.setdefault(p.name, {}).setdefault(frozenset(p.choices), set()).add(p.choices)
+    for name, by_set in seen.items():
+        for orders in by_set.values():
+            assert len(orders) == 1, f"parameter {name!r} lists the same choices in different orders: {orders}"

@@ -40,8 +40,10 @@ from .transfer_curvature_detail import planar_map
                   "how detail is carried over: 'conservative' (measure, totals kept) or 'pointwise' "
                   "(the paper: K interpolated, times the target's area)",
                   choices=("conservative", "pointwise")),
+        # the same order as apply_curvature_reconstruction's, so that an index means one row mode
+        # in every filter (the defaults differ: free here, as SPEC's experiment, all there)
         Parameter("rows", "str", "free", "residual rows of the reconstruction energy E_Q",
-                  choices=("free", "all")),
+                  choices=("all", "free")),
         Parameter("location", "str", "closest",
                   "where target vertices lie on the source: 'closest' point in space or 'uv' "
                   "(shared planar parameterization)", choices=("closest", "uv")),
