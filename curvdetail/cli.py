@@ -316,7 +316,7 @@ def _remesh_command(parser):
     parser.add_argument("--transfer", choices=("conservative", "pointwise"), default="conservative",
                         help="detail transfer: conservative (edge curvature measure, default) or "
                              "pointwise (the paper: K interpolated times target area)")
-    parser.add_argument("--rows", choices=("free", "all"), default="free",
+    parser.add_argument("--rows", choices=("all", "free"), default="free",
                         help="residual rows of the reconstruction energy (default: free)")
     parser.add_argument("--location", choices=("closest", "uv"), default="closest",
                         help="locate points by 3D closest point (default) or in a shared planar domain")

@@ -62,7 +62,7 @@ def test_list_json_is_every_filter_with_typed_parameters(capsys):
     remesh = {f["name"]: f for f in found}["generate_curvature_remeshing"]
     params = {p["name"]: p for p in remesh["parameters"]}
     assert params["target_edge"]["type"] == "PercentageValue" and params["target_edge"]["default"] == "1.0%"
-    assert params["rows"]["default"] == "free" and params["rows"]["choices"] == ["free", "all"]
+    assert params["rows"]["default"] == "free" and params["rows"]["choices"] == ["all", "free"]
     assert "\n" not in remesh["description"] and "Fig. 3" in remesh["description"]
     rc, out, _ = run_cli(capsys, "list", "generate_minimal_surface", "--json")
     one = json.loads(out)
