@@ -87,7 +87,7 @@ def test_vertex_distance_refuses_nan_points_naming_them(far):
     V, F = grid(5, 5)
     P = V[:3].copy()
     P[1, 2] = np.inf
-    with pytest.raises(MeshError, match=r"V: 1 vertices have NaN or infinite coordinates \(first: 1\)"):
+    with pytest.raises(MeshError, match=r"V: 1 vertex has NaN or infinite coordinates \(first: 1\)"):
         vertex_distance(P, V, F, far=far)
 
 
