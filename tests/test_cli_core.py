@@ -11,7 +11,7 @@ from curvdetail import boundary_vertices, read_mesh
 from curvdetail.cli import main
 from curvdetail.curvature._validate import bbox_diagonal
 
-from conftest import data_path
+from conftest import data_path, run_commit_interrupted_by
 
 NOSE = data_path("mannequin_nose.obj")
 SPOT = data_path("spot.obj")
@@ -406,48 +406,7 @@ def test_ctrl_c_during_a_commit_lets_it_finish(tmp_path):
     # as with SIGTERM: the outputs are all written (exit status 130 all the same) or none, and
     # no old file is left in a hidden folder. The commit goes on only once the watcher has asked
     # for the commit lock; the main thread then waits for the watcher, which only its exit ends
-    script = tmp_path / "interrupted.py"
-    script.write_text(
-        "import os, signal, sys, threading\n"
-        "from curvdetail import _output, cli\n"
-        "from curvdetail._output import Output, atomic_outputs\n"
-        "asked = threading.Event()\n"
-        "class Lock:                                  # the commit lock, telling when the watcher asks\n"
-        "    def __init__(self, lock):\n"
-        "        self.lock = lock\n"
-        "    def acquire(self, *args, **kwargs):\n"
-        "        if threading.current_thread() is not threading.main_thread():\n"
-        "            asked.set()\n"
-        "        return self.lock.acquire(*args, **kwargs)\n"
-        "    def release(self):\n"
-        "        self.lock.release()\n"
-        "    def __enter__(self):\n"
-        "        self.lock.acquire()\n"
-        "    def __exit__(self, *exc):\n"
-        "        self.lock.release()\n"
-        "_output.COMMIT_LOCK = Lock(_output.COMMIT_LOCK)\n"
-        "real = os.replace\n"
-        "def replace(src, dst):\n"
-        "    real(src, dst)\n"
-        "    if dst.endswith('a.txt'):\n"
-        "        os.kill(os.getpid(), signal.SIGINT)    # Ctrl-C between the renames of a.txt and b.txt\n"
-        "        asked.wait()                           # until the watcher asks for the lock\n"
-        "os.replace = replace\n"
-        "before = set(threading.enumerate())\n"
-        "cli._watch_sigterm()\n"
-        "(watcher,) = set(threading.enumerate()) - before\n"
-        "a, b = sys.argv[1:]\n"
-        "with atomic_outputs([Output(a, hint=None), Output(b, hint=None)], overwrite=True) as temps:\n"
-        "    for tmp, text in zip(temps, ('new a', 'new b')):\n"
-        "        open(tmp, 'w').write(text)\n"
-        "watcher.join()                                 # the watcher ends the process, or returns\n"
-        "print('not ended', flush=True)\n")
-    out = tmp_path / "out"
-    out.mkdir()
-    (out / "a.txt").write_text("old a")
-    (out / "b.txt").write_text("old b")
-    done = subprocess.run([sys.executable, str(script), str(out / "a.txt"), str(out / "b.txt")],
-                          capture_output=True, text=True, timeout=300)
+    done, out = run_commit_interrupted_by(tmp_path, "SIGINT")
     assert done.returncode == 130 and done.stdout == "", (done.returncode, done.stdout, done.stderr)
     assert done.stderr == "curvdetail: interrupted\n"
     assert ((out / "a.txt").read_text(), (out / "b.txt").read_text()) == ("new a", "new b")

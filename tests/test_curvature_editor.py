@@ -8,6 +8,8 @@ from curvdetail.curvature import sparse_solver
 from curvdetail.curvature.errors import ConstraintError, UndeterminedEditError
 from curvdetail.curvature.testing import grid
 
+from conftest import InexactSolves
+
 
 def _rotation(rng):
     Q, R = np.linalg.qr(rng.normal(size=(3, 3)))
@@ -17,24 +19,6 @@ def _rotation(rng):
 
 def _diag(V):
     return np.linalg.norm(V.max(0) - V.min(0))
-
-
-class _InexactSolves:
-    """A factorization whose every solve comes back 1e-8 (relative) off: a stand-in for normal
-    equations that lose cond^2 * eps, with an error that rounding on no machine can hide. The
-    plain solve is then ~1e-8 off, and each corrected semi-normal step contracts the error by
-    ~1e-8. (Asserting that the exact solves' plain error is large depended on the machine's
-    rounding; "refined <= plain" does not hold by construction either: refine_least_squares
-    does not keep the better iterate, and at the rounding floor a step may add rounding.)"""
-
-    def __init__(self, factor):
-        self.factor = factor
-
-    def __getattr__(self, name):
-        return getattr(self.factor, name)
-
-    def solve(self, b):
-        return self.factor.solve(b) * (1 + 1e-8)
 
 
 @pytest.mark.parametrize("relations", ["one-ring", "one+two-ring"])
@@ -149,9 +133,9 @@ def test_the_normal_equation_embedding_is_refined_to_solver_precision(load_mesh)
     b = boundary_vertices(F)
     ed = CurvatureEditor(V, F, b, np.arange(V.shape[0]), rows="all")
     assert np.abs(ed.solve() - V).max() < 1e-14 * _diag(V)
-    # the step is what does it: with solves 1e-8 off (see _InexactSolves) the plain embedding
+    # the step is what does it: with solves 1e-8 off (see InexactSolves) the plain embedding
     # comes back ~4e-9 of the diagonal off (measured 3.8e-9), refined 2e-16 (measured)
-    ed._embed = _InexactSolves(ed._embed)
+    ed._embed = InexactSolves(ed._embed)
     assert np.abs(ed.solve() - V).max() < 1e-14 * _diag(V)
     ed.refinement_steps = 0
     assert np.abs(ed.solve() - V).max() > 1e-10 * _diag(V)
@@ -425,10 +409,10 @@ def test_one_plus_two_ring_normal_equations_are_refined_to_the_rest_shape(load_m
         ed = CurvatureEditor(V, F, h, h, relations="one+two-ring")
         assert ed.rest_error < 1e-13
         assert np.linalg.norm(ed.solve() - V, axis=1).max() < 1e-13 * _diag(V)
-        # the refinement is what does it: with both stages' solves 1e-8 off (see _InexactSolves)
+        # the refinement is what does it: with both stages' solves 1e-8 off (see InexactSolves)
         # the plain normal equations come back ~8e-9 of the diagonal off (measured 7.7e-9 ...
         # 8.7e-9), refined 1.5e-15 at most (measured)
-        ed._curv, ed._embed = _InexactSolves(ed._curv), _InexactSolves(ed._embed)
+        ed._curv, ed._embed = InexactSolves(ed._curv), InexactSolves(ed._embed)
         assert np.linalg.norm(ed.solve() - V, axis=1).max() < 1e-13 * _diag(V)
         ed.refinement_steps = 0                   # the plain normal equations, as before
         assert np.linalg.norm(ed.solve() - V, axis=1).max() > 1e-10 * _diag(V)

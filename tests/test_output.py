@@ -17,6 +17,8 @@ from curvdetail.cli import main
 from curvdetail.curvature.errors import MeshError
 from curvdetail.curvature.testing import grid
 
+from conftest import run_commit_interrupted_by
+
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
 
 
@@ -405,48 +407,7 @@ def test_sigterm_during_a_commit_lets_it_finish(tmp_path):
     # Handshakes, not sleeps: the commit goes on only once the watcher has asked for the commit
     # lock (it was a 1 s sleep), and the main thread then waits for the watcher's thread, which
     # only the watcher's exit ends (it was a 10 s sleep)
-    script = tmp_path / "killed.py"
-    script.write_text(
-        "import os, signal, sys, threading\n"
-        "from curvdetail import _output, cli\n"
-        "from curvdetail._output import Output, atomic_outputs\n"
-        "asked = threading.Event()\n"
-        "class Lock:                                  # the commit lock, telling when the watcher asks\n"
-        "    def __init__(self, lock):\n"
-        "        self.lock = lock\n"
-        "    def acquire(self, *args, **kwargs):\n"
-        "        if threading.current_thread() is not threading.main_thread():\n"
-        "            asked.set()\n"
-        "        return self.lock.acquire(*args, **kwargs)\n"
-        "    def release(self):\n"
-        "        self.lock.release()\n"
-        "    def __enter__(self):\n"
-        "        self.lock.acquire()\n"
-        "    def __exit__(self, *exc):\n"
-        "        self.lock.release()\n"
-        "_output.COMMIT_LOCK = Lock(_output.COMMIT_LOCK)\n"
-        "real = os.replace\n"
-        "def replace(src, dst):\n"
-        "    real(src, dst)\n"
-        "    if dst.endswith('a.txt'):\n"
-        "        os.kill(os.getpid(), signal.SIGTERM)   # between the renames of a.txt and b.txt\n"
-        "        asked.wait()                           # until the watcher asks for the lock\n"
-        "os.replace = replace\n"
-        "before = set(threading.enumerate())\n"
-        "cli._watch_sigterm()\n"
-        "(watcher,) = set(threading.enumerate()) - before\n"
-        "a, b = sys.argv[1:]\n"
-        "with atomic_outputs([Output(a, hint=None), Output(b, hint=None)], overwrite=True) as temps:\n"
-        "    for tmp, text in zip(temps, ('new a', 'new b')):\n"
-        "        open(tmp, 'w').write(text)\n"
-        "watcher.join()                                 # the watcher ends the process, or returns\n"
-        "print('not ended', flush=True)\n")
-    out = tmp_path / "out"
-    out.mkdir()
-    (out / "a.txt").write_text("old a")
-    (out / "b.txt").write_text("old b")
-    done = subprocess.run([sys.executable, str(script), str(out / "a.txt"), str(out / "b.txt")],
-                          capture_output=True, text=True, timeout=300)
+    done, out = run_commit_interrupted_by(tmp_path, "SIGTERM")
     assert done.returncode == 128 + 15 and done.stdout == "", (done.stdout, done.stderr)
     assert ((out / "a.txt").read_text(), (out / "b.txt").read_text()) == ("new a", "new b")
     assert sorted(os.listdir(out)) == ["a.txt", "b.txt"]

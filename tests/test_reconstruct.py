@@ -14,7 +14,7 @@ from curvdetail.curvature import sparse_solver
 from curvdetail.curvature._validate import bbox_diagonal
 from curvdetail.curvature.testing import grid, icosphere
 
-from conftest import every_backend, jittered_grid
+from conftest import InexactSolves, every_backend, jittered_grid
 
 ROWS = ("all", "free")
 
@@ -38,20 +38,6 @@ def test_own_detail_round_trip_is_exact(load_mesh, name, rows):
     assert np.abs(X - V).max() <= 1e-9 * bbox_diagonal(V)
 
 
-class _InexactSolves:
-    """A factorization whose every solve comes back 1e-8 (relative) off: a stand-in for normal
-    equations that lose cond^2 * eps, with an error that rounding on no machine can hide."""
-
-    def __init__(self, factor):
-        self.factor = factor
-
-    def __getattr__(self, name):
-        return getattr(self.factor, name)
-
-    def solve(self, b):
-        return self.factor.solve(b) * (1 + 1e-8)
-
-
 def test_rows_all_refinement_reaches_the_square_systems_accuracy(load_mesh):
     # spot with 5 fixed vertices: the plain normal equations lose cond^2 * eps (measured 5e-12 of
     # the diagonal here, but that is rounding: another BLAS or CPU may give less); one corrected
@@ -65,7 +51,7 @@ def test_rows_all_refinement_reaches_the_square_systems_accuracy(load_mesh):
     # 4.4e-9), and one step contracts that error by ~1e-8 (measured 2.4e-15 refined). Not
     # "refined <= plain" with the exact solves: refine_least_squares does not keep the better
     # iterate, and at the rounding floor a step may add a little rounding
-    rec._factor = _InexactSolves(rec._factor)
+    rec._factor = InexactSolves(rec._factor)
     assert np.abs(rec.solve(D, V[fixed]) - V).max() / bbox_diagonal(V) < 1e-13
     rec.refinement_steps = 0
     assert np.abs(rec.solve(D, V[fixed]) - V).max() / bbox_diagonal(V) > 1e-10
