@@ -15,7 +15,8 @@ from .registry import PAPER, filter
         between the sampled layer (by default the current one, e.g. the retriangulation rebuilt
         from transferred curvature detail) and the target layer (by default layer 0, the source as
         loaded), with pymeshlab's get_hausdorff_distance sampling the faces in both directions
-        (curvdetail.remesh.hausdorff, the same figures as the remeshing report; layers more than
+        and every vertex measured exactly, for the maxima (curvdetail.remesh.hausdorff, the same
+        figures as the remeshing report; layers more than
         one bounding-box diagonal apart are measured with its kd-tree engine instead, and the
         figures say which engine ran). Returns the
         maximum and RMS distances as fractions of the target's bounding-box diagonal (the
