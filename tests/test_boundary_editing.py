@@ -294,3 +294,35 @@ def test_options_given_as_arrays_are_refused_before_the_displacement_runs(kwargs
     V, F = grid(6, 6)
     with pytest.raises(error, match=message):
         edit_boundary(V, F, lambda s, P: pytest.fail("the displacement ran"), **kwargs)
+
+
+@pytest.mark.parametrize("raised", [IndexError("index 99 is out of bounds"), ValueError("my own check failed"),
+                                    TypeError("unsupported operand"), KeyError("axis")])
+def test_an_error_inside_the_displacement_callable_reaches_the_caller_unchanged(raised):
+    # a ValueError or TypeError of the user's own was re-labelled "the displacement callable failed
+    # (...); it must map (s, P) to a (b, 3) float array" and its traceback dropped (from None)
+    V, F = grid(6, 6)
+
+    def user_displacement(s, P):
+        raise raised
+
+    with pytest.raises(type(raised)) as caught:
+        edit_boundary(V, F, user_displacement)
+    assert caught.value is raised
+    assert any(entry.name == "user_displacement" for entry in caught.traceback)     # where it went wrong
+
+
+@pytest.mark.parametrize("displacement", [lambda s: np.zeros((s.size, 3)), lambda s, P, scale: P * scale])
+def test_a_displacement_callable_that_does_not_take_s_and_p_is_named_before_it_runs(displacement):
+    V, F = grid(6, 6)
+    with pytest.raises(ValueError, match=r"the displacement callable cannot be called as displacement\(s, P\) "
+                                         r"\(.*\); it must map the boundary's arc lengths s \(20,\) and positions "
+                                         r"P \(20, 3\) to a \(20, 3\) float array of displacements"):
+        edit_boundary(V, F, displacement)
+
+
+def test_a_displacement_callable_with_a_ragged_result_is_named_as_such():
+    V, F = grid(6, 6)
+    with pytest.raises(ValueError, match=r"the displacement callable returned a list that numpy cannot read as "
+                                         r"an array \(.*\); it must return a \(20, 3\) float array"):
+        edit_boundary(V, F, lambda s, P: [[0.0, 0.0, 0.0], [0.0]])

@@ -500,10 +500,56 @@ def test_return_details_must_be_a_bool(plane_grid, flag):
     (dict(position_constrained=[0, 1, 2], detail_constrained={0, 1, 2}),
      r"detail_constrained is a set, which has no order; pass a list or array of vertex indices \(row r of the "
      r"details belongs to detail_constrained\[r\]\)"),
-    (dict(position_constrained=[0], detail_constrained=[0], roi=frozenset(range(40))), r"roi is a frozenset"),
 ])
 def test_constraint_sets_given_as_none_or_a_set_are_named_as_such(plane_grid, kwargs, message):
     # both were "has dtype object; pass integer vertex indices", about the type
     V, F = plane_grid
     with pytest.raises(ConstraintError, match=message):
         CurvatureEditor(V, F, **kwargs)
+
+
+def test_a_region_and_precomputed_handles_given_as_sets_are_taken(plane_grid):
+    # their order does not matter (no values are paired with their rows), so a set is no mistake: it
+    # was refused as "roi is a frozenset, which has no order", as position_constrained still is
+    V, F = plane_grid
+    roi, h = np.arange(40, 120), [60, 61, 62]
+    target = V[h] + [0.0, 0.0, 0.1]
+    ed = CurvatureEditor(V, F, h, h, roi=frozenset(roi.tolist()))
+    assert np.array_equal(ed.roi, roi)
+    X = CurvatureEditor(V, F, h, h, roi=roi).solve(positions=target)
+    assert np.array_equal(ed.solve(positions=target), X)
+    # the precomputed response: the same solve up to rounding (one product instead of two solves)
+    fast = ed.precompute_handles({62, 60, 61}).solve(positions=target)
+    assert np.abs(fast - X).max() < 1e-12
+
+
+@pytest.mark.parametrize("given", [[60.0, 61.0, 62.0], np.array([60.0, 61.0, 62.0], dtype=np.float32),
+                                   range(60, 63), np.array([[60], [61], [62]])])
+def test_index_arguments_take_whole_floats_ranges_and_columns(plane_grid, given):
+    # as the filter apply_curvature_editing does: float index arrays are common from pymeshlab / libigl
+    V, F = plane_grid
+    ed = CurvatureEditor(V, F, given, given, roi=np.arange(40, 120))
+    assert ed.position_constrained.tolist() == [60, 61, 62] and ed.position_constrained.dtype == np.int64
+    assert CurvatureEditor(V, F, 60, 60, roi=np.arange(40, 120)).position_constrained.tolist() == [60]
+
+
+@pytest.mark.parametrize("given, how_many", [
+    ([60, 61.5, 62], r"1 value is not a whole number \(first: 61\.5, at position 1\)"),
+    (np.array([60.25, np.nan, 62.0]), r"2 values are not whole numbers \(first: 60\.25, at position 0\)"),
+    (np.array([60.0, np.inf]), r"1 value is not a whole number \(first: inf, at position 1\)"),
+])
+def test_indices_that_are_not_whole_numbers_are_refused_naming_the_first(plane_grid, given, how_many):
+    # it was "position_constrained has dtype float64; pass integer vertex indices": no value, no place
+    V, F = plane_grid
+    with pytest.raises(ConstraintError, match=rf"position_constrained: {how_many}; vertex indices are whole "
+                                              r"numbers: pass integers \(or whole floats such as 3\.0\)"):
+        CurvatureEditor(V, F, given, [60, 61, 62], roi=np.arange(40, 120))
+
+
+def test_true_or_false_among_indices_is_refused(plane_grid):
+    # numpy reads [True, 61] as [1, 61]: vertex 1 was constrained without a word
+    V, F = plane_grid
+    with pytest.raises(ConstraintError, match=r"detail_constrained has True/False among its vertex indices "
+                                              r"\(first at position 0\); pass indices only, or an \(441,\) "
+                                              "boolean mask"):
+        CurvatureEditor(V, F, [60, 61], [True, 61], roi=np.arange(40, 120))

@@ -90,8 +90,9 @@ def test_filter_is_declared_with_its_parameters():
 @pytest.mark.parametrize("params, error, message", [
     (dict(handles=""), FilterParameterError, "empty"),
     (dict(handles="1 2 999999"), FilterParameterError, "outside"),
-    (dict(handles="1 99999999999999999999999"), FilterParameterError, r"1 indices are outside \[0, \d+\) "
+    (dict(handles="1 99999999999999999999999"), FilterParameterError, r"1 index is outside \[0, \d+\) "
                                                                         r"\(first: 99999999999999999999999\)"),
+    (dict(handles="1 2 2"), FilterParameterError, r"1 index is repeated \(first: 2\); list each vertex once"),
     (dict(handles="1 2", transform="1 0 0"), FilterParameterError, "16 finite numbers"),
     (dict(handles="1 2", detail_scale=-1.0), FilterParameterError, "greater than 0"),
     # transforms that collapse the handles: refused here as curvdetail edit's .def files are
@@ -217,3 +218,57 @@ def test_a_positive_region_radius_that_reaches_no_vertex_is_named_as_given(radiu
     assert np.array_equal(ms.current_mesh().vertex_matrix(), V)
     with pytest.raises(ConstraintError, match="no selected vertices and region_radius is 0: the region"):
         apply(ms, "apply_curvature_editing", handles="1 2 3", region_radius=0.0)
+
+
+def _edited(handles, transform="1 0 0 0 0 1 0 0 0 0 1 0.02 0 0 0 1"):
+    """Positions after the filter with these handles (and a lift by 0.02) on a fresh MeshSet."""
+    ms, *_ = _meshset_with_roi()
+    apply(ms, "apply_curvature_editing", handles=handles, transform=transform)
+    return ms.current_mesh().vertex_matrix()
+
+
+@pytest.mark.parametrize("as_floats", [lambda h: h.astype(float), lambda h: h.astype(np.float32),
+                                       lambda h: [float(i) for i in h], lambda h: " ".join(f"{i}.0" for i in h)])
+def test_handles_given_as_whole_number_floats_make_the_edit_of_the_ints(as_floats):
+    # [3.0, 7.0] was refused ("must be vertex indices separated by spaces or commas; got '3.0 7.0'")
+    # while CurvatureEditor took it: float index arrays are common from pymeshlab / libigl
+    ms, V, d, handles = _meshset_with_roi()
+    assert np.array_equal(_edited(as_floats(handles)), _edited(handles))       # the same path: bit for bit
+
+
+@pytest.mark.parametrize("handles, how_many", [
+    ([3.5, 7.0], r"1 value is not a whole number \(first: 3\.5, at position 0\)"),
+    (np.array([3.0, 7.25, 9.5]), r"2 values are not whole numbers \(first: 7\.25, at position 1\)"),
+    ("3 7.5", r"1 value is not a whole number \(first: 7\.5, at position 1\)"),
+    ([2, np.nan], r"1 value is not a whole number \(first: nan, at position 1\)"),
+])
+def test_handles_that_are_not_whole_numbers_are_refused_naming_the_first(handles, how_many):
+    # [3.5, 7.0] was "must be vertex indices separated by spaces or commas; got '3.5 7.0'", naming no value
+    ms, V, d, _ = _meshset_with_roi()
+    with pytest.raises(FilterParameterError, match=rf"parameter 'handles': {how_many}; vertex indices are whole "
+                                                   r"numbers: pass integers \(or whole floats such as 3\.0\)"):
+        apply(ms, "apply_curvature_editing", handles=handles, transform="1 0 0 0 0 1 0 0 0 0 1 0.02 0 0 0 1")
+    assert np.array_equal(ms.current_mesh().vertex_matrix(), V)
+
+
+def test_a_single_handle_is_taken_as_one_index():
+    # 12 was refused with "expects a str (from Python also a list or array of numbers); got 12 (int)"
+    X = _edited([12])
+    for single in (12, np.int64(12), 12.0, np.array(12)):
+        assert np.array_equal(_edited(single), X)
+
+
+def test_a_range_of_handles_is_taken_as_its_indices():
+    # vertices 0 ... 14 are handles of _meshset_with_roi; range(15) was refused as "got range(0, 15) (range)"
+    assert np.array_equal(_edited(range(15)), _edited(list(range(15))))
+
+
+def test_a_set_of_handles_is_taken_since_one_transform_moves_them_all():
+    # the filter gives every handle the same transform, so their order does not matter (unlike the
+    # rows of CurvatureEditor.solve's positions): a set was refused as "got {...} (set)"
+    ms, V, d, handles = _meshset_with_roi()
+    X = _edited(handles)
+    assert np.array_equal(_edited(set(handles.tolist())), X)          # sorted: the same order as handles
+    assert np.array_equal(_edited(frozenset(handles.tolist())), X)
+    # another order gives the same edit up to the solvers' rounding
+    assert np.abs(_edited(handles[::-1]) - X).max() < 1e-12 * np.linalg.norm(np.ptp(V, axis=0))

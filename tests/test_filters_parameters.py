@@ -187,6 +187,25 @@ def test_an_index_parameter_takes_any_array_of_indices():
     assert p.check(np.argwhere(np.array([0, 1, 1, 0]))) == "1 2"
 
 
+@pytest.mark.parametrize("value, text", [(3, "3"), (np.int64(3), "3"), (3.0, "3.0"), (range(2, 5), "2 3 4"),
+                                         ({7, 2, 5}, "2 5 7"), (frozenset({1.0, 0.0}), "0.0 1.0")])
+def test_an_index_parameter_takes_a_single_number_a_range_and_a_set(value, text):
+    # each was "expects a str (from Python also a list or array of numbers); got 3 (int)": an index
+    # set's order does not matter (a set comes sorted), and one number is one index
+    assert Parameter("handles", "str", "", "indices").check(value) == text
+
+
+@pytest.mark.parametrize("value, what", [(3, r"a single number \(3\)"),
+                                         (set(range(16)), "a set of 16 values, which has no order")])
+def test_a_matrix_parameter_refuses_a_single_number_and_a_set_with_the_fix(value, what):
+    # a matrix is read row by row: one number is no matrix, and a set has no order to read
+    p = Parameter("transform", "str", "", "4x4 matrix", shape=(4, 4))
+    with pytest.raises(FilterParameterError, match=rf"parameter 'transform' is {what}; it must be a 4x4 matrix: "
+                                                   r"a \(4, 4\) array, or its 16 numbers row by row"):
+        p.check(value)
+    assert p.check(range(16)) == " ".join(map(str, range(16)))      # a range has an order
+
+
 @pytest.mark.parametrize("empty", [[], (), np.array([], dtype=np.int64), np.zeros((0, 2))])
 def test_an_empty_sequence_of_numbers_is_the_empty_text(empty):
     # it was "expects a str; got [] (list)": the filter now names the empty value as empty

@@ -388,3 +388,17 @@ def test_check_choice_takes_one_str_of_the_choices_and_names_anything_else():
                         (["all"], "list"), (None, "NoneType")):
         with pytest.raises(ConstraintError, match=rf"^rows=.* \({kind}, not a single str\); use"):
             check_choice(value, "rows", ("all", "free"), "; use 'all' or 'free'.", ConstraintError)
+
+
+def test_index_values_that_are_not_whole_numbers_are_named_with_the_first_and_its_position():
+    from curvdetail.curvature._validate import non_whole_index_error      # here: new in this module
+
+    assert non_whole_index_error([3.0, 7.0, -0.0], "handles") is None         # whole floats are indices
+    assert non_whole_index_error(np.arange(5), "handles") is None
+    error = non_whole_index_error(np.array([3.0, 7.5, np.nan, np.inf]), "handles")
+    assert isinstance(error, ConstraintError)
+    assert str(error) == ("handles: 3 values are not whole numbers (first: 7.5, at position 1); vertex indices "
+                          "are whole numbers: pass integers (or whole floats such as 3.0), not positions or "
+                          "weights.")
+    assert str(non_whole_index_error([np.inf], "fixed", ValueError)).startswith(
+        "fixed: 1 value is not a whole number (first: inf, at position 0)")

@@ -445,6 +445,29 @@ def as_index_set(indices, n, name):
     return arr
 
 
+def non_whole_index_error(values, name, error=ConstraintError):
+    """The ``error`` for index values that are not whole numbers (3.5, NaN, inf), naming how many,
+    the first and its position, and the fix; None where every value is whole (3.0 is an index,
+    as pymeshlab's and libigl's float index arrays are). ``values``: real numbers, flattened.
+
+    Examples
+    --------
+    >>> print(non_whole_index_error([3.0, 7.0], "handles"))
+    None
+    >>> print(non_whole_index_error([3.0, 7.5, np.nan], "handles"))
+    handles: 2 values are not whole numbers (first: 7.5, at position 1); vertex indices are whole numbers: pass integers (or whole floats such as 3.0), not positions or weights.
+    """
+    arr = np.asarray(values, dtype=np.float64).reshape(-1)
+    with np.errstate(invalid="ignore"):
+        bad = np.flatnonzero(~np.isfinite(arr) | (arr != np.round(arr)))
+    if not bad.size:
+        return None
+    what = "is not a whole number" if bad.size == 1 else "are not whole numbers"
+    return error(f"{name}: {counted(bad.size, 'value')} {what} (first: {float(arr[bad[0]])!r}, at position "
+                 f"{bad[0]}); vertex indices are whole numbers: pass integers (or whole floats such as 3.0), "
+                 "not positions or weights.")
+
+
 def check_bool(value, name):
     """``bool(value)`` for True / False (numpy's too), else ValueError: ``"no"`` or ``0`` would
     otherwise count as an answer."""

@@ -1,5 +1,6 @@
 """Shape editing of a patch's boundary (the paper's Fig. 2b)."""
 
+import inspect
 import math
 import numbers
 
@@ -66,9 +67,11 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
     ConstraintError   displacement array of the wrong shape or with NaN / inf; a displaced boundary
                       beyond 1e75; with ``"deformed"``, a displacement that collapses the loop
                       (onto a point or a line: the provisional surface has zero-area triangles)
-    ValueError        the displacement callable returned the wrong shape or non-finite values,
-                      ``return_info`` is not a bool, or an option is not one of its values (or
-                      not a single str); SolverError for an unknown ``backend``
+    ValueError        the displacement callable does not take (s, P), or returned the wrong
+                      shape or non-finite values, ``return_info`` is not a bool, or an option is
+                      not one of its values (or not a single str); SolverError for an unknown
+                      ``backend``. An exception raised inside the displacement callable reaches
+                      the caller unchanged
 
     Examples
     --------
@@ -101,11 +104,16 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
         raise MeshError("the boundary loop has length 0 (all its vertices coincide); repair the mesh.")
     s = np.concatenate([[0.0], np.cumsum(seg)[:-1]]) / seg.sum()
     if callable(displacement):
+        _check_displacement_signature(displacement, loop.size)
+        # called outside any try: an error inside the user's function (an IndexError, a ValueError
+        # of its own) reaches the caller unchanged, with its traceback; it was re-labelled as "the
+        # displacement callable failed" and the traceback dropped, which hid where it went wrong
+        d = displacement(s.copy(), P.copy())
         try:
-            d = np.asarray(displacement(s.copy(), P.copy()))
-        except (TypeError, ValueError) as exc:
-            raise ValueError(f"the displacement callable failed ({exc}); it must map (s, P) to a "
-                             f"({loop.size}, 3) float array.") from None
+            d = np.asarray(d)
+        except (TypeError, ValueError) as exc:            # ragged lists and the like
+            raise ValueError(f"the displacement callable returned a {type(d).__name__} that numpy cannot "
+                             f"read as an array ({exc}); it must return a ({loop.size}, 3) float array.") from None
         if d.dtype.kind not in "fiu":   # complex would lose its imaginary part, bool mean 0/1
             raise ValueError(f"the displacement callable returned dtype {d.dtype}; it must return a "
                              f"({loop.size}, 3) array of real numbers.")
@@ -154,6 +162,22 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
     if not return_info:
         return X
     return X, {"boundary": loop, "arc_length": s, "boundary_detail": Db, "editor": editor}
+
+
+def _check_displacement_signature(displacement, b):
+    """ValueError if ``displacement`` cannot be called as ``displacement(s, P)`` (two positional
+    arguments), checked on its signature before the call, so that a TypeError raised inside it
+    is not taken for a wrong signature; callables without a readable signature pass."""
+    try:
+        signature = inspect.signature(displacement)
+    except (TypeError, ValueError):             # some builtins and extension types
+        return
+    try:
+        signature.bind(None, None)
+    except TypeError as exc:
+        raise ValueError(f"the displacement callable cannot be called as displacement(s, P) ({exc}); it "
+                         f"must map the boundary's arc lengths s ({b},) and positions P ({b}, 3) to a ({b}, 3) "
+                         "float array of displacements.") from None
 
 
 def _check_provisional_surface(Vp, F, P, Q):

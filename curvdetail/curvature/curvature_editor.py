@@ -7,7 +7,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from ._validate import (as_index_set, as_values, bbox_centre, bbox_diagonal, centroid_diameter, check_bool,
-                        check_choice)
+                        check_choice, non_whole_index_error)
 from .cotan_laplacian import checked_cotan_laplacian, laplacian_product
 from .curvature_coefficients import DEFAULT_RCOND, _coefficients, _one_ring_pairs, check_rcond
 from .errors import ConstraintError, UndeterminedEditError, first_indices
@@ -76,7 +76,11 @@ class CurvatureEditor:
     detail_constrained : (q,) int array or (n,) bool mask     vertices whose curvature details
                                 are given to :meth:`solve`; inside ``roi``. May overlap
                                 ``position_constrained`` (a handle with both constrained)
-    roi : (r,) int array or (n,) bool mask or None   region of interest; None = the whole mesh
+    roi : (r,) int array or (n,) bool mask or None   region of interest; None = the whole mesh;
+                                its order does not matter, so a set is taken too
+                                (Index arguments also take a list, a range, a single int and
+                                whole floats such as 3.0, as pymeshlab's and libigl's float index
+                                arrays; 3.5 is refused, naming the first such value.)
     rows : {"all", "free"}      embedding rows: ``"all"`` sums ``E_Q`` over every row that
                                 involves a free position (the paper; normal equations, 2-ring
                                 fill), ``"free"`` over the free vertices' rows only (the square
@@ -127,7 +131,9 @@ class CurvatureEditor:
     Raises
     ------
     MeshError         malformed mesh
-    ConstraintError   indices out of range or repeated, None, or a set (which has no order); a
+    ConstraintError   indices out of range, repeated, not whole numbers (3.0 is taken, 3.5 is
+                      not) or None; ``position_constrained`` / ``detail_constrained`` given
+                      as a set (which has no order; a set ``roi`` is taken); a
                       constraint outside ``roi``; an empty
                       ``roi``; no position constraint (or fewer than three detail constraints)
                       while ``roi`` is the whole mesh; a connected free region that touches no position (or no
@@ -517,7 +523,8 @@ class CurvatureEditor:
         Parameters
         ----------
         handles : (h,) int array     vertices of ``position_constrained`` and/or
-                                     ``detail_constrained`` whose values will change
+                                     ``detail_constrained`` whose values will change (order
+                                     does not matter: a set is taken too)
         positions, details           the base constraint values (as in :meth:`solve`; None = rest)
 
         Returns
@@ -597,14 +604,35 @@ def _check_relations(relations):
 
 
 def _index_set(indices, n, name, values=None):
-    """:func:`as_index_set`, with None and a set named as such (both were "dtype object"); a
-    set has no order, and row r of the ``values`` given to solve belongs to ``name[r]``."""
+    """:func:`as_index_set`, with None, a set, True/False among numbers and fractions named as
+    such (the first three were "dtype object" or read as vertices 1 and 0, the last named only
+    by its dtype). Whole floats (3.0) are indices. A set has no order: where row r of the
+    ``values`` given to solve belongs to ``name[r]`` it is refused, elsewhere (``values`` None:
+    a region, the handles of precompute_handles) it is taken."""
     if indices is None:
         raise ConstraintError(f"{name} is None; pass vertex indices ([] for none) or an ({n},) boolean mask.")
     if isinstance(indices, (set, frozenset)):
-        order = f" (row r of the {values} belongs to {name}[r])" if values else ""
-        raise ConstraintError(f"{name} is a {type(indices).__name__}, which has no order; pass a list or "
-                              f"array of vertex indices{order}, e.g. sorted({name}).")
+        if values is not None:
+            raise ConstraintError(f"{name} is a {type(indices).__name__}, which has no order; pass a list or "
+                                  f"array of vertex indices (row r of the {values} belongs to {name}[r]), e.g. "
+                                  f"sorted({name}).")
+        try:
+            indices = sorted(indices)
+        except TypeError:               # values that do not compare: as_index_set names them
+            indices = list(indices)
+    if isinstance(indices, (list, tuple)):
+        flags = [isinstance(i, (bool, np.bool_)) for i in indices]
+        if any(flags) and not all(flags):       # numpy reads [True, 3] as vertices 1 and 3
+            raise ConstraintError(f"{name} has True/False among its vertex indices (first at position "
+                                  f"{flags.index(True)}); pass indices only, or an ({n},) boolean mask.")
+    try:
+        arr = np.asarray(indices)
+    except Exception:                   # ragged and the like: as_index_set names it
+        arr = None
+    if arr is not None and arr.dtype.kind == "f" and arr.size:
+        error = non_whole_index_error(arr, name)
+        if error is not None:
+            raise error
     return as_index_set(indices, n, name)
 
 

@@ -4,9 +4,10 @@ import time
 
 import numpy as np
 
-from ..curvature._validate import affine_transform_problem, bbox_diagonal, check_transformed_values, real_word
+from ..curvature._validate import (affine_transform_problem, bbox_diagonal, check_transformed_values,
+                                   non_whole_index_error, real_word)
 from ..curvature.curvature_editor import CurvatureEditor
-from ..curvature.errors import ConstraintError, UndeterminedEditError
+from ..curvature.errors import ConstraintError, UndeterminedEditError, counted, first_indices
 from .apply_curvature_reconstruction import BACKEND_DESCRIPTION, BACKENDS
 from .errors import FilterParameterError
 from .meshset import (get_mesh, layer_id, mesh_arrays, selected_vertices, set_vertex_positions,
@@ -18,22 +19,40 @@ IDENTITY = "1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1"
 
 
 def _indices(text, n):
-    try:
-        values = [int(t) for t in str(text).replace(",", " ").split()]
-    except ValueError:
-        raise FilterParameterError(f"parameter 'handles' must be vertex indices separated by spaces "
-                                   f"or commas; got {str(text)[:40]!r}.") from None
-    beyond = [v for v in values if not 0 <= v < n]       # before the int64 cast, which overflows
+    """The handle indices in ``text`` (spaces or commas between them) as an int64 array: whole
+    numbers, written as ints or as whole floats ("3.0", from a Python list or array of floats, as
+    pymeshlab's and libigl's index arrays often are), each once, in [0, n)."""
+    tokens = str(text).replace(",", " ").split()
+    values = []
+    for t in tokens:
+        try:
+            values.append(int(t))                   # exact, however large
+        except ValueError:
+            try:
+                values.append(real_word(t))
+            except ValueError:
+                raise FilterParameterError(f"parameter 'handles' must be vertex indices separated by spaces "
+                                           f"or commas; got {str(text)[:40]!r}.") from None
+    # the ints stand in as 0.0 (whole), keeping the positions: one beyond a double would overflow
+    error = non_whole_index_error([v if isinstance(v, float) else 0.0 for v in values], "parameter 'handles'",
+                                  FilterParameterError)
+    if error is not None:
+        raise error
+    values = [int(v) for v in values]
+    beyond = [k for k, v in enumerate(values) if not 0 <= v < n]      # before the int64 cast, which overflows
     if beyond:
-        raise FilterParameterError(f"parameter 'handles': {len(beyond)} indices are outside [0, {n}) "
-                                   f"(first: {beyond[0]}).")
+        raise FilterParameterError(f"parameter 'handles': {counted(len(beyond), 'index', 'indices', verb='are')} "
+                                   f"outside [0, {n}) (first: {tokens[beyond[0]]}); indices are 0-based into "
+                                   "the mesh's vertices.")
     idx = np.asarray(values, dtype=np.int64)
     if idx.size == 0:
         raise FilterParameterError("parameter 'handles' is empty; name the handle vertices, e.g. "
                                    "handles='12 40 41'.")
-    uniq = np.unique(idx)
+    uniq, counts = np.unique(idx, return_counts=True)
     if uniq.size != idx.size:
-        raise FilterParameterError(f"parameter 'handles': {idx.size - uniq.size} indices are repeated.")
+        repeated = counted(idx.size - uniq.size, 'index', 'indices', verb='are')
+        raise FilterParameterError(f"parameter 'handles': {repeated} repeated (first: "
+                                   f"{first_indices(uniq[counts > 1])}); list each vertex once.")
     return idx
 
 
@@ -70,7 +89,8 @@ def _matrix(text):
     """,
     parameters=[
         Parameter("handles", "str", "", "handle vertex indices, separated by spaces or commas "
-                  "(from Python also a list or array)"),
+                  "(from Python also a list, array, range, set or single int; whole floats such as "
+                  "3.0 are indices)"),
         Parameter("region_radius", "PercentageValue", BBoxLength(0.0, percent=True),
                   "also put every vertex within this distance of a handle into the region of "
                   "interest (0: the selection alone); a percentage of the bbox diagonal or absolute",

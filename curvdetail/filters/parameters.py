@@ -8,9 +8,11 @@ Types, as pymeshlab names them:
 
 ``bool``, ``int``, ``float``, ``str``
     plain values; a ``str`` with ``choices`` is an enumeration (pymeshlab's RichEnum). A ``str``
-    without choices also takes a list, tuple or array of numbers from Python, as the text of
-    those numbers; ``shape`` (e.g. ``(4, 4)`` for a matrix) is the one multi-dimensional shape
-    such an array may have, where the order of its axes matters.
+    without choices also takes a list, tuple, range or array of numbers from Python, as the text
+    of those numbers; ``shape`` (e.g. ``(4, 4)`` for a matrix) is the one multi-dimensional shape
+    such an array may have, where the order of its axes matters. Without a ``shape`` the numbers
+    are an index set, whose order does not matter: a single number (one index) and a set
+    (sorted) are taken too; a matrix refuses both.
 ``PercentageValue``
     a length given either as a percentage of the bounding-box diagonal
     (``pymeshlab.PercentageValue(1.0)``, ``"1%"`` on the command line) or as an absolute value
@@ -103,7 +105,8 @@ class Parameter:
     positive: bool = False
     #: a ``str`` of numbers only: the shape an array from Python must have where it has more than
     #: one axis, e.g. (4, 4) for a matrix read row by row (a flat sequence is counted by the
-    #: filter); None flattens any array (an index set, where the order does not matter)
+    #: filter); None flattens any array (an index set, where the order does not matter: a
+    #: single number and a set are taken too)
     shape: tuple = None
 
     def __post_init__(self):
@@ -172,7 +175,7 @@ class Parameter:
                     and not isinstance(value, (bool, np.bool_)) and 0 <= value < len(self.choices):
                 return self.choices[int(value)]           # an enum index, as pymeshlab takes it
             if self.choices is None:
-                value = _numbers_as_text(self._check_numbers(value))
+                value = _numbers_as_text(self._check_numbers(self._as_sequence(value)))
             if not isinstance(value, str):
                 raise self._fail(value, f"a str (one of {', '.join(self.choices)}, or its index)"
                                  if self.choices else "a str (from Python also a list or array of numbers)")
@@ -200,6 +203,30 @@ class Parameter:
         self._finite(length.value)
         self._range(length.value)
         return length
+
+    def _as_sequence(self, value):
+        """``value`` as a list where a ``str`` of numbers takes it as a sequence: a range; without
+        a ``shape`` (an index set, whose order does not matter) also a single number, as one
+        index, and a set, sorted. A matrix (``shape``) refuses a single number and a set (whose
+        numbers have no order to read row by row) with the fix; anything else unchanged."""
+        if isinstance(value, range):
+            return list(value)
+        single = isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
+        if not (single or isinstance(value, (set, frozenset))):
+            return value
+        if self.shape is not None:
+            dims, count = "x".join(map(str, self.shape)), math.prod(self.shape)
+            what = (f"a single number ({value!r})" if single else
+                    f"a {type(value).__name__} of {len(value)} values, which has no order")
+            raise FilterParameterError(
+                f"parameter {self.name!r} is {what}; it must be a {dims} matrix: a {self.shape} array, or "
+                f"its {count} numbers row by row as a list or as text.")
+        if single:
+            return [value]
+        try:
+            return sorted(value)
+        except TypeError:                   # values that do not compare: refused as no numbers
+            return value
 
     def _check_numbers(self, value):
         """``value`` unchanged, or FilterParameterError where a list, tuple or array would be read
