@@ -188,8 +188,10 @@ def test_fixed_indices_out_of_range_and_repeated_are_named():
         as_index_set([0, 9, -3], 9, "fixed")
     with pytest.raises(ConstraintError, match=r"1 index is repeated \(first: 4\)"):
         as_index_set([4, 1, 4], 9, "fixed")
-    with pytest.raises(ConstraintError, match=r"dtype float64; pass integer"):
-        as_index_set([0.5], 9, "fixed")
+    # a non-whole value is named with its position, as the editing filter names it
+    with pytest.raises(ConstraintError, match=r"fixed: 2 values are not whole numbers \(first: 0\.5, at position 1\)"):
+        as_index_set([3, 0.5, np.inf], 9, "fixed")
+    assert as_index_set([3.0, 0.0], 9, "fixed").tolist() == [3, 0]
 
 
 def test_index_set_keeps_the_callers_order_and_reads_masks():

@@ -414,8 +414,11 @@ def as_index_set(indices, n, name):
                                   f"{', '.join(str(i) for i in arr[out[:3]])}); indices are 0-based into V.")
         arr = arr.astype(np.int64)
     if arr.size and not np.issubdtype(arr.dtype, np.integer):
-        if not (np.issubdtype(arr.dtype, np.floating) and np.all(np.isfinite(arr)) and np.all(arr == np.round(arr))):
+        if not np.issubdtype(arr.dtype, np.floating):
             raise ConstraintError(f"{name} has dtype {arr.dtype}; pass integer vertex indices.")
+        error = non_whole_index_error(arr, name)
+        if error is not None:
+            raise error
         if np.abs(arr).max() >= 2.0 ** 62:      # would not survive the cast to int64
             bad = np.flatnonzero((arr < 0) | (arr >= n))
             raise ConstraintError(f"{name}: {counted(bad.size, 'index', 'indices', verb='are')} outside "
