@@ -33,12 +33,56 @@ def test_full_rank_rings_reproduce_detail_on_real_meshes(load_mesh, name):
 
 def test_pattern_is_the_one_ring_with_zero_diagonal(load_mesh):
     V, F = load_mesh("mannequin_nose.obj")
-    C = curvature_coefficients(V, F)
     edges = {tuple(e) for f in F for e in ((f[0], f[1]), (f[1], f[2]), (f[2], f[0]))}
     edges |= {(j, i) for i, j in edges}
+    C = curvature_coefficients(V, F, max_ring=1)
     coo = C.tocoo()
     assert set(zip(coo.row.tolist(), coo.col.tolist())) == edges
     assert np.all(C.diagonal() == 0)
+    # by default the one corner whose one-ring cannot hold its detail (vertex 95, valence 2)
+    # stores its two-ring instead; every other row keeps the one-ring
+    C, info = curvature_coefficients(V, F, return_info=True)
+    assert info.widened_vertices.tolist() == [95]
+    ring1 = {j for i, j in edges if i == 95}
+    ring2 = ring1 | {k for i, k in edges if i in ring1} - {95}
+    coo = C.tocoo()
+    pairs = set(zip(coo.row.tolist(), coo.col.tolist()))
+    assert {p for p in pairs if p[0] != 95} == {e for e in edges if e[0] != 95}
+    assert {j for i, j in pairs if i == 95} == ring2
+    assert np.all(C.diagonal() == 0)
+
+
+def _corner_strip():
+    # a bent strip: vertex 0 is a corner of one triangle (valence 2), its Gram matrix is singular
+    V = np.array([[0, 0, 0], [1, 0, 0.3], [0, 1, 0.2], [1, 1, 0.9], [2, 0.5, 0.1]], float)
+    F = np.array([[0, 1, 2], [1, 3, 2], [1, 4, 3]])
+    return V, F
+
+
+def test_a_corner_whose_one_ring_misses_its_detail_takes_its_two_ring():
+    # the corner's two neighbours span a plane its detail leaves: the one-ring relation cannot
+    # hold (residual 10 % of the ring's scale); over the two-ring (vertices 1-4) it holds exactly,
+    # and the row is the minimum-norm solution there, as np.linalg.pinv gives it
+    V, F = _corner_strip()
+    D = curvature_detail(V, F)
+    _, narrow = curvature_coefficients(V, F, max_ring=1, return_info=True)
+    assert narrow.residual[0] > 1e-2 * narrow.scale[0]
+    C, info = curvature_coefficients(V, F, return_info=True)
+    assert info.ring[0] == 2 and 0 in info.widened_vertices        # (vertex 4 is such a corner too)
+    expected = np.linalg.pinv(D[[1, 2, 3, 4]].T) @ D[0]
+    assert np.allclose(C[0, [1, 2, 3, 4]].toarray().ravel(), expected, rtol=1e-9)
+    assert info.residual[0] < 1e-12 * info.scale[0]
+
+
+def test_widened_rows_keep_the_coefficients_invariant(load_mesh, rng):
+    # terrainA_1k's two valence-2 grid corners are widened; the decision and the rows are the
+    # same for a rotated, scaled, translated copy
+    V, F = load_mesh("terrainA_1k.obj")
+    C, info = curvature_coefficients(V, F, return_info=True)
+    assert info.widened_vertices.size == 2
+    C2, info2 = curvature_coefficients(2.5 * V @ _rotation(rng).T + 7.0, F, return_info=True)
+    assert np.array_equal(info.widened_vertices, info2.widened_vertices)
+    assert abs(C2 - C).max() < 1e-8
 
 
 def test_coefficients_are_invariant_under_rotation_and_uniform_scale(load_mesh, rng):
@@ -101,14 +145,27 @@ def test_cylinder_rings_are_rank_two_and_still_reproduce_detail(open_cylinder):
 
 
 def test_valence_two_corner_gets_the_pseudo_inverse_not_garbage():
-    # a bent strip: vertex 0 is a corner of one triangle (valence 2), its Gram matrix is singular
-    V = np.array([[0, 0, 0], [1, 0, 0.3], [0, 1, 0.2], [1, 1, 0.9], [2, 0.5, 0.1]], float)
-    F = np.array([[0, 1, 2], [1, 3, 2], [1, 4, 3]])
-    C, info = curvature_coefficients(V, F, return_info=True)
+    # with the one-ring only, the corner's singular Gram matrix takes the pseudo-inverse
+    V, F = _corner_strip()
+    C, info = curvature_coefficients(V, F, max_ring=1, return_info=True)
     D = curvature_detail(V, F)
     expected = np.linalg.pinv(D[[1, 2]].T) @ D[0]
     assert info.rank[0] == 2
     assert np.allclose(C[0, [1, 2]].toarray().ravel(), expected, rtol=1e-9)
+
+
+@pytest.mark.parametrize("max_ring", [0, -1, 1.5, "2", True])
+def test_bad_max_ring_is_refused(plane_grid, max_ring):
+    V, F = plane_grid
+    with pytest.raises(ValueError, match="max_ring"):
+        curvature_coefficients(V, F, max_ring=max_ring)
+
+
+@pytest.mark.parametrize("value", ["no", np.array([True, False])])
+def test_return_info_must_be_a_bool(plane_grid, value):
+    V, F = plane_grid
+    with pytest.raises(ValueError, match="return_info"):
+        curvature_coefficients(V, F, return_info=value)
 
 
 @pytest.mark.parametrize("rcond", [0.0, 1.0, -1e-3, "abc"])

@@ -30,9 +30,13 @@ def test_rest_constraints_reproduce_the_patch(load_mesh, relations):
     assert np.abs(X - V).max() < 1e-8 * _diag(V)
 
 
+# terrainA_1k's two valence-2 grid corners and the nose's one cannot represent their detail from
+# their one-rings: before those rings were widened, the result moved 16 % (terrain) and 5-12 %
+# (nose) of the diagonal away from the similarity's image
+@pytest.mark.parametrize("name", ["spot.obj", "terrainA_1k.obj", "mannequin_nose.obj"])
 @pytest.mark.parametrize("relations", ["one-ring", "one+two-ring"])
-def test_similarity_of_all_constraints_moves_the_result_by_it(load_mesh, rng, relations):
-    V, F = load_mesh("spot.obj")
+def test_similarity_of_all_constraints_moves_the_result_by_it(load_mesh, rng, relations, name):
+    V, F = load_mesh(name)
     handles = rng.choice(V.shape[0], size=40, replace=False)
     ed = CurvatureEditor(V, F, handles, handles, relations=relations)
     # a real edit first: pull ten handles outwards and rotate their details a little
@@ -347,13 +351,14 @@ def test_editing_far_from_the_origin_loses_no_digits(load_mesh):
 
 @pytest.mark.parametrize("relations", ["one-ring", "one+two-ring"])
 def test_unchanged_constraints_give_the_rest_shape_with_rank_deficient_rings(load_mesh, relations):
-    # the grid's valence-2 corners do not reproduce their detail from their coefficients; with
-    # 8 random handles (I - C)_uu amplified that into a rest shape 5 diagonals off. The rest
-    # residual is kept as a constant now, so the rest state solves the system exactly
+    # the grid's valence-2 corners do not reproduce their detail from their one-rings; with 8
+    # random handles (I - C)_uu amplified that into a rest shape 5 diagonals off. Their rings are
+    # widened now (the two-ring holds the detail), and what residual is left is kept as a
+    # constant, so the rest state solves the system exactly
     V, F = load_mesh("terrainA_1k.obj")
     handles = np.random.default_rng(0).choice(V.shape[0], 8, replace=False)
     ed = CurvatureEditor(V, F, handles, handles, relations=relations)
-    assert ed.rank_deficient > 0
+    assert ed.widened_rings == 2
     assert np.abs(ed.solve() - V).max() < 1e-8 * _diag(V)
 
 

@@ -5,7 +5,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ._validate import as_float, centroid_diameter
+from ._validate import as_count, as_float, centroid_diameter, check_bool
 from .cotan_laplacian import checked_cotan_laplacian, laplacian_product
 from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
 
@@ -14,6 +14,10 @@ from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
 #: eigenvalues, i.e. ~1.5e-8 in the singular values, so thresholds below ~1e-7 select noise.
 DEFAULT_RCOND = 1e-6
 
+#: Default widest ring (see :func:`curvature_coefficients`): a ring that cannot represent its
+#: vertex's detail is widened to the two-ring, then the three-ring.
+DEFAULT_MAX_RING = 3
+
 
 @dataclass(frozen=True)
 class CoefficientInfo:
@@ -21,15 +25,19 @@ class CoefficientInfo:
 
     Attributes
     ----------
-    rank : (n,) int array            numerical rank (0-3) of the one-ring detail matrix ``D_N(i)``
-    rank_deficient : int             number of vertices with ``rank < 3`` (flat, cylindrical or
-                                     valence-2 rings); their coefficients are the truncated
-                                     (regularized) minimum-norm solution
+    rank : (n,) int array            numerical rank (0-3) of the detail matrix ``D_N(i)`` of the
+                                     ring the coefficients span (the one-ring but where widened)
+    rank_deficient : int             number of vertices with ``rank < 3`` (flat or cylindrical
+                                     rings); their coefficients are the truncated (regularized)
+                                     minimum-norm solution
     rank_deficient_vertices : (r,) int array   those vertices, increasing
     residual : (n,) float array      ``|D_i - sum_j C_ij D_j|`` (absolute; zero where ``D_i`` lies
                                      in the span of the kept singular directions)
     scale : (n,) float array         the reference ``s_i`` of the relative threshold
     rcond : float                    the threshold used
+    ring : (n,) int array            the ring each vertex's coefficients span: 1 (the one-ring)
+                                     but where the one-ring could not represent the detail
+    widened_vertices : (w,) int array   the vertices with ``ring > 1``, increasing
     """
 
     rank: np.ndarray
@@ -38,9 +46,11 @@ class CoefficientInfo:
     residual: np.ndarray
     scale: np.ndarray
     rcond: float
+    ring: np.ndarray
+    widened_vertices: np.ndarray
 
 
-def curvature_coefficients(V, F, *, rcond=DEFAULT_RCOND, return_info=False):
+def curvature_coefficients(V, F, *, rcond=DEFAULT_RCOND, max_ring=DEFAULT_MAX_RING, return_info=False):
     """Rotation- and scale-invariant curvature coefficients ``C`` with ``D_i = sum_j C_ij D_j``.
 
     For each vertex ``i`` with one-ring ``N(i)`` the coefficients ``c_i`` are the minimum-norm
@@ -68,26 +78,42 @@ def curvature_coefficients(V, F, *, rcond=DEFAULT_RCOND, return_info=False):
     roundoff and its coefficients are zero
     (``D_i = 0`` is kept there). Vertices with fewer than three kept singular values are
     counted as rank-deficient; their detail is represented only where it lies in the kept span.
+    The ill-conditioned rings (those the closed form does not take) are pseudo-inverted through
+    a batched SVD of the ring matrix ``D_N`` itself, whose small singular values are accurate
+    where ``G_i``'s eigenvalues are not.
+
+    Widening: where the detail does not lie in that span (the residual
+    ``|D_i - sum_j C_ij D_j|`` is above ``rcond * s_i``: a valence-2 corner of a grid, whose two
+    neighbours' details span a plane that its own detail leaves), the relation cannot hold and
+    nothing keeps the edited detail there consistent with a similarity of the constraints: the
+    editor's result then moved by up to 16 diagonals under a uniform scale of all constraints
+    (terrainA_10k, two such corners). Those rows take the minimum-norm coefficients over the
+    vertex's two-ring instead (without the vertex), then its three-ring, up to ``max_ring``;
+    ``max_ring=1`` keeps the one-ring everywhere (the paper's relations). The decision depends
+    only on ratios, so it too is invariant.
 
     Parameters
     ----------
     V : (n, 3) float array   vertex positions
     F : (m, 3) int array     triangles
     rcond : float            relative singular-value threshold, in (0, 1); default 1e-6
+    max_ring : int           widest ring for a vertex whose one-ring cannot represent its detail
+                             (>= 1; default 3; 1 = one-ring only)
     return_info : bool       also return a :class:`CoefficientInfo` (ranks, rank-deficient count,
-                             residuals)
+                             residuals, widened rings)
 
     Returns
     -------
     C : (n, n) scipy.sparse.csr_matrix   one-ring sparsity pattern (every mesh edge in both
-                                         directions is stored, possibly as an explicit 0), zero
-                                         diagonal; rows are not normalized and need not sum to 1
+                                         directions is stored, possibly as an explicit 0; a
+                                         widened row stores its whole ring), zero diagonal; rows
+                                         are not normalized and need not sum to 1
     info : CoefficientInfo               only with ``return_info=True``
 
     Raises
     ------
     MeshError    malformed mesh (shapes, NaN, bad indices, zero-area or non-manifold elements)
-    ValueError   ``rcond`` outside (0, 1)
+    ValueError   ``rcond`` outside (0, 1), ``max_ring`` not a count >= 1, ``return_info`` not a bool
 
     Examples
     --------
@@ -106,21 +132,29 @@ def curvature_coefficients(V, F, *, rcond=DEFAULT_RCOND, return_info=False):
     >>> info.rank_deficient
     0
     """
-    V, F, L = checked_cotan_laplacian(V, F)
     rcond = check_rcond(rcond)
+    max_ring = check_max_ring(max_ring)
+    return_info = check_bool(return_info, "return_info")
+    V, F, L = checked_cotan_laplacian(V, F)
     n = V.shape[0]
     D = laplacian_product(L, V)
     A = _mixed_voronoi_area_unchecked(V, F)
     rows, cols = _one_ring_pairs(F, n)
-    C, rank, scale = _coefficients(D, A, rows, cols, n, rcond, centroid_diameter(V), want_scale=return_info)
+    C, rank, scale, ring = _coefficients(D, A, rows, cols, n, rcond, centroid_diameter(V),
+                                         want_scale=return_info, max_ring=max_ring)
     if not return_info:
         return C
     residual = np.linalg.norm(D - C @ D, axis=1)
     deficient = np.flatnonzero(rank < 3)
     info = CoefficientInfo(rank=rank, rank_deficient=int(deficient.size),
                            rank_deficient_vertices=deficient, residual=residual, scale=scale,
-                           rcond=rcond)
+                           rcond=rcond, ring=ring, widened_vertices=np.flatnonzero(ring > 1))
     return C, info
+
+
+def check_max_ring(max_ring):
+    """``max_ring`` as an int >= 1, or ValueError naming the value and the fix."""
+    return as_count(max_ring, "max_ring", minimum=1)
 
 
 def _one_ring_pairs(F, n):
@@ -149,8 +183,13 @@ def check_rcond(rcond):
     return number
 
 
-def _coefficients(D, A, rows, cols, n, rcond, size, *, want_scale=False):
-    """Batched truncated pseudo-inverse solve; returns (C, rank, scale or None)."""
+def _coefficients(D, A, rows, cols, n, rcond, size, *, want_scale=False, max_ring=1, adjacency=None):
+    """Batched truncated pseudo-inverse solve over the pattern (rows, cols), sorted by row.
+
+    Rows whose fit leaves a residual above the threshold are widened by one ring of ``adjacency``
+    (the one-ring pairs; default (rows, cols)) at a time, ``max_ring - 1`` times at most.
+    Returns (C, rank, scale or None, ring): ``C`` on the (widened) pattern, explicit zeros kept;
+    ``ring`` (n,) the number of rings each row spans (1 = the given pattern)."""
     Dj = D[cols]
     # the 6 distinct entries of G_i = sum_j D_j D_j^T
     g = {}
@@ -182,26 +221,100 @@ def _coefficients(D, A, rows, cols, n, rcond, size, *, want_scale=False):
     w[good, 2] = (c02[good] * d0 + c12[good] * d1 + c22[good] * d2) / dg
     rank = np.full(n, 3, dtype=np.int64)
     scale = None
-    hard = np.flatnonzero(~good) if not want_scale else np.arange(n)
-    if hard.size:
-        G = np.empty((hard.size, 3, 3))
+    if want_scale:
+        # sigma_1 of the well-conditioned rows: the largest eigenvalue of G is accurate
+        G = np.empty((n, 3, 3))
         for a in range(3):
             for b in range(a, 3):
-                G[:, a, b] = G[:, b, a] = g[a, b][hard]
-        lam, U = np.linalg.eigh(G)                  # ascending eigenvalues
-        lam = np.maximum(lam, 0.0)
-        sigma = np.sqrt(lam)
-        s_hard = np.maximum(sigma[:, 2], area_scale[hard])
-        keep = sigma > rcond * s_hard[:, None]
-        inv = np.zeros_like(lam)
-        inv[keep] = 1.0 / lam[keep]
-        proj = np.einsum("nab,na->nb", U, D[hard]) * inv
-        bad = ~good[hard]
-        w[hard[bad]] = np.einsum("nab,nb->na", U[bad], proj[bad])
-        rank[hard] = keep.sum(axis=1)
+                G[:, a, b] = G[:, b, a] = g[a, b]
+        scale = np.maximum(np.sqrt(np.maximum(np.linalg.eigvalsh(G)[:, 2], 0.0)), area_scale)
+    ring = np.ones(n, dtype=np.int64)
+    hard = np.flatnonzero(~good)
+    if hard.size:
+        # the ill-conditioned rows through the SVD of the ring matrix itself, not of G: G's small
+        # eigenvalues carry ~1e-16 of the largest, i.e. 1e-8 in the singular values, and rings
+        # with a singular value near the threshold changed by 1e-4 under a rotation
+        indptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=n))])
+        pick = _rows_of(indptr, hard)
+        w[hard], rank[hard], s_hard, residual = _truncated_fit(D, A, hard, rows[pick], cols[pick], rcond, size)
         if want_scale:
-            scale = s_hard
+            scale[hard] = s_hard
+        # widen the rings that cannot represent their own detail (a valence-2 corner's two
+        # neighbours span a plane its detail leaves): the residual would otherwise be a constant
+        # that no similarity of the constraints moves (see CurvatureEditor)
+        grow = residual > rcond * s_hard
+        wide_rows, wide_cols = [], []
+        if max_ring > 1 and grow.any():
+            ar, ac = adjacency if adjacency is not None else (rows, cols)
+            P = sp.csr_matrix((np.ones(ar.size, dtype=np.float32), (ar, ac)), shape=(n, n))
+            target = hard[grow]
+            R = sp.csr_matrix((np.ones(pick.size, dtype=np.float32), (rows[pick], cols[pick])), shape=(n, n))[target]
+            for extra in range(1, max_ring):
+                R = R + R @ P
+                R = R.tocoo()
+                r, c = target[R.row], R.col.astype(np.int64)
+                keep = r != c
+                R = sp.csr_matrix((np.ones(int(keep.sum()), dtype=np.float32), (R.row[keep], c[keep])),
+                                  shape=(target.size, n))
+                R.sort_indices()
+                r = target[np.repeat(np.arange(target.size), np.diff(R.indptr))]
+                c = R.indices.astype(np.int64)
+                w_t, rank_t, s_t, residual_t = _truncated_fit(D, A, target, r, c, rcond, size)
+                # a wider ring never fits worse: take it (its pattern replaces the narrower one)
+                w[target], rank[target], ring[target] = w_t, rank_t, extra + 1
+                if want_scale:
+                    scale[target] = s_t
+                still = residual_t > rcond * s_t
+                wide_rows.append(r[~still[np.searchsorted(target, r)]])
+                wide_cols.append(c[~still[np.searchsorted(target, r)]])
+                if extra == max_ring - 1 or not still.any():
+                    wide_rows.append(r[still[np.searchsorted(target, r)]])
+                    wide_cols.append(c[still[np.searchsorted(target, r)]])
+                    break
+                target = target[still]
+                R = R[still]
+        if wide_rows:
+            narrow = ring[rows] == 1
+            rows = np.concatenate([rows[narrow]] + wide_rows)
+            cols = np.concatenate([cols[narrow]] + wide_cols)
+            Dj = D[cols]
     # C_ij = D_j . w_i  (w_i = G_i^+ D_i)
     vals = np.einsum("ea,ea->e", Dj, w[rows])
     C = sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
-    return C, rank, scale
+    C.sort_indices()
+    return C, rank, scale, ring
+
+
+def _rows_of(indptr, which):
+    """Positions of the entries of rows ``which`` in a row-sorted pattern with ``indptr``."""
+    counts = indptr[which + 1] - indptr[which]
+    starts = np.repeat(indptr[which] - np.concatenate([[0], np.cumsum(counts)[:-1]]), counts)
+    return starts + np.arange(int(counts.sum()))
+
+
+def _truncated_fit(D, A, target, rows, cols, rcond, size):
+    """Truncated minimum-norm fit of ``D_i`` by its ring's details for the rows ``target``
+    (increasing; ``rows``/``cols`` their pattern, sorted by row), through a batched SVD of the
+    zero-padded ring matrices. Returns (w (t, 3), rank (t,), s_i (t,), residual (t,)), where
+    ``C_ij = D_j . w_i``."""
+    at = np.searchsorted(target, rows)
+    counts = np.bincount(at, minlength=target.size)
+    first = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    slot = np.arange(rows.size) - first[at]
+    M = np.zeros((target.size, max(int(counts.max(initial=0)), 3), 3))
+    M[at, slot] = D[cols]
+    area_scale = np.sqrt(np.bincount(at, weights=A[cols] ** 2, minlength=target.size)) / max(size, np.finfo(float).tiny)
+    # M = D_N^T; D_N's left singular vectors are M's right ones
+    with np.errstate(over="ignore", invalid="ignore"):
+        _, sigma, Vt = np.linalg.svd(M, full_matrices=False)      # descending
+    sigma = np.nan_to_num(sigma)
+    s_ref = np.maximum(sigma[:, 0], area_scale)
+    keep = sigma > rcond * s_ref[:, None]
+    Di = D[target]
+    proj = np.einsum("tab,tb->ta", Vt, Di)                           # U^T D_i
+    inv = np.zeros_like(sigma)
+    inv[keep] = 1.0 / sigma[keep] ** 2
+    w = np.einsum("tab,ta->tb", Vt, proj * inv)
+    fitted = np.einsum("tab,ta->tb", Vt, proj * keep)
+    residual = np.linalg.norm(Di - fitted, axis=1)
+    return w, keep.sum(axis=1), s_ref, residual

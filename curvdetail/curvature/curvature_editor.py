@@ -9,7 +9,7 @@ from scipy.sparse.csgraph import connected_components
 from ._validate import (as_index_set, as_values, bbox_centre, bbox_diagonal, centroid_diameter, check_bool,
                         check_choice, non_whole_index_error)
 from .cotan_laplacian import checked_cotan_laplacian, laplacian_product
-from .curvature_coefficients import DEFAULT_RCOND, _coefficients, _one_ring_pairs, check_rcond
+from .curvature_coefficients import DEFAULT_MAX_RING, DEFAULT_RCOND, _coefficients, _one_ring_pairs, check_rcond
 from .errors import ConstraintError, UndeterminedEditError, first_indices
 from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
 from .reconstruct import refine_least_squares
@@ -59,13 +59,17 @@ class CurvatureEditor:
     Invariance (exact up to solver precision): with ``roi=None``, moving every position
     constraint by a similarity ``x -> s R x + t`` and every detail constraint by its linear part
     ``D -> s R D`` (the detail ``D = L V`` scales like a length) moves the result by the same
-    similarity, because ``C`` and ``L`` are invariant and both stages are linear. Two parts of
-    the detail stay as they are at rest and do not follow the similarity: the detail of
-    *detail islands* (see ``detail_islands``), and the rest residual ``(I - C) D`` of
-    rank-deficient rings, which their coefficients cannot represent (kept as a constant term so
-    that unchanged constraints give back the rest shape exactly). Where either is present the
-    invariance holds only approximately (a bump in a plane, 621 island vertices: 3 % of the
-    diagonal under a rotation).
+    similarity, because ``C`` and ``L`` are invariant and both stages are linear. Where a
+    one-ring cannot represent its vertex's detail (a grid's valence-2 corner), ``C`` takes that
+    row over a wider ring (see :func:`curvature_coefficients`, ``max_ring``); without it, the
+    rest residual ``(I - C) D`` there was a constant that no similarity moves, and ``(I - C)_uu``
+    amplified it: terrainA_10k with 40 handles came back 16 diagonals off under a uniform scale
+    of its constraints (now 2e-11). Two parts of the detail still stay as they are at rest and do
+    not follow the similarity: the detail of *detail islands* (see ``detail_islands``), and the
+    residual of any ring still unable to represent its detail at the three-ring (kept as a
+    constant term so that unchanged constraints give back the rest shape exactly; none on the
+    meshes tested). Where either is present the invariance holds only approximately (a bump in
+    a plane, 621 island vertices: 3 % of the diagonal under a rotation).
 
     Parameters
     ----------
@@ -117,7 +121,9 @@ class CurvatureEditor:
                                 ``curvature_setup`` (checks and LU of ``(I - C)_uu``),
                                 ``embedding_setup`` (normal equations and their factorization),
                                 ``rest_check`` (``rest_error``: one back-substitution of each stage)
-    rank_deficient : int        vertices whose one-ring detail is rank-deficient (see
+    widened_rings : int         vertices whose coefficients span a ring wider than the one-ring
+                                (see :func:`curvature_coefficients`)
+    rank_deficient : int        vertices whose ring detail is rank-deficient (see
                                 :func:`curvature_coefficients`)
     detail_islands : int        free vertices whose detail the coefficients cannot determine
                                 (groups cut off from every known detail by flat vertices, whose
@@ -215,27 +221,29 @@ class CurvatureEditor:
         D = laplacian_product(L, V)
         rows, cols = _one_ring_pairs(F, n)
         A, size = _mixed_voronoi_area_unchecked(V, F), centroid_diameter(V)     # rotation-invariant
-        C, rank, _ = _coefficients(D, A, rows, cols, n, rcond, size)
-        cvals = C.data if C.nnz == rows.size else np.asarray(C[rows, cols]).ravel()  # (rows, cols) order
+        C, rank, _, ring = _coefficients(D, A, rows, cols, n, rcond, size, max_ring=DEFAULT_MAX_RING)
+        crows, ccols, cvals = _pattern(C)     # the one-ring, wider where a ring was widened
         self.detail, self.coefficients, self.laplacian = D, C, L
         for state in (D, C.data, L.data, pc, dc):      # read-only: solves read them again
             state.flags.writeable = False
         self.rank_deficient = int(np.count_nonzero(rank < 3))
+        self.widened_rings = int(np.count_nonzero(ring > 1))
         t1 = time.perf_counter()
 
         # -- curvature stage: unknown details fd = roi \ dc --------------------------------
         free_d = in_roi.copy()
         free_d[dc] = False
-        _check_reached(rows, cols, free_d, n, "detail", "detail_constrained")
+        _check_reached(crows, ccols, free_d, n, "detail", "detail_constrained")
         if relations == "one+two-ring":
             rows2, cols2 = _two_ring_pairs(rows, cols, n)
-            C2, rank2, _ = _coefficients(D, A, rows2, cols2, n, rcond, size)
-            cvals2 = C2.data if C2.nnz == rows2.size else np.asarray(C2[rows2, cols2]).ravel()
+            C2, rank2, _, _ = _coefficients(D, A, rows2, cols2, n, rcond, size, max_ring=DEFAULT_MAX_RING,
+                                            adjacency=(rows, cols))
+            rows2, cols2, cvals2 = _pattern(C2)
             self.coefficients_two_ring = C2
-            island = _detail_islands(np.concatenate([rows, rows2]), np.concatenate([cols, cols2]),
+            island = _detail_islands(np.concatenate([crows, rows2]), np.concatenate([ccols, cols2]),
                                      np.concatenate([cvals, cvals2]), free_d, np.maximum(rank, rank2), n)
         else:
-            island = _detail_islands(rows, cols, cvals, free_d, rank, n)
+            island = _detail_islands(crows, ccols, cvals, free_d, rank, n)
         self.detail_islands = int(np.count_nonzero(island))
         self._user_dc = dc.size
         dc = np.concatenate([dc, np.flatnonzero(island)])     # islands keep their rest detail
@@ -246,10 +254,10 @@ class CurvatureEditor:
         at_dc = _positions_in(dc, n)
         curv_backend = "splu" if _chosen_automatically(backend) and fd.size < CURVATURE_SPLU_MAX else backend
         if relations == "one+two-ring":
-            self._stacked_system(D, in_roi, fd, dc, at_fd, at_dc, (rows, cols, cvals),
+            self._stacked_system(D, in_roi, fd, dc, at_fd, at_dc, (crows, ccols, cvals),
                                  (rows2, cols2, cvals2), backend)
         else:
-            self._square_system(D, in_roi, free_d, fd, dc, at_fd, at_dc, rows, cols, cvals, curv_backend)
+            self._square_system(D, in_roi, free_d, fd, dc, at_fd, at_dc, crows, ccols, cvals, curv_backend)
         t2 = time.perf_counter()
         self._embedding(L, V, F, in_roi, pc, rows, cols, backend)
         self._response = None
@@ -634,6 +642,11 @@ def _index_set(indices, n, name, values=None):
         if error is not None:
             raise error
     return as_index_set(indices, n, name)
+
+
+def _pattern(C):
+    """(rows, cols, values) of the stored entries of the CSR matrix ``C``, explicit zeros too."""
+    return np.repeat(np.arange(C.shape[0]), np.diff(C.indptr)), C.indices.astype(np.int64), C.data
 
 
 def _two_ring_pairs(rows, cols, n):
