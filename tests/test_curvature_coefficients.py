@@ -208,3 +208,24 @@ def test_a_rotation_does_not_move_the_flatness_threshold():
     C_turned, info_turned = curvature_coefficients(V @ turn.T, F, return_info=True)
     assert np.array_equal(info.rank, info_turned.rank)
     assert abs(C_turned - C).max() < 1e-12
+
+
+def test_nearly_planar_rings_keep_their_coefficients_under_rotation():
+    # rings whose details nearly lie in a plane (third singular value ~1e-5 of the first, kept):
+    # G's eigenvalues carry ~1e-16 of the largest, so that singular value came out to ~1e-6 of
+    # itself and the coefficients changed by 1.4e-5 of their size under a rotation and scale
+    # (fandisk: 46 rows by more than 1e-6); through the SVD of the ring matrix, ~1e-10
+    from curvdetail.curvature.curvature_coefficients import _coefficients
+
+    worst = 0.0
+    for seed in range(20):
+        rng = np.random.default_rng(seed)
+        k = 6
+        D = np.zeros((k + 1, 3))
+        D[1:] = rng.normal(size=(k, 3)) * [1.0, 0.3, 1e-5] @ _rotation(rng).T
+        D[0] = rng.normal(size=3)
+        rows, cols = np.zeros(k, dtype=np.int64), np.arange(1, k + 1)
+        C, C2 = (_coefficients(X, np.ones(k + 1), rows, cols, k + 1, 1e-6, 1.0)[0][0, 1:].toarray().ravel()
+                 for X in (D, 2.5 * D @ _rotation(rng).T))
+        worst = max(worst, np.abs(C - C2).max() / np.abs(C).max())
+    assert worst < 1e-8

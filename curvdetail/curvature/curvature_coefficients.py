@@ -78,9 +78,10 @@ def curvature_coefficients(V, F, *, rcond=DEFAULT_RCOND, max_ring=DEFAULT_MAX_RI
     roundoff and its coefficients are zero
     (``D_i = 0`` is kept there). Vertices with fewer than three kept singular values are
     counted as rank-deficient; their detail is represented only where it lies in the kept span.
-    The ill-conditioned rings (those the closed form does not take) are pseudo-inverted through
-    a batched SVD of the ring matrix ``D_N`` itself, whose small singular values are accurate
-    where ``G_i``'s eigenvalues are not.
+    Where a singular value lies between ~1e-7 and 1e-3 of the largest (near the threshold, or
+    kept with a large weight), ``G_i``'s eigenvalues do not give it accurately (they carry
+    ~1e-16 of the largest): those rings are pseudo-inverted through a batched SVD of the ring
+    matrix ``D_N`` itself (zero-padded to the largest ring).
 
     Widening: where the detail does not lie in that span (the residual
     ``|D_i - sum_j C_ij D_j|`` is above ``rcond * s_i``: a valence-2 corner of a grid, whose two
@@ -231,12 +232,25 @@ def _coefficients(D, A, rows, cols, n, rcond, size, *, want_scale=False, max_rin
     ring = np.ones(n, dtype=np.int64)
     hard = np.flatnonzero(~good)
     if hard.size:
-        # the ill-conditioned rows through the SVD of the ring matrix itself, not of G: G's small
-        # eigenvalues carry ~1e-16 of the largest, i.e. 1e-8 in the singular values, and rings
-        # with a singular value near the threshold changed by 1e-4 under a rotation
-        indptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=n))])
-        pick = _rows_of(indptr, hard)
-        w[hard], rank[hard], s_hard, residual = _truncated_fit(D, A, hard, rows[pick], cols[pick], rcond, size)
+        G = np.empty((hard.size, 3, 3))
+        for a in range(3):
+            for b in range(a, 3):
+                G[:, a, b] = G[:, b, a] = g[a, b][hard]
+        lam, U = np.linalg.eigh(G)                  # ascending eigenvalues
+        sigma = np.sqrt(np.maximum(lam, 0.0))
+        w[hard], rank[hard], s_hard, residual = _fit(D[hard], U, sigma, area_scale[hard], rcond)
+        # G's eigenvalues carry ~1e-16 of the largest, so a singular value between ~1e-7 and
+        # 1e-3 of the largest (near the threshold, or kept with a large weight 1 / sigma^2) is
+        # known only to 1e-10 ... 1e-2 of itself: those rows (fandisk: 46 of them changed by up to
+        # 5e-5 under a rotation) go through the SVD of the ring matrix itself
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = sigma[:, :2] / sigma[:, 2:]
+        redo = np.flatnonzero(((ratio > 1e-7) & (ratio < 1e-3)).any(axis=1))
+        if redo.size:
+            indptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=n))])
+            pick = _rows_of(indptr, hard[redo])
+            w[hard[redo]], rank[hard[redo]], s_hard[redo], residual[redo] = _truncated_fit(
+                D, A, hard[redo], rows[pick], cols[pick], rcond, size)
         if want_scale:
             scale[hard] = s_hard
         # widen the rings that cannot represent their own detail (a valence-2 corner's two
@@ -248,7 +262,7 @@ def _coefficients(D, A, rows, cols, n, rcond, size, *, want_scale=False, max_rin
             ar, ac = adjacency if adjacency is not None else (rows, cols)
             P = sp.csr_matrix((np.ones(ar.size, dtype=np.float32), (ar, ac)), shape=(n, n))
             target = hard[grow]
-            R = sp.csr_matrix((np.ones(pick.size, dtype=np.float32), (rows[pick], cols[pick])), shape=(n, n))[target]
+            R = sp.csr_matrix((np.ones(rows.size, dtype=np.float32), (rows, cols)), shape=(n, n))[target]
             for extra in range(1, max_ring):
                 R = R + R @ P
                 R = R.tocoo()
@@ -307,14 +321,18 @@ def _truncated_fit(D, A, target, rows, cols, rcond, size):
     # M = D_N^T; D_N's left singular vectors are M's right ones
     with np.errstate(over="ignore", invalid="ignore"):
         _, sigma, Vt = np.linalg.svd(M, full_matrices=False)      # descending
-    sigma = np.nan_to_num(sigma)
-    s_ref = np.maximum(sigma[:, 0], area_scale)
+    return _fit(D[target], Vt.transpose(0, 2, 1), np.nan_to_num(sigma), area_scale, rcond)
+
+
+def _fit(Di, U, sigma, area_scale, rcond):
+    """The truncated pseudo-inverse fit from a ring's singular directions ``U`` (t, 3, 3),
+    columns, and values ``sigma`` (t, 3): (w, rank, s_i, residual) as :func:`_truncated_fit`."""
+    s_ref = np.maximum(sigma.max(axis=1), area_scale)
     keep = sigma > rcond * s_ref[:, None]
-    Di = D[target]
-    proj = np.einsum("tab,tb->ta", Vt, Di)                           # U^T D_i
+    proj = np.einsum("tab,ta->tb", U, Di)                            # U^T D_i
     inv = np.zeros_like(sigma)
     inv[keep] = 1.0 / sigma[keep] ** 2
-    w = np.einsum("tab,ta->tb", Vt, proj * inv)
-    fitted = np.einsum("tab,ta->tb", Vt, proj * keep)
+    w = np.einsum("tab,tb->ta", U, proj * inv)
+    fitted = np.einsum("tab,tb->ta", U, proj * keep)
     residual = np.linalg.norm(Di - fitted, axis=1)
     return w, keep.sum(axis=1), s_ref, residual
