@@ -9,8 +9,8 @@ from ..curvature._validate import (check_choice, ZERO_AREA_ADVICE, ZERO_AREA_REL
 from ..curvature.errors import MeshError, first_indices
 
 #: Points further than this (bbox diagonals of the mesh) from its bounding box skip the fast
-#: engines for the numpy one: pymeshlab's grid search slows down with the distance (0.2 s at
-#: 1e4 diagonals on a 40k-vertex grid, no answer after 60 s at 1e10).
+#: engines for the bounding-box tree search: pymeshlab's grid search slows down with the
+#: distance (0.2 s at 1e4 diagonals on a 40k-vertex grid, no answer after 60 s at 1e10).
 FAR_POINTS = 1.0
 
 #: Largest coordinate taken here: everything runs in a unit frame, so only the squares of the
@@ -38,12 +38,27 @@ def locate(points, V, F, *, engine="auto", candidates=8, chunk=20_000):
 
     Engines: ``"numpy"``: candidate triangles from a ``cKDTree`` of centroids (plus the nearest
     vertex's triangles in a second round where the first is not certain), exact closest point on
-    each (Ericson's region tests, all in numpy). ``"auto"``: in the plane matplotlib's
-    trapezoid-map point location (C++) with the numpy engine for the points it finds outside;
-    in space pymeshlab's ``transfer_attributes_per_vertex`` (a uniform grid, C++) for the
-    nearest face, then the exact barycentric coordinates of the closest point in that face.
-    Points more than ``FAR_POINTS`` bbox diagonals outside the mesh's bounding box always go to
-    the numpy engine (pymeshlab's grid search slows down with the distance, without bound).
+    each (Ericson's region tests, all in numpy); the candidates are certain only where triangle
+    sizes vary little (a large triangle beside small ones can be missed). ``"auto"``: in the
+    plane matplotlib's trapezoid-map point location (C++) with the numpy engine for the points
+    it finds outside; in space pymeshlab's ``transfer_attributes_per_vertex`` (a uniform grid,
+    C++) for the nearest face, then the exact barycentric coordinates of the closest point in
+    that face. Points more than ``FAR_POINTS`` bbox diagonals outside the mesh's bounding box
+    skip both (pymeshlab's grid search slows down with the distance, without bound) for a
+    bounding-box tree search over every triangle that could hold the closest point (that of
+    :func:`~curvdetail.remesh.evaluate.hausdorff`), all points at once.
+
+    What is exact, to rounding: always, the closest point and distance within the triangle
+    returned; with ``"auto"``, the triangle itself for points more than ``FAR_POINTS`` from the
+    bounding box (the tree search, at any distance), points in space pymeshlab's grid finds a
+    face for (within its search radius of one diagonal) and planar points inside the domain.
+    The rest take the numpy engine's candidates: planar points outside the domain but within
+    ``FAR_POINTS`` of the box, points in space the grid finds no face for (within ``FAR_POINTS``
+    of the box but more than a diagonal from the surface), and every point with ``"numpy"``.
+    Far away (from ~1e6 diagonals, facing a flat part) triangles whose distances differ by less
+    than 1e-13 of the distance are ties: the distance is exact to that, and the closest point
+    may be any of theirs.
+
     Everything is computed in a frame where the mesh has unit size, so the scale and position
     of the input do not matter.
 
@@ -99,9 +114,12 @@ def _locate(P, V, F, engine="auto", candidates=8, chunk=20_000):
         face, bary, dist = _locate_kdtree(P, V, F, candidates, chunk)
         return face, bary, dist * scale
     face = np.full(P.shape[0], -1, dtype=np.int64)
-    near = np.flatnonzero(_box_gap(P, V) <= FAR_POINTS)
+    gap = _box_gap(P, V)
+    near, far = np.flatnonzero(gap <= FAR_POINTS), np.flatnonzero(gap > FAR_POINTS)
     if near.size:
         face[near] = _trifinder(P[near], V, F) if V.shape[1] == 2 else _nearest_face_meshlab(P[near], V, F)
+    if far.size:
+        face[far] = _nearest_face_tree(P[far], V, F)
     bad = face < 0
     face = np.where(bad, 0, face)
     bary, dist = np.empty((P.shape[0], 3)), np.empty(P.shape[0])
@@ -218,6 +236,67 @@ def _nearest_face_meshlab(P, V, F):
     face = np.rint(ms.mesh(1).vertex_custom_scalar_attribute_array("NearestFaceIndex")).astype(np.int64)
     face[(face < 0) | (face >= F.shape[0])] = -1
     return face
+
+
+def _nearest_face_tree(P, V, F):
+    """Nearest triangle per point (k, d), exact at any distance: the bounding-box tree search of
+    :func:`~.evaluate._surface_distance` (every triangle that could hold the closest point,
+    all points at once, ``SEARCH_POINTS`` at a time), keeping the triangle of each distance.
+
+    The first bound is the triangle :func:`_greedy_face` picks (the search drops boxes within
+    ``PRUNE_RELATIVE`` of the bound, so the triangle that set it must be known); a triangle
+    closer than the bound lies in boxes closer than it, so none is missed: the face returned
+    is at the least distance, to rounding and to ``PRUNE_RELATIVE`` (very far from a flat
+    part, many triangles tie within that, and the face is any of them)."""
+    from .evaluate import SEARCH_POINTS, _box_tree, _descend, _exact_distances   # evaluate imports locate
+
+    k = P.shape[0]
+    T = V[F]
+    tree = _box_tree(T)
+    Q = np.ascontiguousarray(P.T)
+    face = np.empty(k, dtype=np.int64)
+    for lo in range(0, k, SEARCH_POINTS):
+        face[lo:lo + SEARCH_POINTS] = _greedy_face(tree, Q[:, lo:lo + SEARCH_POINTS])
+    best = _exact_distances(P, T, np.arange(k), face)
+    todo = [np.arange(lo, min(k, lo + SEARCH_POINTS)) for lo in range(0, k, SEARCH_POINTS)]
+    while todo:
+        idx = todo.pop()
+        pairs = _descend(tree, Q[:, idx], best[idx])
+        if pairs is None:                       # too many pairs at once: half the points
+            todo += [idx[:idx.size // 2], idx[idx.size // 2:]]
+            continue
+        pt, tri = pairs
+        if pt.size:
+            d = _exact_distances(P, T, idx[pt], tri)
+            order = np.lexsort((d, pt))             # per point, its nearest pair first
+            win = order[np.flatnonzero(np.r_[True, pt[order][1:] != pt[order][:-1]])]
+            rows = idx[pt[win]]
+            better = d[win] < best[rows]
+            best[rows[better]] = d[win][better]
+            face[rows[better]] = tri[win][better]
+    return face
+
+
+def _greedy_face(tree, Q):
+    """The triangle of :func:`~.evaluate._greedy_bound` (which returns only its distance) for
+    points ``Q`` (d, k): down the tree to the nearer child box at each level (of two that both
+    hold the point, the one of the smaller minmaxdist), then the leaf's triangle whose own box
+    comes first in that order."""
+    from .evaluate import _box_distance2
+
+    lo, hi, leaves, tri_lo, tri_hi = tree
+    k = Q.shape[1]
+    every = np.arange(k)
+    node = np.zeros(k, dtype=np.int64)
+    for level in range(1, len(lo)):
+        left = 2 * node
+        near_l, cap_l = _box_distance2(Q, every, lo[level], hi[level], left)
+        near_r, cap_r = _box_distance2(Q, every, lo[level], hi[level], left + 1)
+        node = left + ((near_r < near_l) | ((near_r == near_l) & (cap_r < cap_l)))
+    width = leaves.shape[1]
+    tri = leaves.take(node, axis=0)
+    near, cap = _box_distance2(Q, np.repeat(every, width), tri_lo, tri_hi, tri.ravel())
+    return tri[every, np.lexsort((cap.reshape(k, width), near.reshape(k, width)), axis=1)[:, 0]]
 
 
 def _locate_kdtree(P, V, F, candidates, chunk):
