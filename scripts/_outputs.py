@@ -1,76 +1,209 @@
 """How the reproduction and benchmark scripts write their files (JSON, markdown, pictures, and
-the blocks they refresh inside docs/*.md): through :mod:`curvdetail._output`, as the package's
-own outputs are.
+the blocks they refresh inside docs/*.md): checked before any work, committed together after it.
 
-* Before any work, :func:`refuse_existing` stops a script (``parser.error``, exit status 2) at
-  an output file that exists, naming the file and the flag that allows replacing it (``--force``;
-  bench_reconstruct.py: ``--overwrite``, as its ``--force`` runs the cases left out by default).
-* Every file is written atomically (:func:`curvdetail._output.atomic_output`: a temporary file
-  in the destination's folder, renamed over it once complete), so a failed or interrupted write
-  leaves the old file as it was and no temporary file; matplotlib figures are saved to the
-  temporary path with their format given explicitly.
+A script makes one :class:`Run` right after parsing its arguments, naming every file it writes:
+
+* Before any work, each output is checked, and the first that cannot be written stops the
+  script (``parser.error``: usage message, exit status 2) with a message naming it and the fix:
+  a file that exists, unless the script's ``--force`` (bench_reconstruct.py: ``--overwrite``, as
+  its ``--force`` runs the cases left out by default); a folder given for a file; a folder that
+  does not exist (except the script's own ``--out`` folder, which it makes: then the folder it
+  would be made in is checked), that is a file, or that is not writable.
+* During the work, the outputs are kept in memory (pictures are rendered in a scratch folder
+  and read back); no destination is touched.
+* :meth:`Run.commit` writes them together through :func:`curvdetail._output.atomic_outputs`:
+  every output to a temporary file beside its destination first, then all renamed into place.
+  A failure before the renames removes the temporary files and leaves every old file as it was;
+  a rename that fails takes back those done (the error names the output; the run's results
+  go with the process). The renames are still one system call each, not one for all: a process
+  reading the files during the commit, or a crash in the middle of it, can see some new files
+  and some old (that module's docstring says what is left). bench_reconstruct.py also commits
+  its JSON after each group of a run of several, on purpose: a run stopped part-way keeps them.
 """
 
 import contextlib
 import json
 import os
+import shlex
+import tempfile
 
-from curvdetail._output import atomic_output, check_output_path
+from curvdetail._output import Output, atomic_output, atomic_outputs, check_output_path
 
 
-def refuse_existing(parser, paths, force, flag="--force"):
-    """Check the outputs of a run before any work; ``parser.error`` (exit status 2) at the first
-    that cannot be written.
+class _Planned:
+    """One output of a :class:`Run`: its path as given, whether an existing file may be replaced,
+    and the option a refusal names."""
 
-    ``paths``: the files the run writes (None: not written this run). One that exists is refused
-    unless ``force`` (the message names it and ``flag``); a folder given for a file, or an
-    existing folder that is not writable, is refused too. A file whose folder does not exist yet
-    (the script makes it) has nothing to replace.
+    def __init__(self, path, force, flag):
+        self.path, self.force, self.flag = path, force, flag
+
+
+def _key(path):
+    return os.path.abspath(os.fsdecode(path))
+
+
+class Run:
+    """The output files of one run of a script: checked now, kept during the work, written
+    together by :meth:`commit` (see the module docstring).
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser   its ``error`` refuses an output (exit status 2)
+    paths : iterable of str or None    the files the run writes (None: not written this run)
+    force : bool                       an existing file may be replaced
+    flag : str                         the option that a refusal of an existing file names
+    makes : iterable of str            folders the run makes where they are missing (its
+                                       ``--out`` folder; :meth:`commit` makes them): checked that
+                                       they can be made. Every other output's folder must exist.
     """
-    for path in paths:
-        if path is None or not os.path.isdir(os.path.dirname(os.path.abspath(path))):
-            continue
+
+    def __init__(self, parser, paths=(), force=False, flag="--force", *, makes=()):
+        self._parser = parser
+        self._makes = {_key(folder) for folder in makes}
+        self._planned = {}          # abspath -> _Planned
+        self._content = {}          # abspath -> bytes, in the order written
+        self.check(paths, force, flag)
+
+    def check(self, paths, force, flag="--force"):
+        """Check more outputs, with their own ``force`` and ``flag``, before any work."""
+        for path in paths:
+            if path is None:
+                continue
+            key = _key(path)
+            if key in self._planned:
+                self._parser.error(f"{path} is given for two outputs; name a separate file for each.")
+            problem = self._folder_problem(path) or _file_problem(path, force, flag)
+            if problem:
+                self._parser.error(problem)
+            self._planned[key] = _Planned(path, force, flag)
+
+    def _folder_problem(self, path):
+        """Why ``path``'s folder cannot take it (a message naming the fix), or None."""
+        folder = os.path.dirname(_key(path))
+        shown = os.path.dirname(path) or "."
+        existing = folder
+        while not os.path.lexists(existing):
+            existing = os.path.dirname(existing)
+        if not os.path.isdir(existing):
+            return (f"cannot write {path!r}: {existing!r} is not a folder; name a folder for it "
+                    "(or move that file away).")
+        if existing != folder and folder not in self._makes:
+            return (f"cannot write {path!r}: folder {shown!r} does not exist; create it first "
+                    f"(mkdir -p {shlex.quote(shown)}) or name a folder that exists.")
+        if not os.access(existing, os.W_OK | os.X_OK):
+            what = f"folder {shown!r} is not writable" if existing == folder else \
+                f"folder {shown!r} cannot be made: {existing!r} is not writable"
+            return f"cannot write {path!r}: {what}; make it writable or name another folder."
+        return None
+
+    def _find(self, path):
+        key = _key(path)
+        if key not in self._planned:
+            raise ValueError(f"{path} was not checked before the work; name it in the Run's outputs.")
+        return key
+
+    def _keep(self, path, content):
+        self._content[self._find(path)] = content
+
+    def write_text(self, path, text):
+        """Keep ``text`` (UTF-8) for ``path``."""
+        self._keep(path, text.encode("utf-8"))
+
+    def write_json(self, path, obj, *, end="", **dump_options):
+        """Keep ``json.dumps(obj, **dump_options)`` and ``end`` for ``path``."""
+        self._keep(path, (json.dumps(obj, **dump_options) + end).encode("utf-8"))
+
+    @contextlib.contextmanager
+    def stage(self, path):
+        """Yield a path in a new scratch folder, with ``path``'s name (so its extension), to
+        write ``path``'s content to; the content is kept when the block succeeds, and the
+        scratch folder removed either way."""
+        self._find(path)
+        with tempfile.TemporaryDirectory(prefix="curvdetail-stage-") as scratch:
+            tmp = os.path.join(scratch, os.path.basename(path))
+            yield tmp
+            with open(tmp, "rb") as fh:
+                content = fh.read()
+        self._keep(path, content)
+
+    def save_figure(self, fig, path, **savefig_options):
+        """Keep ``fig.savefig``'s picture for ``path`` (see :func:`save_figure`)."""
+        with self.stage(path) as tmp:
+            save_figure(fig, tmp, False, **savefig_options)
+
+    def render_panels(self, path, panels, **options):
+        """Keep :func:`curvdetail.deformation_benchmark.render_panels`'s picture for ``path``."""
+        from curvdetail.deformation_benchmark import render_panels
+
+        with self.stage(path) as tmp:
+            render_panels(tmp, panels, **options)
+
+    def read(self, path):
+        """The content kept for ``path`` (bytes), e.g. a picture that a composite reuses."""
+        return self._content[self._find(path)]
+
+    def commit(self, paths=None):
+        """Write the outputs kept so far (``paths``: only these) together, all or none (see the
+        module docstring), making the ``makes`` folders they need; afterwards they are this
+        run's own files, which a later commit (a progress save updated) may replace.
+
+        Raises what :func:`curvdetail._output.atomic_outputs` raises: ``FileExistsError`` where
+        a file refused now appeared during the work, ``OSError`` where an output cannot be
+        written (the message names it; no output was written, folders made are removed).
+        """
+        keys = list(self._content) if paths is None else [self._find(p) for p in paths]
+        if not keys:
+            return
+        planned = [self._planned[key] for key in keys]
+        made = []
         try:
-            check_output_path(path, force, hint=None, error=FileNotFoundError, flag=flag)
-        except OSError as exc:
-            parser.error(str(exc))
+            for out in planned:
+                folder = os.path.dirname(_key(out.path))
+                if folder in self._makes:
+                    made += _make_folder(folder)
+            for out in planned:     # a file that appeared during the work, where none may be replaced
+                if not out.force:
+                    check_output_path(out.path, False, hint=None, error=FileNotFoundError, flag=out.flag)
+            outputs = [Output(out.path, None, FileNotFoundError, out.flag) for out in planned]
+            with atomic_outputs(outputs, overwrite=any(out.force for out in planned)) as temps:
+                for tmp, key in zip(temps, keys):
+                    with open(tmp, "wb") as fh:
+                        fh.write(self._content[key])
+        except BaseException:
+            for folder in reversed(made):
+                with contextlib.suppress(OSError):
+                    os.rmdir(folder)
+            raise
+        for key, out in zip(keys, planned):
+            del self._content[key]
+            out.force = True
 
 
-@contextlib.contextmanager
-def atomic(path, force, flag="--force"):
-    """:func:`curvdetail._output.atomic_output` for a script's output: yields the temporary path
-    to write ``path``'s content to; ``force`` allows replacing an existing file (a refusal names
-    ``flag``)."""
-    with atomic_output(path, overwrite=force, hint=None, error=FileNotFoundError, flag=flag) as tmp:
-        yield tmp
+def _file_problem(path, force, flag):
+    """Why ``path`` itself cannot be written (it exists, or is a folder), or None."""
+    if not os.path.isdir(os.path.dirname(_key(path))):
+        return None                 # its folder is made by the run: nothing there to replace
+    try:
+        check_output_path(path, force, hint=None, error=FileNotFoundError, flag=flag)
+    except OSError as exc:
+        return str(exc)
+    return None
 
 
-def write_text(path, text, force, flag="--force"):
-    """Write ``text`` (UTF-8) to ``path`` atomically."""
-    with atomic(path, force, flag) as tmp:
-        with open(tmp, "w", encoding="utf-8") as fh:
-            fh.write(text)
-
-
-def write_json(path, obj, force, flag="--force", *, end="", **dump_options):
-    """``json.dump(obj)`` (with ``dump_options``) and ``end`` to ``path`` atomically."""
-    with atomic(path, force, flag) as tmp:
-        with open(tmp, "w", encoding="utf-8") as fh:
-            json.dump(obj, fh, **dump_options)
-            fh.write(end)
+def _make_folder(folder):
+    """``os.makedirs(folder)``; the folders it made, outermost first."""
+    missing = []
+    while not os.path.lexists(folder):
+        missing.append(folder)
+        folder = os.path.dirname(folder)
+    for made in reversed(missing):
+        os.mkdir(made)
+    return missing[::-1]
 
 
 def save_figure(fig, path, force, flag="--force", **savefig_options):
     """``fig.savefig`` to ``path`` atomically, the format (from ``path``'s extension) given
     explicitly, as the temporary file's name does not choose it."""
     fmt = os.path.splitext(path)[1].lstrip(".").lower() or "png"
-    with atomic(path, force, flag) as tmp:
+    with atomic_output(path, overwrite=force, hint=None, error=FileNotFoundError, flag=flag) as tmp:
         fig.savefig(tmp, format=fmt, **savefig_options)
-
-
-def render_panels(path, panels, force, **options):
-    """:func:`curvdetail.deformation_benchmark.render_panels` (which writes atomically) with
-    ``overwrite=force``; :func:`refuse_existing` has checked ``path`` before the work."""
-    from curvdetail.deformation_benchmark import render_panels as render
-
-    render(path, panels, overwrite=force, **options)

@@ -116,10 +116,9 @@ def main(argv=None):
     ap.add_argument("--skip-100k", action="store_true")
     ap.add_argument("--force", action="store_true", help="replace OUT if it exists")
     args = ap.parse_args(argv)
-    _outputs.refuse_existing(ap, [args.out], args.force)
+    run = _outputs.Run(ap, [args.out], args.force, makes=[os.path.dirname(os.path.abspath(args.out))])
     require("mannequin_nose.obj", "mannequin.off", "mannequin_ear.obj", "cat_tosca.off", "deformation",
             *(() if args.skip_100k else ("terrainA_100k.ply",)))
-    os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
     report = {"machine": {"platform": platform.platform(), "cpus": os.cpu_count(),
                           "load_average_before": os.getloadavg()}}
     report["table1"] = bench_table1(args.repeat)
@@ -140,7 +139,8 @@ def main(argv=None):
                   f"{1e3 * r['handle_resolve_s']:.2f} ms = {r['handle_resolves_per_second']:.0f}/s "
                   "(target 20/s)")
     report["machine"]["load_average_after"] = os.getloadavg()
-    _outputs.write_json(args.out, report, args.force, indent=2)
+    run.write_json(args.out, report, indent=2)
+    run.commit()
     print(f"wrote {args.out}")
     return 0
 

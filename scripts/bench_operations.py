@@ -137,7 +137,7 @@ def main(argv=None):
     unknown = [s for s in sizes if s not in SIDES] + [c for c in cases if c not in CASES]
     if unknown:
         ap.error(f"unknown size or case: {', '.join(unknown)}")
-    _outputs.refuse_existing(ap, [args.out], args.force)
+    run = _outputs.Run(ap, [args.out], args.force, makes=[os.path.dirname(os.path.abspath(args.out))])
     results = []
     for size in sizes:
         for case in cases:
@@ -150,8 +150,8 @@ def main(argv=None):
                 print(f"{size} {case} [{variant}]: {shown}", flush=True)
     report = {"machine": {"cpu": platform.processor() or platform.machine(), "cores": os.cpu_count()},
               "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "results": results}
-    os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
-    _outputs.write_json(args.out, report, args.force, indent=2, end="\n")
+    run.write_json(args.out, report, indent=2, end="\n")
+    run.commit()
     return 0
 
 

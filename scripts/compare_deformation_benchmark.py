@@ -9,8 +9,9 @@ first-solve time (setup + solve) and the re-solve time, and save pictures side b
 
 Usage: python scripts/compare_deformation_benchmark.py [--out out/compare] [--docs docs] [--force]
 Writes OUT/compare.json, OUT/compare.md and OUT/NAME.png (and docs/editing_NAME.png with --docs),
-each atomically; an existing one is refused before any work unless --force is given (the
-pictures in docs/ are in the repository: refreshing them is ``--docs docs --force``).
+all together at the end (scripts/_outputs.py: none is written where one fails). Before any work,
+an existing one is refused unless --force is given (the pictures in docs/ are in the repository:
+refreshing them is ``--docs docs --force``), and so is a --docs folder that does not exist.
 """
 
 import argparse
@@ -76,12 +77,13 @@ def main(argv=None):
     ap.add_argument("--docs", default=None, help="also write small pictures docs/editing_NAME.png here")
     ap.add_argument("--force", action="store_true", help="replace output files that exist")
     args = ap.parse_args(argv)
-    _outputs.refuse_existing(ap, [os.path.join(args.out, name) for name in ("compare.json", "compare.md")]
-                             + [os.path.join(args.out, name + ".png") for name in CASES]
-                             + [os.path.join(args.docs, f"editing_{name}.png") for name in CASES if args.docs],
-                             args.force)
+    pictures = {name: [(os.path.join(args.out, name + ".png"), 3.5)]
+                + ([(os.path.join(args.docs, f"editing_{name}.png"), 2.4)] if args.docs else [])
+                for name in CASES}          # (file, panel size): the ones in docs/ are small
+    run = _outputs.Run(ap, [os.path.join(args.out, name) for name in ("compare.json", "compare.md")]
+                       + [target for name in CASES for target, _ in pictures[name]], args.force,
+                       makes=[args.out])
     require("deformation")
-    os.makedirs(args.out, exist_ok=True)
     folder = os.path.join(MESHES, "deformation")
     rows = []
     for name in CASES:
@@ -98,11 +100,8 @@ def main(argv=None):
                      f"max {100 * row[mode]['max']:.1f} %")
             panels.append((X, F, label))
         panels.append((ref, F, "survey: Laplacian editing"))
-        for target in [os.path.join(args.out, name + ".png")] + (
-                [os.path.join(args.docs, f"editing_{name}.png")] if args.docs else []):
-            small = target.startswith(args.docs) if args.docs else False
-            _outputs.render_panels(target, panels, args.force, elev=elev, azim=azim,
-                                   panel_size=2.4 if small else 3.5)
+        for target, size in pictures[name]:
+            run.render_panels(target, panels, elev=elev, azim=azim, panel_size=size)
         print(name, {m: (round(row[m]["mean"], 4), round(row[m]["max"], 4)) for m in LABELS})
     lines = ["| case | vertices (fixed/free/handle) | survey result moved from rest (mean / max) | "
              + " | ".join(f"{LABELS[m]}: distance to survey (mean / max)" for m in LABELS)
@@ -117,9 +116,10 @@ def main(argv=None):
                      + " / ".join(f"{1e3 * r[m]['resolve_s']:.1f}" for m in LABELS) + " |")
     table = "\n".join(lines)
     print(table)
-    _outputs.write_json(os.path.join(args.out, "compare.json"),
-                        {"load_average": os.getloadavg(), "rows": rows}, args.force, indent=2)
-    _outputs.write_text(os.path.join(args.out, "compare.md"), table + "\n", args.force)
+    run.write_json(os.path.join(args.out, "compare.json"), {"load_average": os.getloadavg(), "rows": rows},
+                   indent=2)
+    run.write_text(os.path.join(args.out, "compare.md"), table + "\n")
+    run.commit()
     return 0
 
 

@@ -14,11 +14,13 @@ Feature points are found from the geometry (extreme vertices), the regions of in
 Euclidean distance. Every edit is one CurvatureEditor (constructor = all factoring) and one
 solve. Usage: python scripts/reproduce_fig1.py [--out out/fig1] [--docs docs] [--force]
 Writes OUT/fig1.json, OUT/fig1a.png, OUT/fig1b.png, OUT/fig1c.png (docs/editing_fig1.png with --docs),
-each atomically; an existing one is refused before any work unless --force is given (the
-picture in docs/ is in the repository: refreshing it is ``--docs docs --force``).
+all together at the end (scripts/_outputs.py: none is written where one fails). Before any work,
+an existing one is refused unless --force is given (the picture in docs/ is in the repository:
+refreshing it is ``--docs docs --force``), and so is a --docs folder that does not exist.
 """
 
 import argparse
+import io
 import json
 import os
 import sys
@@ -125,12 +127,11 @@ def main(argv=None):
     ap.add_argument("--force", action="store_true", help="replace output files that exist")
     args = ap.parse_args(argv)
     views = {"fig1a": (10, 0), "fig1b": (10, -90), "fig1c": (10, -30)}
-    _outputs.refuse_existing(ap, [os.path.join(args.out, key + ".png") for key in views]
-                             + [os.path.join(args.out, "fig1.json"),
-                                os.path.join(args.docs, "editing_fig1.png") if args.docs else None],
-                             args.force)
+    run = _outputs.Run(ap, [os.path.join(args.out, key + ".png") for key in views]
+                       + [os.path.join(args.out, "fig1.json"),
+                          os.path.join(args.docs, "editing_fig1.png") if args.docs else None],
+                       args.force, makes=[args.out])
     require("elephant.obj", "cactus.off", "mannequin_devil.off")
-    os.makedirs(args.out, exist_ok=True)
     report, docs_panels = [], []
     for key, make in (("fig1a", elephant), ("fig1b", cactus), ("fig1c", devil)):
         V, F, X, info, y_up = make()
@@ -144,7 +145,7 @@ def main(argv=None):
         if extra is not None:
             panels.append((show(extra[0]), F, extra[1], np.linalg.norm(extra[0] - V, axis=1)))
         panels.append((show(X), F, label, moved))
-        _outputs.render_panels(os.path.join(args.out, key + ".png"), panels, args.force, elev=elev, azim=azim)
+        run.render_panels(os.path.join(args.out, key + ".png"), panels, elev=elev, azim=azim)
         docs_panels += [(show(V), F, f"({key[-1]}) rest"), (show(X), F, f"({key[-1]}) edited", moved)]
         print(json.dumps(info))
     if args.docs:
@@ -157,14 +158,15 @@ def main(argv=None):
 
         fig, axes = plt.subplots(1, 3, figsize=(12, 3.2))
         for ax, key in zip(axes, views):
-            ax.imshow(mpimg.imread(os.path.join(args.out, key + ".png")))
+            ax.imshow(mpimg.imread(io.BytesIO(run.read(os.path.join(args.out, key + ".png")))))
             ax.set_axis_off()
         fig.tight_layout()
         try:
-            _outputs.save_figure(fig, os.path.join(args.docs, "editing_fig1.png"), args.force, dpi=80)
+            run.save_figure(fig, os.path.join(args.docs, "editing_fig1.png"), dpi=80)
         finally:
             plt.close(fig)
-    _outputs.write_json(os.path.join(args.out, "fig1.json"), report, args.force, indent=2)
+    run.write_json(os.path.join(args.out, "fig1.json"), report, indent=2)
+    run.commit()
     return 0
 
 

@@ -12,12 +12,14 @@
     two-ring relations. Folded triangles (normals pointing down) are counted.
 
 Usage: python scripts/reproduce_fig2.py [--out out/fig2] [--docs docs] [--force]
-Writes OUT/fig2.json, OUT/fig2a.png, OUT/fig2b.png (docs/editing_fig2.png with --docs), each
-atomically; an existing one is refused before any work unless --force is given (the picture in
-docs/ is in the repository: refreshing it is ``--docs docs --force``).
+Writes OUT/fig2.json, OUT/fig2a.png, OUT/fig2b.png (docs/editing_fig2.png with --docs), all
+together at the end (scripts/_outputs.py: none is written where one fails). Before any work, an
+existing one is refused unless --force is given (the picture in docs/ is in the repository:
+refreshing it is ``--docs docs --force``), and so is a --docs folder that does not exist.
 """
 
 import argparse
+import io
 import json
 import os
 import sys
@@ -99,12 +101,10 @@ def main(argv=None):
     ap.add_argument("--docs", default=None)
     ap.add_argument("--force", action="store_true", help="replace output files that exist")
     args = ap.parse_args(argv)
-    _outputs.refuse_existing(ap, [os.path.join(args.out, name)
-                                  for name in ("fig2a.png", "fig2b.png", "fig2.json")]
-                             + [os.path.join(args.docs, "editing_fig2.png") if args.docs else None],
-                             args.force)
+    run = _outputs.Run(ap, [os.path.join(args.out, name) for name in ("fig2a.png", "fig2b.png", "fig2.json")]
+                       + [os.path.join(args.docs, "editing_fig2.png") if args.docs else None],
+                       args.force, makes=[args.out])
     require("cow.off", "terrainA_10k.obj")
-    os.makedirs(args.out, exist_ok=True)
     V, F, status, meshes, info_a = cow()
     print(json.dumps(info_a))
     panels = [(V @ Y_UP.T, F, "cow: rest (fixed / region / handle)", status)]
@@ -113,8 +113,7 @@ def main(argv=None):
                         ("free/one-ring", "handle details free")):
         X = meshes[mode]
         panels.append((X @ Y_UP.T, F, label, np.linalg.norm(X - V, axis=1)))
-    _outputs.render_panels(os.path.join(args.out, "fig2a.png"), panels, args.force, elev=COW_VIEW[0],
-                           azim=COW_VIEW[1])
+    run.render_panels(os.path.join(args.out, "fig2a.png"), panels, elev=COW_VIEW[0], azim=COW_VIEW[1])
     Vt, Ft, tmeshes, info_b = terrain()
     print(json.dumps(info_b))
     panels = [(Vt, Ft, "terrain: rest", Vt[:, 2])]
@@ -123,10 +122,8 @@ def main(argv=None):
             X = tmeshes[f"{key}_{mode}"]
             folds = info_b[key + "_" + mode]["folded_triangles"]
             panels.append((X, Ft, f"{label} {short}\n{folds} folded triangles", X[:, 2]))
-    _outputs.render_panels(os.path.join(args.out, "fig2b.png"), panels, args.force, elev=35, azim=-60,
-                           panel_size=3.0)
-    _outputs.write_json(os.path.join(args.out, "fig2.json"), {"cow": info_a, "terrain": info_b}, args.force,
-                        indent=2)
+    run.render_panels(os.path.join(args.out, "fig2b.png"), panels, elev=35, azim=-60, panel_size=3.0)
+    run.write_json(os.path.join(args.out, "fig2.json"), {"cow": info_a, "terrain": info_b}, indent=2)
     if args.docs:
         import matplotlib
 
@@ -136,13 +133,14 @@ def main(argv=None):
 
         fig, axes = plt.subplots(2, 1, figsize=(11, 6.2))
         for ax, key in zip(axes, ("fig2a", "fig2b")):
-            ax.imshow(mpimg.imread(os.path.join(args.out, key + ".png")))
+            ax.imshow(mpimg.imread(io.BytesIO(run.read(os.path.join(args.out, key + ".png")))))
             ax.set_axis_off()
         fig.tight_layout()
         try:
-            _outputs.save_figure(fig, os.path.join(args.docs, "editing_fig2.png"), args.force, dpi=75)
+            run.save_figure(fig, os.path.join(args.docs, "editing_fig2.png"), dpi=75)
         finally:
             plt.close(fig)
+    run.commit()
     return 0
 
 

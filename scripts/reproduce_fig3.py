@@ -12,9 +12,9 @@ Writes (paths relative to the repository):
                                   between its <!-- fig3-table --> markers)
   docs/fig3.png                   the Fig. 3 patches, default configuration
 With --quick (a subset) the tables go to out/fig3/table_quick.md and docs/ is left alone.
-Every file is written atomically; one that exists is refused before any work unless --force is
-given. The files in docs/ are in the repository, so a full run (which refreshes them) takes
---force.
+The files are written all together at the end (scripts/_outputs.py: none is written where one
+fails); one that exists is refused before any work unless --force is given. The files in docs/
+are in the repository, so a full run (which refreshes them) takes --force.
 
 Usage: python scripts/reproduce_fig3.py [--meshes DIR] [--quick] [--force]
 (DIR defaults to $CURVDETAIL_MESHES, else ../shared/meshes beside the repository.)
@@ -110,10 +110,10 @@ def main(argv=None):
         if _with_table(doc, "") is None:
             doc = None
         figure = os.path.join(ROOT, "docs", "fig3.png")
-    _outputs.refuse_existing(ap, [results_json, table_file, doc, figure], args.force)
+    run = _outputs.Run(ap, [results_json, table_file, doc, figure], args.force,
+                       makes=[os.path.join(ROOT, "out", "fig3")])
     if not os.path.isdir(meshes):
         ap.error(f"mesh folder {meshes!r} does not exist; pass --meshes DIR or set CURVDETAIL_MESHES")
-    os.makedirs(os.path.join(ROOT, "out", "fig3"), exist_ok=True)
     results, lines_main, lines_all = [], [], []
     figure_inputs = {}
     configs = CONFIGS[:1] if args.quick else CONFIGS
@@ -178,7 +178,7 @@ def main(argv=None):
         line = row(name.rsplit(".", 1)[0] + (f" ({100 * target_edge:g} %)" if target_edge != 0.01 else ""), rep)
         extra.append(line)
         print(line, flush=True)
-    _outputs.write_json(results_json, results, args.force, indent=1)
+    run.write_json(results_json, results, indent=1)
     table = ("### Default configuration (isotropic 1 %, conservative transfer, free rows, closest-point location)\n\n"
              f"{HEADER}\n" + "\n".join(lines_main) +
              "\n\n### Every transfer configuration on the same targets\n\n" + f"{HEADER}\n" + "\n".join(lines_all) +
@@ -189,12 +189,14 @@ def main(argv=None):
                   "not counted)\n\n" + HEADER.replace(" |\n|", " | flipped source / target |\n|", 1) + "---|\n"
                   + "\n".join(params) + "\n")
     # --quick: a subset; the committed tables and figure in docs/ stay as they are
-    _outputs.write_text(table_file, table, args.force)
+    run.write_text(table_file, table)
     text = _with_table(doc, table) if doc else None
     if text is not None:      # refresh the copy between the markers in docs/remeshing.md
-        _outputs.write_text(doc, text, args.force)
+        run.write_text(doc, text)
     if figure is not None and figure_inputs:
-        _figure(figure_inputs, figure, args.force)
+        with run.stage(figure) as tmp:
+            _figure(figure_inputs, tmp)
+    run.commit()
     print(table)
 
 

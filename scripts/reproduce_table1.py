@@ -12,8 +12,9 @@ constrained). Times are medians of repeated runs, split into coefficients, curva
 back-substitution per stage).
 
 Usage: python scripts/reproduce_table1.py [--out out/table1] [--repeat 7] [--force]
-Writes OUT/table1.json, OUT/table1.md and OUT/table1.png, each atomically; an existing one is
-refused before any work unless --force is given.
+Writes OUT/table1.json, OUT/table1.md and OUT/table1.png, all together at the end
+(scripts/_outputs.py: none is written where one fails); an existing one is refused before any
+work unless --force is given.
 """
 
 import argparse
@@ -156,10 +157,9 @@ def main(argv=None):
     ap.add_argument("--repeat", type=at_least_one, default=7)
     ap.add_argument("--force", action="store_true", help="replace output files that exist")
     args = ap.parse_args(argv)
-    _outputs.refuse_existing(ap, [os.path.join(args.out, "table1" + ext) for ext in (".json", ".md", ".png")],
-                             args.force)
+    run = _outputs.Run(ap, [os.path.join(args.out, "table1" + ext) for ext in (".json", ".md", ".png")],
+                       args.force, makes=[args.out])
     require("mannequin_nose.obj", "mannequin.off", "mannequin_ear.obj", "cat_tosca.off")
-    os.makedirs(args.out, exist_ok=True)
     meshes = table1_meshes()
     results, panels = [], []
     for name, nv, nf, paper_s in PAPER:
@@ -178,11 +178,10 @@ def main(argv=None):
                      f"{1e3 * r['embedding']:.1f} | {1e3 * r['rest_check']:.2f} | {1e3 * r['resolve']:.2f} |")
     table = "\n".join(lines)
     print(table)
-    _outputs.write_json(os.path.join(args.out, "table1.json"), {"repeat": args.repeat, "rows": results},
-                        args.force, indent=2)
-    _outputs.write_text(os.path.join(args.out, "table1.md"), table + "\n", args.force)
-    _outputs.render_panels(os.path.join(args.out, "table1.png"), panels, args.force, elev=10, azim=-80,
-                           panel_size=2.6)
+    run.write_json(os.path.join(args.out, "table1.json"), {"repeat": args.repeat, "rows": results}, indent=2)
+    run.write_text(os.path.join(args.out, "table1.md"), table + "\n")
+    run.render_panels(os.path.join(args.out, "table1.png"), panels, elev=10, azim=-80, panel_size=2.6)
+    run.commit()
     return 0
 
 

@@ -1,7 +1,8 @@
 """scripts/: every output file is refused, before any work, where it exists (unless the script's
---force; bench_reconstruct.py: --overwrite, or --merge for its JSON), and written atomically
-through curvdetail._output, so that a failed write leaves the old file and no temporary one; the
-commands the docs show still run as written.
+--force; bench_reconstruct.py: --overwrite, or --merge for its JSON) or its folder cannot take it
+(missing, not a folder, not writable), and a run's outputs are written together at its end
+through curvdetail._output.atomic_outputs, so that a failed run or write leaves every old file
+and no temporary one; the commands the docs show still run as written.
 
 Only the cheap paths run: argument parsing, the refusals, --rebuild-markdown, and the scripts'
 drivers with their measurements replaced by stubs. The public meshes (/work/shared) are not
@@ -9,6 +10,7 @@ needed: the mesh folder is pointed at one that does not exist, so a script that 
 output check stops at its mesh check, in no time.
 """
 
+import errno
 import importlib.util
 import json
 import os
@@ -65,6 +67,22 @@ def write(path, text):
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     with open(path, "w", encoding="utf-8") as fh:
         fh.write(text)
+
+
+# --- _outputs.Run --------------------------------------------------------------------------------
+
+def test_run_keeps_only_outputs_checked_before_the_work(tmp_path, monkeypatch):
+    import argparse
+
+    monkeypatch.syspath_prepend(SCRIPTS)
+    import _outputs
+
+    run = _outputs.Run(argparse.ArgumentParser(), [str(tmp_path / "a.txt")], False)
+    with pytest.raises(ValueError, match="b.txt was not checked"):
+        run.write_text(str(tmp_path / "b.txt"), "late")
+    run.write_text(str(tmp_path / "a.txt"), "checked")
+    run.commit()
+    assert os.listdir(tmp_path) == ["a.txt"]
 
 
 # --- bench_reconstruct.py -----------------------------------------------------------------------
@@ -160,6 +178,77 @@ def test_bench_reconstruct_force_runs_left_out_cases_but_does_not_replace_files(
     assert open(out).read() == before
 
 
+def test_bench_reconstruct_refuses_one_file_named_for_out_and_markdown(tmp_path, capsys, monkeypatch,
+                                                                       bench_reconstruct):
+    monkeypatch.chdir(tmp_path)
+    module, calls = bench_reconstruct
+    with pytest.raises(SystemExit) as exit_:
+        module.main(["--sizes", "10k", "--surfaces", "grid", "--rows", "free", "--methods", "splu",
+                     "--out", "bench.json", "--markdown", "./bench.json"])
+    assert exit_.value.code == 2 and calls == []
+    assert "given for two outputs" in capsys.readouterr().err
+
+
+def test_bench_reconstruct_refuses_a_markdown_folder_that_does_not_exist_before_any_case(
+        tmp_path, bench_reconstruct, capsys):
+    module, calls = bench_reconstruct
+    md = os.path.join(str(tmp_path), "no-docs", "bench.md")
+    with pytest.raises(SystemExit) as exit_:
+        module.main(["--sizes", "10k", "--methods", "splu", "--out", str(tmp_path / "b.json"),
+                     "--markdown", md])
+    assert exit_.value.code == 2 and calls == []
+    message = capsys.readouterr().err
+    assert md in message and "mkdir -p" in message
+    assert os.listdir(tmp_path) == []
+
+
+def fail_rename_to(monkeypatch, path):
+    """``os.replace`` onto ``path`` fails as on a full disk (every other rename works)."""
+    real, target = os.replace, os.path.abspath(path)
+
+    def replace(src, dst, **kw):
+        if os.path.abspath(dst) == target:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return real(src, dst, **kw)
+
+    monkeypatch.setattr(os, "replace", replace)
+
+
+def test_bench_reconstruct_run_of_one_group_writes_out_and_markdown_together(
+        tmp_path, bench_reconstruct, monkeypatch):
+    module, calls = bench_reconstruct
+    out, md = stored_results(tmp_path), tmp_path / "bench.md"
+    md.write_text(BENCH_DOC)
+    before = snapshot(tmp_path)
+    fail_rename_to(monkeypatch, md)
+    with pytest.raises(OSError, match="bench.md"):
+        module.main(["--sizes", "10k", "--surfaces", "sphere", "--rows", "free", "--methods", "splu",
+                     "--out", out, "--markdown", str(md), "--overwrite"])
+    assert calls                                                    # the work was done
+    assert snapshot(tmp_path) == before                             # the JSON is not replaced either
+    assert leftovers(tmp_path) == []
+
+
+def test_bench_reconstruct_run_of_several_groups_keeps_the_groups_done_when_stopped(
+        tmp_path, bench_reconstruct, monkeypatch):
+    """The progress save of --out, kept on purpose: each group is committed once it is done."""
+    module, calls = bench_reconstruct
+
+    def run(case, timeout, mem_limit_gb=None):
+        if case["surface"] == "sphere":
+            raise KeyboardInterrupt
+        calls.append(case)
+        return fake_result(case)
+
+    monkeypatch.setattr(module, "run_in_subprocess", run)
+    out = tmp_path / "new" / "b.json"
+    with pytest.raises(KeyboardInterrupt):
+        module.main(["--sizes", "10k", "--surfaces", "grid,sphere", "--rows", "free", "--methods", "splu",
+                     "--out", str(out), "--markdown", ""])
+    assert [r["surface"] for r in json.load(open(out))["results"]] == ["grid"]
+    assert leftovers(tmp_path) == []
+
+
 def documented_commands(text, script):
     """The ``python scripts/SCRIPT ...`` command lines in ``text`` (continuations joined), as
     argument lists."""
@@ -221,6 +310,20 @@ def test_bench_operations_failed_write_keeps_the_old_report_and_leaves_no_tempor
     assert os.listdir(tmp_path) == ["ops.json"]
 
 
+def test_bench_operations_refuses_an_out_folder_that_cannot_be_made_before_any_case(
+        tmp_path, monkeypatch, capsys):
+    module = load("bench_operations")
+    calls = []
+    monkeypatch.setattr(module, "in_subprocess", lambda *a: calls.append(a) or {"seconds": 0.1})
+    (tmp_path / "results").write_text("a file, not a folder")
+    out = str(tmp_path / "results" / "ops.json")
+    with pytest.raises(SystemExit) as exit_:
+        module.main(["--sizes", "10k", "--cases", "edge_measure", "--out", out])
+    assert exit_.value.code == 2 and calls == []                    # found before the work
+    message = capsys.readouterr().err
+    assert out in message and "not a folder" in message
+
+
 # --- the scripts on the public meshes: refusals before any work ---------------------------------
 
 #: (script, arguments, an output file of that run, relative to the working folder)
@@ -269,6 +372,54 @@ def test_script_with_force_gets_past_the_output_check(script, args, existing, tm
     assert open(existing).read() == "old"
 
 
+#: (script, arguments, the folder refused) where an output's folder is missing, not a folder or
+#: cannot be made; "afile" is a file in the working folder
+FOLDER_REFUSALS = [
+    ("compare_deformation_benchmark", ["--docs", "no-docs"], "no-docs", "does not exist"),
+    ("reproduce_fig1", ["--docs", "no-docs"], "no-docs", "does not exist"),
+    ("reproduce_fig2", ["--docs", "no-docs"], "no-docs", "does not exist"),
+    ("reproduce_fig2", ["--docs", "afile"], "afile", "not a folder"),
+    ("reproduce_table1", ["--out", "afile/table1"], "afile", "not a folder"),
+    ("bench_editing", ["--out", "afile/e.json"], "afile", "not a folder"),
+]
+
+
+@pytest.mark.parametrize("script, args, folder, why", FOLDER_REFUSALS,
+                         ids=[f"{script}-{why}" for script, _, _, why in FOLDER_REFUSALS])
+def test_script_refuses_an_output_folder_it_cannot_write_in_before_any_work(
+        script, args, folder, why, tmp_path, monkeypatch, no_meshes, capsys):
+    monkeypatch.chdir(tmp_path)
+    write("afile", "a file")
+    module = load(script)
+    with pytest.raises(SystemExit) as exit_:
+        module.main(args + ["--force"])
+    assert exit_.value.code == 2                                    # a usage error, not the mesh check
+    message = capsys.readouterr().err
+    assert folder in message and why in message
+    if why == "does not exist":
+        assert f"mkdir -p {folder}" in message                      # the fix
+    assert snapshot(tmp_path) == {"afile": b"a file"}               # no folder made
+
+
+@pytest.mark.parametrize("args, why", [(["--docs", "locked"], "folder 'locked' is not writable"),
+                                       (["--out", "locked/fig1"], "'locked/fig1' cannot be made")])
+def test_script_refuses_an_output_folder_that_is_not_writable_before_any_work(
+        args, why, tmp_path, monkeypatch, no_meshes, capsys):
+    """The tests may run as root, who may write anywhere: os.access is made to deny the folder."""
+    monkeypatch.chdir(tmp_path)
+    os.mkdir("locked")
+    locked, real = str(tmp_path / "locked"), os.access
+    monkeypatch.setattr(os, "access",
+                        lambda p, mode, **kw: os.path.abspath(p) != locked and real(p, mode, **kw))
+    module = load("reproduce_fig1")
+    with pytest.raises(SystemExit) as exit_:
+        module.main(args)
+    assert exit_.value.code == 2
+    message = capsys.readouterr().err
+    assert why in message and "make it writable or name another folder" in message
+    assert os.listdir("locked") == []
+
+
 def tiny_case(name, folder):
     """What compare_deformation_benchmark.run_case returns, on a 4 x 4 grid (the stub)."""
     from curvdetail.curvature.testing import grid
@@ -283,7 +434,7 @@ def tiny_case(name, folder):
     return row, (V, F, status, {mode: V + 0.01 for mode in row if "/" in mode}, V)
 
 
-def test_compare_deformation_benchmark_failed_write_keeps_the_old_files_and_no_temporary_ones(
+def test_compare_deformation_benchmark_failed_run_writes_no_output_and_keeps_the_old_ones(
         tmp_path, monkeypatch):
     monkeypatch.syspath_prepend(SCRIPTS)
     import _meshes
@@ -296,14 +447,95 @@ def test_compare_deformation_benchmark_failed_write_keeps_the_old_files_and_no_t
     out = tmp_path / "out"
     with pytest.raises(TypeError):                                  # no earlier files
         module.main(["--out", str(out)])
-    assert sorted(os.listdir(out)) == ["bar.png"]                   # no half-written compare.json
-    write(out / "compare.json", "old json")
-    write(out / "compare.md", "old table")
+    assert not out.exists()                     # not the picture made before the failure, nor the folder
+    old = {"compare.json": "old json", "compare.md": "old table", "bar.png": "old picture"}
+    for name, text in old.items():
+        write(out / name, text)
     with pytest.raises(TypeError):
         module.main(["--out", str(out), "--force"])
-    assert (out / "compare.json").read_text() == "old json"
-    assert (out / "compare.md").read_text() == "old table"
-    assert sorted(os.listdir(out)) == ["bar.png", "compare.json", "compare.md"]
+    assert snapshot(out) == {name: text.encode() for name, text in old.items()}
+    assert leftovers(tmp_path) == []
+
+
+@pytest.fixture
+def table1(monkeypatch):
+    """reproduce_table1.py with its meshes and timings stubbed (4 x 4 grids, fixed figures)."""
+    from curvdetail.curvature.testing import grid
+
+    module = load("reproduce_table1")
+    med = {"total": 0.01, "coefficients": 0.001, "curvature_stage": 0.002, "embedding": 0.003,
+           "rest_check": 0.0001, "resolve": 0.0005, "total_min": 0.009}
+    monkeypatch.setattr(module, "require", lambda *names: None)
+    monkeypatch.setattr(module, "table1_meshes", lambda: {name: grid(4, 4) for name, *_ in module.PAPER})
+    monkeypatch.setattr(module, "time_edit", lambda V, F, repeat: (dict(med), V + 0.01, None))
+    return module
+
+
+def fail_temporary_file_for(monkeypatch, suffix, folder):
+    """The temporary file of an output ending in ``suffix`` in ``folder`` cannot be made (full disk)."""
+    import tempfile
+
+    real, folder = tempfile.mkstemp, os.path.abspath(folder)
+
+    def mkstemp(*args, **kw):
+        if kw.get("suffix") == suffix and os.path.abspath(kw.get("dir") or "") == folder:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return real(*args, **kw)
+
+    monkeypatch.setattr(tempfile, "mkstemp", mkstemp)
+
+
+@pytest.mark.parametrize("failure", ["temporary file", "rename"])
+def test_reproduce_table1_output_that_cannot_be_written_leaves_every_old_file(failure, table1, tmp_path,
+                                                                              monkeypatch):
+    """The third output (table1.png) fails, before the renames (its temporary file cannot be made)
+    or during them (its rename): the first two are not replaced either."""
+    out = tmp_path / "table1"
+    old = {"table1.json": "old json", "table1.md": "old table", "table1.png": "old picture"}
+    for name, text in old.items():
+        write(out / name, text)
+    new = tmp_path / "new" / "table1"                               # a folder the run makes
+    if failure == "temporary file":
+        fail_temporary_file_for(monkeypatch, ".png", out)
+        fail_temporary_file_for(monkeypatch, ".png", new)
+    else:
+        fail_rename_to(monkeypatch, out / "table1.png")
+        fail_rename_to(monkeypatch, new / "table1.png")
+    with pytest.raises(OSError, match="table1.png"):
+        table1.main(["--out", str(out), "--repeat", "1", "--force"])
+    assert snapshot(out) == {name: text.encode() for name, text in old.items()}
+    with pytest.raises(OSError, match="table1.png"):
+        table1.main(["--out", str(new), "--repeat", "1"])
+    assert not (tmp_path / "new").exists()                          # the folders it made are removed
+    assert leftovers(tmp_path) == []
+
+
+def test_reproduce_table1_writes_its_three_outputs(table1, tmp_path):
+    out = tmp_path / "a" / "table1"
+    assert table1.main(["--out", str(out), "--repeat", "1"]) == 0
+    assert sorted(os.listdir(out)) == ["table1.json", "table1.md", "table1.png"]
+    assert (out / "table1.png").read_bytes().startswith(b"\x89PNG")
+    assert json.load(open(out / "table1.json"))["repeat"] == 1
+
+
+def test_reproduce_fig1_docs_composite_is_made_from_the_pictures_of_the_run(tmp_path, monkeypatch):
+    """The pictures are kept in memory until the commit: the --docs composite reads them there."""
+    from curvdetail.curvature.testing import grid
+
+    module = load("reproduce_fig1")
+    V, F = grid(4, 4)
+
+    def edit(name):
+        return lambda: (V, F, V + 0.01, {"model": name}, False)
+
+    monkeypatch.setattr(module, "require", lambda *names: None)
+    for name in ("elephant", "cactus", "devil"):
+        monkeypatch.setattr(module, name, edit(name))
+    os.mkdir(tmp_path / "docs")
+    assert module.main(["--out", str(tmp_path / "out"), "--docs", str(tmp_path / "docs")]) == 0
+    assert sorted(os.listdir(tmp_path / "out")) == ["fig1.json", "fig1a.png", "fig1b.png", "fig1c.png"]
+    assert (tmp_path / "docs" / "editing_fig1.png").read_bytes().startswith(b"\x89PNG")
+    assert leftovers(tmp_path) == []
 
 
 def test_documented_compare_command_passes_the_flag_that_the_committed_pictures_need(
@@ -355,6 +587,16 @@ def test_reproduce_fig3_full_run_refuses_an_existing_output_without_force(existi
     message = capsys.readouterr().err
     assert os.path.join(str(repo), existing) in message and "--force" in message
     assert snapshot(repo) == {existing: DOCS_FILES.get(existing, "old").encode()}
+
+
+def test_reproduce_fig3_full_run_refuses_a_checkout_without_docs_before_any_work(fig3, capsys):
+    run, repo = fig3
+    with pytest.raises(SystemExit) as exit_:
+        run()
+    assert exit_.value.code == 2
+    message = capsys.readouterr().err
+    assert os.path.join(str(repo), "docs") in message and "mkdir -p" in message
+    assert not repo.exists()
 
 
 def test_reproduce_fig3_refuses_docs_remeshing_md_only_where_it_has_the_table_markers(fig3, capsys):
