@@ -159,12 +159,31 @@ POINT_FORMATS = (".xyz", ".e57", ".pts", ".ptx", ".apts", ".asc")
 _MESH_HINT = "use .ply, .obj, .off, .stl, ..."
 _WRITES = {}            # extension -> None (pymeshlab writes it) or why it does not
 
+_NEXUS = ("its Nexus writer uses memory it never set, and crashes the process (segmentation fault or bus "
+          "error in NexusBuilder::saturateNode) where that memory is not zero, as in a process that has "
+          "run a while")
+#: Formats whose pymeshlab writer is never run, not even on the one-triangle probe, and why
+#: (pymeshlab 2025.7; the message of :func:`check_mesh_output`). ``.nxs``, ``.nxz``: the .nxz
+#: probe crashed a full test run (tests/test_io.py); where malloc hands out nonzero memory
+#: (glibc's ``MALLOC_PERTURB_``, as memory recycled in a long run is) every .nxs and .nxz write
+#: crashed, in fresh processes and in test_io.py alike, and no other format's did.
+#: ``.u3d``: it writes no file, only a fixed-name one in the shared temporary folder
+#: (``$TMPDIR/<name>.u3d.idtf``, then deleted) and a LaTeX file named by the path up to its
+#: first dot, wherever that is.
+UNWRITTEN_FORMATS = {
+    ".nxs": _NEXUS,
+    ".nxz": _NEXUS,
+    ".u3d": "it reports success but writes no file: its U3D converter fails without a word",
+}
+
 
 def check_mesh_output(path, overwrite=False, *, hint=_MESH_HINT):
     """Return ``path`` as a str, or raise before any work if a mesh cannot be written there:
     :func:`curvdetail._output.check_output_path` (existing file, folder, no extension), a format
-    that keeps the points only (:data:`POINT_FORMATS`), or one pymeshlab does not write (found by
-    writing one triangle to a temporary file, once per extension and process).
+    that keeps the points only (:data:`POINT_FORMATS`), one whose pymeshlab writer crashes or
+    writes nothing (:data:`UNWRITTEN_FORMATS`: .nxs, .nxz, .u3d; never run), or one pymeshlab
+    does not write (found by writing one triangle to a temporary file, once per extension and
+    process).
 
     Raises
     ------
@@ -177,6 +196,9 @@ def check_mesh_output(path, overwrite=False, *, hint=_MESH_HINT):
     if extension in POINT_FORMATS:
         raise MeshFileError(f"cannot write {path!r}: {extension} files hold points only, so the "
                             f"triangles would be lost; {hint}")
+    if extension in UNWRITTEN_FORMATS:
+        raise MeshFileError(f"cannot write {path!r}: {extension} meshes are refused: pymeshlab's writer for them "
+                            f"is not run ({UNWRITTEN_FORMATS[extension]}); {hint}")
     if extension not in _WRITES:
         _WRITES[extension] = _why_not_written(extension)
     if _WRITES[extension] is not None:
@@ -186,10 +208,14 @@ def check_mesh_output(path, overwrite=False, *, hint=_MESH_HINT):
 
 
 def _why_not_written(extension):
-    """None if pymeshlab writes a triangle to a ``extension`` file, else its message."""
+    """None if pymeshlab writes a triangle to a ``extension`` file, else its message; the
+    formats of :data:`UNWRITTEN_FORMATS` are refused without running their writer."""
     import tempfile
 
     import pymeshlab
+
+    if extension in UNWRITTEN_FORMATS:
+        return UNWRITTEN_FORMATS[extension]
 
     with tempfile.TemporaryDirectory(prefix="curvdetail-format-") as folder:
         ms = _meshset()
@@ -236,7 +262,7 @@ _COORDINATES = {
                    f"pass lossless=True (save_mesh's default: single precision), or write {_SAFE}"),
     ".nxs": ("float32",),
     ".nxz": ("pymeshlab's NXZ writer compresses the coordinates with a quantization whose error is not "
-             f"known here; write .nxs (single precision), or {_SAFE}"),
+             f"known here; write {_SAFE}"),
     ".dae": ("float32",),                                  # "%g": 6 significant digits
     ".json": ("float32",),
     ".wrl": ("float32",),
@@ -387,7 +413,8 @@ def write_mesh(path, V, F, *, quality=None, overwrite=False):
     FileExistsError   ``path`` exists and ``overwrite`` is False
     MeshError         malformed ``V``, ``F`` or ``quality``
     MeshFileError     ``path`` is a folder, its folder is missing or not writable, or the format
-                      is unknown or keeps points only (.xyz, ...; see :func:`check_mesh_output`),
+                      is unknown, keeps points only (.xyz, ...) or has a writer that crashes or
+                      writes nothing (.nxs, .nxz, .u3d; see :func:`check_mesh_output`),
                       or it cannot hold the coordinates (before anything is written; see
                       :func:`check_coordinates`): binary PLY writes doubles (exact); OBJ 16
                       decimals (a mesh smaller than about 5e-8 loses more than 1e-9 of its

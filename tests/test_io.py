@@ -691,13 +691,20 @@ def test_stl_ascii_is_single_precision_too(tmp_path):
     ("idtf", 0.1, r"writes IDTF coordinates with 6 decimals \(an error up to 5e-07\)"),
     ("dae", 1e-41, r"DAE holds coordinates in single precision"),
     ("wrl", 1e39, r"WRL holds coordinates in single precision, whose largest value"),
-    ("nxz", 1.0, r"pymeshlab's NXZ writer compresses the coordinates"),
 ])
 def test_other_formats_refuse_what_they_cannot_hold(tmp_path, ext, scale, message):
     V, F = icosphere(subdivisions=1)
     with pytest.raises(MeshFileError, match=message):
         write_mesh(tmp_path / f"m.{ext}", V * scale, F)
     assert not (tmp_path / f"m.{ext}").exists()
+
+
+def test_nxz_coordinates_are_refused_by_the_check_itself():
+    # write_mesh refuses .nxz before this check (UNWRITTEN_FORMATS); the check says why on its own
+    from curvdetail.io import check_coordinates
+
+    with pytest.raises(MeshFileError, match=r"pymeshlab's NXZ writer compresses the coordinates"):
+        check_coordinates("m.nxz", icosphere(subdivisions=1)[0])
 
 
 def test_ctm_is_written_lossless_and_its_lossy_compression_refused(tmp_path):
@@ -713,10 +720,87 @@ def test_ctm_is_written_lossless_and_its_lossy_compression_refused(tmp_path):
 
 def test_u3d_is_refused_since_pymeshlab_writes_no_file(tmp_path):
     V, F = icosphere(subdivisions=1)
-    with pytest.raises(MeshFileError, match=r"pymeshlab does not write .u3d meshes \(it reports success but writes "
-                                            r"no file\)"):
+    with pytest.raises(MeshFileError, match=r"\.u3d meshes are refused: pymeshlab's writer for them is not run \(it "
+                                            r"reports success but writes no file"):
         write_mesh(tmp_path / "m.u3d", V, F)
     assert list(tmp_path.iterdir()) == []
+
+
+# Every format pymeshlab 2025.7 saves (pymeshlab lists none; found by saving to each extension MeshLab
+# knows): the probe and write_mesh run these writers in the caller's process.
+_SAVE_FORMATS = (".3ds", ".3mf", ".ctm", ".dae", ".dxf", ".e57", ".idtf", ".json", ".nxs", ".nxz", ".obj", ".off",
+                 ".ply", ".stl", ".u3d", ".wrl", ".x3d", ".xyz")
+_UNWRITTEN = (".nxs", ".nxz", ".u3d")
+
+
+@pytest.mark.parametrize("ext", _UNWRITTEN)
+def test_unsafe_writers_are_refused_without_running_them(tmp_path, monkeypatch, ext):
+    # the format probe ran pymeshlab's writer on one triangle in the caller's process: for .nxz it
+    # crashed a full test run (segmentation fault in the Nexus writer, which reads memory it never
+    # set); .u3d wrote a fixed-name file in the shared temporary folder. No writer may run for these.
+    import curvdetail.io as io
+    from curvdetail.filters.files import check_output_path
+
+    assert set(io.UNWRITTEN_FORMATS) == set(_UNWRITTEN)
+    ran = []
+    monkeypatch.setattr(pymeshlab.MeshSet, "save_current_mesh", lambda self, path, **kw: ran.append(path))
+    monkeypatch.setattr(io, "_WRITES", {})                          # as in a fresh process
+    mesh = pymeshlab.Mesh(vertex_matrix=np.eye(3), face_matrix=np.array([[0, 1, 2]], dtype=np.int32))
+    for write in (lambda p: io.check_mesh_output(p), lambda p: write_mesh(p, *icosphere(subdivisions=1)),
+                  lambda p: save_mesh(p, mesh), lambda p: check_output_path(p)):
+        with pytest.raises(MeshFileError, match=rf"cannot write .*m\{ext}': \{ext} meshes are refused: pymeshlab's "
+                                                r"writer for them is not run \("):
+            write(tmp_path / f"m{ext}")
+    assert ran == [] and io._WRITES == {} and list(tmp_path.iterdir()) == []
+    assert io._why_not_written(ext) == io.UNWRITTEN_FORMATS[ext] and ran == []
+
+
+_PERTURBED_WRITES = """
+import os, sys, tempfile
+import numpy as np
+from curvdetail.io import MeshFileError, check_mesh_output, write_mesh
+from curvdetail.curvature.testing import icosphere
+V, F = icosphere(subdivisions=1)
+folder = tempfile.mkdtemp()
+for ext in sys.argv[1:]:
+    print(ext, end=" ", flush=True)
+    try:
+        check_mesh_output(os.path.join(folder, "probe" + ext))
+        if ext not in (".e57", ".xyz"):                 # points only: refused above
+            write_mesh(os.path.join(folder, "m" + ext), 10.0 * V + 10.0, F)
+        print("written", flush=True)
+    except MeshFileError as exc:
+        print("refused:", exc, flush=True)
+"""
+
+
+def _perturbed_child(extensions):
+    """Probe and write each extension in a child process whose heap memory is handed out filled
+    with a nonzero byte (glibc's MALLOC_PERTURB_), as memory recycled in a long run is: a writer
+    that reads memory it never set crashes there every time, not once in a while."""
+    env = dict(os.environ, MALLOC_PERTURB_="85", PYTHONFAULTHANDLER="1")
+    done = subprocess.run([sys.executable, "-c", _PERTURBED_WRITES, *extensions], capture_output=True, text=True,
+                          env=env, timeout=300)
+    assert done.returncode == 0, (done.returncode, done.stdout, done.stderr[-3000:])
+    return dict(line.split(" ", 1) for line in done.stdout.splitlines())
+
+
+def test_unsafe_writers_are_refused_in_a_process_where_they_crash():
+    # the old probe crashed this child (segmentation fault or bus error in NexusBuilder::saturateNode)
+    result = _perturbed_child(_UNWRITTEN)
+    assert all(result[ext].startswith("refused: cannot write") and "meshes are refused" in result[ext]
+               for ext in _UNWRITTEN), result
+
+
+def test_every_other_save_format_is_probed_and_written_safely_with_recycled_memory():
+    # what keeps the probe in-process: the writers left run cleanly where memory is not zero (a
+    # pymeshlab upgrade whose writer crashes here belongs in UNWRITTEN_FORMATS)
+    others = [ext for ext in _SAVE_FORMATS if ext not in _UNWRITTEN]
+    result = _perturbed_child(others)
+    assert set(result) == set(others)
+    points = (".e57", ".xyz")
+    assert all(result[ext] == "written" for ext in others if ext not in points), result
+    assert all("hold points only" in result[ext] for ext in points), result
 
 
 def test_save_mesh_refuses_non_finite_coordinates(tmp_path):
