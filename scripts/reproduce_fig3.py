@@ -53,21 +53,27 @@ def pct(x, digits=3):
     return f"{100 * x:.{digits}f}"
 
 
+def _ratio(value, spec, suffix=""):
+    """A report ratio as table text; "n/a" where the report gives None (an RMS at rounding)."""
+    return "n/a" if value is None else f"{value:{spec}}{suffix}"
+
+
 def row(name, rep, t_retri=None, method=None):
     """One table line; ``t_retri`` = the time of a retriangulation made outside the experiment
     (shared by several configurations), added to its stage times; ``method`` = how that
     retriangulation was made (the report says "given")."""
     e, b, f, s, o = (rep["error"], rep["baseline_zero_detail"], rep["floor_retriangulated"], rep["seconds"],
                      rep["options"])
-    ok = e["hausdorff_rms"] <= 1e-3 and e["hausdorff_max"] <= 1e-2 and rep["improvement_over_zero_detail"] >= 50
+    improvement = rep["improvement_over_zero_detail"]          # None where an RMS is rounding
+    ok = e["hausdorff_rms"] <= 1e-3 and e["hausdorff_max"] <= 1e-2 and (improvement is None or improvement >= 50)
     loc = o["location"] + (f" ({o['parameterization']})" if o["location"] == "uv" else "")
     total = s["total"] + (t_retri or 0.0)
     t_retri = s["retriangulate"] if t_retri is None else t_retri
     return (f"| {name} | {rep['source']['vertices']:,} | {rep['target']['vertices']:,} | {method or o['method']} | "
             f"{o['transfer']} | {o['rows']} | {loc} | **{pct(e['hausdorff_rms'], 4)}** / {pct(e['hausdorff_max'])} | "
             f"{pct(b['hausdorff_rms'], 2)} / {pct(b['hausdorff_max'], 1)} | "
-            f"{pct(f['hausdorff_rms'], 4)} / {pct(f['hausdorff_max'])} | {rep['improvement_over_zero_detail']:,.0f}x | "
-            f"{rep['ratio_to_floor']:.2f} | {'yes' if ok else 'NO'} | "
+            f"{pct(f['hausdorff_rms'], 4)} / {pct(f['hausdorff_max'])} | {_ratio(improvement, ',.0f', 'x')} | "
+            f"{_ratio(rep['ratio_to_floor'], '.2f')} | {'yes' if ok else 'NO'} | "
             f"{t_retri:.2f} / {s['parameterize']:.2f} / {s['transfer']:.2f} / {s['reconstruct']:.2f} / "
             f"{s['evaluate']:.2f} / {total:.2f} |")
 

@@ -29,7 +29,9 @@ def run_example(name, before=None):
 
 
 def test_remesh_transfer_rebuild_pipeline():
-    # measured: RMS 0.037 %, max 0.34 % of the diagonal after pymeshlab's remeshing at 2 %
+    # measured (2026-12-01, exact vertex maxima): RMS 0.0373 %, max 0.369 % of the diagonal after
+    # pymeshlab's remeshing at 2 %, as docs/filters.md says; the RMS is a Monte Carlo estimate
+    # whose samples depend on pymeshlab's generator state in this process (~1 %)
     retriangulated = {}
 
     def before(ms, step):
@@ -44,7 +46,7 @@ def test_remesh_transfer_rebuild_pipeline():
     assert ms.mesh(1).vertex_number() != ms.mesh(0).vertex_number()          # really retriangulated
     assert steps[2]["figures"]["detail_total_gap"] < 1e-12
     error = steps[-1]["figures"]
-    assert error["hausdorff_rms"] < 1e-3 and error["hausdorff_max"] < 1e-2
+    assert 3.4e-4 < error["hausdorff_rms"] < 4.1e-4 and 3.5e-3 < error["hausdorff_max"] < 3.9e-3
     # the retriangulated surface alone meets those bounds: the rebuilt layer is the core rebuild
     # of it from the transferred detail, with the script's rows="free" (measured equal)
     Vt, Ft = retriangulated["Vt"], ms.mesh(1).face_matrix()
@@ -52,18 +54,22 @@ def test_remesh_transfer_rebuild_pipeline():
     b = boundary_vertices(Ft)
     expected = reconstruct(Vt, Ft, Dt, b, Vt[b], rows="free")
     assert np.abs(ms.mesh(1).vertex_matrix() - expected).max() < 1e-9 * bbox_diagonal(Vt)
-    d = vertex_distance(ms.mesh(1).vertex_matrix(), ms.mesh(0).vertex_matrix(), ms.mesh(0).face_matrix())
-    assert np.array_equal(ms.mesh(1).vertex_scalar_array(), d)
+    # quality = each vertex's exact distance to the source (the search the Hausdorff maximum uses)
+    d = vertex_distance(ms.mesh(1).vertex_matrix(), ms.mesh(0).vertex_matrix(), ms.mesh(0).face_matrix(), far=True)
+    assert np.abs(ms.mesh(1).vertex_scalar_array() - d).max() < 1e-15 * bbox_diagonal(Vt)
+    assert ms.mesh(1).vertex_scalar_array().max() <= error["hausdorff_max"] * bbox_diagonal(ms.mesh(0).vertex_matrix())
 
 
 def test_minimal_surface_pipeline():
-    # the terrain's relief: the minimal surface lies 1.3 % (RMS) of the diagonal away from it
+    # the terrain's relief: the minimal surface lies 1.30 % (RMS), 3.19 % (max) of the diagonal
+    # away from it, after 22 steps (docs/filters.md)
     ms, steps = run_example("minimal_surface.mlx")
     assert ms.mesh_number() == 2 and ms.mesh(0).selected_vertex_number() == 128    # Select Border
     minimal = steps[2]["figures"]
     assert minimal["converged"] and minimal["area_minimal"] < minimal["area_source"]
     error = steps[3]["figures"]
-    assert 0.005 < error["hausdorff_rms"] < 0.05
+    assert minimal["iterations"] == 22
+    assert 0.0124 < error["hausdorff_rms"] < 0.0137 and 0.0305 < error["hausdorff_max"] < 0.0335
 
 
 def test_remeshing_experiment_pipeline(tmp_path, capsys):

@@ -131,3 +131,24 @@ def test_filter_saves_write_ctm_lossless(tmp_path):
     loaded = load_meshset(tmp_path / "m.ctm")
     W = loaded.current_mesh().vertex_matrix()
     assert W.shape == V.shape and np.abs(W - V.astype(np.float32)).max() == 0.0
+
+
+def test_a_ctm_save_holds_the_geometry_only_and_reads_back(tmp_path):
+    # a mesh with a quality (here the reconstruction filter's) saved as CTM wrote a lone "Quality"
+    # map, on which pymeshlab's CTM reader crashes the process: the geometry only now
+    import subprocess
+    import sys
+
+    from curvdetail._ctm_scan import ctm_problem
+
+    ms = load_meshset(NOSE)
+    apply(ms, "compute_curvature_detail")
+    apply(ms, "apply_curvature_reconstruction")
+    assert ms.current_mesh().has_vertex_scalar()
+    out = tmp_path / "out.ctm"
+    save_current_mesh(ms, out)
+    assert ctm_problem(str(out)) is None
+    code = f"import curvdetail; V, F = curvdetail.read_mesh({str(out)!r}); print(V.shape[0], F.shape[0])"
+    child = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert child.returncode == 0, child.stderr
+    assert child.stdout.split() == [str(ms.current_mesh().vertex_number()), str(ms.current_mesh().face_number())]

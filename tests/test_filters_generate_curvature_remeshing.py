@@ -73,7 +73,8 @@ def test_rebuilt_layers_stored_detail_rebuilds_that_layer(terrain_run, tmp_path)
 
 def test_rebuilt_quality_is_the_distance_to_the_source(terrain_run):
     ms, _ = terrain_run
-    d = vertex_distance(ms.mesh(2).vertex_matrix(), ms.mesh(0).vertex_matrix(), ms.mesh(0).face_matrix())
+    d = vertex_distance(ms.mesh(2).vertex_matrix(), ms.mesh(0).vertex_matrix(), ms.mesh(0).face_matrix(),
+                        far=True)
     assert np.array_equal(ms.mesh(2).vertex_scalar_array(), d)
 
 
@@ -115,19 +116,16 @@ def test_a_parameterization_without_uv_location_is_refused_not_ignored():
 
 
 def test_the_baseline_layer_is_coloured_by_its_distance_to_the_source():
-    # the distances came from run_experiment for every run; only this layer uses them. The
-    # fast far-surface candidates give the exact closest-point distances here (to rounding)
-    from curvdetail.remesh import vertex_distance
-
+    # the distances run_experiment measured for the baseline's Hausdorff maximum, exact
     ms = pymeshlab.MeshSet()
     ms.load_new_mesh(os.path.join(DATA, "mannequin_nose.obj"))
     V, F = ms.mesh(0).vertex_matrix(), ms.mesh(0).face_matrix()
     report = apply(ms, "generate_curvature_remeshing", target_edge=pymeshlab.PercentageValue(3.0),
                    add_baseline=True)
     zero = ms.mesh(report["layers"]["zero_detail"])
-    expected = vertex_distance(zero.vertex_matrix(), V, F)
+    expected = vertex_distance(zero.vertex_matrix(), V, F, far=True)
     assert expected.max() > 0.05 * report["source"]["bbox_diagonal"]       # far from the source
-    np.testing.assert_allclose(zero.vertex_scalar_array(), expected, rtol=0, atol=1e-9 * expected.max())
+    assert np.array_equal(zero.vertex_scalar_array(), expected)
 
 
 @pytest.mark.parametrize("kwargs, expected", [({}, True), ({"surface_check": False}, False)])
@@ -241,3 +239,117 @@ def test_a_rebuild_worse_than_zero_detail_is_said_by_the_filter():
                        transfer="pointwise")
     assert report["improvement_over_zero_detail"] < 0.5
     assert caught[0].filename == __file__
+
+
+def _triangle_brute_force(P, V, F):
+    """Distance from each point of ``P`` to the surface ``(V, F)``, every triangle measured
+    (the package's point-triangle formula, checked against Ericson's in test_remesh_evaluate)."""
+    from curvdetail.remesh.evaluate import _triangle_distance
+
+    k, m = P.shape[0], F.shape[0]
+    return _triangle_distance(np.repeat(P, m, axis=0), np.tile(V[F], (k, 1, 1))).reshape(k, m).min(axis=1)
+
+
+def test_layer_qualities_are_exact_where_the_grid_search_is_not(monkeypatch):
+    # the rebuild forced beside a wavy source (as in test_remesh_experiment: the transfer patched
+    # to give L(Vt) Y, Y the retriangulation with its interior flattened at z = 0.3 and spread
+    # 1.4x past the source's edge): pymeshlab's closest-face grid, which gave the rebuilt layer's
+    # quality, put 4 of its 500 vertices up to 0.49 % of the diagonal too far
+    import warnings
+
+    import curvdetail.remesh.experiment as experiment
+    from curvdetail import cotan_laplacian
+    from curvdetail.curvature.testing import grid
+    from curvdetail.remesh import WorseThanZeroDetailWarning
+
+    V, F = grid(10, 10)
+    V[:, 2] = 0.5 * np.sin(8 * V[:, 0]) * np.cos(6.4 * V[:, 1])
+
+    def beside(Vs, Fs, Vt, Ft, **options):
+        Y = Vt.copy()
+        inner = np.setdiff1d(np.arange(Vt.shape[0]), boundary_vertices(Ft))
+        Y[inner, :2] = (Y[inner, :2] - 0.5) * 1.4 + 0.5
+        Y[inner, 2] = 0.3
+        return cotan_laplacian(Vt, Ft) @ Y
+
+    monkeypatch.setattr(experiment, "transfer_curvature", beside)
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(V, F.astype(np.int32)), "wavy")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", WorseThanZeroDetailWarning)       # it is worse: forced off
+        report = apply(ms, "generate_curvature_remeshing", target_edge=pymeshlab.PercentageValue(5),
+                       add_baseline=True)
+    d = bbox_diagonal(V)
+    for name in ("rebuilt", "zero_detail"):
+        layer = ms.mesh(report["layers"][name])
+        exact = _triangle_brute_force(layer.vertex_matrix(), V, F)
+        if name == "rebuilt":
+            assert (vertex_distance(layer.vertex_matrix(), V, F) - exact).max() > 1e-3 * d    # the grid is off
+        np.testing.assert_allclose(layer.vertex_scalar_array(), exact, rtol=1e-12, atol=1e-15 * d)
+
+
+def test_the_baseline_layers_vertices_are_searched_once(monkeypatch):
+    # its quality is the distances the experiment measured for the baseline's Hausdorff maximum
+    # (they were searched a second time for the layer, and the rebuilt ones twice: 5 x 640 +
+    # 20,000 rows); every vertex set once, as in test_remesh_experiment's
+    # test_each_vertex_set_is_searched_once
+    import curvdetail.remesh.evaluate as evaluate
+    from curvdetail.remesh.experiment import BASELINE_SAMPLES
+
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(os.path.join(DATA, "mannequin_nose.obj"))
+    m = ms.mesh(0).face_number()
+    rows = []
+
+    def spying(search):
+        def spy(P, Vs, Fs, *args, **kwargs):
+            if Fs.shape[0] == m:                           # against the source
+                rows.append(P.shape[0])
+            return search(P, Vs, Fs, *args, **kwargs)
+        return spy
+
+    monkeypatch.setattr(evaluate, "_surface_distance", spying(evaluate._surface_distance))
+    monkeypatch.setattr(evaluate, "_locate", spying(evaluate._locate))
+    report = apply(ms, "generate_curvature_remeshing", target_edge=pymeshlab.PercentageValue(3.0),
+                   add_baseline=True)
+    p = report["target"]["vertices"]
+    assert report["target"]["faces"] != m
+    assert sum(rows) == 3 * p + BASELINE_SAMPLES, rows
+
+
+def test_report_names_the_source_file_by_its_absolute_path(tmp_path, monkeypatch):
+    # as `curvdetail remesh --report` does (os.path.abspath of its input); it gave the bare file
+    # name (pymeshlab's layer label), which names no file once the folder is not the current one
+    import shutil
+
+    from curvdetail.filters.files import load_meshset
+
+    (tmp_path / "patches").mkdir()
+    shutil.copy(os.path.join(DATA, "terrainA_1k.obj"), tmp_path / "patches")
+    monkeypatch.chdir(tmp_path)
+    ms = load_meshset(os.path.join("patches", "terrainA_1k.obj"))            # a relative path
+    monkeypatch.chdir(DATA)                                                 # and elsewhere since
+    report = apply(ms, "generate_curvature_remeshing", target_edge=pymeshlab.PercentageValue(5), evaluate=False)
+    assert report["source"]["path"] == str(tmp_path / "patches" / "terrainA_1k.obj")
+    assert report["source"]["label"] == "terrainA_1k.obj"
+    assert ms.mesh(0).label() == "terrainA_1k.obj"                          # the layer names are kept
+    assert ms.mesh(report["layers"]["rebuilt"]).label() == "terrainA_1k.obj rebuilt"
+
+
+def test_report_of_a_layer_pymeshlab_loaded_gives_its_label_not_a_path():
+    # pymeshlab gives Python only the bare file name: not a path, so not reported as one
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(os.path.join(DATA, "terrainA_1k.obj"))
+    report = apply(ms, "generate_curvature_remeshing", target_edge=pymeshlab.PercentageValue(5), evaluate=False)
+    assert report["source"]["path"] is None
+    assert report["source"]["label"] == "terrainA_1k.obj"
+
+
+def test_report_of_a_layer_made_in_memory_names_no_file():
+    from curvdetail.curvature.testing import disk
+
+    V, F = disk(n_rings=8)
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(V, F.astype(np.int32)), "patch")
+    report = apply(ms, "generate_curvature_remeshing", target_edge=pymeshlab.PercentageValue(8), evaluate=False)
+    assert report["source"]["path"] is None

@@ -357,3 +357,80 @@ def test_tree_search_far_from_a_surface_is_exact_and_quick():
     assert time.perf_counter() - t < 20
     check = rng.choice(P.shape[0], 50, replace=False)
     assert np.allclose(d[check], _brute_force_distance(P[check], V, F), rtol=1e-12, atol=0)
+
+
+def test_given_vertex_distances_give_the_figures_bit_for_bit():
+    # vertex_distance(far=True) measures in hausdorff's frame (the two meshes together of unit
+    # size): handing its distances over changes no figure, not even in the last bit. A noisy
+    # copy off the origin, reaching out of the surface's bounding box: in the surface's own
+    # frame 202 of the 225 distances, and the maximum, came out otherwise in the last bits
+    from curvdetail.remesh.evaluate import _surface_distance
+    from curvdetail.remesh.locate import _unit_frame
+
+    Vb, F = grid(15, 15)
+    Vb[:, 2] = 0.1 * np.sin(4 * Vb[:, 0])
+    Vb += [3.1, -7.3, 1.7]
+    Va = Vb + np.random.default_rng(5).normal(scale=0.02, size=Vb.shape)
+    d = vertex_distance(Va, Vb, F, far=True)
+    # the kd-tree engine's figures repeat exactly from call to call
+    assert hausdorff(Va, F, Vb, F, engine="kdtree", samples=2000, a_vertex_distance=d) == \
+        hausdorff(Va, F, Vb, F, engine="kdtree", samples=2000)
+    P, S, scale = _unit_frame(Va, Vb)                          # the surface's own frame
+    assert (scale * _surface_distance(P, S, F)).max() != d.max()    # the test can tell frames apart
+
+
+def test_given_vertex_distances_give_pymeshlabs_maxima_bit_for_bit():
+    # pymeshlab's samples change from call to call in one process: the maxima are compared where
+    # they lie at vertices (a flat square and a copy with one interior vertex lifted by 0.05, as
+    # in test_a_maximum_at_a_vertex_is_found_exactly), both ways round
+    V, F = grid(11, 11)
+    W = V.copy()
+    W[5 * 11 + 3, 2] = 0.05
+    for Va, Vb in ((W, V), (V, W)):
+        given = hausdorff(Va, F, Vb, F, samples=2000, a_vertex_distance=vertex_distance(Va, Vb, F, far=True))
+        measured = hausdorff(Va, F, Vb, F, samples=2000)
+        keys = ("max", "a_to_b_max", "b_to_a_max", "engine")
+        assert {k: given[k] for k in keys} == {k: measured[k] for k in keys}
+
+
+@pytest.mark.parametrize("engine", ["meshlab", "kdtree"])
+def test_given_vertex_distances_are_not_searched_again(monkeypatch, engine):
+    # a's vertices are searched by the caller (vertex_distance) and not again in hausdorff: only
+    # b's vertices (and the kd-tree engine's own samples) are searched there
+    import curvdetail.remesh.evaluate as evaluate
+
+    rows = []
+    search = evaluate._surface_distance
+
+    def spy(P, V, F):
+        rows.append(P.shape[0])
+        return search(P, V, F)
+
+    Va, Fa = grid(9, 9)                                  # 81 vertices
+    Vb, Fb = grid(12, 12)                                # 144 vertices
+    Vb[:, 2] = 0.05 * np.sin(5 * Vb[:, 0])
+    d = vertex_distance(Va, Vb, Fb, far=True)
+    monkeypatch.setattr(evaluate, "_surface_distance", spy)
+    hausdorff(Va, Fa, Vb, Fb, engine=engine, samples=500, a_vertex_distance=d)
+    given, rows[:] = list(rows), []
+    hausdorff(Va, Fa, Vb, Fb, engine=engine, samples=500)
+    measured = list(rows)
+    if engine == "meshlab":
+        assert given == [144] and measured == [81, 144]
+    else:
+        assert given == [500, 500 + 144] and measured == [500 + 81, 500 + 144]
+
+
+@pytest.mark.parametrize("value, words", [
+    (np.zeros(24), r"shape \(24,\), but Va has 25 vertices.*shape \(25,\)"),
+    (np.zeros((25, 1)), r"shape \(25, 1\)"),
+    (np.r_[np.zeros(24), np.nan], r"1 of 25 entries are NaN, infinite or negative \(first: 24\)"),
+    (np.r_[-1.0, np.zeros(23), np.inf], r"2 of 25 entries .* \(first: 0, 24\)"),
+    (np.full(25, True), "dtype bool"),
+    (["far"] * 25, "dtype <U3"),
+])
+def test_given_vertex_distances_that_are_not_distances_are_refused(value, words):
+    V, F = grid(5, 5)
+    with pytest.raises(ValueError, match=words) as info:
+        hausdorff(V, F, V, F, a_vertex_distance=value)
+    assert "vertex_distance(Va, Vb, Fb, far=True)" in str(info.value)          # what to pass

@@ -71,7 +71,7 @@ def test_report_figures_are_the_distances_over_the_source_diagonal(height_field)
         # (pymeshlab's face sampling is not repeatable to the last digit: ~0.1 %)
         assert r[key]["hausdorff_rms"] == pytest.approx(h["rms"] / d, rel=0.02)
         assert r[key]["hausdorff_max"] == pytest.approx(h["max"] / d, rel=0.05)
-    assert r["error"]["vertex_max"] == pytest.approx(vertex_distance(X, V, F).max() / d, rel=1e-12)
+    assert r["error"]["vertex_max"] == pytest.approx(vertex_distance(X, V, F, far=True).max() / d, rel=1e-12)
     rms = r["error"]["hausdorff_rms"]
     assert r["improvement_over_zero_detail"] == pytest.approx(r["baseline_zero_detail"]["hausdorff_rms"] / rms)
     assert r["improvement_over_zero_detail"] > 20
@@ -126,9 +126,10 @@ def test_run_experiment_returns_exact_per_vertex_distances(height_field):
 
     V, F = height_field
     r = run_experiment(V, F, target_edge=0.05)
-    assert np.array_equal(r["distance"], vertex_distance(r["X"], V, F))
-    assert r["distance"].max() / r["report"]["source"]["bbox_diagonal"] == pytest.approx(
-        r["report"]["error"]["vertex_max"])
+    # the tree search's distances (exact at any distance), the ones the maxima are taken over
+    assert np.array_equal(r["distance"], vertex_distance(r["X"], V, F, far=True))
+    assert np.array_equal(r["zero_distance"], vertex_distance(r["Z"], V, F, far=True))
+    assert r["distance"].max() / r["report"]["source"]["bbox_diagonal"] == r["report"]["error"]["vertex_max"]
 
 
 def test_unknown_backend_is_refused_before_retriangulating(height_field, monkeypatch):
@@ -369,3 +370,155 @@ def test_what_to_try_follows_the_options_that_failed(options, cli, says):
     report["error"]["hausdorff_rms"] = 0.2                      # as near as zero detail: nothing said
     assert worse_than_zero_detail(report, cli=cli) is None
     assert worse_than_zero_detail({"options": options}, cli=cli) is None     # not measured
+
+
+def test_each_vertex_set_is_searched_once(height_field, monkeypatch):
+    # the rebuilt, zero-detail and retriangulated vertices are searched against the source once
+    # each (vertex_distance(far=True), whose distances hausdorff then takes), besides the
+    # baseline's own face samples (the kd-tree engine; pymeshlab's engine samples inside
+    # pymeshlab). The rebuilt vertices used to be searched twice, by locate's grid for the
+    # per-vertex distances and by hausdorff for its maximum: 4 x 202 + 20,000 rows here
+    import curvdetail.remesh.evaluate as evaluate
+    from curvdetail.remesh.experiment import BASELINE_SAMPLES, run_experiment
+
+    V, F = height_field
+    rows = []
+
+    def spying(search):
+        def spy(P, Vs, Fs, *args, **kwargs):
+            if Fs.shape[0] == F.shape[0]:              # against the source
+                rows.append(P.shape[0])
+            return search(P, Vs, Fs, *args, **kwargs)
+        return spy
+
+    monkeypatch.setattr(evaluate, "_surface_distance", spying(evaluate._surface_distance))
+    monkeypatch.setattr(evaluate, "_locate", spying(evaluate._locate))
+    r = run_experiment(V, F, target_edge=0.05)
+    p = r["X"].shape[0]
+    assert r["Ft"].shape[0] != F.shape[0]                # the spy tells the surfaces apart
+    assert sum(rows) == 3 * p + BASELINE_SAMPLES, rows
+
+
+def test_report_figures_are_those_hausdorff_measures_itself(height_field, monkeypatch):
+    # the vertex distances handed to hausdorff change none of its figures (to the last bit):
+    # each call is repeated without them, with the kd-tree engine forced (seeded, so that a
+    # figure repeats exactly; pymeshlab's samples change from call to call)
+    import curvdetail.remesh.experiment as experiment
+
+    V, F = height_field
+    d = np.linalg.norm(np.ptp(V, axis=0))
+    calls = []
+
+    def spy(P, Ft, Vs, Fs, *, samples=None, engine="meshlab", a_vertex_distance=None):
+        n = samples or 20000
+        given = hausdorff(P, Ft, Vs, Fs, samples=n, engine="kdtree", a_vertex_distance=a_vertex_distance)
+        calls.append((a_vertex_distance, given, hausdorff(P, Ft, Vs, Fs, samples=n, engine="kdtree")))
+        return given
+
+    monkeypatch.setattr(experiment, "hausdorff", spy)
+    r = experiment.run_experiment(V, F, target_edge=0.05)
+    assert len(calls) == 3
+    for (dist, given, measured), key in zip(calls, ("error", "baseline_zero_detail", "floor_retriangulated")):
+        assert dist is not None and given == measured
+        assert r["report"][key] == {**r["report"][key], "hausdorff_max": given["max"] / d,
+                                    "hausdorff_rms": given["rms"] / d}
+    assert calls[0][0] is r["distance"] and calls[1][0] is r["zero_distance"]
+
+
+def _triangle_brute_force(P, V, F):
+    """Distance from each point of ``P`` to the surface ``(V, F)``, every triangle measured
+    (the package's point-triangle formula, checked against Ericson's in test_remesh_evaluate)."""
+    from curvdetail.remesh.evaluate import _triangle_distance
+
+    k, m = P.shape[0], F.shape[0]
+    return _triangle_distance(np.repeat(P, m, axis=0), np.tile(V[F], (k, 1, 1))).reshape(k, m).min(axis=1)
+
+
+def _wavy_source_and_a_rebuild_beside_it(monkeypatch):
+    """A wavy 10 x 10 grid (heights +-0.5) as the source, and its rebuild forced beside it: the
+    transfer patched to give ``L(Vt) Y``, so the rebuild is ``Y`` exactly, the retriangulation
+    with its interior flattened at z = 0.3 (the source's height) and spread 1.4x about the
+    centre, past the source's edge. There pymeshlab's closest-face grid (locate's search)
+    returns faces that are not the closest: 4 of the 500 vertices up to 0.49 % of the diagonal
+    too far."""
+    import curvdetail.remesh.experiment as experiment
+    from curvdetail import cotan_laplacian
+    from curvdetail.curvature.testing import grid
+
+    V, F = grid(10, 10)
+    V[:, 2] = 0.5 * np.sin(8 * V[:, 0]) * np.cos(6.4 * V[:, 1])
+
+    def beside(Vs, Fs, Vt, Ft, **options):
+        Y = Vt.copy()
+        inner = np.setdiff1d(np.arange(Vt.shape[0]), boundary_vertices(Ft))
+        Y[inner, :2] = (Y[inner, :2] - 0.5) * 1.4 + 0.5
+        Y[inner, 2] = 0.3
+        return cotan_laplacian(Vt, Ft) @ Y
+
+    monkeypatch.setattr(experiment, "transfer_curvature", beside)
+    return V, F
+
+
+def test_rebuilt_vertex_distances_are_exact_where_the_grid_search_is_not(monkeypatch):
+    # the per-vertex distances (the CLI's and the filter's quality, vertex_max) were locate's,
+    # up to 0.49 % of the diagonal too large here; now the exact ones, to rounding
+    import warnings
+
+    from curvdetail.remesh.experiment import run_experiment
+
+    V, F = _wavy_source_and_a_rebuild_beside_it(monkeypatch)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", WorseThanZeroDetailWarning)      # it is worse: forced off
+        r = run_experiment(V, F, target_edge=0.05)
+    d = r["report"]["source"]["bbox_diagonal"]
+    exact = _triangle_brute_force(r["X"], V, F)
+    assert (vertex_distance(r["X"], V, F) - exact).max() > 1e-3 * d          # the grid is off here
+    np.testing.assert_allclose(r["distance"], exact, rtol=1e-12, atol=1e-15 * d)
+    assert r["report"]["error"]["vertex_max"] == pytest.approx(exact.max() / d, rel=1e-12)
+    np.testing.assert_allclose(r["zero_distance"], _triangle_brute_force(r["Z"], V, F), rtol=1e-12, atol=1e-15 * d)
+
+
+def test_ratios_of_a_flat_patch_are_none_with_the_reason():
+    # a flat square: the rebuilt, zero-detail and retriangulated surfaces all lie on it, to
+    # pymeshlab's single precision (RMS ~1e-10 of the diagonal) or the kd-tree engine's double
+    # (~1e-16): ratios of those are noise (they came out 0.3-1.3, or 0 where one was exactly 0)
+    import json
+    import warnings
+
+    from curvdetail.curvature.testing import grid
+
+    V, F = grid(12, 12)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", WorseThanZeroDetailWarning)        # nor is it worse
+        _, r = remesh_experiment(V, F, target_edge=0.03)
+    assert r["baseline_zero_detail"]["hausdorff_rms"] < 1e-12 and r["error"]["hausdorff_rms"] < 1e-7
+    assert r["improvement_over_zero_detail"] is None and r["ratio_to_floor"] is None
+    assert r["ratio_notes"]["improvement_over_zero_detail"].startswith(
+        "the zero-detail surface lies on the source to rounding")
+    assert "nothing to improve on" in r["ratio_notes"]["improvement_over_zero_detail"]
+    assert "no floor to compare with" in r["ratio_notes"]["ratio_to_floor"]
+    text = json.dumps(r, allow_nan=False)                                # valid JSON: null, no NaN
+    assert json.loads(text) == r
+
+
+def test_ratios_of_a_curved_patch_are_the_rms_quotients(height_field):
+    _, r = remesh_experiment(*height_field, target_edge=0.04)
+    rms = r["error"]["hausdorff_rms"]
+    assert r["improvement_over_zero_detail"] == r["baseline_zero_detail"]["hausdorff_rms"] / rms
+    assert r["ratio_to_floor"] == rms / r["floor_retriangulated"]["hausdorff_rms"]
+    assert "ratio_notes" not in r
+
+
+def test_a_rebuild_at_rounding_is_not_said_to_be_worse_than_zero_detail():
+    # a two-triangle square rebuilt from itself: pymeshlab's single precision gave it an RMS of
+    # 1.4e-9 of the diagonal against the kd-tree engine's exact 0 for zero detail, and the
+    # warning said the transferred detail had made it worse
+    import warnings
+
+    from curvdetail.curvature.testing import grid
+
+    V, F = grid(2, 2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", WorseThanZeroDetailWarning)
+        _, report = remesh_experiment(V, F, target=(V, F))
+    assert report["improvement_over_zero_detail"] is None

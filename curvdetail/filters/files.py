@@ -11,6 +11,7 @@ and renamed, so a failed save leaves nothing behind; an existing file is replace
 """
 
 import os
+import weakref
 
 import numpy as np
 
@@ -20,6 +21,10 @@ from .meshset import WRITTEN_ATTRIBUTES, set_vertex_attribute, vertex_attribute
 from .ply_attributes import read_ply_vertex_attributes
 
 _HINT = "use .ply to keep quality and curvature attributes, or .obj, .off, .stl"
+
+#: the absolute path each layer of a MeshSet made by :func:`load_meshset` was read from
+#: (pymeshlab keeps it too, but gives Python only the bare file name, ``Mesh.label()``)
+_LOADED_FROM = weakref.WeakKeyDictionary()
 
 
 def load_meshset(path, *more):
@@ -37,10 +42,17 @@ def load_meshset(path, *more):
     ms = pymeshlab.MeshSet()
     for p in paths:
         n = load_checked(ms, p).vertex_number()
+        _LOADED_FROM.setdefault(ms, {})[ms.current_mesh_id()] = os.path.abspath(os.fsdecode(p))
         for name, values in read_ply_vertex_attributes(p).items():
             if values.shape in ((n,), (n, 3)) and np.all(np.isfinite(values)):
                 set_vertex_attribute(ms, ms.current_mesh_id(), name, values)
     return ms
+
+
+def loaded_from(ms, mesh_id):
+    """The absolute path of the file :func:`load_meshset` read layer ``mesh_id`` of ``ms`` from,
+    or None (a layer pymeshlab loaded itself, or one made in memory)."""
+    return _LOADED_FROM.get(ms, {}).get(mesh_id)
 
 
 def check_output_path(path, overwrite=False):
@@ -52,10 +64,12 @@ def check_output_path(path, overwrite=False):
 
 def save_options(ms, path):
     """pymeshlab ``save_current_mesh`` options that keep quality and our attributes in PLY, and
-    the coordinates in CTM (its default compresses them to a grid)."""
+    the coordinates in CTM (its default compresses them to a grid). CTM gets the geometry only:
+    a "Quality" map without a "Color" one crashes pymeshlab's CTM reader, and with one it reads
+    the colours' red channel as the quality (:mod:`curvdetail._ctm_scan`)."""
     extension = os.path.splitext(os.fspath(path))[1].lower()
     if extension == ".ctm":
-        return {"lossless": True}
+        return {"lossless": True, "save_vertex_quality": False, "save_vertex_color": False}
     if extension != ".ply":
         return {}
     mesh = ms.current_mesh()

@@ -5,6 +5,7 @@ import os
 from ..curvature._validate import bbox_diagonal
 from .apply_curvature_reconstruction import BACKEND_DESCRIPTION, BACKENDS
 from .detail_attributes import DETAIL, stamp
+from .files import loaded_from
 from .meshset import add_layer, get_mesh, layer_id, mesh_arrays, set_vertex_attribute
 from .parameters import BBoxLength, Parameter
 from .registry import PAPER, filter
@@ -23,9 +24,13 @@ from .transfer_curvature_detail import planar_map
         zero-detail surface with the same boundary and the retriangulated surface itself, the
         floor). Adds the retriangulated layer and the rebuilt layer (current; quality = distance
         to the source, none without evaluate; attribute 'curvature_detail' = the transferred
-        detail) and, on request, the zero-detail baseline. Returns the report of
-        curvdetail.remesh.remesh_experiment (error and baselines as fractions of the source's bbox
-        diagonal, sizes, options, seconds per stage) with the new layer ids; a rebuild farther
+        detail) and, on request, the zero-detail baseline (quality = its distance to the source);
+        each quality is the exact distance, the one the Hausdorff maxima are taken over. Returns
+        the report of curvdetail.remesh.remesh_experiment (error and baselines as fractions of the
+        source's bbox diagonal, sizes, options, seconds per stage; source.path the absolute path
+        of the file the current layer was read from where curvdetail loaded it (the CLI, or
+        curvdetail.filters.files.load_meshset), as curvdetail remesh reports it, else None;
+        source.label the layer's label) with the new layer ids; a rebuild farther
         from the source than the zero-detail surface is said with a
         curvdetail.remesh.WorseThanZeroDetailWarning. {PAPER}, section "Remeshing", Fig. 3.
     """,
@@ -64,12 +69,12 @@ from .transfer_curvature_detail import planar_map
 )
 def generate_curvature_remeshing(ms, *, method, target_edge, transfer, rows, location,
                                  parameterization, backend, surface_check, evaluate, add_baseline):
-    from ..remesh import vertex_distance
     from ..remesh.experiment import run_experiment
 
     mid = layer_id(ms)
     V, F = mesh_arrays(ms, mid)
     label = get_mesh(ms, mid).label()
+    path = loaded_from(ms, mid)
     diagonal = bbox_diagonal(V)
     length = target_edge.resolve(diagonal)
     fraction = length / diagonal
@@ -80,7 +85,7 @@ def generate_curvature_remeshing(ms, *, method, target_edge, transfer, rows, loc
 
     result = run_experiment(V, F, method=method, target_edge=fraction, transfer=transfer, rows=rows,
                             location=location, parameterization=planar_map(location, parameterization),
-                            backend=backend, evaluate=evaluate, source_path=label, surface_check=surface_check,
+                            backend=backend, evaluate=evaluate, source_path=path, surface_check=surface_check,
                             progress=progress)
     Ft = result["Ft"]
     layers = {"source": mid,
@@ -88,13 +93,14 @@ def generate_curvature_remeshing(ms, *, method, target_edge, transfer, rows, loc
     # without evaluation the measured layers get no quality at all, not pymeshlab's zeros
     measured_layer = add_layer if evaluate else _add_layer_without_quality
     if add_baseline:
-        # per-vertex distances of the baseline only here, where they colour its layer (the
-        # experiment itself needs the Hausdorff figures only: 2-3 % of its time at 100k)
-        zero_distance = vertex_distance(result["Z"], V, F, far=True) if evaluate else None
-        layers["zero_detail"] = measured_layer(ms, result["Z"], Ft, f"{label} zero detail", quality=zero_distance)
+        # the distances the experiment measured for the baseline's Hausdorff maximum (None
+        # without evaluation)
+        layers["zero_detail"] = measured_layer(ms, result["Z"], Ft, f"{label} zero detail",
+                                               quality=result["zero_distance"])
     layers["rebuilt"] = measured_layer(ms, result["X"], Ft, f"{label} rebuilt", quality=result["distance"],
                                        attributes={DETAIL: result["Dt"], **stamp(Ft, result["X"].shape[0])})
     report = dict(result["report"])
+    report["source"] = {**report["source"], "label": label}
     report["layers"] = layers
     return report
 

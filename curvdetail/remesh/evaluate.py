@@ -3,7 +3,7 @@
 import numpy as np
 
 from ..curvature._validate import as_count, check_choice, as_faces, bbox_diagonal, check_bool, check_mesh, face_double_areas
-from ..curvature.errors import MeshError
+from ..curvature.errors import MeshError, first_indices
 from .locate import EXACT_BLOCK, FAR_POINTS, _locate, _unit_frame, check_points_and_mesh
 
 #: Largest ``samples`` (per direction), well below pymeshlab's 32-bit int: 5M took 35 s with
@@ -16,7 +16,7 @@ MAX_SAMPLE_COUNT = 10_000_000
 SAMPLES_PER_FACE, MIN_SAMPLES, MAX_SAMPLES = 10, 100_000, 1_000_000
 
 
-def hausdorff(Va, Fa, Vb, Fb, *, samples=None, engine="meshlab", seed=0):
+def hausdorff(Va, Fa, Vb, Fb, *, samples=None, engine="meshlab", seed=0, a_vertex_distance=None):
     """Two-sided Hausdorff distance (max) and RMS distance between two triangle meshes.
 
     The figures, each direction (a to b, then b to a) alike:
@@ -55,6 +55,11 @@ def hausdorff(Va, Fa, Vb, Fb, *, samples=None, engine="meshlab", seed=0):
     :func:`_surface_distance`): exact to rounding, at any distance. Both engines work in a
     frame where the two meshes together have unit size.
 
+    A caller that needs the distances of a's vertices anyway (a per-vertex quality, the largest
+    vertex error) measures them once with ``vertex_distance(Va, Vb, Fb, far=True)``, which
+    works in the same frame, and passes them as ``a_vertex_distance``: the figures are then bit
+    for bit those of a call without it, and a's vertices are not searched a second time.
+
     Parameters
     ----------
     Va, Fa, Vb, Fb : the two meshes ((n, 3) float, (m, 3) int)
@@ -65,6 +70,11 @@ def hausdorff(Va, Fa, Vb, Fb, *, samples=None, engine="meshlab", seed=0):
     engine : {"meshlab", "kdtree"}
     seed : int or None      random seed (>= 0) of the ``"kdtree"`` engine's samples (None: fresh
                             entropy, as numpy's ``default_rng``)
+    a_vertex_distance : (n_a,) float array or None
+                            the distance of each vertex of a to the surface b, measured already:
+                            ``vertex_distance(Va, Vb, Fb, far=True)``, used for ``a_to_b_max``
+                            instead of measuring them again (taken as given: other values give
+                            other maxima); None measures them here
 
     Returns
     -------
@@ -76,7 +86,8 @@ def hausdorff(Va, Fa, Vb, Fb, *, samples=None, engine="meshlab", seed=0):
     ------
     MeshError   malformed meshes; coordinates beyond 1e150 (see :func:`locate`)
     ValueError  unknown ``engine``; ``samples`` not a whole number from 1 to 10,000,000 (bools
-                refused); ``seed`` not a whole number >= 0
+                refused); ``seed`` not a whole number >= 0; ``a_vertex_distance`` not of shape
+                (n_a,), not real numbers, or with NaN, infinite or negative entries
 
     Examples
     --------
@@ -98,10 +109,43 @@ def hausdorff(Va, Fa, Vb, Fb, *, samples=None, engine="meshlab", seed=0):
     engine = check_choice(engine, "engine", ("meshlab", "kdtree"), "; use 'meshlab' or 'kdtree'.")
     samples = _check_samples(samples)
     seed = None if seed is None else as_count(seed, "seed", minimum=0)
+    given = _check_vertex_distance(a_vertex_distance, Va.shape[0])
     engine = "kdtree" if engine == "kdtree" or _apart(Va, Vb) else "meshlab"
-    figures = _hausdorff_kdtree(Va, Fa, Vb, Fb, samples, seed) if engine == "kdtree" else \
-        _hausdorff_meshlab(Va, Fa, Vb, Fb, samples)
-    return dict(_scaled(figures, scale), engine=engine)
+    measure = given is None
+    figures = _hausdorff_kdtree(Va, Fa, Vb, Fb, samples, seed, measure) if engine == "kdtree" else \
+        _hausdorff_meshlab(Va, Fa, Vb, Fb, samples, measure)
+    figures = _scaled(figures, scale)
+    if given is not None:
+        # after scaling: the given distances are absolute (scale * d in this frame, see
+        # vertex_distance), and rounding a product is monotonic, so the maxima come out as
+        # those of a call that measured the vertices here
+        figures["a_to_b_max"] = float(max(figures["a_to_b_max"], given.max()))
+        figures["max"] = float(max(figures["a_to_b_max"], figures["b_to_a_max"]))
+    return dict(figures, engine=engine)
+
+
+def _check_vertex_distance(d, n):
+    """``a_vertex_distance`` of :func:`hausdorff` as a (n,) float64 array (None stays None), or
+    ValueError saying what is wrong and what to pass."""
+    if d is None:
+        return None
+    fix = "pass vertex_distance(Va, Vb, Fb, far=True), or None to measure them here"
+    try:
+        arr = np.asarray(d)
+    except (TypeError, ValueError):             # ragged lists and the like
+        arr = np.asarray(None)
+    if arr.dtype == bool or arr.dtype.kind not in "fiu":
+        raise ValueError(f"a_vertex_distance has dtype {arr.dtype}; it must hold one distance (a real "
+                         f"number) per vertex of Va: {fix}.")
+    if arr.shape != (n,):
+        raise ValueError(f"a_vertex_distance has shape {arr.shape}, but Va has {n} vertices: it must hold one "
+                         f"distance per vertex, shape ({n},); {fix}.")
+    arr = arr.astype(np.float64)
+    bad = np.flatnonzero(~(arr >= 0) | ~np.isfinite(arr))
+    if bad.size:
+        raise ValueError(f"a_vertex_distance: {bad.size} of {n} entries are NaN, infinite or negative (first: "
+                         f"{first_indices(bad)}); distances are finite and >= 0: {fix}.")
+    return arr
 
 
 def _check_samples(samples):
@@ -135,7 +179,7 @@ def _sample_count(samples, F):
     return int(samples) if samples else int(np.clip(SAMPLES_PER_FACE * F.shape[0], MIN_SAMPLES, MAX_SAMPLES))
 
 
-def _hausdorff_meshlab(Va, Fa, Vb, Fb, samples):
+def _hausdorff_meshlab(Va, Fa, Vb, Fb, samples, measure_a=True):
     import pymeshlab
 
     ms = pymeshlab.MeshSet()
@@ -154,8 +198,8 @@ def _hausdorff_meshlab(Va, Fa, Vb, Fb, samples):
     rms = np.sqrt(0.5 * (out[0]["RMS"] ** 2 + out[1]["RMS"] ** 2))
     mean = 0.5 * (out[0]["mean"] + out[1]["mean"])
     # the maxima also over every vertex, measured exactly: face samples miss them, and a
-    # maximum sits at a vertex more often than not
-    ab = max(out[0]["max"], _surface_distance(Va, Vb, Fb).max())
+    # maximum sits at a vertex more often than not (a's: by the caller, if it measured them)
+    ab = max(out[0]["max"], _surface_distance(Va, Vb, Fb).max()) if measure_a else out[0]["max"]
     ba = max(out[1]["max"], _surface_distance(Vb, Va, Fa).max())
     return {"max": float(max(ab, ba)), "rms": float(rms), "mean": float(mean),
             "a_to_b_max": float(ab), "b_to_a_max": float(ba), "samples": int(n1 + n2)}
@@ -165,14 +209,19 @@ def vertex_distance(V, Vs, Fs, *, far=False):
     """Distance from each point of ``V`` (k, 3) to the closest point of the surface ``(Vs, Fs)``,
     shape (k,) (e.g. per-vertex error of a rebuilt mesh against its source).
 
-    Two searches. ``far=False``: :func:`locate`'s (pymeshlab's closest-face grid, exact; points
-    more than a diagonal from the mesh go to its numpy engine, whose candidates are certain only
-    where triangle sizes vary little), fastest near the surface but slowing down with the
-    distance without bound (22-27 s for mannequin_devil's 13k
-    vertices against its zero-detail surface, up to 0.68 diagonals away). ``far=True``: the
-    bounding-box tree search of :func:`hausdorff` (every triangle that could hold the closest
-    point: exact at any distance), whose cost grows far less with the distance (0.32 s there),
-    and which takes 2-3 times locate's near the surface (0.1-0.5 s for 6k-100k points).
+    Two searches. ``far=True``: the bounding-box tree search of :func:`hausdorff` (every
+    triangle that could hold the closest point: exact at any distance), in hausdorff's frame
+    (the points and the surface together of unit size), so that ``vertex_distance(Va, Vb, Fb,
+    far=True)`` is bit for bit what ``hausdorff(Va, Fa, Vb, Fb)`` measures for a's vertices
+    and can be passed to it as ``a_vertex_distance``; its cost grows little with the distance
+    (0.32 s for mannequin_devil's 13k vertices against its zero-detail surface, up to 0.68
+    diagonals away), and near the surface it takes 2-3 times locate's (0.1-0.5 s for 6k-100k
+    points). ``far=False``: :func:`locate`'s (pymeshlab's closest-face grid; points more than a
+    diagonal from the mesh go to its tree search), fastest near the surface but slowing down
+    with the distance without bound (22-27 s in the devil's case), and not always exact away
+    from the surface: the grid can return a face that is not the closest (a flat layer at the
+    height of a wavy one and reaching past its edge: up to 0.7 % of the diagonal too far).
+    Per-vertex figures that are written (a quality, a maximum) use ``far=True``.
 
     Parameters
     ----------
@@ -180,12 +229,14 @@ def vertex_distance(V, Vs, Fs, *, far=False):
                               (k, 2) with a planar ``Vs``
     Vs : (n, 3) float array   the surface's vertex positions ((n, 2) for planar points)
     Fs : (m, 3) int array     its triangles
-    far : bool                the tree search instead of locate's grid (see above)
+    far : bool                the tree search (exact) instead of locate's grid (see above)
 
     Returns
     -------
     d : (k,) float64 array    unsigned distances, in the unit of the coordinates (0, up to
-                              rounding, for a point on the surface), row i for ``V[i]``
+                              rounding, for a point on the surface), row i for ``V[i]``; with
+                              ``far=True`` rounded relative to the size of the points and the
+                              surface together (as :func:`hausdorff`'s)
 
     Raises
     ------
@@ -205,8 +256,11 @@ def vertex_distance(V, Vs, Fs, *, far=False):
     P, Vs, Fs = check_points_and_mesh(V, Vs, Fs, names=("V", "Vs", "Fs"))
     if not far:
         return _locate(P, Vs, Fs)[2]
-    P, Vs, scale = _unit_frame(P, Vs)
-    return scale * _surface_distance(P, Vs, Fs)
+    # hausdorff's frame, where the points (its Va) and the surface together have unit size: the
+    # same coordinates, so the same distances to the last bit
+    both = np.vstack([P, Vs])
+    _, both, scale = _unit_frame(both[:0], both)
+    return scale * _surface_distance(both[:P.shape[0]], both[P.shape[0]:], Fs)
 
 
 def _area_samples(V, F, n, rng):
@@ -463,14 +517,14 @@ def _descend(tree, Q, bound, cap_levels=None):
             node[1::2] += 1
 
 
-def _hausdorff_kdtree(Va, Fa, Vb, Fb, samples, seed):
+def _hausdorff_kdtree(Va, Fa, Vb, Fb, samples, seed, measure_a=True):
     rng = np.random.default_rng(seed)
     out = []
-    for (V1, F1), (V2, F2) in (((Va, Fa), (Vb, Fb)), ((Vb, Fb), (Va, Fa))):
+    for (V1, F1), (V2, F2), vertices in (((Va, Fa), (Vb, Fb), measure_a), ((Vb, Fb), (Va, Fa), True)):
         n = _sample_count(samples, F1)
         P, _ = _area_samples(V1, F1, n, rng)
-        d = _surface_distance(np.vstack([P, V1]), V2, F2)
-        out.append((d[:n], d[n:].max()))
+        d = _surface_distance(np.vstack([P, V1]) if vertices else P, V2, F2)
+        out.append((d[:n], d[n:].max() if vertices else -np.inf))
     (d1, v1), (d2, v2) = out
     rms = np.sqrt(0.5 * ((d1 ** 2).mean() + (d2 ** 2).mean()))
     ab, ba = max(d1.max(), v1), max(d2.max(), v2)

@@ -37,6 +37,17 @@ FAR_SURFACE = 0.02
 #: retriangulate() puts them within 1e-12.
 TARGET_BOUNDARY_TOLERANCE = 1e-6
 
+#: RMS distances (fractions of the source's bbox diagonal) below which a figure is rounding, not
+#: a measurement, by the engine that measured it (see :func:`hausdorff`): pymeshlab's works in
+#: single precision (a flat square against its retriangulation: RMS 3e-11 to 1.6e-10, max up
+#: to 5e-8, where the distances are 0), the kd-tree engine in double (1e-17 to 1e-16). On a
+#: flat patch the rebuilt, zero-detail and retriangulated surfaces all lie on the source, and a
+#: ratio of two such figures is noise (on those squares the improvement over zero detail came
+#: out 0 to 7e-6 and the ratio to the floor 0.3 to 1.3; with a divisor of exactly 0, clamped to
+#: 1e-300, up to ~1e284). The report's ratios with such a figure are None, with the reason in
+#: ``ratio_notes``; a rebuild that close is never said to be worse than zero detail.
+ROUNDING_RMS = {"meshlab": 1e-7, "kdtree": 1e-12}
+
 STAGES = ("retriangulate", "parameterize", "transfer", "reconstruct", "evaluate")
 
 DEFAULTS = {"method": "isotropic", "target_edge": 0.01, "transfer": "conservative", "rows": "free",
@@ -61,13 +72,14 @@ def _option(name, value, cli):
 def worse_than_zero_detail(report, cli=False):
     """The message of a :class:`WorseThanZeroDetailWarning` for an evaluated ``report`` of
     :func:`remesh_experiment`, or None where the rebuild is no farther from the source than the
-    zero-detail surface (RMS) or was not measured. ``cli``: naming the options of ``curvdetail
-    remesh`` instead of the function's parameters."""
+    zero-detail surface (RMS), lies on the source to rounding (RMS below its engine's
+    ``ROUNDING_RMS``) or was not measured. ``cli``: naming the options of ``curvdetail remesh``
+    instead of the function's parameters."""
     if "error" not in report or "baseline_zero_detail" not in report:
         return None
     rms, zero = report["error"]["hausdorff_rms"], report["baseline_zero_detail"]["hausdorff_rms"]
-    if not rms > zero:
-        return None
+    if not (rms > zero and rms >= ROUNDING_RMS[report["error"].get("engine", "kdtree")]):
+        return None                                 # not worse, or rounding (a flat patch)
     options = report.get("options", {})
     tries = []
     if options.get("transfer") == "pointwise":
@@ -151,8 +163,13 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="c
         ``target.{vertices, faces, boundary_vertices}``, ``options``, ``error``,
         ``baseline_zero_detail`` and ``floor_retriangulated`` (each ``{hausdorff_max, hausdorff_rms}``
         as fractions of the source bbox diagonal; ``error`` also has ``vertex_max``, the largest
-        distance of a rebuilt vertex to the source),
-        ``improvement_over_zero_detail`` (RMS ratio), ``ratio_to_floor`` (RMS ratio),
+        distance of a rebuilt vertex to the source, exact),
+        ``improvement_over_zero_detail`` (zero-detail RMS / error RMS) and ``ratio_to_floor``
+        (error RMS / floor RMS), each None where one of its two RMS values is rounding, not a
+        measurement (below ``ROUNDING_RMS``: 1e-7 of the diagonal as pymeshlab's single-precision
+        engine measures, 1e-12 as the kd-tree engine does; e.g. every surface of a flat patch, or
+        a target equal to the source), with the reason under ``ratio_notes``
+        (``{ratio name: reason}``, present only then),
         ``parameterization`` (flip counts, for ``location="uv"``) and
         ``seconds.{retriangulate, parameterize, transfer, reconstruct, evaluate, total}``.
         With ``evaluate=False`` the measured keys (``error``, ``baseline_zero_detail``,
@@ -175,8 +192,10 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="c
     Warns
     -----
     WorseThanZeroDetailWarning   the rebuild is farther from the source than the zero-detail
-                                 surface (RMS; ``improvement_over_zero_detail`` below 1): the
-                                 configuration failed on this patch; the message says what to try
+                                 surface (RMS; ``improvement_over_zero_detail`` below 1, or None
+                                 where the zero-detail surface lies on the source to rounding),
+                                 and farther than rounding: the configuration failed on this
+                                 patch; the message says what to try
 
     Examples
     --------
@@ -219,6 +238,40 @@ def _check_target_boundary(P, X, d):
             "curvdetail.remesh.retriangulate, or target=None to make it here.")
 
 
+def _ratios(report, engines):
+    """``improvement_over_zero_detail`` and ``ratio_to_floor`` of a measured ``report``, each
+    None where one of its RMS figures is below the ``ROUNDING_RMS`` of the engine that measured
+    it (``engines``: figure key -> engine), and ``ratio_notes`` saying why, where one is None."""
+    def rounding(key, what, then):
+        rms = report[key]["hausdorff_rms"]
+        floor = ROUNDING_RMS[engines[key]]
+        if rms >= floor:
+            return None
+        return (f"{what} lies on the source to rounding (RMS {rms:.3g} of the bbox diagonal, below the "
+                f"{floor:g} its {engines[key]} engine resolves): {then}")
+
+    out, notes = {}, {}
+    rebuilt = "the rebuilt surface"
+    for name, top, bottom, reasons in (
+            ("improvement_over_zero_detail", "baseline_zero_detail", "error",
+             (("baseline_zero_detail", "the zero-detail surface", "the source has no detail to carry over "
+               "(e.g. a flat patch), so there is nothing to improve on"),
+              ("error", rebuilt, "the ratio would divide by rounding noise"))),
+            ("ratio_to_floor", "error", "floor_retriangulated",
+             (("floor_retriangulated", "the retriangulated surface", "there is no floor to compare with "
+               "(e.g. a flat patch, or a target equal to the source)"),
+              ("error", rebuilt, "the ratio would be one of rounding noise")))):
+        reason = next(filter(None, (rounding(*r) for r in reasons)), None)
+        if reason is None:
+            out[name] = report[top]["hausdorff_rms"] / report[bottom]["hausdorff_rms"]
+        else:
+            out[name] = None
+            notes[name] = reason
+    if notes:
+        out["ratio_notes"] = notes
+    return out
+
+
 def _check_choice(name, value, choices):
     if value not in choices:
         raise ValueError(f"{name}={value!r} is not one of {', '.join(map(repr, choices))}.")
@@ -228,8 +281,9 @@ def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="cons
                    location="closest", parameterization=None, backend="auto", evaluate=True,
                    source_path=None, progress=None, target=None, surface_check=True):
     """:func:`remesh_experiment` returning everything as a dict: ``X``, ``Ft``, ``Vt`` (the
-    retriangulated surface), ``Z`` (zero-detail baseline), ``Dt``, ``distance`` (per rebuilt
-    vertex to the source; None when ``evaluate=False``) and ``report``."""
+    retriangulated surface), ``Z`` (zero-detail baseline), ``Dt``, ``distance`` and
+    ``zero_distance`` (the exact distance of each vertex of ``X``, of ``Z``, to the source: the
+    ones the Hausdorff maxima are taken over; None when ``evaluate=False``) and ``report``."""
     _check_choice("method", method, RETRIANGULATIONS)
     _check_choice("transfer", transfer, TRANSFERS)
     _check_choice("rows", rows, ROW_MODES)
@@ -312,23 +366,29 @@ def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="cons
     }
     if param_info is not None:
         report["parameterization"] = param_info
-    out = {"X": X, "Ft": Ft, "Vt": Vt, "Z": Z, "Dt": Dt, "distance": None}
+    out = {"X": X, "Ft": Ft, "Vt": Vt, "Z": Z, "Dt": Dt, "distance": None, "zero_distance": None}
     if evaluate:
         t = stage("evaluate")
-        out["distance"] = vertex_distance(X, V, F)
+        # each vertex set searched once, exactly (the tree search, at any distance: pymeshlab's
+        # grid may miss the closest face away from the source): these distances are the
+        # per-vertex figures (quality, vertex_max) and hausdorff takes them for its maxima, in
+        # its own frame, so its figures are those it would measure itself
+        out["distance"] = vertex_distance(X, V, F, far=True)
+        out["zero_distance"] = vertex_distance(Z, V, F, far=True)
         # pymeshlab's grid search slows down with the cube of the distance: surfaces that are
         # far apart (a failed rebuild, the zero-detail baseline) use the kd-tree engine.
         far = out["distance"].max() > FAR_SURFACE * d
-        for key, P, n, engine in (("error", X, None, "kdtree" if far else "meshlab"),
-                                  ("baseline_zero_detail", Z, BASELINE_SAMPLES, "kdtree"),
-                                  ("floor_retriangulated", Vt, None, "meshlab")):
-            h = hausdorff(P, Ft, V, F, samples=n, engine=engine)
+        engines = {}
+        for key, P, dist, n, engine in (
+                ("error", X, out["distance"], None, "kdtree" if far else "meshlab"),
+                ("baseline_zero_detail", Z, out["zero_distance"], BASELINE_SAMPLES, "kdtree"),
+                ("floor_retriangulated", Vt, vertex_distance(Vt, V, F, far=True), None, "meshlab")):
+            h = hausdorff(P, Ft, V, F, samples=n, engine=engine, a_vertex_distance=dist)
             report[key] = {"hausdorff_max": h["max"] / d, "hausdorff_rms": h["rms"] / d}
+            engines[key] = h["engine"]
         report["error"]["engine"] = "kdtree" if far else "meshlab"
         report["error"]["vertex_max"] = float(out["distance"].max() / d)
-        rms = report["error"]["hausdorff_rms"]
-        report["improvement_over_zero_detail"] = report["baseline_zero_detail"]["hausdorff_rms"] / max(rms, 1e-300)
-        report["ratio_to_floor"] = rms / max(report["floor_retriangulated"]["hausdorff_rms"], 1e-300)
+        report.update(_ratios(report, engines))
         seconds["evaluate"] = time.perf_counter() - t
         worse = worse_than_zero_detail(report)
         if worse is not None:
