@@ -11,8 +11,9 @@ further corners; OFF face rows beyond the header's count are dropped, and a deci
 an OFF or OBJ number (``1,5`` -> 1). Its OFF and OBJ coordinates are read with atof, which takes
 any text for a number without a word: up to the first character that does not fit (``0.3abc`` ->
 0.3, ``abc`` and ``-`` -> 0, ``1d3`` -> 1), and C's hexadecimal floats too (``0x10`` -> 16).
-PLY files are scanned by :mod:`._ply_scan`. The scans read the file once more, vectorized over
-its bytes.
+PLY files are scanned by :mod:`._ply_scan`, OpenCTM files (whose reader crashes on some
+layouts) by :mod:`._ctm_scan`. The scans read the file once more, vectorized over its bytes
+(CTM: its header and the names of its maps only).
 """
 
 import contextlib
@@ -23,6 +24,7 @@ import re
 
 import numpy as np
 
+from ._ctm_scan import ctm_problem
 from ._file_counts import _off_header, _whole
 from ._ply_scan import _ply_problem
 
@@ -63,6 +65,11 @@ def check_before_loading(path, error=ValueError):
     rows than the header declares; rows split over lines that hold exactly their values (not
     faces), blank lines, comments in the header, other elements and properties pass.
 
+    CTM (:func:`curvdetail._ctm_scan.ctm_problem`): a vertex attribute map named "Quality" with
+    none named "Color", or a map without a name that the reader's look-up of either reaches (each
+    crashed the process), a file shorter than its sections (RAW: the rest was read from whatever
+    memory held), and counts whose arrays OpenCTM sizes past 32 bits.
+
     Other files pass unread. Returns the number of triangles an ASCII PLY file's faces make (a
     polygon of k vertices k - 2; pymeshlab drops faces with a repeated index or the 'deleted'
     flag bit, which the caller finds by comparing), else None."""
@@ -78,6 +85,10 @@ def check_before_loading(path, error=ValueError):
         problem = _off_rows_problem(path)
         if problem:
             raise error(f"{path!r}: {problem}; fix the file and read it again.")
+    elif extension == ".ctm":
+        problem = ctm_problem(path)
+        if problem:
+            raise error(f"{path!r}: {problem}.")
     elif extension == ".ply":
         problem, triangles = _ply_problem(path)
         if problem:

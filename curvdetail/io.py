@@ -10,6 +10,7 @@ import re
 
 import numpy as np
 
+from ._ctm_scan import ctm_problem
 from ._file_counts import check_loaded
 from ._file_scan import check_before_loading
 from ._output import atomic_output, check_output_path
@@ -66,8 +67,10 @@ def read_mesh(path):
                         misparses or crashes on, or face lists of types it does not read;
                         ASCII PLY values it would not read whole as their type, faces of
                         fewer than 3 or more than 255 vertices, a face row not on a line of
-                        its own, rows with values missing or extra (see
-                        :func:`curvdetail._file_scan.check_before_loading`)
+                        its own, rows with values missing or extra; CTM files with a
+                        "Quality" map but no "Color" map or a map without a name (its CTM
+                        reader crashed the process on each), or shorter than their sections
+                        (see :func:`curvdetail._file_scan.check_before_loading`)
 
     Examples
     --------
@@ -405,7 +408,8 @@ def write_mesh(path, V, F, *, quality=None, overwrite=False):
     V : (n, 3) float array      vertex positions
     F : (m, 3) int array        triangles
     quality : (n,) float array or None   per-vertex quality (saved where the format holds it,
-                                          e.g. PLY; MeshLab colours meshes by it)
+                                          e.g. PLY; MeshLab colours meshes by it); refused for
+                                          CTM, whose quality pymeshlab cannot read back
     overwrite : bool            replace an existing file; by default an existing file is refused
 
     Raises
@@ -421,7 +425,10 @@ def write_mesh(path, V, F, *, quality=None, overwrite=False):
                       bounding-box diagonal: refused); OFF 16 significant digits (refused more
                       than about 2e6 diagonals from the origin); STL, 3DS, CTM, COLLADA, VRML,
                       X3D, JSON single precision (refused where a coordinate overflows, above
-                      3.4e38, or the mesh underflows it)
+                      3.4e38, or the mesh underflows it); ``quality`` with a .ctm path:
+                      pymeshlab's CTM reader reads the quality from the colour map, and
+                      crashed where there is none (without quality, a CTM file is written
+                      with neither, which it reads)
 
     Examples
     --------
@@ -442,6 +449,10 @@ def write_mesh(path, V, F, *, quality=None, overwrite=False):
     import pymeshlab
 
     check_mesh_output(path, overwrite)
+    extension = os.path.splitext(os.fspath(path))[1].lower()
+    if quality is not None and extension == ".ctm":
+        raise MeshFileError(f"cannot write {os.fspath(path)!r} with quality: {_CTM_QUALITY}; write {_SAFE} to keep "
+                            "the quality, or pass quality=None to write the CTM file without it.")
     V = as_vertices(V)
     F = as_faces(F, V.shape[0])
     kwargs = {}
@@ -461,15 +472,27 @@ def write_mesh(path, V, F, *, quality=None, overwrite=False):
     # geometry (and quality) only: pymeshlab would add its default white colours and computed
     # normals, and its OFF writer then says NCOFF, a header libigl's readOFF refuses; and its
     # meshes always carry a quality, which without ours would be written as zeros (in MeshLab:
-    # zero error everywhere)
-    no_quality = quality is None and os.path.splitext(os.fspath(path))[1].lower() == ".ply"
+    # zero error everywhere), and in CTM without colours would crash its reader
+    no_quality = quality is None and extension in (".ply", ".ctm")
     plain = dict(_PLAIN_OPTIONS, **({"save_vertex_quality": False} if no_quality else {}))
     save_mesh(path, mesh, overwrite=overwrite, _plain=plain)
 
 
 #: What :func:`write_mesh` turns off where the format has the option (pymeshlab refuses an
-#: option the format lacks, e.g. ``save_vertex_normal`` for VRML).
+#: option the format lacks, e.g. ``save_vertex_normal`` for VRML). Not for .3ds, whose face
+#: colours :func:`save_mesh` keeps (see :data:`_3DS_FACE_COLOURS`).
 _PLAIN_OPTIONS = {"save_vertex_color": False, "save_vertex_normal": False, "save_face_color": False}
+
+#: Why pymeshlab cannot read a CTM file's quality back (vcglib's ImporterCTM reads it from the
+#: "Color" map): tried on RAW, MG1 and MG2 files; see :mod:`curvdetail._ctm_scan`.
+_CTM_QUALITY = ("pymeshlab's CTM reader reads a file's quality from its colour map: where there is none it crashes "
+                "the process (segmentation fault), and where there is one it reads the colours' red channel as "
+                "the quality (MeshLab uses the same reader)")
+#: Why .3ds files are written with face colours: without them pymeshlab's 3DS writer leaves each
+#: face's material name unset and writes whatever its stack held there (a stack address, a
+#: different name in every process), so no two writes were alike.
+_3DS_FACE_COLOURS = ("pymeshlab's 3DS writer names each face's material from uninitialised memory where face colours "
+                     "are not saved (a different name in every process)")
 
 
 def save_mesh(path, mesh, *, overwrite=False, _plain=None, **save_options):
@@ -492,7 +515,13 @@ def save_mesh(path, mesh, *, overwrite=False, _plain=None, **save_options):
     overwrite : bool            replace an existing file (refused by default)
     **save_options              passed to ``MeshSet.save_current_mesh`` (e.g. ``binary=False``);
                                 for PLY, ``save_vertex_quality`` defaults to True when the mesh
-                                has vertex quality; for CTM, ``lossless`` to True
+                                has vertex quality; for CTM, ``lossless`` to True, and
+                                ``save_vertex_quality`` to False where no vertex colours are
+                                saved (pymeshlab's CTM reader crashes on quality without
+                                colours; with colours it reads their red channel as the
+                                quality); for 3DS, ``save_face_color`` is True (faces without
+                                a colour are given white: without face colours pymeshlab's
+                                writer names the faces' material from uninitialised memory)
 
     Raises
     ------
@@ -502,7 +531,10 @@ def save_mesh(path, mesh, *, overwrite=False, _plain=None, **save_options):
                       that asks for a custom attribute (``__ca_...``), or coordinates the format
                       (with ``binary``, ``lossless``) cannot hold: :func:`check_coordinates`,
                       before anything is written. For CTM ``lossless`` defaults to True
-                      (pymeshlab's default compresses the coordinates to a grid)
+                      (pymeshlab's default compresses the coordinates to a grid). CTM with
+                      ``save_vertex_quality=True`` and no colours saved, 3DS with
+                      ``save_face_color=False`` (see above), and a written CTM file that
+                      :func:`read_mesh` would refuse (checked before it replaces ``path``)
 
     Examples
     --------
@@ -526,11 +558,25 @@ def save_mesh(path, mesh, *, overwrite=False, _plain=None, **save_options):
         options.setdefault("save_vertex_quality", True)
     if extension == ".ctm":
         options.setdefault("lossless", True)     # pymeshlab's default compresses the coordinates
+        colours = mesh.has_vertex_color() and options.get("save_vertex_color", plain.get("save_vertex_color", True))
+        if not colours and mesh.has_vertex_scalar():
+            if options.get("save_vertex_quality"):
+                raise MeshFileError(f"cannot write {os.fspath(path)!r} with save_vertex_quality=True and no vertex "
+                                    f"colours: {_CTM_QUALITY}; save the colours too, or write {_SAFE}.")
+            options["save_vertex_quality"] = False
+    if extension == ".3ds":
+        if options.get("save_face_color", True) is False:
+            raise MeshFileError(f"cannot write {os.fspath(path)!r} with save_face_color=False: {_3DS_FACE_COLOURS}; "
+                                "leave save_face_color on.")
+        options["save_face_color"] = True
+        plain = {k: v for k, v in plain.items() if k != "save_face_color"}
     check_coordinates(path, mesh.vertex_matrix(), **options)
     # the temporary file keeps path's extension: pymeshlab picks the format from it
     with atomic_output(path, overwrite=overwrite, error=MeshFileError) as tmp:
         ms = _meshset()
-        ms.add_mesh(mesh)
+        ms.add_mesh(mesh)                        # a copy: the caller's mesh is not changed
+        if extension == ".3ds" and not ms.current_mesh().has_face_color():
+            ms.compute_color_by_function_per_face(r="255", g="255", b="255", a="255")     # white
         try:
             _save(ms, tmp, options, plain)
         except Exception as exc:
@@ -539,6 +585,10 @@ def save_mesh(path, mesh, *, overwrite=False, _plain=None, **save_options):
         if os.path.getsize(tmp) == 0:
             raise MeshFileError(f"could not write {os.fspath(path)!r}: pymeshlab reported success but wrote "
                                 f"nothing; {_MESH_HINT}")
+        problem = ctm_problem(tmp) if extension == ".ctm" else None
+        if problem:                              # what the options above should have kept out
+            raise MeshFileError(f"could not write {os.fspath(path)!r}: pymeshlab wrote a CTM file that read_mesh "
+                                f"refuses ({problem}); write {_SAFE}.")
 
 
 def _save(ms, path, options, optional):

@@ -585,3 +585,22 @@ def test_obj_backslashes_pymeshlab_reads_right_pass(tmp_path, text, triangles):
     V, F = read_mesh(path)
     assert F.tolist() == triangles
     assert V[:3].tolist() == [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
+
+
+def test_ctm_files_are_scanned_whatever_the_case_of_their_extension(tmp_path):
+    # a RAW OpenCTM file of one triangle with a "Quality" map and no "Color" map: pymeshlab's CTM
+    # reader crashed on it (the scan itself is tested in test_ctm_scan.py)
+    import struct
+
+    def string(text):
+        return struct.pack("<I", len(text)) + text
+
+    data = (b"OCTM" + struct.pack("<I", 5) + b"RAW\0" + struct.pack("<5I", 3, 1, 0, 1, 0) + string(b"")
+            + b"INDX" + struct.pack("<3I", 0, 1, 2) + b"VERT" + np.eye(3, dtype="<f4").tobytes()
+            + b"ATTR" + string(b"Quality") + np.zeros((3, 4), "<f4").tobytes())
+    for name in ("m.ctm", "M.CTM"):
+        (tmp_path / name).write_bytes(data)
+        with pytest.raises(ValueError, match=r"it holds a vertex attribute map named 'Quality' but none named 'Color'"):
+            check_before_loading(str(tmp_path / name))
+    (tmp_path / "ok.ctm").write_bytes(data.replace(b"Quality", b"Color\0\0"))
+    assert check_before_loading(str(tmp_path / "ok.ctm")) is None

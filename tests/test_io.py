@@ -1,5 +1,6 @@
 """read_mesh / write_mesh / save_mesh: round trips per format, overwrite refusal, atomic writes."""
 
+import json
 import re
 import os
 import stat
@@ -716,6 +717,140 @@ def test_ctm_is_written_lossless_and_its_lossy_compression_refused(tmp_path):
     with pytest.raises(MeshFileError, match=r"with lossless=False pymeshlab's CTM writer compresses the coordinates"):
         save_mesh(tmp_path / "lossy.ctm", pymeshlab.Mesh(vertex_matrix=V, face_matrix=F.astype(np.int32)),
                   lossless=False)
+
+
+def _triangles(F):
+    """The triangles as a sorted list, each from its least corner (orientation kept): how MG1
+    stores them."""
+    return sorted(tuple(np.roll(t, -int(np.argmin(t)))) for t in np.asarray(F).tolist())
+
+
+_CTM_ROUND_TRIP = """
+import json, sys
+import numpy as np
+from curvdetail import read_mesh, write_mesh
+from curvdetail.curvature.testing import icosphere
+V, F = icosphere(subdivisions=2)
+write_mesh(sys.argv[1], V, F)
+W, G = read_mesh(sys.argv[1])
+print(json.dumps({"V": W.tolist(), "F": G.tolist()}))
+"""
+
+
+def test_ctm_written_by_write_mesh_is_read_back(tmp_path):
+    # write_mesh turned colours off, and pymeshlab's meshes always carry a quality: the file held a
+    # "Quality" map and no "Color" one, on which pymeshlab's CTM reader crashed the process every
+    # time. In a child process: that crash would end this one.
+    path = tmp_path / "m.ctm"
+    done = subprocess.run([sys.executable, "-c", _CTM_ROUND_TRIP, str(path)], capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 0, (done.returncode, done.stderr[-2000:])
+    back = json.loads(done.stdout)
+    V, F = icosphere(subdivisions=2)
+    # lossless CTM (MG1) keeps the float32 values and the vertex order exactly; it stores each
+    # triangle from its least corner, sorted
+    assert np.array_equal(back["V"], V.astype(np.float32).astype(np.float64))
+    assert _triangles(back["F"]) == _triangles(F)
+    from curvdetail._ctm_scan import ctm_layout
+
+    assert ctm_layout(path)["attribute_maps"] == []                      # neither colours nor quality
+
+
+def test_ctm_with_quality_is_refused_since_pymeshlab_cannot_read_it_back(tmp_path):
+    V, F = icosphere(subdivisions=1)
+    with pytest.raises(MeshFileError, match=r"cannot write .*m\.ctm' with quality: pymeshlab's CTM reader reads a "
+                                            r"file's quality from its colour map: where there is none it crashes the "
+                                            r"process .*; write \.ply \(binary: .*\) to keep the quality, or pass "
+                                            r"quality=None"):
+        write_mesh(tmp_path / "m.ctm", V, F, quality=V[:, 2])
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_save_mesh_writes_no_ctm_quality_without_colours(tmp_path):
+    # the layout pymeshlab's reader crashes on: quality without colours. Defaults write both (read
+    # back, the quality as the colours' red channel), no colours writes neither, and asking for
+    # the quality without colours is refused.
+    from curvdetail._ctm_scan import ctm_layout
+
+    V, F = icosphere(subdivisions=1)
+    mesh = pymeshlab.Mesh(vertex_matrix=V, face_matrix=F.astype(np.int32), v_scalar_array=V[:, 0])
+    save_mesh(tmp_path / "both.ctm", mesh)
+    assert ctm_layout(tmp_path / "both.ctm")["attribute_maps"] == [b"Color", b"Quality"]
+    save_mesh(tmp_path / "plain.ctm", mesh, save_vertex_color=False)
+    assert ctm_layout(tmp_path / "plain.ctm")["attribute_maps"] == []
+    with pytest.raises(MeshFileError, match=r"with save_vertex_quality=True and no vertex colours: pymeshlab's CTM "
+                                            r"reader reads a file's quality from its colour map"):
+        save_mesh(tmp_path / "q.ctm", mesh, save_vertex_color=False, save_vertex_quality=True)
+    assert not (tmp_path / "q.ctm").exists()
+
+
+_CTM_CRASH = """
+import sys
+import numpy as np, pymeshlab
+from curvdetail.io import read_mesh, MeshFileError
+from curvdetail.filters.files import load_meshset
+from curvdetail.curvature.testing import icosphere
+V, F = icosphere(subdivisions=1)
+for name, lossless in (("mg1.ctm", True), ("mg2.ctm", False)):
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(V, F.astype(np.int32)))
+    path = sys.argv[1] + "/" + name
+    ms.save_current_mesh(path, lossless=lossless, save_vertex_color=False)      # quality, no colours
+    for read in (read_mesh, load_meshset):
+        try:
+            read(path)
+        except MeshFileError as exc:
+            print(exc)
+"""
+
+
+def test_ctm_files_that_crash_pymeshlab_are_refused_before_it_reads_them(tmp_path):
+    # pymeshlab's own CTM writer makes such files (save_vertex_color=False); its reader then
+    # crashed the process: read_mesh and the filters' loader refuse them unread
+    done = subprocess.run([sys.executable, "-c", _CTM_CRASH, str(tmp_path)], capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 0, (done.returncode, done.stderr[-2000:])
+    lines = done.stdout.splitlines()
+    assert len(lines) == 4 and all("it holds a vertex attribute map named 'Quality' but none named 'Color'" in line
+                                   and "crashes the process (segmentation fault" in line for line in lines), lines
+
+
+_3DS_WRITES = """
+import sys
+import numpy as np, pymeshlab
+from curvdetail.io import save_mesh, write_mesh
+from curvdetail.curvature.testing import icosphere
+V, F = icosphere(subdivisions=1)
+write_mesh(sys.argv[1] + "/w.3ds", V, F)
+mesh = pymeshlab.Mesh(vertex_matrix=V, face_matrix=F.astype(np.int32))
+save_mesh(sys.argv[1] + "/s.3ds", mesh)
+assert not mesh.has_face_color()                                    # the caller's mesh is left alone
+"""
+
+
+def test_3ds_files_are_the_same_in_every_process(tmp_path):
+    # without face colours pymeshlab's 3DS writer named the faces' material from uninitialised
+    # stack memory (a stack address: different in every process); two processes, as two runs
+    folders = [tmp_path / "a", tmp_path / "b"]
+    for folder in folders:
+        folder.mkdir()
+        done = subprocess.run([sys.executable, "-c", _3DS_WRITES, str(folder)], capture_output=True, text=True,
+                              timeout=120)
+        assert done.returncode == 0, done.stderr[-2000:]
+    for name in ("w.3ds", "s.3ds"):
+        assert (folders[0] / name).read_bytes() == (folders[1] / name).read_bytes(), name
+    V, F = icosphere(subdivisions=1)
+    W, G = read_mesh(folders[0] / "w.3ds")
+    assert np.array_equal(W, V.astype(np.float32).astype(np.float64)) and np.array_equal(G, F)
+
+
+def test_3ds_without_face_colours_is_refused(tmp_path):
+    V, F = icosphere(subdivisions=1)
+    with pytest.raises(MeshFileError, match=r"with save_face_color=False: pymeshlab's 3DS writer names each face's "
+                                            r"material from uninitialised memory"):
+        save_mesh(tmp_path / "m.3ds", pymeshlab.Mesh(vertex_matrix=V, face_matrix=F.astype(np.int32)),
+                  save_face_color=False)
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_u3d_is_refused_since_pymeshlab_writes_no_file(tmp_path):
