@@ -1,13 +1,16 @@
 """apply_curvature_editing: handles land on the transform, the unselected part stays, errors."""
 
 import os
+import warnings
 
 import numpy as np
 import pymeshlab
 import pytest
 
 from curvdetail import ConstraintError
+from curvdetail.curvature.errors import FoldedTrianglesWarning
 from curvdetail.filters import BBoxLength, FilterParameterError, apply, get_filter
+from curvdetail.filters.editing import AMPLIFICATION_LIMIT, AmplifiedEditWarning
 
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
 
@@ -49,10 +52,219 @@ def test_handles_follow_the_transform_and_unselected_vertices_stay():
 
 def test_amplification_is_none_where_the_handles_do_not_move():
     # a pure detail edit moves the region but not the handles: the ratio was reported as 1.0, and
-    # rounding noise with move_handles=false as 3.4 (above the CLI's warning threshold)
+    # rounding noise with move_handles=false as 3.4 (above the CLI's warning threshold);
+    # one+two-ring relations: the one-ring ones fold 6 triangles here (see the fold test below)
     ms, V, d, handles = _meshset_with_roi()
-    figures = apply(ms, "apply_curvature_editing", handles=" ".join(map(str, handles)), detail_scale=0.5)
+    figures = apply(ms, "apply_curvature_editing", handles=" ".join(map(str, handles)), detail_scale=0.5,
+                    relations="one+two-ring")
     assert figures["amplification"] is None and figures["max_displacement"] > 1e-3
+
+
+def test_a_detail_edit_reports_its_amplification_in_the_details():
+    # amplification was None for every detail edit, blown up or not; detail_amplification is the
+    # largest detail change over the largest the edit asks (the handles' change applied to every
+    # region vertex): measured 0.19 here with one+two-ring, 0.97 with one-ring. With
+    # move_handles=false the handles' motion is an outcome, not the edit: no ratio to it
+    ms, V, d, handles = _meshset_with_roi()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")                      # nothing folds or is amplified
+        figures = apply(ms, "apply_curvature_editing", handles=handles, detail_scale=0.5,
+                        move_handles=False, relations="one+two-ring")
+    assert figures["amplification"] is None
+    assert 0.05 < figures["detail_amplification"] < 1.0
+    assert figures["folded_triangles"] == 0
+    # a translation asks no detail change
+    ms, *_ = _meshset_with_roi()
+    figures = apply(ms, "apply_curvature_editing", handles=handles, transform="1 0 0 0 0 1 0 0 0 0 1 0.02 0 0 0 1")
+    assert figures["detail_amplification"] is None and figures["amplification"] == pytest.approx(1.0, abs=0.05)
+
+
+def _folded(V, X, F):
+    """Triangles whose normal in X points against the rest normal (an untransformed edit)."""
+    def normals(Y):
+        return np.cross(Y[F[:, 1]] - Y[F[:, 0]], Y[F[:, 2]] - Y[F[:, 0]])
+    return int(np.count_nonzero(np.einsum("ij,ij->i", normals(V), normals(X)) < 0))
+
+
+def test_a_detail_edit_that_folds_triangles_warns_with_the_count_and_what_to_try():
+    # the handles' details doubled on the ear with the paper's one-ring relations fold 201 of 2403
+    # triangles; the filter said nothing (amplification None, "the handles do not move")
+    ms, V, d, handles = _meshset_with_roi()
+    F = ms.current_mesh().face_matrix()
+    with pytest.warns(FoldedTrianglesWarning, match=r"apply_curvature_editing with relations='one-ring': "
+                                                    r"\d+ triangles of 2403 folded over .*first: \d+, \d+, \d+\).*"
+                                                    r"try relations='one\+two-ring', more handles, a "
+                                                    r"detail_scale closer to 1 or a larger region") as record:
+        figures = apply(ms, "apply_curvature_editing", handles=handles, detail_scale=2.0)
+    X = ms.current_mesh().vertex_matrix()
+    assert figures["folded_triangles"] == _folded(V, X, F) > 100
+    assert f"{figures['folded_triangles']} triangles of 2403" in str(record[0].message)
+    assert record[0].filename == __file__                   # the caller's line, not the package's
+    # the advice works: one+two-ring folds nothing and says nothing
+    ms, *_ = _meshset_with_roi()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        figures = apply(ms, "apply_curvature_editing", handles=handles, detail_scale=2.0, relations="one+two-ring")
+    assert figures["folded_triangles"] == _folded(V, ms.current_mesh().vertex_matrix(), F) == 0
+
+
+def test_a_region_turned_with_the_handles_counts_no_folded_triangle():
+    # the end of a strip turned by 2 rad (115 degrees) about y: 378 of its triangles face away from
+    # their rest normals, every one of them between the rest and the handles' turn; a fold is a
+    # normal against both
+    from curvdetail.curvature.testing import grid
+
+    V, F = grid(30, 10, size=(3.0, 1.0))
+    V[:, 2] = 0.05 * np.sin(4 * V[:, 0]) * np.cos(3 * V[:, 1])
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=V, face_matrix=F))
+    T = np.eye(4)
+    T[:3, :3] = [[np.cos(2.0), 0, -np.sin(2.0)], [0, 1, 0], [np.sin(2.0), 0, np.cos(2.0)]]
+    T[:3, 3] = [0.2, 0.0, 0.4]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        figures = apply(ms, "apply_curvature_editing", handles=np.flatnonzero(V[:, 0] > 2.4), transform=T,
+                        region_radius=BBoxLength(1.85, percent=False))     # x > 0.55 or so
+    assert _folded(V, ms.current_mesh().vertex_matrix(), F) > 300
+    assert figures["folded_triangles"] == 0 and figures["amplification"] == pytest.approx(1.0)
+
+
+def _terrain_handles():
+    """terrainA_1k in a MeshSet and 20 scattered handles (the review's case, on the small terrain)."""
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(os.path.join(DATA, "terrainA_1k.obj"))
+    V = ms.current_mesh().vertex_matrix().copy()
+    return ms, V, np.random.default_rng(1).choice(V.shape[0], 20, replace=False)
+
+
+def test_a_detail_edit_amplified_without_folds_warns_with_the_ratio():
+    # 20 scattered handles on terrainA_1k, details x1.2, one-ring: the details changed 14 times
+    # as much as the edit asks and the vertices moved 10 times as far as with one+two-ring
+    # (6.0 % against 0.58 % of the diagonal), without a fold; nothing was said
+    ms, V, handles = _terrain_handles()
+    edit = dict(handles=handles, region_radius=pymeshlab.PercentageValue(10.0), detail_scale=1.2)
+    with pytest.warns(AmplifiedEditWarning, match=r"the details changed up to \d+\.\d times as much as the "
+                                                  r"edit asks of the region \(vertex \d+\).*amplified.*try "
+                                                  r"relations='one\+two-ring'"):
+        amplified = apply(ms, "apply_curvature_editing", **edit)
+    assert amplified["folded_triangles"] == 0 and amplified["amplification"] is None
+    assert amplified["detail_amplification"] > 3.0 * AMPLIFICATION_LIMIT          # 14.2
+    ms, *_ = _terrain_handles()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        steady = apply(ms, "apply_curvature_editing", relations="one+two-ring", **edit)
+    assert steady["detail_amplification"] < 1.05                                   # 0.80
+    assert amplified["max_displacement"] > 5.0 * steady["max_displacement"]
+
+
+def test_the_filter_warns_where_curvdetail_edit_exits_with_status_4(tmp_path, capsys):
+    # the same edit through curvdetail edit (.sel/.def) and the filter: the CLI exited 4 ("vertices
+    # moved up to 4.3 times as far as the handles") and the filter returned the same ratio silently
+    from curvdetail import read_mesh, write_mesh
+    from curvdetail.cli import main
+    from curvdetail.deformation_benchmark import write_selection, write_transform
+
+    V, F = read_mesh(os.path.join(DATA, "mannequin_nose.obj"))
+    diagonal = np.linalg.norm(np.ptp(V, axis=0))
+    centre = int(np.argmin(np.linalg.norm(V - V.mean(axis=0), axis=1)))
+    handles = np.flatnonzero(np.linalg.norm(V - V[centre], axis=1) < 0.06 * diagonal)
+    radius = 0.3 * diagonal
+    from scipy.spatial import cKDTree
+    status = np.where(cKDTree(V[handles]).query(V)[0] <= radius, 1, 0)
+    status[handles] = 2
+    T = np.eye(4)
+    T[1:3, 1:3] = [[np.cos(0.3), -np.sin(0.3)], [np.sin(0.3), np.cos(0.3)]]
+    T[:3, 3] = V[handles].mean(axis=0) - T[:3, :3] @ V[handles].mean(axis=0)
+    write_mesh(tmp_path / "nose.off", V, F)
+    write_selection(tmp_path / "nose.sel", status)
+    write_transform(tmp_path / "nose.def", T)
+    for relations, rc in (("one-ring", 4), ("one+two-ring", 0)):
+        out = tmp_path / f"{relations}.ply"
+        assert main(["edit", str(tmp_path / "nose.off"), "--sel", str(tmp_path / "nose.sel"), "--def",
+                     str(tmp_path / "nose.def"), str(out), "--relations", relations]) == rc
+        err = capsys.readouterr().err
+        ms = pymeshlab.MeshSet()
+        ms.add_mesh(pymeshlab.Mesh(vertex_matrix=V, face_matrix=F))
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always")
+            figures = apply(ms, "apply_curvature_editing", handles=handles, transform=T, relations=relations,
+                            region_radius=BBoxLength(radius, percent=False))
+        assert figures["roi_vertices"] == int(np.count_nonzero(status))
+        if rc == 4:
+            assert figures["amplification"] > AMPLIFICATION_LIMIT                  # 4.26
+            assert f"moved up to {figures['amplification']:.1f} times as far as the handles" in err
+            assert [type(w.message) for w in said] == [AmplifiedEditWarning]
+            assert f"{figures['amplification']:.1f} times as far as the handles" in str(said[0].message)
+        else:
+            assert figures["amplification"] < AMPLIFICATION_LIMIT and "warning" not in err   # 1.66
+            assert said == []
+        # and `curvdetail apply` with the filter exits as `edit` does, the warning on stderr
+        params = [f"handles={' '.join(map(str, handles))}", f"transform={' '.join(map(repr, T.ravel().tolist()))}",
+                  f"relations={relations}", f"region_radius={float(radius)!r}"]
+        assert main(["apply", "apply_curvature_editing", str(tmp_path / "nose.off"), str(tmp_path / f"a-{relations}.ply"),
+                     *[a for p in params for a in ("--param", p)]]) == rc
+        err = capsys.readouterr().err
+        assert ("curvdetail: warning: " in err) == (rc == 4)
+
+
+def test_detail_scale_below_1_shortens_a_protrusion_and_the_description_says_so():
+    # the description said "a factor below 1 shortens them, which lengthens a protrusion"; the
+    # detail D = K A is constrained, and the nose's tip details x0.5 shorten the nose (x0.80), x2
+    # lengthen it (x1.42), as the horn of mannequin_devil (scripts/reproduce_fig1.py)
+    from curvdetail.curvature import boundary_vertices
+
+    description = get_filter("apply_curvature_editing").parameter("detail_scale").description
+    assert "below 1 flattens what the handles sit on, above 1 sharpens it" in description
+    assert "lengthens a protrusion" not in description
+    lengths = {}
+    for scale in (0.5, 2.0):
+        ms = pymeshlab.MeshSet()
+        ms.load_new_mesh(os.path.join(DATA, "mannequin_nose.obj"))
+        V, F = ms.current_mesh().vertex_matrix().copy(), ms.current_mesh().face_matrix()
+        base = V[boundary_vertices(F)].mean(axis=0)
+        tip = int(np.argmax(np.linalg.norm(V - base, axis=1)))
+        handles = np.flatnonzero(np.linalg.norm(V - V[tip], axis=1) < 0.05 * np.linalg.norm(np.ptp(V, axis=0)))
+        apply(ms, "apply_curvature_editing", handles=handles, region_radius=pymeshlab.PercentageValue(40.0),
+              detail_scale=scale, move_handles=False)
+        X = ms.current_mesh().vertex_matrix()
+        lengths[scale] = np.linalg.norm(X[tip] - base) / np.linalg.norm(V[tip] - base)
+    assert lengths[0.5] < 0.9 and lengths[2.0] > 1.3
+
+
+def _bump_on_a_plane():
+    """A 30 x 30 grid, a bump for x < 0.5 and flat beyond (417 rank-deficient rings there, the
+    bump none); the corner (0, 1), vertex 870, has a widened ring."""
+    from curvdetail.curvature.testing import grid
+
+    V, F = grid(30, 30)
+    V[:, 2] = np.where(V[:, 0] < 0.5, 0.05 * np.sin(12 * V[:, 0]) * np.cos(9 * V[:, 1]), 0.0)
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=V, face_matrix=F))
+    return ms, V, F
+
+
+@pytest.mark.parametrize("centre, radius", [((0.15, 0.85), 0.2), ((0.3, 0.5), 0.4)])
+def test_ring_figures_count_the_region_not_the_whole_mesh(centre, radius):
+    # rank_deficient_vertices was the editor's count over the whole mesh: 417 for an edit of the
+    # bump that reaches no flat ring; widened_ring_vertices (the editor's widened_rings) is new
+    from scipy.spatial import cKDTree
+
+    from curvdetail.curvature import curvature_coefficients
+
+    ms, V, F = _bump_on_a_plane()
+    handles = np.flatnonzero(np.linalg.norm(V[:, :2] - centre, axis=1) < 0.05)
+    figures = apply(ms, "apply_curvature_editing", handles=handles, region_radius=BBoxLength(radius, percent=False),
+                    transform="1 0 0 0 0 1 0 0 0 0 1 0.01 0 0 0 1", relations="one+two-ring")
+    roi = np.flatnonzero(cKDTree(V[handles]).query(V)[0] <= radius)
+    assert figures["roi_vertices"] == roi.size
+    _, info = curvature_coefficients(V, F, return_info=True)
+    assert info.rank_deficient == 417 and info.widened_vertices.tolist() == [870]
+    assert figures["rank_deficient_vertices"] == np.isin(info.rank_deficient_vertices, roi).sum()
+    assert figures["widened_ring_vertices"] == np.isin(info.widened_vertices, roi).sum()
+    if radius == 0.2:                       # on the bump, at the corner: no flat ring, the widened one
+        assert figures["rank_deficient_vertices"] == 0 and figures["widened_ring_vertices"] == 1
+    else:                                   # into the flat part, away from the corner
+        assert 0 < figures["rank_deficient_vertices"] < 417 and figures["widened_ring_vertices"] == 0
 
 
 def test_python_callers_may_pass_handles_and_transform_as_arrays():

@@ -1,8 +1,8 @@
-"""Exceptions raised for malformed input.
+"""Exceptions raised for malformed input, and the warning of a result that folded.
 
-Every class derives from ``ValueError`` so that ``except ValueError`` keeps working for callers
-who do not care about the details; the message always says what is wrong, how much, where (the
-first offending indices) and what to do about it.
+Every exception class derives from ``ValueError`` so that ``except ValueError`` keeps working for
+callers who do not care about the details; the message always says what is wrong, how much,
+where (the first offending indices) and what to do about it.
 """
 
 
@@ -25,6 +25,14 @@ class UndeterminedEditError(ConstraintError):
     def __init__(self, problem, advice):
         super().__init__(f"{problem} {advice}")
         self.problem, self.advice = problem, advice
+
+
+class FoldedTrianglesWarning(UserWarning):
+    """Said when triangles of an edit's result fold over (their normals point against the rest
+    shape's), e.g. by :func:`edit_boundary`: the edit ran, but the surface is not usable as it
+    is. The message gives the count, the first folded triangles, how far the vertices moved and
+    what to try; the same figures are in the function's ``info``. Turn it into an error with
+    ``warnings.simplefilter("error", FoldedTrianglesWarning)``."""
 
 
 def first_indices(indices, count=3):

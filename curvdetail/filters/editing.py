@@ -1,13 +1,16 @@
 """Filter ``apply_curvature_editing``: move handles, rebuild the selection from curvature detail."""
 
 import time
+import warnings
 
 import numpy as np
 
 from ..curvature._validate import (affine_transform_problem, bbox_diagonal, check_transformed_values,
                                    non_whole_index_error, real_word)
+from ..curvature.curvature_coefficients import curvature_coefficients
 from ..curvature.curvature_editor import CurvatureEditor
-from ..curvature.errors import ConstraintError, UndeterminedEditError, counted, first_indices
+from ..curvature.errors import (ConstraintError, FoldedTrianglesWarning, UndeterminedEditError, counted,
+                                first_indices)
 from .apply_curvature_reconstruction import BACKEND_DESCRIPTION, BACKENDS
 from .errors import FilterParameterError
 from .meshset import (get_mesh, layer_id, mesh_arrays, selected_vertices, set_vertex_positions,
@@ -16,6 +19,24 @@ from .parameters import BBoxLength, Parameter
 from .registry import PAPER, filter
 
 IDENTITY = "1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1"
+
+#: ``amplification`` or ``detail_amplification`` above this says that the curvature stage
+#: amplified the handles' change: the threshold of ``curvdetail edit``'s warning and exit status
+#: 4 (vertices moved more than 3 times as far as the handles). Measured 2026-12-01 with
+#: one+two-ring relations (terrainA_1k/10k, mannequin_ear, mannequin_nose, mannequin_devil):
+#: detail_amplification 0.2-1.1, amplification 1.0-2.8 (handles inside the region, turned);
+#: with one-ring relations on the same edits up to 160 and 1100 (see docs/editing.md).
+AMPLIFICATION_LIMIT = 3.0
+
+
+class AmplifiedEditWarning(UserWarning):
+    """Said by ``apply_curvature_editing`` when its result moved more than
+    :data:`AMPLIFICATION_LIMIT` times as far as the handles, or its details changed more than that
+    many times as much as the edit asks, without folding triangles (folds are said with
+    :class:`~curvdetail.curvature.errors.FoldedTrianglesWarning`): the edit ran and the mesh is
+    changed, but the curvature stage amplified the handles' change. The message gives the figures
+    and what to try; the same figures are in the filter's dict. Turn it into an error with
+    ``warnings.simplefilter("error", AmplifiedEditWarning)``."""
 
 
 def _indices(text, n):
@@ -77,15 +98,20 @@ def _matrix(text):
     category="Curvature detail",
     description=f"""
         Mesh editing with curvature coefficients: the handle vertices are moved by a 4x4
-        transform, their curvature normals are transformed by its linear part and optionally
-        scaled (a factor below 1 shortens them, which lengthens a protrusion), and the region of
-        interest - the selected vertices, the handles and, with region_radius, every vertex that
-        close to a handle - is rebuilt in two stages: the
+        transform, their curvature normals are transformed by its linear part and scaled by
+        detail_scale, and the region of interest - the selected vertices, the handles and, with
+        region_radius, every vertex that close to a handle - is rebuilt in two stages: the
         details of the other region vertices from the rotation- and scale-invariant curvature
         coefficients (min |(I - C) D|^2), then the positions from the details (E_Q). Vertices
         outside the region do not move. Vertices move in place; the vertex quality is set to
-        the distance each vertex moved. {PAPER}, sections "Curvature coefficients" and "Mesh
-        editing".
+        the distance each vertex moved. Returns the largest move, how far the curvature stage
+        amplified the handles' motion (amplification) and their detail change
+        (detail_amplification), the triangles that folded over and the region's counts; a
+        result with folded triangles is said with a
+        curvdetail.curvature.errors.FoldedTrianglesWarning, one amplified more than 3 times (the
+        limit of curvdetail edit's warning) with a
+        curvdetail.filters.editing.AmplifiedEditWarning. {PAPER}, sections "Curvature
+        coefficients" and "Mesh editing".
     """,
     parameters=[
         Parameter("handles", "str", "", "handle vertex indices, separated by spaces or commas "
@@ -99,7 +125,10 @@ def _matrix(text):
                   "4x4 handle transform, 16 numbers row by row, applied to homogeneous positions "
                   "(from Python also a 4x4 array)", shape=(4, 4)),
         Parameter("detail_scale", "float", 1.0,
-                  "factor on the handles' curvature normals after the transform (1 keeps them)",
+                  "factor on the handles' curvature details D = K A after the transform (1 keeps "
+                  "them); below 1 flattens what the handles sit on, above 1 sharpens it "
+                  "(mannequin_devil, move_handles=false, the horn's tip as handles: x0.5 makes the "
+                  "horn 0.91-0.93 times as long, x2 1.19-1.23 times, region_radius 10-20 %)",
                   positive=True),
         Parameter("move_handles", "bool", True,
                   "constrain the handles' positions to the transformed ones; false constrains "
@@ -160,7 +189,7 @@ def apply_curvature_editing(ms, *, handles, region_radius, transform, detail_sca
         positions = V[pc] @ T[:3, :3].T + T[:3, 3] if pc.size else None
     for values, what in ((positions, "the transform"), (details, "the transform with detail_scale")):
         check_transformed_values(values, what, "use a smaller transform or detail_scale", FilterParameterError)
-    X = editor.solve(positions=positions, details=details)
+    X, D = editor.solve(positions=positions, details=details, return_details=True)
     seconds = time.perf_counter() - t
     moved = np.linalg.norm(X - V, axis=1)
     if not np.all(np.isfinite(moved)):      # checked before the MeshSet is touched
@@ -168,15 +197,113 @@ def apply_curvature_editing(ms, *, handles, region_radius, transform, detail_sca
                                    "double precision; use a smaller transform or detail_scale.")
     set_vertex_positions(ms, mid, X)
     set_vertex_quality(ms, mid, moved)
-    return {
-        "max_displacement": float(moved.max() / bbox_diagonal(V)),
+    diagonal = bbox_diagonal(V)
+    folded = _folded_triangles(V, F, X, T[:3, :3])
+    rank_deficient, widened = _region_ring_counts(V, F, roi, editor)
+    figures = {
+        "max_displacement": float(moved.max() / diagonal),
         # far above 1: the curvature stage amplified the handle details (see docs/editing.md);
-        # None where the handles do not move (a ratio of rounding, or of a pure detail edit)
+        # None where the handles are not placed or do not move (a ratio of rounding, or of a pure
+        # detail edit, which detail_amplification measures)
         "amplification": (float(moved.max() / moved[h].max())
-                          if moved[h].max() > 1e-12 * bbox_diagonal(V) else None),
+                          if move_handles and moved[h].max() > 1e-12 * diagonal else None),
+        "detail_amplification": _detail_amplification(editor.detail, D, roi, detail_scale * T[:3, :3])
+                                if dc.size else None,
+        "folded_triangles": int(folded.size),
         "roi_vertices": int(roi.size),
         "handle_vertices": int(h.size),
-        "rank_deficient_vertices": int(editor.rank_deficient),
+        "rank_deficient_vertices": rank_deficient,
+        "widened_ring_vertices": widened,
         "detail_island_vertices": int(editor.detail_islands),
         "seconds": float(seconds),
     }
+    _warn_if_amplified(figures, folded, F.shape[0], moved, D, editor.detail, dict(
+        relations=relations, detail_scale=detail_scale, handle_detail=handle_detail,
+        handles_moved=figures["amplification"] is not None))
+    return figures
+
+
+def _folded_triangles(V, F, X, A):
+    """Triangles of the result ``X`` folded over, increasing: their normal points against both
+    their rest normal and their rest normal under the linear part ``A`` of the handles' transform
+    (the normal the handles' own triangles get), so that neither the rest shape nor a region
+    turned by up to the handles' turn counts (a triangle turned by any angle between 0 and the
+    handles' turn faces one of the two)."""
+    def normals(Y):
+        return np.cross(Y[F[:, 1]] - Y[F[:, 0]], Y[F[:, 2]] - Y[F[:, 0]])
+
+    after = normals(X)
+    against_rest = np.einsum("ij,ij->i", normals(V), after) < 0
+    against_turned = np.einsum("ij,ij->i", normals(V @ A.T), after) < 0
+    return np.flatnonzero(against_rest & against_turned)
+
+
+def _detail_amplification(D0, D, roi, M):
+    """The largest detail change in the region over the largest one the edit asks for: the
+    handles' change ``D -> M D`` (``M`` = detail_scale times the transform's linear part) applied
+    to every region vertex's rest detail, which is what a region following the handles fully
+    would get. About 1 or below where the curvature stage spreads the handles' change (it
+    interpolates it towards the fixed rest); None where the edit asks no detail change (a
+    translation, or the identity with detail_scale 1)."""
+    asked = np.linalg.norm(D0[roi] @ (M - np.eye(3)).T, axis=1).max()
+    if not asked > 1e-12 * np.linalg.norm(D0[roi], axis=1).max():
+        return None
+    return float(np.linalg.norm(D[roi] - D0[roi], axis=1).max() / asked)
+
+
+def _region_ring_counts(V, F, roi, editor):
+    """Vertices of the region whose one-ring detail is rank-deficient, and those whose
+    coefficients span a widened ring (:func:`curvature_coefficients`, the editor's settings).
+    The editor counts the whole mesh; only where it found any are the coefficients computed
+    again for the per-vertex answer."""
+    if not (editor.rank_deficient or editor.widened_rings):
+        return 0, 0
+    _, info = curvature_coefficients(V, F, return_info=True)
+    in_roi = np.zeros(V.shape[0], dtype=bool)
+    in_roi[roi] = True
+    return (int(np.count_nonzero(in_roi[info.rank_deficient_vertices])),
+            int(np.count_nonzero(in_roi[info.widened_vertices])))
+
+
+def _warn_if_amplified(figures, folded, m, moved, D, D0, options):
+    """A FoldedTrianglesWarning where triangles folded, else an AmplifiedEditWarning where
+    ``amplification`` or ``detail_amplification`` is above :data:`AMPLIFICATION_LIMIT` (the
+    rule of curvdetail edit's warning); nothing otherwise. The message names the figures, the
+    first folded triangles and the vertices that moved and changed most, and what to try."""
+    ratio, detail_ratio = figures["amplification"], figures["detail_amplification"]
+    amplified = [r for r in (ratio, detail_ratio) if r is not None and r > AMPLIFICATION_LIMIT]
+    if not folded.size and not amplified:
+        return
+    from ..remesh.experiment import _caller_outside_the_package
+
+    parts = []
+    if folded.size:
+        parts.append(f"{counted(folded.size, 'triangle')} of {m} folded over (normal against the rest "
+                     f"shape's; first: {first_indices(folded)})")
+    moved_most = int(np.argmax(moved))
+    parts.append(f"vertices moved up to {100 * figures['max_displacement']:.3g} % of the bbox diagonal "
+                 f"(vertex {moved_most})" + (f", {ratio:.1f} times as far as the handles" if ratio is not None
+                                             else ""))
+    if detail_ratio is not None:
+        changed_most = int(np.argmax(np.linalg.norm(D - D0, axis=1)))
+        parts.append(f"the details changed up to {detail_ratio:.1f} times as much as the edit asks of the "
+                     f"region (vertex {changed_most})")
+    relations = options["relations"]
+    other = "one+two-ring" if relations == "one-ring" else "one-ring"
+    tries = [f"relations={other!r}"]
+    if options["handles_moved"] and options["handle_detail"] == "transform":
+        tries.append("handle_detail='free'")
+    tries.append("more handles")
+    if options["detail_scale"] != 1:
+        tries.append("a detail_scale closer to 1")
+    if amplified:
+        cause = "the curvature stage amplified the handles' change (ill-conditioned coefficients"
+    else:
+        cause = ("the region cannot follow the handles' change without folding (too large an edit for the "
+                 "region, or coefficients that distort it")
+        tries.append("a larger region")
+    category = FoldedTrianglesWarning if folded.size else AmplifiedEditWarning
+    warnings.warn(f"apply_curvature_editing with relations={relations!r}: {'; '.join(parts)}: {cause}, see "
+                  "docs/editing.md). "
+                  f"The mesh was edited all the same; try {', '.join(tries[:-1])} or {tries[-1]} on the original.",
+                  category, stacklevel=_caller_outside_the_package())
