@@ -4,6 +4,9 @@ Every subcommand is declared with :func:`command` next to the code that runs it.
 anywhere exits non-zero with a ``curvdetail: error: ...`` message on stderr and leaves no output
 file behind (outputs are written atomically, last). Ctrl-C (SIGINT) and SIGTERM end a run at
 once, even during a long native call, removing the temporary files: exit status 130 or 143.
+A run that stops before its iteration converged (``minimal``, or ``apply`` / ``run`` with a filter
+whose figures say ``converged: false``) writes OUTPUT all the same and exits with status 3
+(:data:`NOT_CONVERGED`); ``edit`` exits with status 4 when its edit amplified the handles' motion.
 """
 
 import argparse
@@ -167,7 +170,7 @@ def fixed_vertices(args, F, n):
 @command("reconstruct", help="rebuild a mesh from its own curvature detail with the boundary fixed")
 def _reconstruct_command(parser):
     add_input_output_arguments(parser, "mesh file (any format MeshLab reads)",
-                               "rebuilt mesh; quality = distance to INPUT")
+                               "rebuilt mesh; quality = distance to INPUT (.ply keeps it)")
     parser.add_argument("--rows", choices=("all", "free"), default="all",
                         help="residual rows in E_Q: all vertices (the paper) or free ones only")
     add_fix_arguments(parser)
@@ -196,19 +199,25 @@ def _reconstruct_command(parser):
         seconds = time.perf_counter() - t
         progress.stage("write")
         dist = np.linalg.norm(X - V, axis=1)
-        write_mesh(args.output, X, F, quality=dist, overwrite=args.overwrite)
+        write_mesh(args.output, X, F, quality=_quality_for(args.output, dist), overwrite=args.overwrite)
         progress.close()
         print(f"max vertex error {dist.max() / bbox_diagonal(V):.3e} of the bbox diagonal "
               f"({V.shape[0]} vertices, {fixed.size} fixed, rows={args.rows}, {seconds:.3f} s)")
+        _note_geometry_only(args.output, quality=not _keeps_quality(args.output))
         return 0
 
     return run
 
 
+#: Exit status of ``minimal``, ``apply`` and ``run`` when OUTPUT is written but an iteration
+#: stopped before it converged (``max_iterations`` reached): scripts can tell it from a clean run.
+NOT_CONVERGED = 3
+
+
 @command("minimal", help="minimal surface spanned by a mesh's boundary (zero curvature detail)")
 def _minimal_command(parser):
     add_input_output_arguments(parser, "mesh file with a boundary",
-                               "minimal surface; quality = distance moved")
+                               "minimal surface; quality = distance moved (.ply keeps it)")
     parser.add_argument("--max-iterations", type=_whole_number_from_one, default=200,
                         help="Pinkall-Polthier steps at most; if the shape has not settled by then, "
                              "OUTPUT is still written and the exit status is 3")
@@ -243,7 +252,8 @@ def _minimal_command(parser):
                             step=args.step, backend=args.backend,
                             callback=lambda i, s: progress.stage(f"step {i}"))
         progress.close()
-        write_mesh(args.output, X, F, quality=np.linalg.norm(X - V, axis=1), overwrite=args.overwrite)
+        write_mesh(args.output, X, F, quality=_quality_for(args.output, np.linalg.norm(X - V, axis=1)),
+                   overwrite=args.overwrite)
         state = "converged" if X.converged else "stopped (not converged)"
         if args.step == "normal":
             last = (f"last step {X.last_step:.2e} of the bbox diagonal normal to the surface "
@@ -251,7 +261,8 @@ def _minimal_command(parser):
         else:
             last = f"last step {X.last_full_step:.2e} of the bbox diagonal (tangential sliding included)"
         print(f"{state} after {counted(X.iterations, 'step')}, {last}")
-        return 0 if X.converged else 3
+        _note_geometry_only(args.output, quality=not _keeps_quality(args.output))
+        return 0 if X.converged else NOT_CONVERGED
 
     return run
 
@@ -388,7 +399,8 @@ def _remesh_command(parser):
                     with open(report_tmp, "w", encoding="utf-8") as fh:
                         json.dump(report, fh, indent=2)
                         fh.write("\n")
-                write_mesh(mesh_tmp, result["X"], result["Ft"], quality=result["distance"], overwrite=True)
+                write_mesh(mesh_tmp, result["X"], result["Ft"], quality=_quality_for(args.output, result["distance"]),
+                           overwrite=True)
         finally:
             progress.close()
         if args.no_evaluate:
@@ -457,16 +469,18 @@ def _add_layers_argument(parser):
                              "a retriangulation for transfer_curvature_detail")
 
 
-def _run_on_file(args, work):
+def _run_on_file(args, work, *, other_inputs=()):
     """Check OUTPUT, load INPUT (and --add meshes) into a MeshSet, ``work(ms)``, print its figures
-    as JSON, save the current mesh (quality and curvature attributes kept in PLY)."""
+    as JSON, save the current mesh (quality and curvature attributes kept in PLY); returns the
+    figures. OUTPUT may replace INPUT (with --overwrite), never an --add mesh or one of
+    ``other_inputs`` (the script of ``run``)."""
     import json
 
     from . import _output
     from .filters.files import attributes_lost_in, check_output_path, load_meshset, save_current_mesh
     from .io import MeshFileError
 
-    _check_image_and_distinct(None, args.output, inputs=[args.input], other_inputs=args.add)
+    _check_image_and_distinct(None, args.output, inputs=[args.input], other_inputs=[*args.add, *other_inputs])
     # an existing file refused in the command line's words, then the filters' checks (format hint)
     _output.check_output_path(args.output, args.overwrite, hint=None, error=MeshFileError, flag=OVERWRITE)
     check_output_path(args.output, args.overwrite)
@@ -474,15 +488,69 @@ def _run_on_file(args, work):
     figures = work(ms)
     save_current_mesh(ms, args.output, overwrite=args.overwrite)
     print(json.dumps(figures, indent=2, default=str))
-    lost = attributes_lost_in(ms, args.output)
+    # documented, but the next step ("no attribute 'curvature_detail'") is confusing without it
+    quality = ms.current_mesh().has_vertex_scalar() and not _keeps_quality(args.output)
+    _note_geometry_only(args.output, attributes_lost_in(ms, args.output), quality=quality)
+    return figures
+
+
+def _keeps_quality(path):
+    """Whether :func:`curvdetail.write_mesh` keeps the per-vertex quality in ``path``'s format
+    (PLY; OBJ, OFF, STL and the rest drop it, and CTM is written without it: pymeshlab's reader
+    crashes on, or misreads, CTM files with a quality)."""
+    return os.path.splitext(os.fspath(path))[1].lower() == ".ply"
+
+
+def _quality_for(path, quality):
+    """``quality`` where ``path``'s format keeps it, else None (write_mesh refuses a quality for
+    .ctm; the other formats drop it)."""
+    return quality if _keeps_quality(path) else None
+
+
+def _note_geometry_only(path, attributes=(), *, quality=False):
+    """The note, on stderr, that OUTPUT's format dropped what PLY keeps: the per-vertex quality
+    (``quality``) and the filters' custom ``attributes`` (names). Nothing where neither is lost."""
+    lost = (["the vertex quality"] if quality else []) + \
+           ([f"the attributes {', '.join(attributes)}"] if attributes else [])
     if lost:
-        # documented, but the next step ("no attribute 'curvature_detail'") is confusing without it
-        _say(f"curvdetail: note: {os.path.basename(args.output)} holds the geometry only; the attributes "
-             f"{', '.join(lost)} are kept by PLY output.")
-    return 0
+        verb = "is" if lost == ["the vertex quality"] else "are"
+        _say(f"curvdetail: note: {os.path.basename(os.fspath(path))} holds the geometry only; "
+             f"{' and '.join(lost)} {verb} kept by PLY output.")
 
 
-@command("apply", help="apply one filter to a mesh file and write the current mesh")
+def _not_converged_status(steps, output):
+    """:data:`NOT_CONVERGED`, with a note on stderr for each, where the figures of a step (``steps``:
+    ``(name, figures)`` pairs) say ``converged: false``, as ``curvdetail minimal`` does;
+    :data:`AMPLIFIED` where they say an edit folded triangles or amplified its constraints
+    beyond the limit (the filter's warning has said how), as ``curvdetail edit`` does; else 0.
+    Where both happen, the first step's status."""
+    from .curvature.errors import counted
+    from .filters.editing import AMPLIFICATION_LIMIT
+
+    status = 0
+    for name, figures in steps:
+        if not isinstance(figures, dict):
+            continue
+        ratios = [figures.get(key) for key in ("amplification", "detail_amplification")]
+        if figures.get("folded_triangles") or any(isinstance(r, float) and r > AMPLIFICATION_LIMIT for r in ratios):
+            status = status or AMPLIFIED
+            continue
+        if figures.get("converged") is None or figures["converged"]:
+            continue
+        text = f"{name} stopped (not converged)"
+        if isinstance(figures.get("iterations"), int):
+            text += f" after {counted(figures['iterations'], 'step')}"
+        if isinstance(figures.get("last_step"), float):
+            text += f", last step {figures['last_step']:.2e} of the bbox diagonal"
+        _say(f"curvdetail: note: {text}; {os.path.basename(os.fspath(output))} is written all the same "
+             f"(exit status {NOT_CONVERGED}): allow more iterations or a larger tolerance.")
+        status = status or NOT_CONVERGED
+    return status
+
+
+@command("apply", help="apply one filter to a mesh file and write the current mesh (exit status 3: "
+                        "written, but the filter's figures say converged: false; 4: written, but an "
+                        "edit folded triangles or amplified its constraints)")
 def _apply_command(parser):
     parser.add_argument("filter", metavar="FILTER", help="filter name (see `curvdetail list`)")
     parser.add_argument("input", metavar="INPUT", help="mesh file (any format MeshLab reads)")
@@ -505,14 +573,18 @@ def _apply_command(parser):
             # target_edge=0.01 is 0.01 model units): its LongRunWarning, shown as a note by main()
             return apply(ms, spec.name, **params)
 
-        return _run_on_file(args, work)
+        figures = _run_on_file(args, work)
+        return _not_converged_status([(spec.name, figures)], args.output)
 
     return run
 
 
-@command("run", help="run a MeshLab filter script (.mlx; ours and pymeshlab's) on a mesh file")
+@command("run", help="run a MeshLab filter script (.mlx; ours and pymeshlab's) on a mesh file (exit "
+                      "status 3: written, but a step's figures say converged: false; 4: written, but "
+                      "an editing step folded triangles or amplified its constraints)")
 def _run_command(parser):
-    parser.add_argument("script", metavar="SCRIPT", help="MeshLab filter script (.mlx)")
+    parser.add_argument("script", metavar="SCRIPT",
+                        help="MeshLab filter script (.mlx); never written over, even with --overwrite")
     parser.add_argument("input", metavar="INPUT", help="mesh file (any format MeshLab reads)")
     parser.add_argument("output", metavar="OUTPUT",
                         help="the current mesh after the script (.ply keeps quality and attributes)")
@@ -520,7 +592,6 @@ def _run_command(parser):
     add_output_arguments(parser)
 
     def run(args):
-
         from .filters import run_script
 
         if not os.path.isfile(args.script):
@@ -537,7 +608,10 @@ def _run_command(parser):
             finally:
                 bar.close()
 
-        return _run_on_file(args, work)
+        steps = _run_on_file(args, work, other_inputs=[args.script])
+        script = os.path.basename(args.script)
+        return _not_converged_status([(f"{script} step {k} ({done['filter']})", done["figures"])
+                                      for k, done in enumerate(steps, start=1)], args.output)
 
     return run
 
@@ -611,7 +685,7 @@ def _edit_command(parser):
                 render_panels(image_tmp, [(V, F, "rest (status 0/1/2)", status),
                                           (X, F, f"edited (handle detail: {args.handle_detail})", moved)],
                               overwrite=True)
-            write_mesh(mesh_tmp, X, F, quality=moved, overwrite=True)
+            write_mesh(mesh_tmp, X, F, quality=_quality_for(args.output, moved), overwrite=True)
         progress.close()
         counts = np.bincount(status, minlength=3)
         print(f"{V.shape[0]} vertices ({counts[0]} fixed, {counts[1]} free, {counted(counts[2], 'handle')}); "
@@ -669,7 +743,12 @@ def build_parser():
     parser = argparse.ArgumentParser(
         prog="curvdetail",
         description="Curvature detail representation of triangle meshes: reconstruct, edit and "
-                    "remesh surfaces from their mean-curvature normals.")
+                    "remesh surfaces from their mean-curvature normals.",
+        epilog="Exit status: 0 done; 1 an error, said on stderr, and no output written; 2 a command "
+               "line that cannot be parsed; 3 OUTPUT written, but an iteration stopped before it "
+               "converged (minimal, or a filter of apply/run whose figures say converged: false); "
+               "4 OUTPUT written, but edit amplified the handles' motion (or an editing filter of "
+               "apply/run folded triangles or amplified its constraints); 130 Ctrl-C, 143 SIGTERM.")
     parser.add_argument("--version", action="version", version=f"curvdetail {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
@@ -751,11 +830,16 @@ def _watch_sigterm():
 
 def _show_warning(message, category, filename, lineno, file=None, line=None):
     """A LongRunWarning (a filter in a script about to take minutes) or a
-    WorseThanZeroDetailWarning (a remeshing that failed) as a note line."""
+    WorseThanZeroDetailWarning (a remeshing that failed) as a note line; a FoldedTrianglesWarning
+    or AmplifiedEditWarning (an edit that folded or amplified) as a warning line."""
+    from .curvature.errors import FoldedTrianglesWarning
+    from .filters.editing import AmplifiedEditWarning
     from .remesh import LongRunWarning, WorseThanZeroDetailWarning
 
     if issubclass(category, (LongRunWarning, WorseThanZeroDetailWarning)):
         _say(f"note: {message}")
+    elif issubclass(category, (FoldedTrianglesWarning, AmplifiedEditWarning)):
+        _say(f"curvdetail: warning: {message}")
     else:
         _default_showwarning(message, category, filename, lineno, file, line)
 

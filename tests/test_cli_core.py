@@ -125,12 +125,61 @@ def test_minimal_not_converged_exits_3_and_says_so(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("command", ["reconstruct", "minimal"])
+@pytest.mark.parametrize("name", ["out.obj", "out.OFF", "out.stl"])
+def test_an_output_without_quality_says_it_is_left_out(tmp_path, capsys, command, name):
+    # --help promises quality = distance; OBJ, OFF and STL cannot hold it: said, as apply/run say it
+    assert main([command, NOSE, str(tmp_path / name)]) == 0
+    assert capsys.readouterr().err == (f"curvdetail: note: {name} holds the geometry only; the vertex quality "
+                                       "is kept by PLY output.\n")
+
+
+@pytest.mark.parametrize("command", ["reconstruct", "minimal"])
+def test_a_ctm_output_is_written_without_quality_and_reads_back(tmp_path, capsys, command):
+    # a CTM "Quality" map without a "Color" one crashes pymeshlab's reader; write_mesh refuses a
+    # quality for .ctm, so the command writes the geometry only, says so, and the file reads back
+    import subprocess
+    import sys
+
+    out = tmp_path / "out.ctm"
+    assert main([command, NOSE, str(out)]) == 0
+    assert capsys.readouterr().err == ("curvdetail: note: out.ctm holds the geometry only; the vertex quality "
+                                       "is kept by PLY output.\n")
+    code = f"import curvdetail; V, F = curvdetail.read_mesh({str(out)!r}); print(V.shape[0], F.shape[0])"
+    child = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    V, F = read_mesh(NOSE)
+    assert child.returncode == 0, child.stderr
+    assert child.stdout.split() == [str(V.shape[0]), str(F.shape[0])]
+
+
+@pytest.mark.parametrize("command", ["reconstruct", "minimal"])
+def test_a_ply_output_keeps_the_quality_without_a_note(tmp_path, capsys, command):
+    assert main([command, NOSE, str(tmp_path / "out.ply")]) == 0
+    assert capsys.readouterr().err == ""
+    from curvdetail.filters.files import load_meshset
+
+    ms = load_meshset(tmp_path / "out.ply")
+    V, _ = read_mesh(NOSE)
+    assert np.allclose(ms.current_mesh().vertex_scalar_array(),
+                       np.linalg.norm(ms.current_mesh().vertex_matrix() - V, axis=1), rtol=0, atol=1e-15)
+
+
+@pytest.mark.parametrize("command", ["reconstruct", "minimal"])
 def test_help_describes_the_command(command, capsys):
     with pytest.raises(SystemExit) as info:
         main([command, "--help"])
     assert info.value.code == 0
     text = capsys.readouterr().out
     assert "INPUT" in text and "OUTPUT" in text and "--example" in text and "--overwrite" in text
+
+
+def test_help_lists_the_exit_statuses(capsys):
+    with pytest.raises(SystemExit):
+        main(["--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "Exit status: 0 done; 1 an error" in text
+    assert "3 OUTPUT written, but an iteration stopped before it converged (minimal, or a filter of " \
+           "apply/run whose figures say converged: false)" in text
+    assert "4 OUTPUT written, but edit amplified" in text and "130 Ctrl-C, 143 SIGTERM" in text
 
 
 def test_console_script_help_runs():

@@ -8,6 +8,7 @@ import sys
 
 import numpy as np
 import pymeshlab
+import pytest
 
 from curvdetail.cli import main
 from curvdetail.filters import list_filters
@@ -89,8 +90,9 @@ def test_apply_writes_ply_with_attributes_and_prints_figures(capsys, tmp_path):
 def test_apply_to_a_format_without_attributes_says_what_is_left_out(capsys, tmp_path):
     rc, _, err = run_cli(capsys, "apply", "compute_curvature_detail", NOSE, tmp_path / "d.obj")
     assert rc == 0
-    assert ("note: d.obj holds the geometry only; the attributes curvature_area, curvature_detail, "
-            "curvature_normal, curvature_vertex_id, curvature_vertex_ring are kept by PLY output.") in err
+    assert ("note: d.obj holds the geometry only; the vertex quality and the attributes curvature_area, "
+            "curvature_detail, curvature_normal, curvature_vertex_id, curvature_vertex_ring are kept by PLY "
+            "output.") in err
     rc, _, err = run_cli(capsys, "apply", "compute_curvature_detail", NOSE, tmp_path / "d.ply")
     assert rc == 0 and "note:" not in err
 
@@ -119,7 +121,7 @@ def test_apply_writes_the_new_current_layer(capsys, tmp_path):
 
     rc, out, _ = run_cli(capsys, "apply", "generate_minimal_surface", NOSE, tmp_path / "m.obj",
                          "--param", "max_iterations=2")
-    assert rc == 0 and json.loads(out)["iterations"] == 2
+    assert rc == 3 and json.loads(out)["iterations"] == 2         # 3: written, not converged
     assert np.abs(vertices(tmp_path / "m.obj") - vertices(NOSE)).max() > 1e-3
     # the file holds the core's two steps (MeshLab's OBJ keeps 16 digits: measured 5.6e-17)
     V, F = read_mesh(NOSE)
@@ -246,7 +248,7 @@ SCRIPT = """<!DOCTYPE FilterScript>
 def test_run_writes_the_current_mesh_after_the_script(capsys, tmp_path):
     (tmp_path / "s.mlx").write_text(SCRIPT)
     rc, out, _ = run_cli(capsys, "run", tmp_path / "s.mlx", NOSE, tmp_path / "o.ply")
-    assert rc == 0
+    assert rc == 3                              # written, but two minimal-surface steps do not converge
     steps = json.loads(out)
     assert [s["filter"] for s in steps] == ["Select Border", "compute_curvature_detail",
                                             "generate_minimal_surface"]
@@ -398,3 +400,71 @@ def test_apply_remeshing_says_a_rebuild_worse_than_zero_detail_as_a_note(capsys,
     notes = [line for line in err.splitlines() if line.startswith("note: ")]
     assert len(notes) == 1 and "farther from the source than the zero-detail surface" in notes[0], err
     assert "WorseThanZeroDetailWarning" not in err
+
+
+# --- exit status 3 and the script as an input ----------------------------------------------------
+
+def test_apply_not_converged_exits_3_and_writes_what_minimal_writes(capsys, tmp_path):
+    # the rule of `curvdetail minimal`: stopped at max_iterations -> OUTPUT written, a line saying
+    # so, exit status 3; the same mesh as minimal's (both run the core's one step; PLY doubles)
+    rc, out, err = run_cli(capsys, "apply", "generate_minimal_surface", NOSE, tmp_path / "a.ply",
+                           "--param", "max_iterations=1")
+    figures = json.loads(out)                       # stdout stays the figures, JSON only
+    assert rc == 3 and figures["converged"] is False and figures["iterations"] == 1
+    notes = [line for line in err.splitlines() if "not converged" in line]
+    assert notes == [f"curvdetail: note: generate_minimal_surface stopped (not converged) after 1 step, "
+                     f"last step {figures['last_step']:.2e} of the bbox diagonal; a.ply is written all the "
+                     "same (exit status 3): allow more iterations or a larger tolerance."], err
+    assert main(["minimal", NOSE, str(tmp_path / "m.ply"), "--max-iterations", "1"]) == 3
+    capsys.readouterr()
+    assert np.array_equal(vertices(tmp_path / "a.ply"), vertices(tmp_path / "m.ply"))
+
+
+def test_apply_converged_exits_0_without_a_note(capsys, tmp_path):
+    rc, out, err = run_cli(capsys, "apply", "generate_minimal_surface", NOSE, tmp_path / "a.ply")
+    assert rc == 0 and json.loads(out)["converged"] is True and err == ""
+
+
+def test_every_filter_reporting_convergence_is_covered_by_the_rule():
+    # the filters whose figures carry "converged" (grep): if another one appears, give it a test
+    # like test_apply_not_converged_exits_3_and_writes_what_minimal_writes
+    import inspect
+
+    carrying = sorted(spec.name for spec in list_filters()
+                      if '"converged"' in inspect.getsource(inspect.getmodule(spec.function)))
+    assert carrying == ["generate_minimal_surface"]
+
+
+def test_run_not_converged_step_exits_3_and_names_the_step(capsys, tmp_path):
+    (tmp_path / "s.mlx").write_text(SCRIPT)
+    rc, out, err = run_cli(capsys, "run", tmp_path / "s.mlx", NOSE, tmp_path / "o.ply")
+    assert rc == 3 and json.loads(out)[2]["figures"]["converged"] is False
+    notes = [line for line in err.splitlines() if "not converged" in line]
+    assert len(notes) == 1 and notes[0].startswith(
+        "curvdetail: note: s.mlx step 3 (generate_minimal_surface) stopped (not converged) after 2 steps, "), err
+    assert (tmp_path / "o.ply").exists()
+    (tmp_path / "c.mlx").write_text(SCRIPT.replace('value="2"', 'value="200"'))
+    rc, _, err = run_cli(capsys, "run", tmp_path / "c.mlx", NOSE, tmp_path / "c.ply")
+    assert rc == 0 and "not converged" not in err
+
+
+def test_a_minimal_surface_in_obj_says_its_quality_is_left_out(capsys, tmp_path):
+    rc, _, err = run_cli(capsys, "apply", "generate_minimal_surface", NOSE, tmp_path / "m.obj")
+    assert rc == 0
+    assert err == "curvdetail: note: m.obj holds the geometry only; the vertex quality is kept by PLY output.\n"
+
+
+@pytest.mark.parametrize("spelling", ["same", "dot-slash", "symlink"])
+def test_run_refuses_to_write_over_its_script_even_with_overwrite(capsys, tmp_path, monkeypatch, spelling):
+    # the README: inputs other than the mesh are never written over, even with --overwrite; the
+    # names are compared as real paths
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "s.ply").write_text(SCRIPT)              # a script under any name runs
+    output = {"same": "s.ply", "dot-slash": "./s.ply", "symlink": "link.ply"}[spelling]
+    if spelling == "symlink":
+        os.symlink("s.ply", tmp_path / "link.ply")
+    rc, out, err = run_cli(capsys, "run", "s.ply", NOSE, output, "--overwrite")
+    assert rc == 1 and out == ""
+    assert err == (f"curvdetail: error: {output} is an input of this run (s.ply); writing there would destroy "
+                   "it even with --overwrite. Name another file.\n")
+    assert (tmp_path / "s.ply").read_text() == SCRIPT
