@@ -449,11 +449,16 @@ def _box_distance2(Q, pt, lo, hi, node, upper=True):
 
 def _greedy_bound(tree, Q, P, T):
     """An upper bound of each point ``P[i]`` (``Q[:, i]``) to the surface: the exact distance
-    to one triangle, found by descending the tree to the nearer child box at each level (of
-    two that both hold the point, the one of the smaller minmaxdist) and taking the leaf's
-    triangle whose own box comes first in that order: 2 box tests a level and one exact
-    distance a point. Far above a wavy surface it leads to the top of a wave, where the
-    closest point is; near the surface a kd-tree's nearest centroid is the better bound."""
+    to the triangle :func:`_greedy_triangle` picks, one exact distance a point. Far above a
+    wavy surface it leads to the top of a wave, where the closest point is; near the surface a
+    kd-tree's nearest centroid is the better bound."""
+    return _exact_distances(P, T, np.arange(Q.shape[1]), _greedy_triangle(tree, Q))
+
+
+def _greedy_triangle(tree, Q):
+    """One triangle per point ``Q[:, i]``, found by descending the tree to the nearer child box at
+    each level (of two that both hold the point, the one of the smaller minmaxdist) and taking
+    the leaf's triangle whose own box comes first in that order: 2 box tests a level."""
     lo, hi, leaves, tri_lo, tri_hi = tree
     k = Q.shape[1]
     every = np.arange(k)
@@ -466,8 +471,7 @@ def _greedy_bound(tree, Q, P, T):
     width = leaves.shape[1]
     tri = leaves.take(node, axis=0)
     near, cap = _box_distance2(Q, np.repeat(every, width), tri_lo, tri_hi, tri.ravel())
-    pick = tri[every, np.lexsort((cap.reshape(k, width), near.reshape(k, width)), axis=1)[:, 0]]
-    return _exact_distances(P, T, every, pick)
+    return tri[every, np.lexsort((cap.reshape(k, width), near.reshape(k, width)), axis=1)[:, 0]]
 
 
 def _descend(tree, Q, bound, cap_levels=None):

@@ -243,12 +243,13 @@ def _nearest_face_tree(P, V, F):
     :func:`~.evaluate._surface_distance` (every triangle that could hold the closest point,
     all points at once, ``SEARCH_POINTS`` at a time), keeping the triangle of each distance.
 
-    The first bound is the triangle :func:`_greedy_face` picks (the search drops boxes within
-    ``PRUNE_RELATIVE`` of the bound, so the triangle that set it must be known); a triangle
+    The first bound is the triangle :func:`~.evaluate._greedy_triangle` picks (the search drops
+    boxes within ``PRUNE_RELATIVE`` of the bound, so the triangle that set it must be known); a triangle
     closer than the bound lies in boxes closer than it, so none is missed: the face returned
     is at the least distance, to rounding and to ``PRUNE_RELATIVE`` (very far from a flat
     part, many triangles tie within that, and the face is any of them)."""
-    from .evaluate import SEARCH_POINTS, _box_tree, _descend, _exact_distances   # evaluate imports locate
+    # imported here: evaluate imports locate
+    from .evaluate import SEARCH_POINTS, _box_tree, _descend, _exact_distances, _greedy_triangle
 
     k = P.shape[0]
     T = V[F]
@@ -256,7 +257,7 @@ def _nearest_face_tree(P, V, F):
     Q = np.ascontiguousarray(P.T)
     face = np.empty(k, dtype=np.int64)
     for lo in range(0, k, SEARCH_POINTS):
-        face[lo:lo + SEARCH_POINTS] = _greedy_face(tree, Q[:, lo:lo + SEARCH_POINTS])
+        face[lo:lo + SEARCH_POINTS] = _greedy_triangle(tree, Q[:, lo:lo + SEARCH_POINTS])
     best = _exact_distances(P, T, np.arange(k), face)
     todo = [np.arange(lo, min(k, lo + SEARCH_POINTS)) for lo in range(0, k, SEARCH_POINTS)]
     while todo:
@@ -275,28 +276,6 @@ def _nearest_face_tree(P, V, F):
             best[rows[better]] = d[win][better]
             face[rows[better]] = tri[win][better]
     return face
-
-
-def _greedy_face(tree, Q):
-    """The triangle of :func:`~.evaluate._greedy_bound` (which returns only its distance) for
-    points ``Q`` (d, k): down the tree to the nearer child box at each level (of two that both
-    hold the point, the one of the smaller minmaxdist), then the leaf's triangle whose own box
-    comes first in that order."""
-    from .evaluate import _box_distance2
-
-    lo, hi, leaves, tri_lo, tri_hi = tree
-    k = Q.shape[1]
-    every = np.arange(k)
-    node = np.zeros(k, dtype=np.int64)
-    for level in range(1, len(lo)):
-        left = 2 * node
-        near_l, cap_l = _box_distance2(Q, every, lo[level], hi[level], left)
-        near_r, cap_r = _box_distance2(Q, every, lo[level], hi[level], left + 1)
-        node = left + ((near_r < near_l) | ((near_r == near_l) & (cap_r < cap_l)))
-    width = leaves.shape[1]
-    tri = leaves.take(node, axis=0)
-    near, cap = _box_distance2(Q, np.repeat(every, width), tri_lo, tri_hi, tri.ravel())
-    return tri[every, np.lexsort((cap.reshape(k, width), near.reshape(k, width)), axis=1)[:, 0]]
 
 
 def _locate_kdtree(P, V, F, candidates, chunk):
