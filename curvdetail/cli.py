@@ -6,7 +6,8 @@ file behind (outputs are written atomically, last). Ctrl-C (SIGINT) and SIGTERM 
 once, even during a long native call, removing the temporary files: exit status 130 or 143.
 A run that stops before its iteration converged (``minimal``, or ``apply`` / ``run`` with a filter
 whose figures say ``converged: false``) writes OUTPUT all the same and exits with status 3
-(:data:`NOT_CONVERGED`); ``edit`` exits with status 4 when its edit amplified the handles' motion.
+(:data:`NOT_CONVERGED`); ``edit`` exits with status 4 when its edit folded triangles or amplified the
+handles' motion, ``apply`` / ``run`` when an editing filter did.
 """
 
 import argparse
@@ -618,13 +619,15 @@ def _run_command(parser):
 
 # --- edit (editing issue) -------------------------------------------------------------------
 
-#: Exit status of ``curvdetail edit`` when OUTPUT is written but vertices moved more than three
-#: times as far as the handles (the warning says so; scripts can tell it from a clean edit).
+#: Exit status of ``curvdetail edit`` when OUTPUT is written but triangles folded over or vertices
+#: moved more than three times as far as the handles (the warning says so; scripts can tell it
+#: from a clean edit); of ``apply`` / ``run`` when an editing filter's figures say the same.
 AMPLIFIED = 4
 
 
 @command("edit", help="deform a mesh with curvature-detail editing, given a benchmark .sel/.def pair "
-                      "(exit status 4: written, but the edit amplified the handles' motion)")
+                      "(exit status 4: written, but the edit folded triangles or amplified the "
+                      "handles' motion)")
 def _edit_command(parser):
     parser.add_argument("mesh", metavar="MESH", help="mesh file (vertex order must match SEL)")
     parser.add_argument("output", metavar="OUTPUT", help="edited mesh; quality = distance moved")
@@ -651,7 +654,8 @@ def _edit_command(parser):
         from .curvature._validate import bbox_diagonal, check_mesh
         from .deformation_benchmark import (edit_with_selection, read_selection, read_transform,
                                             render_panels)
-        from .curvature.errors import UndeterminedEditError, counted
+        from .curvature._geometry import folded_triangles
+        from .curvature.errors import UndeterminedEditError, counted, first_indices
         from .io import MeshFileError
 
         _check_image_and_distinct(args.image, args.output, inputs=[args.mesh],
@@ -692,14 +696,23 @@ def _edit_command(parser):
               f"largest move {moved.max() / bbox_diagonal(V):.3e} of the bbox diagonal; "
               f"{counted(editor.rank_deficient, 'rank-deficient ring')}, "
               f"{counted(editor.detail_islands, 'island vertex', 'island vertices')}; {seconds:.3f} s")
+        status_code = 0
         handle_move = moved[status == 2].max()
         if moved.max() > 3.0 * handle_move + 1e-12 * bbox_diagonal(V):
             _say(f"curvdetail: warning: vertices moved up to {moved.max() / max(handle_move, 1e-300):.1f} "
                  "times as far as the handles: the curvature stage amplified the handle details "
                  "(ill-conditioned coefficients, see docs/editing.md); try --relations one+two-ring "
                  "or --handle-detail free.")
-            return AMPLIFIED
-        return 0
+            status_code = AMPLIFIED
+        folded = folded_triangles(V, F, X, T[:3, :3])
+        if folded.size:
+            # the same count as apply_curvature_editing's (against the rest normal and the
+            # handles' turn of it): an edit that folds is not clean whatever it amplified
+            _say(f"curvdetail: warning: {counted(folded.size, 'triangle')} of {F.shape[0]} folded over (first: "
+                 f"{first_indices(folded)}); try --relations "
+                 f"{'one-ring' if args.relations == 'one+two-ring' else 'one+two-ring'} or --handle-detail free.")
+            status_code = AMPLIFIED
+        return status_code
 
     return run
 
@@ -747,7 +760,7 @@ def build_parser():
         epilog="Exit status: 0 done; 1 an error, said on stderr, and no output written; 2 a command "
                "line that cannot be parsed; 3 OUTPUT written, but an iteration stopped before it "
                "converged (minimal, or a filter of apply/run whose figures say converged: false); "
-               "4 OUTPUT written, but edit amplified the handles' motion (or an editing filter of "
+               "4 OUTPUT written, but edit folded triangles or amplified the handles' motion (or an editing filter of "
                "apply/run folded triangles or amplified its constraints); 130 Ctrl-C, 143 SIGTERM.")
     parser.add_argument("--version", action="version", version=f"curvdetail {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")

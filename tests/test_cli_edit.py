@@ -158,3 +158,36 @@ def test_a_free_piece_no_constraint_reaches_is_refused_in_the_selections_terms(t
     assert "Add handles (status 2) or fixed vertices (status 0) in" in err and "q.sel" in err
     assert "roi" not in err and "detail_constrained" not in err
     assert not (tmp_path / "o.ply").exists()
+
+
+def test_an_edit_that_folds_triangles_is_written_with_exit_status_4(tmp_path, capsys):
+    # terrainA_1k, handles within 8 % of the diagonal of the centre turned by 0.8 rad about x,
+    # region within 30 %: 12 triangles fold over while nothing moves more than 1.2x as far as the
+    # handles, so the amplification rule alone let it exit 0; apply_curvature_editing warned
+    from scipy.spatial import cKDTree
+
+    from curvdetail.curvature._geometry import folded_triangles
+
+    V, F = read_mesh(os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "terrainA_1k.obj"))
+    diagonal = np.linalg.norm(np.ptp(V, axis=0))
+    centre = int(np.argmin(np.linalg.norm(V - V.mean(axis=0), axis=1)))
+    handles = np.flatnonzero(np.linalg.norm(V - V[centre], axis=1) < 0.08 * diagonal)
+    status = np.where(cKDTree(V[handles]).query(V)[0] <= 0.3 * diagonal, 1, 0)
+    status[handles] = 2
+    T = np.eye(4)
+    T[1:3, 1:3] = [[np.cos(0.8), -np.sin(0.8)], [np.sin(0.8), np.cos(0.8)]]
+    T[:3, 3] = V[handles].mean(axis=0) - T[:3, :3] @ V[handles].mean(axis=0)
+    paths = {k: tmp_path / f"terrain.{k}" for k in ("off", "sel", "def")}
+    write_mesh(paths["off"], V, F)
+    write_selection(paths["sel"], status)
+    write_transform(paths["def"], T)
+    out = tmp_path / "out.ply"
+    rc = main(["edit", str(paths["off"]), "--sel", str(paths["sel"]), "--def", str(paths["def"]), str(out)])
+    err = capsys.readouterr().err
+    X = read_mesh(str(out))[0]
+    moved = np.linalg.norm(X - V, axis=1)
+    assert moved.max() < 3.0 * moved[handles].max()                        # not amplified (1.2x)
+    folded = folded_triangles(V, F, X, T[:3, :3])
+    assert folded.size == 12
+    assert rc == 4
+    assert f"warning: 12 triangles of {F.shape[0]} folded over" in err and "--relations one+two-ring" in err

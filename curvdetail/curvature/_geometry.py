@@ -102,3 +102,18 @@ def _dot(a, b, out=None):
     out += a[1] * b[1]
     out += a[2] * b[2]
     return out
+
+
+def folded_triangles(V, F, X, A):
+    """Triangles of ``X`` (same ``F`` as the rest shape ``V``) folded over, increasing: their
+    normal points against both their rest normal and the normal they get from the linear map
+    ``A`` (3, 3) applied to the rest shape (the turn of an edit's handles or of a boundary's
+    best-fitting similarity), so that neither an unmoved triangle nor one turned by up to that
+    turn counts (a triangle turned by any angle between 0 and the turn faces one of the two)."""
+    def normals(Y):
+        return np.cross(Y[F[:, 1]] - Y[F[:, 0]], Y[F[:, 2]] - Y[F[:, 0]])
+
+    after = normals(X)
+    against_rest = np.einsum("ij,ij->i", normals(V), after) < 0
+    against_turned = np.einsum("ij,ij->i", normals(V @ np.asarray(A).T), after) < 0
+    return np.flatnonzero(against_rest & against_turned)

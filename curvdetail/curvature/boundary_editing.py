@@ -7,6 +7,7 @@ import warnings
 
 import numpy as np
 
+from ._geometry import folded_triangles
 from ._validate import (MIN_DIAGONAL, ZERO_AREA_RELATIVE, _check_magnitude, _compact_ids, as_faces, as_values,
                         as_vertices, bbox_diagonal, boundary_edges, check_bool, check_choice, check_mesh,
                         check_oriented, face_double_areas, vertex_components)
@@ -203,12 +204,7 @@ def _figures(V, F, X, loop, R):
     ``boundary_displacement`` are the largest vertex moves, overall and on the loop, over the
     rest bbox diagonal (as the filter's ``max_displacement``), ``amplification`` their ratio
     (None where the boundary does not move, as in the filter)."""
-    def normals(Y):
-        return np.cross(Y[F[:, 1]] - Y[F[:, 0]], Y[F[:, 2]] - Y[F[:, 0]])
-
-    rest, after = normals(V), normals(X)
-    folded = np.flatnonzero((np.einsum("ij,ij->i", rest, after) < 0)
-                            & (np.einsum("ij,ij->i", rest @ R.T, after) < 0))
+    folded = folded_triangles(V, F, X, R)
     diag = bbox_diagonal(V)
     moved = np.linalg.norm(X - V, axis=1)
     on_loop = moved[loop].max()

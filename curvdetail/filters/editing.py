@@ -5,6 +5,7 @@ import warnings
 
 import numpy as np
 
+from ..curvature._geometry import folded_triangles
 from ..curvature._validate import (affine_transform_problem, bbox_diagonal, check_transformed_values,
                                    non_whole_index_error, real_word)
 from ..curvature.curvature_coefficients import curvature_coefficients
@@ -198,7 +199,7 @@ def apply_curvature_editing(ms, *, handles, region_radius, transform, detail_sca
     set_vertex_positions(ms, mid, X)
     set_vertex_quality(ms, mid, moved)
     diagonal = bbox_diagonal(V)
-    folded = _folded_triangles(V, F, X, T[:3, :3])
+    folded = folded_triangles(V, F, X, T[:3, :3])
     rank_deficient, widened = _region_ring_counts(V, F, roi, editor)
     figures = {
         "max_displacement": float(moved.max() / diagonal),
@@ -221,21 +222,6 @@ def apply_curvature_editing(ms, *, handles, region_radius, transform, detail_sca
         relations=relations, detail_scale=detail_scale, handle_detail=handle_detail,
         handles_moved=figures["amplification"] is not None))
     return figures
-
-
-def _folded_triangles(V, F, X, A):
-    """Triangles of the result ``X`` folded over, increasing: their normal points against both
-    their rest normal and their rest normal under the linear part ``A`` of the handles' transform
-    (the normal the handles' own triangles get), so that neither the rest shape nor a region
-    turned by up to the handles' turn counts (a triangle turned by any angle between 0 and the
-    handles' turn faces one of the two)."""
-    def normals(Y):
-        return np.cross(Y[F[:, 1]] - Y[F[:, 0]], Y[F[:, 2]] - Y[F[:, 0]])
-
-    after = normals(X)
-    against_rest = np.einsum("ij,ij->i", normals(V), after) < 0
-    against_turned = np.einsum("ij,ij->i", normals(V @ A.T), after) < 0
-    return np.flatnonzero(against_rest & against_turned)
 
 
 def _detail_amplification(D0, D, roi, M):
