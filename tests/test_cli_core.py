@@ -179,7 +179,8 @@ def test_help_lists_the_exit_statuses(capsys):
     assert "Exit status: 0 done; 1 an error" in text
     assert "3 OUTPUT written, but an iteration stopped before it converged (minimal, or a filter of " \
            "apply/run whose figures say converged: false)" in text
-    assert "4 OUTPUT written, but edit amplified" in text and "130 Ctrl-C, 143 SIGTERM" in text
+    assert "4 OUTPUT written, but edit folded triangles or amplified the handles' motion (or an editing filter of " \
+           "apply/run folded triangles or amplified its constraints)" in text and "130 Ctrl-C, 143 SIGTERM" in text
 
 
 def test_console_script_help_runs():
