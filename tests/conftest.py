@@ -196,3 +196,37 @@ def isotropic_calls(monkeypatch):
 
     monkeypatch.setattr(pymeshlab.MeshSet, "meshing_isotropic_explicit_remeshing", spy)
     return calls
+
+
+def triangle_brute_force(P, V, F):
+    """Distance from each point of ``P`` to the surface ``(V, F)``, every triangle measured
+    (the package's point-triangle formula, checked against Ericson's in test_remesh_evaluate)."""
+    from curvdetail.remesh.evaluate import _triangle_distance
+
+    k, m = P.shape[0], F.shape[0]
+    return _triangle_distance(np.repeat(P, m, axis=0), np.tile(V[F], (k, 1, 1))).reshape(k, m).min(axis=1)
+
+
+def wavy_source_and_a_rebuild_beside_it(monkeypatch):
+    """A wavy 10 x 10 grid (heights +-0.5) as the source, and its rebuild forced beside it: the
+    transfer patched to give ``L(Vt) Y``, so the rebuild is ``Y`` exactly, the retriangulation
+    with its interior flattened at z = 0.3 (the source's height) and spread 1.4x about the
+    centre, past the source's edge. There pymeshlab's closest-face grid (locate's search)
+    returns faces that are not the closest: 4 of the 500 vertices up to 0.49 % of the diagonal
+    too far."""
+    import curvdetail.remesh.experiment as experiment
+    from curvdetail import boundary_vertices, cotan_laplacian
+    from curvdetail.curvature.testing import grid
+
+    V, F = grid(10, 10)
+    V[:, 2] = 0.5 * np.sin(8 * V[:, 0]) * np.cos(6.4 * V[:, 1])
+
+    def beside(Vs, Fs, Vt, Ft, **options):
+        Y = Vt.copy()
+        inner = np.setdiff1d(np.arange(Vt.shape[0]), boundary_vertices(Ft))
+        Y[inner, :2] = (Y[inner, :2] - 0.5) * 1.4 + 0.5
+        Y[inner, 2] = 0.3
+        return cotan_laplacian(Vt, Ft) @ Y
+
+    monkeypatch.setattr(experiment, "transfer_curvature", beside)
+    return V, F

@@ -13,6 +13,8 @@ from curvdetail.filters.errors import FilterParameterError
 from curvdetail.filters.meshset import vertex_attribute
 from curvdetail.remesh import NotADiskError, transfer_curvature, vertex_distance
 
+from conftest import triangle_brute_force, wavy_source_and_a_rebuild_beside_it
+
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
 
 
@@ -241,15 +243,6 @@ def test_a_rebuild_worse_than_zero_detail_is_said_by_the_filter():
     assert caught[0].filename == __file__
 
 
-def _triangle_brute_force(P, V, F):
-    """Distance from each point of ``P`` to the surface ``(V, F)``, every triangle measured
-    (the package's point-triangle formula, checked against Ericson's in test_remesh_evaluate)."""
-    from curvdetail.remesh.evaluate import _triangle_distance
-
-    k, m = P.shape[0], F.shape[0]
-    return _triangle_distance(np.repeat(P, m, axis=0), np.tile(V[F], (k, 1, 1))).reshape(k, m).min(axis=1)
-
-
 def test_layer_qualities_are_exact_where_the_grid_search_is_not(monkeypatch):
     # the rebuild forced beside a wavy source (as in test_remesh_experiment: the transfer patched
     # to give L(Vt) Y, Y the retriangulation with its interior flattened at z = 0.3 and spread
@@ -257,22 +250,9 @@ def test_layer_qualities_are_exact_where_the_grid_search_is_not(monkeypatch):
     # quality, put 4 of its 500 vertices up to 0.49 % of the diagonal too far
     import warnings
 
-    import curvdetail.remesh.experiment as experiment
-    from curvdetail import cotan_laplacian
-    from curvdetail.curvature.testing import grid
     from curvdetail.remesh import WorseThanZeroDetailWarning
 
-    V, F = grid(10, 10)
-    V[:, 2] = 0.5 * np.sin(8 * V[:, 0]) * np.cos(6.4 * V[:, 1])
-
-    def beside(Vs, Fs, Vt, Ft, **options):
-        Y = Vt.copy()
-        inner = np.setdiff1d(np.arange(Vt.shape[0]), boundary_vertices(Ft))
-        Y[inner, :2] = (Y[inner, :2] - 0.5) * 1.4 + 0.5
-        Y[inner, 2] = 0.3
-        return cotan_laplacian(Vt, Ft) @ Y
-
-    monkeypatch.setattr(experiment, "transfer_curvature", beside)
+    V, F = wavy_source_and_a_rebuild_beside_it(monkeypatch)
     ms = pymeshlab.MeshSet()
     ms.add_mesh(pymeshlab.Mesh(V, F.astype(np.int32)), "wavy")
     with warnings.catch_warnings():
@@ -282,7 +262,7 @@ def test_layer_qualities_are_exact_where_the_grid_search_is_not(monkeypatch):
     d = bbox_diagonal(V)
     for name in ("rebuilt", "zero_detail"):
         layer = ms.mesh(report["layers"][name])
-        exact = _triangle_brute_force(layer.vertex_matrix(), V, F)
+        exact = triangle_brute_force(layer.vertex_matrix(), V, F)
         if name == "rebuilt":
             assert (vertex_distance(layer.vertex_matrix(), V, F) - exact).max() > 1e-3 * d    # the grid is off
         np.testing.assert_allclose(layer.vertex_scalar_array(), exact, rtol=1e-12, atol=1e-15 * d)

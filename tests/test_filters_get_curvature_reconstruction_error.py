@@ -11,6 +11,8 @@ from curvdetail.curvature.testing import grid
 from curvdetail.filters import FilterError, apply
 from curvdetail.remesh import hausdorff, vertex_distance
 
+from conftest import triangle_brute_force
+
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
 
 
@@ -154,20 +156,11 @@ def _flat_layer_beside_a_wavy_one():
     return ms
 
 
-def _triangle_brute_force(P, V, F):
-    """Distance from each point of ``P`` to the surface ``(V, F)``, every triangle measured
-    (the package's point-triangle formula, checked against Ericson's in test_remesh_evaluate)."""
-    from curvdetail.remesh.evaluate import _triangle_distance
-
-    k, m = P.shape[0], F.shape[0]
-    return _triangle_distance(np.repeat(P, m, axis=0), np.tile(V[F], (k, 1, 1))).reshape(k, m).min(axis=1)
-
-
 def test_quality_is_exact_where_the_grid_search_is_not():
     ms = _flat_layer_beside_a_wavy_one()
     figures = apply(ms, "get_curvature_reconstruction_error", samplenum=2000)
     V, F, P = ms.mesh(0).vertex_matrix(), ms.mesh(0).face_matrix(), ms.mesh(1).vertex_matrix()
-    exact = _triangle_brute_force(P, V, F)
+    exact = triangle_brute_force(P, V, F)
     d = bbox_diagonal(V)
     assert (vertex_distance(P, V, F) - exact).max() > 1e-3 * d            # the grid is off here
     np.testing.assert_allclose(ms.mesh(1).vertex_scalar_array(), exact, rtol=1e-12, atol=1e-15 * d)

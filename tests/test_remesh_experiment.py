@@ -10,6 +10,8 @@ from curvdetail.curvature.testing import disk
 from curvdetail.remesh import (NotADiskError, RemeshError, WorseThanZeroDetailWarning, hausdorff, remesh_experiment,
                                retriangulate, vertex_distance)
 
+from conftest import triangle_brute_force, wavy_source_and_a_rebuild_beside_it
+
 
 def _gaussians(xy):
     """Sum of three Gaussian bumps (heights 0.25, -0.15, 0.2) over the unit disk."""
@@ -425,40 +427,6 @@ def test_report_figures_are_those_hausdorff_measures_itself(height_field, monkey
     assert calls[0][0] is r["distance"] and calls[1][0] is r["zero_distance"]
 
 
-def _triangle_brute_force(P, V, F):
-    """Distance from each point of ``P`` to the surface ``(V, F)``, every triangle measured
-    (the package's point-triangle formula, checked against Ericson's in test_remesh_evaluate)."""
-    from curvdetail.remesh.evaluate import _triangle_distance
-
-    k, m = P.shape[0], F.shape[0]
-    return _triangle_distance(np.repeat(P, m, axis=0), np.tile(V[F], (k, 1, 1))).reshape(k, m).min(axis=1)
-
-
-def _wavy_source_and_a_rebuild_beside_it(monkeypatch):
-    """A wavy 10 x 10 grid (heights +-0.5) as the source, and its rebuild forced beside it: the
-    transfer patched to give ``L(Vt) Y``, so the rebuild is ``Y`` exactly, the retriangulation
-    with its interior flattened at z = 0.3 (the source's height) and spread 1.4x about the
-    centre, past the source's edge. There pymeshlab's closest-face grid (locate's search)
-    returns faces that are not the closest: 4 of the 500 vertices up to 0.49 % of the diagonal
-    too far."""
-    import curvdetail.remesh.experiment as experiment
-    from curvdetail import cotan_laplacian
-    from curvdetail.curvature.testing import grid
-
-    V, F = grid(10, 10)
-    V[:, 2] = 0.5 * np.sin(8 * V[:, 0]) * np.cos(6.4 * V[:, 1])
-
-    def beside(Vs, Fs, Vt, Ft, **options):
-        Y = Vt.copy()
-        inner = np.setdiff1d(np.arange(Vt.shape[0]), boundary_vertices(Ft))
-        Y[inner, :2] = (Y[inner, :2] - 0.5) * 1.4 + 0.5
-        Y[inner, 2] = 0.3
-        return cotan_laplacian(Vt, Ft) @ Y
-
-    monkeypatch.setattr(experiment, "transfer_curvature", beside)
-    return V, F
-
-
 def test_rebuilt_vertex_distances_are_exact_where_the_grid_search_is_not(monkeypatch):
     # the per-vertex distances (the CLI's and the filter's quality, vertex_max) were locate's,
     # up to 0.49 % of the diagonal too large here; now the exact ones, to rounding
@@ -466,16 +434,16 @@ def test_rebuilt_vertex_distances_are_exact_where_the_grid_search_is_not(monkeyp
 
     from curvdetail.remesh.experiment import run_experiment
 
-    V, F = _wavy_source_and_a_rebuild_beside_it(monkeypatch)
+    V, F = wavy_source_and_a_rebuild_beside_it(monkeypatch)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", WorseThanZeroDetailWarning)      # it is worse: forced off
         r = run_experiment(V, F, target_edge=0.05)
     d = r["report"]["source"]["bbox_diagonal"]
-    exact = _triangle_brute_force(r["X"], V, F)
+    exact = triangle_brute_force(r["X"], V, F)
     assert (vertex_distance(r["X"], V, F) - exact).max() > 1e-3 * d          # the grid is off here
     np.testing.assert_allclose(r["distance"], exact, rtol=1e-12, atol=1e-15 * d)
     assert r["report"]["error"]["vertex_max"] == pytest.approx(exact.max() / d, rel=1e-12)
-    np.testing.assert_allclose(r["zero_distance"], _triangle_brute_force(r["Z"], V, F), rtol=1e-12, atol=1e-15 * d)
+    np.testing.assert_allclose(r["zero_distance"], triangle_brute_force(r["Z"], V, F), rtol=1e-12, atol=1e-15 * d)
 
 
 def test_ratios_of_a_flat_patch_are_none_with_the_reason():
