@@ -229,3 +229,58 @@ def test_nearly_planar_rings_keep_their_coefficients_under_rotation():
                  for X in (D, 2.5 * D @ _rotation(rng).T))
         worst = max(worst, np.abs(C - C2).max() / np.abs(C).max())
     assert worst < 1e-8
+
+
+def test_rings_are_padded_by_their_own_size_not_the_largest(monkeypatch):
+    # a gently curved disc meshed as a polar grid: one pole of valence 128 among ~6,500 rings of
+    # valence 6 whose singular values need the SVD (the pole's too). Padding every ring to the
+    # pole's size made the SVD input rows x 128 x 3 (a 1M-vertex mesh with a pole of valence
+    # 2048: ~100 GB); each batch is now at most twice as wide as its widest ring, and the
+    # coefficients are those of pinv
+    S, R = 128, 60
+    r = np.linspace(0, 1, R + 1)[1:]
+    a = np.linspace(0, 2 * np.pi, S, endpoint=False)
+    x, y = (r[:, None] * np.cos(a)).ravel(), (r[:, None] * np.sin(a)).ravel()
+    V = np.r_[[[0.0, 0.0, 0.02 * np.sin(1.0)]], np.c_[x, y, 0.02 * np.sin(2 * x + 1) * np.cos(3 * y)]]
+    idx = 1 + np.arange(R * S).reshape(R, S)
+    nxt = np.roll(idx, -1, axis=1)
+    F = np.concatenate([np.c_[np.zeros(S, dtype=int), idx[0], nxt[0]],
+                        np.c_[idx[:-1].ravel(), idx[1:].ravel(), nxt[1:].ravel()],
+                        np.c_[idx[:-1].ravel(), nxt[1:].ravel(), nxt[:-1].ravel()]])
+    widths = []
+    svd = np.linalg.svd
+
+    def spy(M, *args, **kwargs):
+        widths.append(M.shape)
+        return svd(M, *args, **kwargs)
+
+    monkeypatch.setattr(np.linalg, "svd", spy)
+    C = curvature_coefficients(V, F)
+    monkeypatch.undo()
+    assert sum(batch for batch, _, _ in widths) > 1000                  # the SVD path really ran
+    assert sum(batch for batch, width, _ in widths if width > 16) == 1          # the pole alone
+    assert max(width for _, width, _ in widths if width <= 16) <= 16
+    D = curvature_detail(V, F)
+    for i in (0, 1, S + 1):                                             # the pole and two rings
+        ring = C[i].indices
+        expected = np.linalg.pinv(D[ring].T, rcond=1e-6) @ D[i]
+        assert np.abs(C[i, ring].toarray().ravel() - expected).max() < 1e-9 * np.abs(expected).max()
+
+
+def test_rings_still_unresolved_at_max_ring_keep_their_widest_fit():
+    # a 3 x 3 grid with two lifted corners: vertices 2 and 6 cannot represent their detail even
+    # from their two-rings; with max_ring=2 their rows are the minimum-norm fit over the two-ring
+    # (dropping those rows' entries left them empty and passed every other test)
+    V, F = grid(3, 3)
+    V[2, 2], V[6, 2] = 0.04, 0.08
+    D = curvature_detail(V, F)
+    C, info = curvature_coefficients(V, F, max_ring=2, return_info=True)
+    edges = {tuple(e) for f in F for e in ((f[0], f[1]), (f[1], f[2]), (f[2], f[0]))}
+    edges |= {(j, i) for i, j in edges}
+    for i in (2, 6):
+        assert info.ring[i] == 2 and info.residual[i] > info.rcond * info.scale[i]
+        ring1 = {j for a, j in edges if a == i}
+        ring2 = sorted(ring1 | {k for a, k in edges if a in ring1} - {i})
+        assert C[i].indices.tolist() == ring2
+        expected = np.linalg.pinv(D[ring2].T, rcond=1e-6) @ D[i]
+        assert np.allclose(C[i, ring2].toarray().ravel(), expected, rtol=1e-9, atol=1e-12)

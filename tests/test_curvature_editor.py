@@ -558,3 +558,22 @@ def test_true_or_false_among_indices_is_refused(plane_grid):
                                               r"\(first at position 0\); pass indices only, or an \(441,\) "
                                               "boolean mask"):
         CurvatureEditor(V, F, [60, 61], [True, 61], roi=np.arange(40, 120))
+
+
+def test_max_ring_1_keeps_the_papers_one_ring_relations(load_mesh):
+    # the widened corners are the default; max_ring=1 gives the one-ring relations back, whose
+    # corners' residuals stay constants: the same rest shape, and the coefficients of
+    # curvature_coefficients(max_ring=1)
+    from curvdetail import curvature_coefficients
+
+    V, F = load_mesh("terrainA_1k.obj")
+    handles = np.random.default_rng(0).choice(V.shape[0], 8, replace=False)
+    wide = CurvatureEditor(V, F, handles, handles)
+    narrow = CurvatureEditor(V, F, handles, handles, max_ring=1)
+    assert wide.widened_rings == 2 and narrow.widened_rings == 0
+    assert narrow.widened_vertices.size == 0 and wide.widened_vertices.tolist() == \
+        curvature_coefficients(V, F, return_info=True)[1].widened_vertices.tolist()
+    assert abs(narrow.coefficients - curvature_coefficients(V, F, max_ring=1)).max() == 0
+    assert np.abs(narrow.solve() - V).max() < 1e-8 * _diag(V)
+    with pytest.raises(ValueError, match="max_ring"):
+        CurvatureEditor(V, F, handles, handles, max_ring=0)

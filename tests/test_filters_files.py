@@ -152,3 +152,20 @@ def test_a_ctm_save_holds_the_geometry_only_and_reads_back(tmp_path):
     child = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert child.returncode == 0, child.stderr
     assert child.stdout.split() == [str(ms.current_mesh().vertex_number()), str(ms.current_mesh().face_number())]
+
+
+def test_a_ctm_save_keeps_vertex_colours(tmp_path):
+    # the geometry-only CTM options dropped the colours too; only the quality must go
+    import pymeshlab
+
+    from curvdetail._ctm_scan import ctm_problem
+
+    ms = load_meshset(NOSE)
+    n = ms.current_mesh().vertex_number()
+    colours = np.tile([0.2, 0.4, 0.6, 1.0], (n, 1))
+    m = ms.current_mesh()
+    ms.add_mesh(pymeshlab.Mesh(m.vertex_matrix(), m.face_matrix(), v_color_matrix=colours), "coloured")
+    out = tmp_path / "coloured.ctm"
+    save_current_mesh(ms, out)
+    assert ctm_problem(str(out)) is None
+    assert b"Color" in out.read_bytes() and b"Quality" not in out.read_bytes()

@@ -7,9 +7,10 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from ._validate import (as_index_set, as_values, bbox_centre, bbox_diagonal, centroid_diameter, check_bool,
-                        check_choice, non_whole_index_error)
+                        check_choice)
 from .cotan_laplacian import checked_cotan_laplacian, laplacian_product
-from .curvature_coefficients import DEFAULT_MAX_RING, DEFAULT_RCOND, _coefficients, _one_ring_pairs, check_rcond
+from .curvature_coefficients import (DEFAULT_MAX_RING, DEFAULT_RCOND, _coefficients, _one_ring_pairs, check_max_ring,
+                                     check_rcond)
 from .errors import ConstraintError, UndeterminedEditError, first_indices
 from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
 from .reconstruct import refine_least_squares
@@ -100,6 +101,9 @@ class CurvatureEditor:
                                 inconsistent constraints (a rotated handle), at the price of a
                                 denser factorization
     rcond : float               singular-value threshold of :func:`curvature_coefficients`
+    max_ring : int              widest ring of :func:`curvature_coefficients` (default 3; 1 keeps
+                                the paper's one-ring relations everywhere, with the rank-deficient
+                                corners' residuals kept as constants, see Invariance)
     backend : str               sparse solver backend ("auto", "pardiso", "cholmod", "splu", "banded");
                                 with "auto" the curvature stage uses SuperLU below
                                 :data:`CURVATURE_SPLU_MAX` unknowns (fastest back-substitution
@@ -122,7 +126,8 @@ class CurvatureEditor:
                                 ``embedding_setup`` (normal equations and their factorization),
                                 ``rest_check`` (``rest_error``: one back-substitution of each stage)
     widened_rings : int         vertices whose coefficients span a ring wider than the one-ring
-                                (see :func:`curvature_coefficients`)
+                                (see :func:`curvature_coefficients`); ``widened_vertices`` and
+                                ``rank_deficient_vertices`` (int arrays, increasing) list them
     rank_deficient : int        vertices whose ring detail is rank-deficient (see
                                 :func:`curvature_coefficients`)
     detail_islands : int        free vertices whose detail the coefficients cannot determine
@@ -173,11 +178,13 @@ class CurvatureEditor:
     refinement_steps = 1
 
     def __init__(self, V, F, position_constrained, detail_constrained, *, roi=None,
-                 rows="all", relations="one-ring", rcond=DEFAULT_RCOND, backend="auto"):
+                 rows="all", relations="one-ring", rcond=DEFAULT_RCOND, max_ring=DEFAULT_MAX_RING,
+                 backend="auto"):
         rows = check_choice(rows, "rows", ("all", "free"),
                             " is not a row mode; use 'all' (the paper's E_Q) or 'free'.")
         relations = _check_relations(relations)
         rcond = check_rcond(rcond)
+        max_ring = check_max_ring(max_ring)
         resolve_backend(backend)           # an unknown or missing backend fails before the work
         V, F, L = checked_cotan_laplacian(V, F)       # every mesh check, and L in the same pass
         self.relations = relations
@@ -221,13 +228,15 @@ class CurvatureEditor:
         D = laplacian_product(L, V)
         rows, cols = _one_ring_pairs(F, n)
         A, size = _mixed_voronoi_area_unchecked(V, F), centroid_diameter(V)     # rotation-invariant
-        C, rank, _, ring = _coefficients(D, A, rows, cols, n, rcond, size, max_ring=DEFAULT_MAX_RING)
+        C, rank, _, ring = _coefficients(D, A, rows, cols, n, rcond, size, max_ring=max_ring)
         crows, ccols, cvals = _pattern(C)     # the one-ring, wider where a ring was widened
         self.detail, self.coefficients, self.laplacian = D, C, L
         for state in (D, C.data, L.data, pc, dc):      # read-only: solves read them again
             state.flags.writeable = False
         self.rank_deficient = int(np.count_nonzero(rank < 3))
         self.widened_rings = int(np.count_nonzero(ring > 1))
+        self.rank_deficient_vertices = np.flatnonzero(rank < 3)
+        self.widened_vertices = np.flatnonzero(ring > 1)
         t1 = time.perf_counter()
 
         # -- curvature stage: unknown details fd = roi \ dc --------------------------------
@@ -236,7 +245,7 @@ class CurvatureEditor:
         _check_reached(crows, ccols, free_d, n, "detail", "detail_constrained")
         if relations == "one+two-ring":
             rows2, cols2 = _two_ring_pairs(rows, cols, n)
-            C2, rank2, _, _ = _coefficients(D, A, rows2, cols2, n, rcond, size, max_ring=DEFAULT_MAX_RING,
+            C2, rank2, _, _ = _coefficients(D, A, rows2, cols2, n, rcond, size, max_ring=max_ring,
                                             adjacency=(rows, cols))
             rows2, cols2, cvals2 = _pattern(C2)
             self.coefficients_two_ring = C2
@@ -633,15 +642,7 @@ def _index_set(indices, n, name, values=None):
         if any(flags) and not all(flags):       # numpy reads [True, 3] as vertices 1 and 3
             raise ConstraintError(f"{name} has True/False among its vertex indices (first at position "
                                   f"{flags.index(True)}); pass indices only, or an ({n},) boolean mask.")
-    try:
-        arr = np.asarray(indices)
-    except Exception:                   # ragged and the like: as_index_set names it
-        arr = None
-    if arr is not None and arr.dtype.kind == "f" and arr.size:
-        error = non_whole_index_error(arr, name)
-        if error is not None:
-            raise error
-    return as_index_set(indices, n, name)
+    return as_index_set(indices, n, name)             # names non-whole values too
 
 
 def _pattern(C):

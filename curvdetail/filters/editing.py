@@ -8,7 +8,6 @@ import numpy as np
 from ..curvature._geometry import folded_triangles
 from ..curvature._validate import (affine_transform_problem, bbox_diagonal, check_transformed_values,
                                    non_whole_index_error, real_word)
-from ..curvature.curvature_coefficients import curvature_coefficients
 from ..curvature.curvature_editor import CurvatureEditor
 from ..curvature.errors import (ConstraintError, FoldedTrianglesWarning, UndeterminedEditError, counted,
                                 first_indices)
@@ -238,17 +237,12 @@ def _detail_amplification(D0, D, roi, M):
 
 
 def _region_ring_counts(V, F, roi, editor):
-    """Vertices of the region whose one-ring detail is rank-deficient, and those whose
-    coefficients span a widened ring (:func:`curvature_coefficients`, the editor's settings).
-    The editor counts the whole mesh; only where it found any are the coefficients computed
-    again for the per-vertex answer."""
-    if not (editor.rank_deficient or editor.widened_rings):
-        return 0, 0
-    _, info = curvature_coefficients(V, F, return_info=True)
+    """Vertices of the region whose ring detail is rank-deficient, and those whose coefficients
+    span a widened ring (``curvature_coefficients``, as the editor computed them)."""
     in_roi = np.zeros(V.shape[0], dtype=bool)
     in_roi[roi] = True
-    return (int(np.count_nonzero(in_roi[info.rank_deficient_vertices])),
-            int(np.count_nonzero(in_roi[info.widened_vertices])))
+    return (int(np.count_nonzero(in_roi[editor.rank_deficient_vertices])),
+            int(np.count_nonzero(in_roi[editor.widened_vertices])))
 
 
 def _warn_if_amplified(figures, folded, m, moved, D, D0, options):

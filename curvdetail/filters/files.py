@@ -64,12 +64,13 @@ def check_output_path(path, overwrite=False):
 
 def save_options(ms, path):
     """pymeshlab ``save_current_mesh`` options that keep quality and our attributes in PLY, and
-    the coordinates in CTM (its default compresses them to a grid). CTM gets the geometry only:
-    a "Quality" map without a "Color" one crashes pymeshlab's CTM reader, and with one it reads
-    the colours' red channel as the quality (:mod:`curvdetail._ctm_scan`)."""
+    the coordinates in CTM (its default compresses them to a grid). CTM keeps vertex colours but
+    never the quality: a "Quality" map without a "Color" one crashes pymeshlab's CTM reader, and
+    with one it reads the colours' red channel as the quality (:mod:`curvdetail._ctm_scan`)."""
     extension = os.path.splitext(os.fspath(path))[1].lower()
     if extension == ".ctm":
-        return {"lossless": True, "save_vertex_quality": False, "save_vertex_color": False}
+        return {"lossless": True, "save_vertex_quality": False,
+                "save_vertex_color": bool(ms.current_mesh().has_vertex_color())}
     if extension != ".ply":
         return {}
     mesh = ms.current_mesh()

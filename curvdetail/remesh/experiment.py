@@ -386,7 +386,7 @@ def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="cons
             h = hausdorff(P, Ft, V, F, samples=n, engine=engine, a_vertex_distance=dist)
             report[key] = {"hausdorff_max": h["max"] / d, "hausdorff_rms": h["rms"] / d}
             engines[key] = h["engine"]
-        report["error"]["engine"] = "kdtree" if far else "meshlab"
+        report["error"]["engine"] = engines["error"]            # the engine that ran (hausdorff may switch)
         report["error"]["vertex_max"] = float(out["distance"].max() / d)
         report.update(_ratios(report, engines))
         seconds["evaluate"] = time.perf_counter() - t
