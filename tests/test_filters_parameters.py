@@ -159,8 +159,12 @@ def test_text_parameter_takes_a_sequence_of_numbers_digit_for_digit():
     # a list of numpy scalars (numpy 2 writes np.float64(1.0) as "np.float64(1.0)")
     assert p.check(list(np.eye(2).ravel())) == "1.0 0.0 0.0 1.0"
     assert p.check([np.int64(3), np.int32(4), np.float32(0.5)]) == "3 4 0.5"
-    for bad in ([True, 2], [[1, 2], [3]], ["1", 2], object()):
+    for bad in ([[1, 2], [3]], ["1", 2], object()):
         with pytest.raises(FilterParameterError, match="'transform' expects a str"):
+            p.check(bad)
+    # True/False among numbers are named (the generic message called the list a list it takes)
+    for bad in ([True, 2], (2, np.True_)):
+        with pytest.raises(FilterParameterError, match=r"'transform' has True/False among its numbers \(first at position"):
             p.check(bad)
 
 

@@ -243,6 +243,11 @@ class Parameter:
                    "pass the indices where the mask is true, np.flatnonzero(mask)")
             raise FilterParameterError(f"parameter {self.name!r} is a boolean mask ({arr.size} True/False "
                                        f"values); it takes numbers, not a mask: {fix}.")
+        flags = [isinstance(x, (bool, np.bool_)) for x in items]
+        if any(flags):                  # True/False among numbers: read as 1/0 otherwise
+            raise FilterParameterError(
+                f"parameter {self.name!r} has True/False among its numbers (first at position "
+                f"{flags.index(True)}); pass numbers only (or, for indices, np.flatnonzero(mask) of a mask).")
         if np.ma.isMaskedArray(value) and np.ma.getmaskarray(value).any():
             raise FilterParameterError(
                 f"parameter {self.name!r} has {int(np.ma.getmaskarray(value).sum())} masked entries, which "
