@@ -333,3 +333,13 @@ def test_report_of_a_layer_made_in_memory_names_no_file():
     ms.add_mesh(pymeshlab.Mesh(V, F.astype(np.int32)), "patch")
     report = apply(ms, "generate_curvature_remeshing", target_edge=pymeshlab.PercentageValue(8), evaluate=False)
     assert report["source"]["path"] is None
+
+
+def test_report_names_no_source_file_once_the_layer_changed_in_place():
+    # a script that smooths the loaded layer and then remeshes it: the file is not the source
+    from curvdetail.filters.files import load_meshset
+
+    ms = load_meshset(os.path.join(DATA, "terrainA_1k.obj"))
+    ms.apply_coord_laplacian_smoothing(stepsmoothnum=1, boundary=False, cotangentweight=True, selected=False)
+    report = apply(ms, "generate_curvature_remeshing", target_edge=pymeshlab.PercentageValue(5), evaluate=False)
+    assert report["source"]["path"] is None and report["source"]["label"] == "terrainA_1k.obj"

@@ -22,8 +22,9 @@ from .ply_attributes import read_ply_vertex_attributes
 
 _HINT = "use .ply to keep quality and curvature attributes, or .obj, .off, .stl"
 
-#: the absolute path each layer of a MeshSet made by :func:`load_meshset` was read from
-#: (pymeshlab keeps it too, but gives Python only the bare file name, ``Mesh.label()``)
+#: the absolute path each layer of a MeshSet made by :func:`load_meshset` was read from, with a
+#: digest of its geometry then (pymeshlab keeps the path too, but gives Python only the bare
+#: file name, ``Mesh.label()``)
 _LOADED_FROM = weakref.WeakKeyDictionary()
 
 
@@ -42,7 +43,8 @@ def load_meshset(path, *more):
     ms = pymeshlab.MeshSet()
     for p in paths:
         n = load_checked(ms, p).vertex_number()
-        _LOADED_FROM.setdefault(ms, {})[ms.current_mesh_id()] = os.path.abspath(os.fsdecode(p))
+        _LOADED_FROM.setdefault(ms, {})[ms.current_mesh_id()] = (os.path.abspath(os.fsdecode(p)),
+                                                                  _geometry_digest(ms.current_mesh()))
         for name, values in read_ply_vertex_attributes(p).items():
             if values.shape in ((n,), (n, 3)) and np.all(np.isfinite(values)):
                 set_vertex_attribute(ms, ms.current_mesh_id(), name, values)
@@ -51,8 +53,22 @@ def load_meshset(path, *more):
 
 def loaded_from(ms, mesh_id):
     """The absolute path of the file :func:`load_meshset` read layer ``mesh_id`` of ``ms`` from,
-    or None (a layer pymeshlab loaded itself, or one made in memory)."""
-    return _LOADED_FROM.get(ms, {}).get(mesh_id)
+    or None: a layer pymeshlab loaded itself, one made in memory, or one whose vertices or
+    triangles changed since (a filter in a script smoothed it: the file is no longer its source)."""
+    path, digest = _LOADED_FROM.get(ms, {}).get(mesh_id, (None, None))
+    if path is None or _geometry_digest(ms.mesh(mesh_id)) != digest:
+        return None
+    return path
+
+
+def _geometry_digest(mesh):
+    """A digest of a pymeshlab mesh's vertex and face matrices (a few ms at 100k vertices)."""
+    import hashlib
+
+    h = hashlib.blake2b(digest_size=16)
+    for arr in (mesh.vertex_matrix(), mesh.face_matrix()):
+        h.update(np.ascontiguousarray(arr).tobytes())
+    return h.digest()
 
 
 def check_output_path(path, overwrite=False):

@@ -29,8 +29,8 @@ from .transfer_curvature_detail import planar_map
         the report of curvdetail.remesh.remesh_experiment (error and baselines as fractions of the
         source's bbox diagonal, sizes, options, seconds per stage; source.path the absolute path
         of the file the current layer was read from where curvdetail loaded it (the CLI, or
-        curvdetail.filters.files.load_meshset), as curvdetail remesh reports it, else None;
-        source.label the layer's label) with the new layer ids; a rebuild farther
+        curvdetail.filters.files.load_meshset) and unchanged since, as curvdetail remesh reports
+        it, else None; source.label the layer's label) with the new layer ids; a rebuild farther
         from the source than the zero-detail surface is said with a
         curvdetail.remesh.WorseThanZeroDetailWarning. {PAPER}, section "Remeshing", Fig. 3.
     """,
