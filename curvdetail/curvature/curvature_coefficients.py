@@ -279,12 +279,13 @@ def _coefficients(D, A, rows, cols, n, rcond, size, *, want_scale=False, max_rin
                 if want_scale:
                     scale[target] = s_t
                 still = residual_t > rcond * s_t
-                wide_rows.append(r[~still[np.searchsorted(target, r)]])
-                wide_cols.append(c[~still[np.searchsorted(target, r)]])
-                if extra == max_ring - 1 or not still.any():
-                    wide_rows.append(r[still[np.searchsorted(target, r)]])
-                    wide_cols.append(c[still[np.searchsorted(target, r)]])
+                if extra == max_ring - 1 or not still.any():   # every row's widest fit is final
+                    wide_rows.append(r)
+                    wide_cols.append(c)
                     break
+                done = ~still[np.searchsorted(target, r)]
+                wide_rows.append(r[done])
+                wide_cols.append(c[done])
                 target = target[still]
                 R = R[still]
         if wide_rows:
