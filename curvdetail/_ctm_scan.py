@@ -17,11 +17,15 @@ order: RAW ``INDX VERT [NORM] (TEXC name file)* (ATTR name)*``, each followed by
 MG1 the same, each followed by LZMA data (packed size, 5 bytes of properties, the bytes); MG2
 ``MG2H`` (44 bytes) ``VERT GIDX INDX [NORM]`` then ``TEXC name file precision`` and ``ATTR name
 precision``, each followed by LZMA data. The map names are outside the compressed data, so the
-scan reads the header and names only and seeks past the rest.
+scan reads the header and names only and seeks past the rest; :func:`ctm_vertex_map` then
+decodes the one map whose values pymeshlab's reader gets wrong ("Quality").
 """
 
+import lzma
 import os
 import struct
+
+import numpy as np
 
 _METHODS = (b"RAW\x00", b"MG1\x00", b"MG2\x00")
 _HAS_NORMALS = 1
@@ -83,7 +87,8 @@ def ctm_layout(path):
     (bool), ``uv_maps`` and ``attribute_maps`` (their names as bytes, in file order; ``b""`` for a
     map without a name), and ``problem``: None, or a str naming where the file ends early or
     holds a section other than the one expected (the names read up to there are kept), with
-    ``truncated`` telling which."""
+    ``truncated`` telling which, and ``attribute_offsets``: where each attribute map's values
+    start in the file (RAW: the floats; MG1: the LZMA data's size; MG2: the map's precision)."""
     with open(path, "rb") as f:
         size = os.fstat(f.fileno()).st_size
         r = _Reader(f, size)
@@ -97,8 +102,8 @@ def ctm_layout(path):
         if method not in _METHODS or vertices == 0 or triangles == 0:
             return None
         layout = {"method": method[:3].decode(), "vertices": vertices, "triangles": triangles,
-                  "normals": bool(flags & _HAS_NORMALS), "uv_maps": [], "attribute_maps": [], "problem": None,
-                  "truncated": False}
+                  "normals": bool(flags & _HAS_NORMALS), "uv_maps": [], "attribute_maps": [], "attribute_offsets": [],
+                  "problem": None, "truncated": False}
         raw, mg2 = method == b"RAW\x00", method == b"MG2\x00"
         try:
             r.string()                                                   # the comment
@@ -119,6 +124,8 @@ def ctm_layout(path):
                     names.append(r.string())
                     if tag == b"TEXC":
                         r.string()                                       # the texture's file name
+                    else:
+                        layout["attribute_offsets"].append(r.f.tell())
                     if raw:
                         r.skip(values * vertices)
                     else:
@@ -175,3 +182,72 @@ def ctm_problem(path):
                 "fault; MeshLab uses the same reader); export the mesh again without quality (or with vertex "
                 "colours), or convert it with OpenCTM's own tool (ctmconv in.ctm out.ply), and read that")
     return None
+
+
+def _c_name(name):
+    """A map's name as OpenCTM's look-up compares it: a C string, up to its first zero byte."""
+    return name.split(b"\x00", 1)[0]
+
+
+def ctm_vertex_map(path, name, layout=None):
+    """The values of the first vertex attribute map of the OpenCTM file ``path`` whose name is
+    ``name`` (bytes; compared as OpenCTM's ``ctmGetNamedAttribMap`` does, as a C string), as
+    OpenCTM decodes them: a (vertices, 4) float32 array, in the order of the vertices the
+    reader returns (MG2 stores them sorted, and its maps so). None where no map has that name,
+    or the file is one :func:`ctm_layout` finds no layout in or a problem with.
+
+    RAW holds the floats; MG1 LZMA data of the floats' bytes, interleaved by significance (most
+    significant first), then by column; MG2 the same of integers, each a signed magnitude (its
+    lowest bit the sign) and a difference to the vertex before, in units of the map's precision.
+    ``layout``: :func:`ctm_layout`'s answer for ``path``, where the caller has it.
+
+    Raises ValueError where the LZMA data cannot be decoded to the map's size (OpenCTM's reader
+    then reads nothing from the file) or uses options Python's LZMA decoder lacks."""
+    layout = ctm_layout(path) if layout is None else layout
+    if layout is None or layout["problem"] is not None:
+        return None
+    names = [_c_name(n) for n in layout["attribute_maps"]]
+    if name not in names:
+        return None
+    n = layout["vertices"]
+    with open(path, "rb") as f:
+        r = _Reader(f, os.fstat(f.fileno()).st_size)
+        f.seek(layout["attribute_offsets"][names.index(name)])
+        if layout["method"] == "RAW":
+            return np.frombuffer(r.read(16 * n), dtype="<f4").reshape(n, 4).astype(np.float32)
+        precision = struct.unpack("<f", r.read(4))[0] if layout["method"] == "MG2" else None
+        words = _unpack(r, n, 4, name)
+    if precision is None:                                                # MG1: the floats' bits
+        return words.view(np.float32)
+    signed = np.where(words & 1, -((words.astype(np.int64) + 1) >> 1), words.astype(np.int64) >> 1)
+    # OpenCTM sums the differences in 32-bit integers, then scales each in single precision
+    values = np.cumsum(signed.astype(np.int32), axis=0, dtype=np.int32)
+    return values.astype(np.float32) * np.float32(precision)
+
+
+#: liblzma's smallest dictionary; a larger one than a stream was written with decodes it alike
+_LZMA_DICTIONARY_MIN = 4096
+
+
+def _unpack(r, count, width, name):
+    """OpenCTM's packed 32-bit words at ``r``'s position (LZMA data: its size, 5 bytes of
+    properties, the stream without an end marker) as a (count, width) uint32 array."""
+    size = r.uint()
+    properties = r.read(5)
+    stream = r.read(size)
+    pb, rest = divmod(properties[0], 45)
+    lp, lc = divmod(rest, 9)
+    dictionary = max(struct.unpack("<I", properties[1:])[0], _LZMA_DICTIONARY_MIN)
+    wanted = 4 * count * width
+    label = name.decode(errors="replace")
+    try:
+        decoder = lzma.LZMADecompressor(format=lzma.FORMAT_RAW, filters=[
+            {"id": lzma.FILTER_LZMA1, "dict_size": dictionary, "lc": lc, "lp": lp, "pb": pb}])
+        data = decoder.decompress(stream, max_length=wanted)
+    except (lzma.LZMAError, ValueError) as exc:
+        raise ValueError(f"its {label!r} map's LZMA data cannot be decoded here ({exc})") from None
+    if len(data) != wanted:
+        raise ValueError(f"its {label!r} map's LZMA data holds {len(data)} bytes of the {wanted} its header declares")
+    planes = np.frombuffer(data, dtype=np.uint8).reshape(4, width, count).astype(np.uint32)
+    shifts = np.array([24, 16, 8, 0], dtype=np.uint32)[:, None, None]
+    return np.bitwise_or.reduce(planes << shifts, axis=0).T.copy()

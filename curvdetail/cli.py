@@ -478,7 +478,8 @@ def _run_on_file(args, work, *, other_inputs=()):
     import json
 
     from . import _output
-    from .filters.files import attributes_lost_in, check_output_path, load_meshset, save_current_mesh
+    from .filters.files import (attributes_lost_in, check_output_path, load_meshset, save_current_mesh,
+                                vertex_colours_kept_in)
     from .io import MeshFileError
 
     _check_image_and_distinct(None, args.output, inputs=[args.input], other_inputs=[*args.add, *other_inputs])
@@ -491,7 +492,8 @@ def _run_on_file(args, work, *, other_inputs=()):
     print(json.dumps(figures, indent=2, default=str))
     # documented, but the next step ("no attribute 'curvature_detail'") is confusing without it
     quality = ms.current_mesh().has_vertex_scalar() and not _keeps_quality(args.output)
-    _note_geometry_only(args.output, attributes_lost_in(ms, args.output), quality=quality)
+    _note_geometry_only(args.output, attributes_lost_in(ms, args.output), quality=quality,
+                        colours=vertex_colours_kept_in(ms, args.output))
     return figures
 
 
@@ -508,14 +510,17 @@ def _quality_for(path, quality):
     return quality if _keeps_quality(path) else None
 
 
-def _note_geometry_only(path, attributes=(), *, quality=False):
+def _note_geometry_only(path, attributes=(), *, quality=False, colours=False):
     """The note, on stderr, that OUTPUT's format dropped what PLY keeps: the per-vertex quality
-    (``quality``) and the filters' custom ``attributes`` (names). Nothing where neither is lost."""
+    (``quality``) and the filters' custom ``attributes`` (names), and what the file holds: the
+    geometry, and the vertex colours where ``colours`` (CTM, OBJ, ... keep a coloured layer's
+    colours). Nothing where neither is lost."""
     lost = (["the vertex quality"] if quality else []) + \
            ([f"the attributes {', '.join(attributes)}"] if attributes else [])
     if lost:
         verb = "is" if lost == ["the vertex quality"] else "are"
-        _say(f"curvdetail: note: {os.path.basename(os.fspath(path))} holds the geometry only; "
+        kept = "the geometry and the vertex colours" if colours else "the geometry"
+        _say(f"curvdetail: note: {os.path.basename(os.fspath(path))} holds {kept} only; "
              f"{' and '.join(lost)} {verb} kept by PLY output.")
 
 

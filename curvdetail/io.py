@@ -10,7 +10,7 @@ import re
 
 import numpy as np
 
-from ._ctm_scan import ctm_problem
+from ._ctm_scan import ctm_layout, ctm_problem, ctm_vertex_map
 from ._file_counts import check_loaded
 from ._file_scan import check_before_loading
 from ._output import atomic_output, check_output_path
@@ -82,7 +82,7 @@ def read_mesh(path):
     """
     path = input_path(path)
     ms = _meshset()                 # kept referenced: the mesh is a view into it
-    mesh = load_checked(ms, path)
+    mesh = load_checked(ms, path, vertex_maps=False)      # V and F only: a CTM's maps are not needed
     V = np.ascontiguousarray(mesh.vertex_matrix(), dtype=np.float64)
     F = np.ascontiguousarray(mesh.face_matrix(), dtype=np.int64)
     if F.shape[0] == 0 and V.shape[0] == 0:       # pymeshlab "reads" some other files as nothing
@@ -99,12 +99,17 @@ def read_mesh(path):
 COMMON_FORMATS = (".ply", ".obj", ".off", ".stl")
 
 
-def load_checked(ms, path):
+def load_checked(ms, path, *, vertex_maps=True):
     """Load the mesh file ``path`` into the MeshSet ``ms`` as its new current layer and return
     that ``pymeshlab.Mesh``, with the checks pymeshlab's loader lacks: before it reads the file
     (:func:`curvdetail._file_scan.check_before_loading`) and after (what it dropped:
     :func:`curvdetail._file_counts.check_loaded`, and the triangles an ASCII PLY's faces make).
-    MeshFileError for each; ``path`` is expected to exist (see :func:`input_path`)."""
+    MeshFileError for each; ``path`` is expected to exist (see :func:`input_path`).
+
+    With ``vertex_maps``, a CTM file's vertex colours and quality are set on the layer as the
+    file holds them (:func:`_set_ctm_vertex_maps`: pymeshlab reads the quality from the colour
+    map, and marks the layer as holding neither); without, they are left as pymeshlab read
+    them (for callers that take the vertices and triangles only)."""
     try:
         triangles = check_before_loading(path, error=MeshFileError)
     except OSError as exc:          # unreadable: named as the file's problem, as pymeshlab's are
@@ -125,7 +130,47 @@ def load_checked(ms, path):
             f"loaded {F.shape[0]}: its PLY loader drops, without a word, faces that repeat a vertex index and "
             "faces whose 'flags' value has the 'deleted' bit (1) set. Fix or remove those faces (or their "
             "flags) in the file and read it again.")
+    if vertex_maps and os.path.splitext(path)[1].lower() == ".ctm":
+        _set_ctm_vertex_maps(ms, path)
+        mesh = ms.current_mesh()
     return mesh
+
+
+def _set_ctm_vertex_maps(ms, path):
+    """Give the current layer of ``ms``, just loaded from the CTM file ``path``, the file's vertex
+    colours ("Color" map) and quality ("Quality" map), and mark it as holding them.
+
+    pymeshlab (2025.7; vcglib's ImporterCTM) reads the colours right but the quality from the
+    *colour* map (its red channel: a quality of 10 was read as 0.64), and marks the layer as
+    holding neither (``has_vertex_color()`` and ``has_vertex_scalar()`` False: its filters
+    refused the quality, and saves dropped both). The quality is decoded from the file
+    (:func:`curvdetail._ctm_scan.ctm_vertex_map`: its first value per vertex, as vcglib's writer
+    stores it), and both are set through pymeshlab's per-vertex function filters, which mark
+    the layer. A file with a "Quality" map and no "Color" one never gets here (refused before
+    loading: the reader crashed on it), nor one OpenCTM read as nothing (a NaN in its
+    "Quality" map was refused so). Where the quality cannot be decoded (LZMA options Python's decoder
+    lacks; OpenCTM's own writer uses none of them) it is left out (the layer marked as holding
+    none), with a warning, rather than read as the red channel."""
+    import warnings
+
+    from .filters.meshset import set_vertex_quality
+
+    layout = ctm_layout(path)
+    if layout is None or ms.current_mesh().vertex_number() != layout["vertices"]:
+        return                   # pymeshlab read nothing (OpenCTM refused the file): left to the caller
+    names = {name.split(b"\x00", 1)[0] for name in layout["attribute_maps"]}
+    if b"Color" in names:
+        # the colours pymeshlab read are the file's (to 8 bits): each kept as it is, the layer marked
+        ms.compute_color_by_function_per_vertex(x="r", y="g", z="b", a="a", onselected=False)
+    if b"Quality" in names:
+        try:
+            quality = ctm_vertex_map(path, b"Quality", layout)[:, 0].astype(np.float64)
+        except ValueError as exc:
+            warnings.warn(f"{path!r}: the vertex quality is left out: {exc}. The geometry and the colours are read "
+                          "(pymeshlab would read the quality from the colour map); export the mesh again (e.g. as "
+                          "PLY) to keep the quality.", stacklevel=4)
+            return
+        set_vertex_quality(ms, ms.current_mesh_id(), quality)
 
 
 def load_failure(path, exc):
@@ -519,9 +564,10 @@ def save_mesh(path, mesh, *, overwrite=False, _plain=None, **save_options):
                                 ``save_vertex_quality`` to False where no vertex colours are
                                 saved (pymeshlab's CTM reader crashes on quality without
                                 colours; with colours it reads their red channel as the
-                                quality); for 3DS, ``save_face_color`` is True (faces without
-                                a colour are given white: without face colours pymeshlab's
-                                writer names the faces' material from uninitialised memory)
+                                quality, which :func:`load_checked` corrects); for 3DS,
+                                ``save_face_color`` is True (faces without a colour are
+                                given white: without face colours pymeshlab's writer names
+                                the faces' material from uninitialised memory)
 
     Raises
     ------

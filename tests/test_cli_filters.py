@@ -97,6 +97,28 @@ def test_apply_to_a_format_without_attributes_says_what_is_left_out(capsys, tmp_
     assert rc == 0 and "note:" not in err
 
 
+@pytest.mark.parametrize("name, colours", [("d.ctm", True), ("d.obj", True), ("d.stl", False)])
+def test_the_note_says_what_an_output_keeps_of_a_coloured_mesh(capsys, tmp_path, name, colours):
+    # CTM (and OBJ) keep a layer's vertex colours, and the note said "the geometry only"
+    ms = load_meshset(NOSE)
+    mesh = ms.current_mesh()
+    n = mesh.vertex_number()
+    ms.add_mesh(pymeshlab.Mesh(mesh.vertex_matrix(), mesh.face_matrix(),
+                               v_color_matrix=np.c_[np.linspace(0, 1, n), np.full((n, 2), 0.4), np.ones(n)]))
+    ms.save_current_mesh(str(tmp_path / "coloured.ply"))
+    rc, _, err = run_cli(capsys, "apply", "compute_curvature_detail", tmp_path / "coloured.ply", tmp_path / name)
+    assert rc == 0
+    kept = "the geometry and the vertex colours" if colours else "the geometry"
+    assert err == (f"curvdetail: note: {name} holds {kept} only; the vertex quality and the attributes "
+                   "curvature_area, curvature_detail, curvature_normal, curvature_vertex_id, curvature_vertex_ring "
+                   "are kept by PLY output.\n")
+    back = load_meshset(tmp_path / name)                               # what the file holds
+    assert back.current_mesh().has_vertex_color() == colours and not back.current_mesh().has_vertex_scalar()
+    if colours:
+        assert np.abs(back.current_mesh().vertex_color_matrix() - ms.current_mesh().vertex_color_matrix()).max() \
+            <= 1 / 255 + 1e-9
+
+
 def vertices(path):
     ms = load_meshset(path)          # keep the MeshSet alive while its mesh is read
     return ms.current_mesh().vertex_matrix().copy()

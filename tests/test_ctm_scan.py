@@ -1,6 +1,7 @@
 """_ctm_scan: OpenCTM files that pymeshlab's CTM reader crashes on or misreads, found from their
 header and map names before it reads them."""
 
+import json
 import lzma
 import re
 import struct
@@ -10,7 +11,7 @@ import sys
 import numpy as np
 import pytest
 
-from curvdetail._ctm_scan import ctm_layout, ctm_problem
+from curvdetail._ctm_scan import ctm_layout, ctm_problem, ctm_vertex_map
 from curvdetail._file_scan import check_before_loading
 
 # a unit square of two triangles
@@ -45,22 +46,27 @@ def _index_deltas(F):
     return deltas.astype("<u4")
 
 
-def _ctm(method="RAW", attributes=(), uv_maps=(), normals=False):
+def _ctm(method="RAW", attributes=(), uv_maps=(), normals=False, values=None):
     """The bytes of a CTM file of the square in ``method``, with attribute maps and UV maps of
     these names (values 0.5 and 0) and normals (0, 0, 1). MG2 stores the vertices as offsets in
-    a grid (here one box over the unit cube), sorted by x, and the triangles renumbered so."""
+    a grid (here one box over the unit cube), sorted by x, and the triangles renumbered so.
+    ``values``: a list of (4, 4) values, one per attribute map, instead (MG2: whole multiples of
+    its precision, 1/256, stored as signed magnitudes of the differences between vertices in
+    that order; without ``values``, zeros)."""
     n = len(_V)
+    given = values is not None
+    maps = [np.full((n, 4), 0.5, "<f4")] * len(attributes) if values is None else [np.asarray(v, "<f4") for v in values]
     head = (b"OCTM" + struct.pack("<I", 5) + method.encode() + b"\0"
             + struct.pack("<5I", n, len(_F), len(uv_maps), len(attributes), int(normals)) + _string("test"))
     normal = np.tile(np.float32([0, 0, 1]), (n, 1))
     if method == "RAW":
         body = b"INDX" + _F.tobytes() + b"VERT" + _V.tobytes() + (b"NORM" + normal.tobytes() if normals else b"")
         body += b"".join(b"TEXC" + _string(u) + _string("") + np.zeros((n, 2), "<f4").tobytes() for u in uv_maps)
-        body += b"".join(b"ATTR" + _string(a) + np.full((n, 4), 0.5, "<f4").tobytes() for a in attributes)
+        body += b"".join(b"ATTR" + _string(a) + v.tobytes() for a, v in zip(attributes, maps))
     elif method == "MG1":
         body = b"INDX" + _packed(_index_deltas(_F)) + b"VERT" + _packed(_V) + (b"NORM" + _packed(normal) if normals else b"")
         body += b"".join(b"TEXC" + _string(u) + _string("") + _packed(np.zeros((n, 2), "<f4")) for u in uv_maps)
-        body += b"".join(b"ATTR" + _string(a) + _packed(np.full((n, 4), 0.5, "<f4")) for a in attributes)
+        body += b"".join(b"ATTR" + _string(a) + _packed(v) for a, v in zip(attributes, maps))
     else:
         step = 1.0 / 1024
         order = np.argsort(_V[:, 0], kind="stable")                     # (0,0), (0,1), (1,0), (1,1)
@@ -73,8 +79,11 @@ def _ctm(method="RAW", attributes=(), uv_maps=(), normals=False):
         body += b"NORM" + _packed(np.zeros((n, 3), "<u4")) if normals else b""
         body += b"".join(b"TEXC" + _string(u) + _string("") + struct.pack("<f", 1 / 4096)
                          + _packed(np.zeros((n, 2), "<u4")) for u in uv_maps)
-        body += b"".join(b"ATTR" + _string(a) + struct.pack("<f", 1 / 256) + _packed(np.zeros((n, 4), "<u4"))
-                         for a in attributes)
+        for a, v in zip(attributes, maps):
+            steps = np.round(v[order] * 256).astype(np.int64) if given else np.zeros((n, 4), np.int64)
+            steps[1:] = np.diff(steps, axis=0)
+            magnitudes = np.where(steps < 0, -1 - 2 * steps, 2 * steps).astype("<u4")      # the sign in bit 0
+            body += b"ATTR" + _string(a) + struct.pack("<f", 1 / 256) + _packed(magnitudes)
     return head + body
 
 
@@ -185,3 +194,60 @@ def test_the_scan_agrees_with_pymeshlab(tmp_path):
             assert done.returncode == 0 and done.stdout.split() == ["4", "2"], (method, attributes, done.stderr)
         else:
             assert done.returncode != 0, (method, attributes, done.stdout)
+
+
+# distinct values per vertex and channel, multiples of MG2's precision (1/256), some negative
+_COLOURS = (np.arange(16, dtype=np.float32).reshape(4, 4) + 1) / 32
+_QUALITY = np.array([[10.5, 0, 0, 0], [-3.25, 0, 0, 0], [7, 0, 0, 0], [0.00390625, 0, 0, 0]], dtype=np.float32)
+
+
+@pytest.mark.parametrize("method", ["RAW", "MG1", "MG2"])
+@pytest.mark.parametrize("extras", [{}, {"uv_maps": ("UV",), "normals": True}])
+def test_a_vertex_map_is_decoded_as_openctm_reads_it(tmp_path, method, extras):
+    # pymeshlab reads the quality from the colour map; the "Quality" map is decoded here instead.
+    # Checked two ways: the hand-made values (MG2 stores the vertices sorted by x, and its maps
+    # so), and pymeshlab's own reading of the colour map's first channel (what it calls quality)
+    path = tmp_path / "m.ctm"
+    path.write_bytes(_ctm(method, ("Color", "Other", "Quality"), values=[_COLOURS, -_COLOURS, _QUALITY], **extras))
+    order = np.argsort(_V[:, 0], kind="stable") if method == "MG2" else np.arange(4)
+    assert np.array_equal(ctm_vertex_map(path, b"Quality"), _QUALITY[order])
+    assert np.array_equal(ctm_vertex_map(path, b"Other"), -_COLOURS[order])
+    colours = ctm_vertex_map(path, b"Color")
+    assert np.array_equal(colours, _COLOURS[order]) and colours.dtype == np.float32
+    assert ctm_vertex_map(path, b"quality") is None                   # names compare case and all
+    done = subprocess.run([sys.executable, "-c", _QUALITY_READ, str(path)], capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert np.array_equal(json.loads(done.stdout), colours[:, 0].astype(np.float64).tolist())
+
+
+_QUALITY_READ = """
+import json, sys, pymeshlab
+ms = pymeshlab.MeshSet()
+ms.load_new_mesh(sys.argv[1])
+print(json.dumps(ms.current_mesh().vertex_scalar_array().tolist()))
+"""
+
+
+def test_a_vertex_map_name_is_compared_as_a_c_string(tmp_path):
+    # OpenCTM's look-up compares names up to their first zero byte, and takes the first match
+    path = tmp_path / "m.ctm"
+    path.write_bytes(_ctm("MG1", (b"Quality\0note", "Quality"), values=[_QUALITY, -_QUALITY]))
+    assert np.array_equal(ctm_vertex_map(path, b"Quality"), _QUALITY)
+
+
+def test_a_vertex_map_of_a_damaged_file_is_not_decoded(tmp_path):
+    path = tmp_path / "m.ctm"
+    path.write_bytes(_ctm("MG1", ("Color", "Quality"))[:-3])
+    assert ctm_layout(path)["truncated"] and ctm_vertex_map(path, b"Quality") is None
+
+
+def test_a_vertex_map_whose_data_is_short_is_refused(tmp_path):
+    # OpenCTM's reader fails on such a file (its LZMA data decodes to less than the map's size)
+    data = _ctm("MG1", ("Color", "Quality"), values=[_COLOURS, _QUALITY])
+    path = tmp_path / "m.ctm"
+    path.write_bytes(data[:data.rindex(b"ATTR")] + b"ATTR" + _string("Quality") + _packed(_QUALITY[:2]))
+    assert ctm_problem(path) is None
+    assert np.array_equal(ctm_vertex_map(path, b"Color"), _COLOURS)
+    with pytest.raises(ValueError, match=r"its 'Quality' map's LZMA data holds 32 bytes of the 64 its header declares"):
+        ctm_vertex_map(path, b"Quality")

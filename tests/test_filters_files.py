@@ -169,3 +169,100 @@ def test_a_ctm_save_keeps_vertex_colours(tmp_path):
     save_current_mesh(ms, out)
     assert ctm_problem(str(out)) is None
     assert b"Color" in out.read_bytes() and b"Quality" not in out.read_bytes()
+
+
+def test_a_ctm_files_colours_and_quality_are_loaded_and_kept_in_ply(tmp_path):
+    # pymeshlab read a CTM file's quality from its colour map and marked the layer as holding
+    # neither: a PLY save then dropped both. Written here by pymeshlab itself (lossless: MG1)
+    import pymeshlab
+
+    from curvdetail.curvature.testing import icosphere
+
+    V, F = icosphere(subdivisions=2)
+    quality = 10 + 3.7 * V[:, 2]                                       # not a colour
+    random_colours = np.c_[np.random.default_rng(3).random((len(V), 3)), np.ones(len(V))]
+    written = pymeshlab.MeshSet()
+    written.add_mesh(pymeshlab.Mesh(V, F.astype(np.int32), v_scalar_array=quality, v_color_matrix=random_colours))
+    colours = written.current_mesh().vertex_color_matrix()             # 8 bits, as pymeshlab holds them
+    written.save_current_mesh(str(tmp_path / "m.ctm"), lossless=True)
+    ms = load_meshset(tmp_path / "m.ctm")
+    mesh = ms.current_mesh()
+    assert mesh.has_vertex_scalar() and mesh.has_vertex_color()
+    assert np.array_equal(mesh.vertex_scalar_array(), quality.astype(np.float32))
+    # 8-bit colours, truncated on reading: at most one step off
+    assert np.abs(mesh.vertex_color_matrix() - colours).max() <= 1 / 255 + 1e-9
+    save_current_mesh(ms, tmp_path / "m.ply")
+    loaded = load_meshset(tmp_path / "m.ply")                        # kept: its meshes are views into it
+    back = loaded.current_mesh()
+    assert np.array_equal(back.vertex_scalar_array(), mesh.vertex_scalar_array())
+    assert np.array_equal(back.vertex_color_matrix(), mesh.vertex_color_matrix())
+
+
+_3DS_SAVE = """
+import hashlib, sys
+import numpy as np
+from curvdetail.filters import apply
+from curvdetail.filters.files import load_meshset, save_current_mesh
+from curvdetail.filters.meshset import vertex_attribute
+
+def layer_digest(ms):
+    m = ms.current_mesh()
+    h = hashlib.blake2b()
+    for arrays in ([m.vertex_matrix(), m.face_matrix(), m.vertex_scalar_array()],
+                   [m.face_color_matrix()] if m.has_face_color() else [],
+                   [vertex_attribute(ms, 0, name, kind) for name, kind in
+                    (("curvature_detail", "point"), ("curvature_area", "scalar"))]):
+        for a in arrays:
+            h.update(np.ascontiguousarray(a).tobytes())
+    h.update(repr((ms.mesh_number(), ms.current_mesh_id(), m.label(), m.has_face_color(), m.has_vertex_color(),
+                   m.has_vertex_scalar())).encode())
+    return h.hexdigest()
+
+ms = load_meshset(sys.argv[1])
+apply(ms, "compute_curvature_detail")                    # quality and custom attributes on the layer
+before = layer_digest(ms)
+save_current_mesh(ms, sys.argv[2])
+print(before == layer_digest(ms), ms.current_mesh().has_face_color())
+"""
+
+
+def test_a_3ds_save_is_the_same_in_every_process_and_leaves_the_layer_alone(tmp_path):
+    # written from the layer itself, pymeshlab's 3DS writer named the faces' material (the layer
+    # has no face colours) and set their flags from uninitialised memory: the bytes differed
+    # from process to process (as from run to run). Two processes, the second with malloc
+    # filling its memory (as memory recycled in a long run is)
+    import subprocess
+    import sys
+
+    from curvdetail import read_mesh
+
+    outputs = [tmp_path / "a.3ds", tmp_path / "b.3ds"]
+    for out, env in zip(outputs, [{}, {"MALLOC_PERTURB_": "165"}]):
+        done = subprocess.run([sys.executable, "-c", _3DS_SAVE, NOSE, str(out)], capture_output=True, text=True,
+                              timeout=120, env={**os.environ, **env})
+        assert done.returncode == 0, done.stderr[-2000:]
+        assert done.stdout.split() == ["True", "False"]             # the layer as it was, no face colours added
+    assert outputs[0].read_bytes() == outputs[1].read_bytes()
+    V, F = read_mesh(NOSE)
+    W, G = read_mesh(outputs[0])
+    assert np.array_equal(W, V.astype(np.float32)) and np.array_equal(G, F)
+
+
+@pytest.mark.parametrize("extension", [".3ds", ".3mf", ".ctm", ".dae", ".dxf", ".idtf", ".json", ".obj", ".off", ".ply",
+                                       ".stl", ".wrl", ".x3d"])
+def test_the_vertex_colour_formats_are_those_whose_writer_saves_vertex_colours(tmp_path, extension):
+    # every mesh format pymeshlab writes (the Nexus and U3D writers are never run): the writer
+    # has the save_vertex_color option exactly where the table says the colours are kept
+    import pymeshlab
+
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(np.eye(3), np.array([[0, 1, 2]], dtype=np.int32),
+                               v_color_matrix=np.tile([0.2, 0.4, 0.6, 1.0], (3, 1))))
+    try:
+        ms.save_current_mesh(str(tmp_path / ("m" + extension)), save_vertex_color=True)
+        has_option = True
+    except pymeshlab.PyMeshLabException as exc:
+        assert "Parameter save_vertex_color not found" in str(exc), str(exc)
+        has_option = False
+    assert has_option == (extension in files.VERTEX_COLOUR_FORMATS)
+    assert files.vertex_colours_kept_in(ms, "m" + extension) == has_option

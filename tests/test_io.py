@@ -768,8 +768,8 @@ def test_ctm_with_quality_is_refused_since_pymeshlab_cannot_read_it_back(tmp_pat
 
 def test_save_mesh_writes_no_ctm_quality_without_colours(tmp_path):
     # the layout pymeshlab's reader crashes on: quality without colours. Defaults write both (read
-    # back, the quality as the colours' red channel), no colours writes neither, and asking for
-    # the quality without colours is refused.
+    # back by pymeshlab with the quality as the colours' red channel, by curvdetail from the
+    # "Quality" map), no colours writes neither, and asking for the quality without colours is refused.
     from curvdetail._ctm_scan import ctm_layout
 
     V, F = icosphere(subdivisions=1)
@@ -782,6 +782,69 @@ def test_save_mesh_writes_no_ctm_quality_without_colours(tmp_path):
                                             r"reader reads a file's quality from its colour map"):
         save_mesh(tmp_path / "q.ctm", mesh, save_vertex_color=False, save_vertex_quality=True)
     assert not (tmp_path / "q.ctm").exists()
+
+
+def _coloured_ctm(path, lossless, quality=None):
+    """Write an icosphere with vertex colours and a quality (10 + 3.7 z: not a colour) to the CTM
+    file ``path`` with pymeshlab itself; returns V, F, the colours as pymeshlab holds them (8
+    bits) and the quality."""
+    V, F = icosphere(subdivisions=2)
+    colours = np.c_[np.random.default_rng(7).random((len(V), 3)), np.ones(len(V))]
+    quality = 10 + 3.7 * V[:, 2] if quality is None else quality
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(V, F.astype(np.int32), v_color_matrix=colours, v_scalar_array=quality))
+    ms.save_current_mesh(str(path), lossless=lossless)
+    return V, F, ms.current_mesh().vertex_color_matrix(), quality
+
+
+@pytest.mark.parametrize("lossless", [True, False])
+def test_a_ctm_files_quality_is_read_from_its_quality_map(tmp_path, lossless):
+    # pymeshlab's CTM reader read the quality from the colour map (10.0 came back as 0.64, the
+    # red channel) and marked the layer as holding neither colours nor quality
+    from curvdetail._ctm_scan import ctm_layout
+    from curvdetail.io import load_checked
+
+    path = tmp_path / "m.ctm"
+    V, F, colours, quality = _coloured_ctm(path, lossless)
+    assert ctm_layout(path)["attribute_maps"] == [b"Color", b"Quality"]
+    ms = pymeshlab.MeshSet()
+    mesh = load_checked(ms, str(path))
+    assert mesh.has_vertex_scalar() and mesh.has_vertex_color()
+    W = mesh.vertex_matrix()
+    if lossless:                     # MG1: float32 values, the vertices in their order
+        assert np.array_equal(W, V.astype(np.float32))
+        match = np.arange(len(V))
+        assert np.array_equal(mesh.vertex_scalar_array(), quality.astype(np.float32))
+    else:                            # MG2: the vertices sorted, positions and the map to a grid
+        match = np.argmin(((W[:, None, :] - V[None, :, :]) ** 2).sum(axis=2), axis=1)
+        assert sorted(match) == list(range(len(V))) and np.abs(W - V[match]).max() < 1e-3
+        assert np.abs(mesh.vertex_scalar_array() - quality[match]).max() <= 0.5 / 256     # its precision
+    # 8-bit colours, read back truncated (MG2: from a 1/256 grid)
+    assert np.abs(mesh.vertex_color_matrix() - colours[match]).max() <= (1 if lossless else 2) / 255 + 1e-9
+    X, G = read_mesh(path)                                        # the same vertices and triangles
+    assert np.array_equal(X, W) and np.array_equal(G, mesh.face_matrix())
+
+
+def test_a_ctm_quality_that_cannot_be_decoded_is_left_out_with_a_warning(tmp_path, monkeypatch):
+    # LZMA options Python's decoder lacks (OpenCTM's writer uses none): the quality is left out
+    # (not read as the red channel), the colours and the geometry are read
+    import curvdetail.io
+    from curvdetail.io import load_checked
+
+    def undecodable(path, name, layout=None):
+        raise ValueError(f"its {name.decode()!r} map's LZMA data cannot be decoded here (lc + lp > 4)")
+
+    path = tmp_path / "m.ctm"
+    V, _, colours, _ = _coloured_ctm(path, True)
+    monkeypatch.setattr(curvdetail.io, "ctm_vertex_map", undecodable)
+    ms = pymeshlab.MeshSet()
+    with pytest.warns(UserWarning, match=r"m\.ctm': the vertex quality is left out: its 'Quality' map's LZMA data "
+                                         r"cannot be decoded here \(lc \+ lp > 4\)\. The geometry and the colours are "
+                                         r"read \(pymeshlab would read the quality from the colour map\)"):
+        mesh = load_checked(ms, str(path))
+    assert not mesh.has_vertex_scalar() and mesh.has_vertex_color()
+    assert np.array_equal(mesh.vertex_matrix(), V.astype(np.float32))
+    assert np.abs(mesh.vertex_color_matrix() - colours).max() <= 1 / 255 + 1e-9
 
 
 _CTM_CRASH = """

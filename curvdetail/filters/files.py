@@ -3,11 +3,15 @@
 Saving keeps what the format can hold: in PLY (binary, doubles) the vertex quality and every
 custom per-vertex attribute the filters wrote (``curvature_normal``, ``curvature_detail``,
 ``curvature_area``, ...; pymeshlab's PLY exporter options ``__ca_vp__<name>`` /
-``__ca_vs__<name>``), read back by :func:`load_meshset`; OBJ, OFF and STL hold the geometry
-only. The file is written from the MeshSet itself (pymeshlab crashes when a mesh with custom
-attributes is copied into another MeshSet and exported), to a temporary file in the same folder
-and renamed, so a failed save leaves nothing behind; an existing file is replaced only with
-``overwrite=True``.
+``__ca_vs__<name>``), read back by :func:`load_meshset`; OBJ, OFF and CTM hold the geometry and
+the vertex colours (:data:`VERTEX_COLOUR_FORMATS`), STL the geometry only. The file is written
+from the MeshSet itself (pymeshlab crashes when a mesh with custom attributes is copied into
+another MeshSet and its attributes exported), to a temporary file in the same folder and
+renamed, so a failed save leaves nothing behind; an existing file is replaced only with
+``overwrite=True``. .3ds is the exception: it is written from a copy
+(:func:`curvdetail.io.save_mesh`, as :func:`curvdetail.write_mesh` writes it), since pymeshlab's
+3DS writer fills what it leaves unset from uninitialised memory, and so differed from process to
+process written from the layer itself.
 """
 
 import os
@@ -16,7 +20,7 @@ import weakref
 import numpy as np
 
 from .. import _output
-from ..io import MeshFileError, check_coordinates, check_mesh_output, input_path, load_checked
+from ..io import MeshFileError, check_coordinates, check_mesh_output, input_path, load_checked, save_mesh
 from .meshset import WRITTEN_ATTRIBUTES, set_vertex_attribute, vertex_attribute
 from .ply_attributes import read_ply_vertex_attributes
 
@@ -32,7 +36,9 @@ def load_meshset(path, *more):
     """A new ``pymeshlab.MeshSet`` with the mesh file ``path`` as layer 0 and the files in
     ``more`` as layers 1, 2, ... (the last one loaded is current, as with pymeshlab's
     ``load_new_mesh``). The custom per-vertex attributes of PLY files (pymeshlab's loader drops
-    them) are added back.
+    them) are added back, and a CTM file's vertex colours and quality are set as the file holds
+    them (pymeshlab reads the quality from the colour map; see
+    :func:`curvdetail.io.load_checked`).
 
     Raises FileNotFoundError if a file does not exist, MeshFileError if pymeshlab cannot read it
     or dropped vertices or faces of an OBJ, OFF, PLY or STL file, or a face index is out of range
@@ -82,7 +88,8 @@ def save_options(ms, path):
     """pymeshlab ``save_current_mesh`` options that keep quality and our attributes in PLY, and
     the coordinates in CTM (its default compresses them to a grid). CTM keeps vertex colours but
     never the quality: a "Quality" map without a "Color" one crashes pymeshlab's CTM reader, and
-    with one it reads the colours' red channel as the quality (:mod:`curvdetail._ctm_scan`)."""
+    with one it reads the colours' red channel as the quality (:mod:`curvdetail._ctm_scan`;
+    :func:`load_meshset` reads the map itself, MeshLab and pymeshlab do not)."""
     extension = os.path.splitext(os.fspath(path))[1].lower()
     if extension == ".ctm":
         return {"lossless": True, "save_vertex_quality": False,
@@ -113,14 +120,39 @@ def attributes_lost_in(ms, path):
     return [name for name, _ in _attributes_on_current_mesh(ms)]
 
 
+#: Formats whose pymeshlab writer saves vertex colours (it has the ``save_vertex_color`` option, on
+#: by default; pymeshlab 2025.7): :func:`save_current_mesh` keeps a layer's colours in these. The
+#: other formats it writes (.stl, .3ds, .3mf, .dxf) hold none.
+VERTEX_COLOUR_FORMATS = (".ply", ".obj", ".off", ".ctm", ".dae", ".wrl", ".x3d", ".json", ".idtf")
+
+
+def vertex_colours_kept_in(ms, path):
+    """Whether :func:`save_current_mesh` writes the current mesh's vertex colours to ``path``:
+    the layer has vertex colours other than opaque white everywhere (pymeshlab gives every mesh
+    made from arrays, e.g. a filter's new layer, white ones, which say nothing) and the format
+    holds them (:data:`VERTEX_COLOUR_FORMATS`)."""
+    mesh = ms.current_mesh()
+    if os.path.splitext(os.fspath(path))[1].lower() not in VERTEX_COLOUR_FORMATS or not mesh.has_vertex_color():
+        return False
+    return not bool(np.all(mesh.vertex_color_matrix() == 1.0))
+
+
 def save_current_mesh(ms, path, *, overwrite=False):
     """Atomically save the current mesh of ``ms`` (see the module docstring for what is kept).
+    The layer itself is left as it is (.3ds: written from a copy, its faces given white where
+    they have no colour, as :func:`curvdetail.io.save_mesh` does).
 
     Raises FileExistsError, MeshFileError (unknown or points-only format, a folder, missing
     folder, pymeshlab failed)."""
     import pymeshlab
 
     check_output_path(path, overwrite)
+    if os.path.splitext(os.fspath(path))[1].lower() == ".3ds":
+        # from the layer itself the writer named the faces' material (no face colours) and set
+        # their flags from uninitialised memory: the bytes differed from process to process.
+        # 3DS holds no custom attributes, so the copy's (which crash an attribute export) stay unsaved.
+        save_mesh(path, ms.current_mesh(), overwrite=overwrite)
+        return
     options = save_options(ms, path)
     check_coordinates(path, ms.current_mesh().vertex_matrix(), **options)    # what the format cannot hold
     with _output.atomic_output(path, overwrite=overwrite, hint=_HINT, error=MeshFileError) as tmp:
