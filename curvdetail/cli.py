@@ -173,7 +173,8 @@ def _reconstruct_command(parser):
     add_input_output_arguments(parser, "mesh file (any format MeshLab reads)",
                                "rebuilt mesh; quality = distance to INPUT (.ply keeps it)")
     parser.add_argument("--rows", choices=("all", "free"), default="all",
-                        help="residual rows in E_Q: all vertices (the paper) or free ones only")
+                        help="residual rows in E_Q: all vertices (the paper) or free ones only "
+                             "(default: %(default)s)")
     add_fix_arguments(parser)
     add_backend_argument(parser)
     add_output_arguments(parser)
@@ -220,8 +221,8 @@ def _minimal_command(parser):
     add_input_output_arguments(parser, "mesh file with a boundary",
                                "minimal surface; quality = distance moved (.ply keeps it)")
     parser.add_argument("--max-iterations", type=_whole_number_from_one, default=200,
-                        help="Pinkall-Polthier steps at most; if the shape has not settled by then, "
-                             "OUTPUT is still written and the exit status is 3")
+                        help="Pinkall-Polthier steps at most (default: %(default)s); if the shape has "
+                             "not settled by then, OUTPUT is still written and the exit status is 3")
     from .curvature.minimal_surface import DEFAULT_TOL
 
     parser.add_argument("--tol", type=_positive_number, default=DEFAULT_TOL,
@@ -345,7 +346,9 @@ def _remesh_command(parser):
     parser.add_argument("--no-evaluate", action="store_true",
                         help="skip the distance measurements (most of the time on big meshes); OUTPUT "
                              "gets no quality, and --image is not available")
-    parser.add_argument("--quiet", action="store_true", help="no stage progress on stderr")
+    parser.add_argument("--quiet", action="store_true",
+                        help="no stage progress on stderr (notes and warnings, such as the one on a "
+                             "target of minutes, are still said)")
     add_output_arguments(parser)
 
     def run(args):
@@ -372,8 +375,8 @@ def _remesh_command(parser):
         if args.no_evaluate and args.image is not None:
             raise ValueError("--image shows the measured distances; leave out --no-evaluate or --image.")
         V, F = read_mesh(args.input)
-        if not args.quiet:
-            _note_a_big_target(V, F, args.target_edge / 100.0, method=args.method, evaluate=not args.no_evaluate)
+        # a note, not progress: said with --quiet too (the run it announces may take minutes)
+        _note_a_big_target(V, F, args.target_edge / 100.0, method=args.method, evaluate=not args.no_evaluate)
         stages = 3 + (not args.no_evaluate) + (args.location == "uv") + (args.image is not None)
         progress = Progress(stages, enabled=not args.quiet)
         try:
@@ -414,6 +417,7 @@ def _remesh_command(parser):
               f"diagonal (zero detail {100 * b['hausdorff_rms']:.3f} % / {100 * b['hausdorff_max']:.2f} %, "
               f"floor {100 * fl['hausdorff_rms']:.4f} % / {100 * fl['hausdorff_max']:.3f} %); "
               f"{report['seconds']['total']:.2f} s")
+        _note_geometry_only(args.output, quality=not _keeps_quality(args.output))
         worse = worse_than_zero_detail(report, cli=True)
         if worse is not None:           # the run did what was asked: a finding, not an error
             _say(f"note: {worse}")
@@ -630,12 +634,21 @@ def _run_command(parser):
 AMPLIFIED = 4
 
 
+def _edit_retries(args):
+    """What an edit that folded or amplified could try instead: the other ``--relations``, and
+    ``--handle-detail free`` unless already in use (as apply_curvature_editing suggests)."""
+    tries = [f"--relations {'one-ring' if args.relations == 'one+two-ring' else 'one+two-ring'}"]
+    if args.handle_detail == "transform":
+        tries.append("--handle-detail free")
+    return " or ".join(tries)
+
+
 @command("edit", help="deform a mesh with curvature-detail editing, given a benchmark .sel/.def pair "
                       "(exit status 4: written, but the edit folded triangles or amplified the "
                       "handles' motion)")
 def _edit_command(parser):
     parser.add_argument("mesh", metavar="MESH", help="mesh file (vertex order must match SEL)")
-    parser.add_argument("output", metavar="OUTPUT", help="edited mesh; quality = distance moved")
+    parser.add_argument("output", metavar="OUTPUT", help="edited mesh; quality = distance moved (.ply keeps it)")
     parser.add_argument("--sel", required=True, metavar="SEL",
                         help="per-vertex status file: 0 fixed, 1 free, 2 handle ('#' comments)")
     parser.add_argument("--def", dest="transform", required=True, metavar="DEF",
@@ -701,21 +714,20 @@ def _edit_command(parser):
               f"largest move {moved.max() / bbox_diagonal(V):.3e} of the bbox diagonal; "
               f"{counted(editor.rank_deficient, 'rank-deficient ring')}, "
               f"{counted(editor.detail_islands, 'island vertex', 'island vertices')}; {seconds:.3f} s")
+        _note_geometry_only(args.output, quality=not _keeps_quality(args.output))
         status_code = 0
         handle_move = moved[status == 2].max()
         if moved.max() > 3.0 * handle_move + 1e-12 * bbox_diagonal(V):
             _say(f"curvdetail: warning: vertices moved up to {moved.max() / max(handle_move, 1e-300):.1f} "
                  "times as far as the handles: the curvature stage amplified the handle details "
-                 "(ill-conditioned coefficients, see docs/editing.md); try --relations one+two-ring "
-                 "or --handle-detail free.")
+                 f"(ill-conditioned coefficients, see docs/editing.md); try {_edit_retries(args)}.")
             status_code = AMPLIFIED
         folded = folded_triangles(V, F, X, T[:3, :3])
         if folded.size:
             # the same count as apply_curvature_editing's (against the rest normal and the
             # handles' turn of it): an edit that folds is not clean whatever it amplified
             _say(f"curvdetail: warning: {counted(folded.size, 'triangle')} of {F.shape[0]} folded over (first: "
-                 f"{first_indices(folded)}); try --relations "
-                 f"{'one-ring' if args.relations == 'one+two-ring' else 'one+two-ring'} or --handle-detail free.")
+                 f"{first_indices(folded)}); try {_edit_retries(args)}.")
             status_code = AMPLIFIED
         return status_code
 

@@ -560,3 +560,15 @@ def test_a_line_said_during_a_stage_gets_a_line_of_its_own():
     assert lines[0] == "[1/2] retriangulate ..." and lines[1] == "note: something"
     assert lines[2].startswith("[1/2] retriangulate ... ") and lines[2].endswith(" s")
     assert lines[3].startswith("[2/2] transfer ... ") and len(lines) == 4
+
+
+@pytest.mark.parametrize("command, says", [
+    ("minimal", "Pinkall-Polthier steps at most (default: 200)"),
+    ("reconstruct", "all vertices (the paper) or free ones only (default: all)"),
+])
+def test_help_gives_the_defaults(command, capsys, says):
+    # remesh rebuilds over the free rows by default, reconstruct over all: --help said neither
+    # reconstruct's --rows nor minimal's --max-iterations default
+    with pytest.raises(SystemExit):
+        main([command, "--help"])
+    assert says in " ".join(capsys.readouterr().out.split())

@@ -3,6 +3,7 @@
 import os
 
 import numpy as np
+import pytest
 
 from curvdetail import read_mesh, write_mesh
 from curvdetail.cli import main
@@ -191,3 +192,58 @@ def test_an_edit_that_folds_triangles_is_written_with_exit_status_4(tmp_path, ca
     assert folded.size == 12
     assert rc == 4
     assert f"warning: 12 triangles of {F.shape[0]} folded over" in err and "--relations one+two-ring" in err
+
+
+def _mirrored_free_region(X, status):
+    """``X`` with the free vertices mirrored across the strip's midline: their triangles fold over,
+    and nothing moves more than the strip's width (under the handles' move)."""
+    X = X.copy()
+    free = status == 1
+    X[free, 1] = 1.0 - X[free, 1]
+    return X
+
+
+def _blown_up_free_region(X, status):
+    """``X`` with the free vertices moved 50 units up: far beyond the handle motion."""
+    X = X.copy()
+    X[status == 1] += [0.0, 0.0, 50.0]
+    return X
+
+
+@pytest.mark.parametrize("spoil, warning", [(_mirrored_free_region, "folded over"),
+                                            (_blown_up_free_region, "times as far as the handles")])
+@pytest.mark.parametrize("options, tries", [
+    ([], "try --relations one+two-ring or --handle-detail free."),
+    (["--relations", "one+two-ring"], "try --relations one-ring or --handle-detail free."),
+    (["--handle-detail", "free"], "try --relations one+two-ring."),
+    (["--handle-detail", "free", "--relations", "one+two-ring"], "try --relations one-ring."),
+])
+def test_the_warnings_suggest_only_options_not_in_use(tmp_path, capsys, monkeypatch, spoil, warning, options,
+                                                      tries):
+    # the bar with --handle-detail free --relations one+two-ring folded 96 triangles and was told
+    # "try --relations one-ring or --handle-detail free"; an amplified edit was always told
+    # "--relations one+two-ring or --handle-detail free", whatever it ran with
+    import curvdetail.deformation_benchmark as benchmark
+
+    V, F, status, T, p = _case(tmp_path)
+    real = benchmark.edit_with_selection
+    monkeypatch.setattr(benchmark, "edit_with_selection",
+                        lambda *args, **kwargs: (lambda X, editor: (spoil(X, status), editor))(*real(*args, **kwargs)))
+    rc = main(["edit", str(p["off"]), "--sel", str(p["sel"]), "--def", str(p["def"]), str(tmp_path / "out.ply"),
+               *options])
+    lines = [line for line in capsys.readouterr().err.splitlines() if "warning:" in line]
+    assert rc == 4 and any(warning in line for line in lines), lines
+    assert all(line.endswith(tries) for line in lines), lines     # the fold line too, where the blow-up folds
+
+
+@pytest.mark.parametrize("name", ["out.obj", "out.off"])
+def test_an_output_without_quality_says_it_is_left_out(tmp_path, capsys, name):
+    # --help promises quality = distance moved; OBJ and OFF cannot hold it: said, as the other
+    # commands say it
+    V, F, status, T, p = _case(tmp_path)
+    assert main(["edit", str(p["off"]), "--sel", str(p["sel"]), "--def", str(p["def"]), str(tmp_path / name)]) == 0
+    assert capsys.readouterr().err == (f"curvdetail: note: {name} holds the geometry only; the vertex quality "
+                                       "is kept by PLY output.\n")
+    assert read_mesh(str(tmp_path / name))[0].shape == V.shape
+    assert main(["edit", str(p["off"]), "--sel", str(p["sel"]), "--def", str(p["def"]), str(tmp_path / "o.ply")]) == 0
+    assert capsys.readouterr().err == ""

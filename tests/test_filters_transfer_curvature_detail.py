@@ -129,3 +129,61 @@ def test_same_layer_is_refused():
     ms.load_new_mesh(os.path.join(DATA, "mannequin_nose.obj"))
     with pytest.raises(FilterError, match="both layer 0"):
         apply(ms, "transfer_curvature_detail")
+
+
+def smoothed_nose_with_stored_detail():
+    """Layer 0: the nose with its detail computed, then smoothed by pymeshlab (vertices moved,
+    numbering and triangles kept, so the stamp holds); returns ``(ms, V, D)``: the original
+    vertices and the stored detail (that of the original geometry)."""
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(os.path.join(DATA, "mannequin_nose.obj"))
+    V = ms.mesh(0).vertex_matrix().copy()
+    apply(ms, "compute_curvature_detail")
+    D = vertex_attribute(ms, 0, "curvature_detail", "point")
+    ms.apply_coord_laplacian_smoothing(stepsmoothnum=10)
+    return ms, V, D
+
+
+def test_a_moved_source_carries_its_stored_detail_not_its_geometry():
+    ms, V, D = smoothed_nose_with_stored_detail()
+    Vs, F = ms.mesh(0).vertex_matrix().copy(), ms.mesh(0).face_matrix().copy()
+    assert np.abs(curvature_detail(Vs, F) - D).max() > 1e-2      # smoothing changed it (0.0226)
+    ms.generate_copy_of_current_mesh()                            # layer 1: the smoothed copy
+    figures = apply(ms, "transfer_curvature_detail", sourcemesh=0, targetmesh=1)
+    assert figures["detail_source"] == "stored"
+    # onto an identical copy the transfer is exact: the stored detail comes back, as a transfer
+    # from an unsmoothed copy of the source (whose geometry's detail it is) gives it
+    Dt = vertex_attribute(ms, 1, "curvature_detail", "point")
+    assert np.abs(Dt - D).max() < 1e-14
+    assert np.abs(Dt - transfer_curvature(V, F, V, F)).max() < 1e-14
+    assert np.allclose(figures["detail_total_source"], D.sum(axis=0), rtol=0, atol=1e-14)
+
+
+def test_a_moved_source_carries_its_stored_detail_onto_a_retriangulation():
+    ms, _, D = smoothed_nose_with_stored_detail()
+    ms.generate_copy_of_current_mesh()
+    ms.meshing_isotropic_explicit_remeshing(iterations=5, targetlen=pymeshlab.PercentageValue(2.0))
+    figures = apply(ms, "transfer_curvature_detail", sourcemesh=0, targetmesh=1)
+    Vs, Fs = ms.mesh(0).vertex_matrix(), ms.mesh(0).face_matrix()
+    Vt, Ft = ms.mesh(1).vertex_matrix(), ms.mesh(1).face_matrix()
+    stored = transfer_curvature(Vs, Fs, Vt, Ft, detail=D)
+    assert np.array_equal(vertex_attribute(ms, 1, "curvature_detail", "point"), stored)
+    assert np.abs(stored - transfer_curvature(Vs, Fs, Vt, Ft)).max() > 1e-2
+    assert figures["detail_source"] == "stored" and figures["detail_total_gap"] < 1e-12
+
+
+def test_a_source_without_stored_detail_carries_its_geometry():
+    figures = apply(remeshed_nose(), "transfer_curvature_detail")
+    assert figures["detail_source"] == "computed"
+
+
+def test_a_source_retriangulated_since_its_detail_was_stored_is_refused():
+    # as apply_curvature_reconstruction: pymeshlab kept the attribute but not its numbering
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(os.path.join(DATA, "mannequin_nose.obj"))
+    apply(ms, "compute_curvature_detail")
+    ms.meshing_isotropic_explicit_remeshing(iterations=5, targetlen=pymeshlab.PercentageValue(2.0))
+    assert vertex_attribute(ms, 0, "curvature_detail", "point") is not None
+    ms.generate_copy_of_current_mesh()
+    with pytest.raises(FilterError, match="belongs to another triangulation"):
+        apply(ms, "transfer_curvature_detail", sourcemesh=0, targetmesh=1)

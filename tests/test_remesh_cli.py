@@ -284,3 +284,27 @@ def test_no_surface_check_is_passed_to_the_remesher_and_recorded(tmp_path, isotr
     V, F = read_mesh(src)
     Vt, Ft = retriangulate(V, F, target_edge=0.03, surface_check=expected)
     assert read_mesh(str(out))[0].shape == Vt.shape
+
+
+def test_the_big_target_note_is_said_with_quiet_too(tmp_path, capsys, monkeypatch):
+    # --quiet drops the stage progress; the note before minutes of work was dropped with it
+    monkeypatch.setattr(importlib.import_module("curvdetail.remesh.retriangulate"), "BIG_TARGET", 1_000)
+    rc = main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "o.ply"), "--target-edge", "2",
+               "--no-evaluate", "--quiet"])
+    err = capsys.readouterr().err
+    assert rc == 0
+    assert err.startswith("note: a 2 % target edge gives about ") and "this takes minutes." in err
+    assert "[1/3]" not in err                    # still no progress
+
+
+@pytest.mark.parametrize("name", ["o.obj", "o.off"])
+def test_an_output_without_quality_says_it_is_left_out(tmp_path, capsys, name):
+    # --help promises quality = distance to SOURCE; OBJ and OFF cannot hold it: said, as the
+    # other commands say it (and nothing where there is no quality to lose, or PLY keeps it)
+    src = os.path.join(DATA, "mannequin_nose.obj")
+    assert main(["remesh", src, str(tmp_path / name), "--target-edge", "4", "--quiet"]) == 0
+    assert capsys.readouterr().err == (f"curvdetail: note: {name} holds the geometry only; the vertex quality "
+                                       "is kept by PLY output.\n")
+    assert main(["remesh", src, str(tmp_path / f"n{name}"), "--target-edge", "4", "--quiet", "--no-evaluate"]) == 0
+    assert main(["remesh", src, str(tmp_path / "o.ply"), "--target-edge", "4", "--quiet"]) == 0
+    assert capsys.readouterr().err == ""

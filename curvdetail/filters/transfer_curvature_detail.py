@@ -4,9 +4,9 @@ import numpy as np
 
 from ..curvature import curvature_detail, mixed_voronoi_area
 from .compute_curvature_detail import signed_mean_curvature
-from .detail_attributes import store_detail
+from .detail_attributes import DETAIL, load_detail, store_detail
 from .errors import FilterError, FilterParameterError
-from .meshset import layer_id, mesh_arrays, set_vertex_quality
+from .meshset import layer_id, mesh_arrays, set_vertex_quality, vertex_attribute
 from .parameters import Parameter
 from .registry import PAPER, filter
 
@@ -29,7 +29,11 @@ def planar_map(location, parameterization, default="harmonic"):
     description=f"""
         Carry the curvature detail of the source layer (a disk-topology patch) over to the target
         layer (a retriangulation of it, also a disk), the transfer step of the paper's remeshing
-        experiment. 'pointwise' (the paper) interpolates the source's intensive mean curvature
+        experiment. The detail carried is the source's stored 'curvature_detail' where it holds
+        one (from compute_curvature_detail, kept while its vertices were moved; refused if the
+        source was retriangulated since, as apply_curvature_reconstruction refuses it), else the
+        detail of its current geometry; the returned 'detail_source' says which ('stored' or
+        'computed'). 'pointwise' (the paper) interpolates the source's intensive mean curvature
         normal K at each target vertex and multiplies it by the target's own mixed Voronoi area;
         'conservative' moves the extensive detail D as a measure so that its total is kept.
         Target vertices are located on the source by the closest point in space ('closest') or in
@@ -39,7 +43,9 @@ def planar_map(location, parameterization, default="harmonic"):
         quality to the transferred signed mean curvature. {PAPER}, section "Remeshing", Fig. 3.
     """,
     parameters=[
-        Parameter("sourcemesh", "mesh", 0, "layer whose curvature detail is carried over"),
+        Parameter("sourcemesh", "mesh", 0,
+                  "layer whose curvature detail is carried over: its stored 'curvature_detail' "
+                  "where it holds one, else the detail of its current geometry"),
         Parameter("targetmesh", "mesh", None, "layer that receives it (default: the current one)"),
         Parameter("method", "str", "conservative",
                   "'conservative' (detail moved as a measure, totals kept) or 'pointwise' "
@@ -66,7 +72,10 @@ def transfer_curvature_detail(ms, *, sourcemesh, targetmesh, method, location, p
     Vt, Ft = mesh_arrays(ms, target)
     check_disk(Vs, Fs, f"the source (layer {source})")
     check_disk(Vt, Ft, f"the target (layer {target})")
-    figures = {"method": method, "location": location}
+    # stored detail outlives moved vertices (the editing use); a broken stamp is refused in load_detail
+    stored = vertex_attribute(ms, source, DETAIL, "point") is not None
+    Ds = load_detail(ms, source, Fs) if stored else curvature_detail(Vs, Fs)
+    figures = {"method": method, "location": location, "detail_source": "stored" if stored else "computed"}
     uv = None
     if location == "uv":
         UVs, UVt, info = parameterize(Vs, Fs, Vt, Ft, method=parameterization)
@@ -74,12 +83,12 @@ def transfer_curvature_detail(ms, *, sourcemesh, targetmesh, method, location, p
         figures.update(parameterization=parameterization, flipped_source=info["flipped_source"],
                        flipped_target=info["flipped_target"],
                        boundary_mismatch=info["boundary_mismatch"])
-    Dt = transfer_curvature(Vs, Fs, Vt, Ft, method=method, location=location, uv=uv)
+    Dt = transfer_curvature(Vs, Fs, Vt, Ft, method=method, location=location, uv=uv,
+                            detail=Ds if stored else None)
     At = mixed_voronoi_area(Vt, Ft)
     Kt = Dt / At[:, None]
     store_detail(ms, target, Ft, Dt, Kt, At)
     set_vertex_quality(ms, target, signed_mean_curvature(Vt, Ft, Kt))
-    Ds = curvature_detail(Vs, Fs)
     scale = max(np.abs(Ds).sum(), np.finfo(float).tiny)
     figures.update(
         source_vertices=int(Vs.shape[0]), target_vertices=int(Vt.shape[0]),

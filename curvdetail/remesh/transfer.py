@@ -1,11 +1,13 @@
 """Carry curvature detail from a source mesh to its retriangulation (paper Fig. 3, step 3)."""
 
 import numpy as np
+import scipy.sparse as sp
 
-from ..curvature._validate import _edge_keys, as_count, check_choice, bbox_diagonal, check_mesh
+from ..curvature._validate import _edge_keys, as_count, as_values, check_choice, bbox_diagonal, check_mesh
 from ..curvature.errors import MeshError
 from ..curvature.mean_curvature_normal import mean_curvature_normal
 from ..curvature.mixed_voronoi_area import mixed_voronoi_area
+from ..curvature.sparse_solver import factorize
 from .locate import _as_coordinates, _locate, check_points_and_mesh, interpolate, spread
 
 METHODS = ("conservative", "pointwise")
@@ -70,8 +72,12 @@ def _edge_curvature_measure(V, F):
 
 
 def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="closest", uv=None,
-                       samples_per_edge=None):
+                       samples_per_edge=None, detail=None):
     """Curvature detail ``D`` for the target mesh, carried over from the source mesh.
+
+    The detail carried is ``detail`` where given (e.g. stored before the source's vertices were
+    moved: the editing use), else the detail of the source's geometry ``Vs, Fs``; the geometry
+    locates the target either way.
 
     ``method="pointwise"`` (the paper): the intensive mean curvature normal ``K`` of the source is
     interpolated (barycentric) at each target vertex's location and multiplied by the target's own
@@ -82,7 +88,11 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     edge's measure is split evenly over sample points along the edge, every sample is located in
     a target triangle and split over its three corners by barycentric weights. Totals are kept
     exactly over any union of target stars, in particular ``sum_t D_t = sum_s D_s`` (to rounding),
-    and a target equal to the source gets its own detail back exactly.
+    and a target equal to the source gets its own detail back exactly. A given ``detail`` is put
+    on the edges as the measure closest (least squares) to the geometry's whose halves give it
+    exactly: ``c'_e = c_e + 2 (mu_i + mu_j)`` with ``Q mu = detail - D(Vs, Fs)``, ``Q`` the
+    signless Laplacian of the edge graph (degree + adjacency; positive definite on a mesh of
+    triangles, well conditioned, so the correction stays near the vertices it belongs to).
 
     Location: ``"closest"`` = the closest point on the other surface in space (the meshes are
     two triangulations of one surface); ``"uv"`` = point location in a shared planar domain
@@ -99,6 +109,9 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     samples_per_edge : int or None   conservative only: samples per source edge, a whole number
                        >= 1 (the total over all edges at most 20,000,000, ~10 GB); ``None`` =
                        enough that samples are at most half the target's mean edge length apart
+    detail : (n_s, 3) float array or None   the source's detail to carry (pointwise: ``K`` =
+                       ``detail`` / the source's mixed Voronoi area); ``None`` = the detail of
+                       ``Vs, Fs``
 
     Returns
     -------
@@ -112,6 +125,7 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     ValueError   unknown method / location; ``uv`` missing, not a pair or of the wrong shape for
                  ``"uv"``, or given with ``"closest"``; ``samples_per_edge`` not a whole number
                  >= 1, too many samples, or given with ``"pointwise"``
+    ConstraintError   (a ValueError) ``detail`` not a finite (n_s, 3) array
 
     Examples
     --------
@@ -120,6 +134,9 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     >>> V, F = grid(9, 9); V[:, 2] = V[:, 0] ** 2
     >>> D = transfer_curvature(V, F, V, F, method="conservative")   # a mesh onto itself
     >>> bool(np.allclose(D, curvature_detail(V, F), atol=1e-12))
+    True
+    >>> D2 = transfer_curvature(V, F, V, F, detail=2 * D)            # a given detail is carried
+    >>> bool(np.allclose(D2, 2 * D, atol=1e-12))
     True
     """
     method = check_choice(method, "method", METHODS, " is not a transfer; use 'conservative' or 'pointwise'.")
@@ -131,6 +148,8 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
         samples_per_edge = as_count(samples_per_edge, "samples_per_edge")
     Vs, Fs = check_mesh(Vs, Fs)
     Vt, Ft = check_mesh(Vt, Ft)
+    if detail is not None:
+        detail = as_values(detail, Vs.shape[0], "detail (the source's detail)")
     if location == "uv":
         src_dom, tgt_dom = _check_uv(uv, Vs.shape[0], Vt.shape[0])
         names = ("uv[0] (UVs)", "uv[1] (UVt)")
@@ -140,11 +159,16 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     else:
         src_dom, tgt_dom, names = Vs, Vt, ("Vs", "Vt")
     if method == "pointwise":
-        K, _ = mean_curvature_normal(Vs, Fs)
+        if detail is None:
+            K, _ = mean_curvature_normal(Vs, Fs)
+        else:
+            K = detail / mixed_voronoi_area(Vs, Fs)[:, None]
         face, bary, dist = _locate(*check_points_and_mesh(tgt_dom, src_dom, Fs, names=(names[1], names[0], "Fs")))
         _check_same_surface(dist, Vs, location)
         return interpolate(K, Fs, face, bary) * mixed_voronoi_area(Vt, Ft)[:, None]
     E, c = _edge_curvature_measure(Vs, Fs)
+    if detail is not None:
+        c = _carrying(E, c, detail)
     q = _samples_per_edge(Vs, E, Vt, Ft, samples_per_edge)
     edge = np.repeat(np.arange(E.shape[0]), q)
     start = np.concatenate([[0], np.cumsum(q)[:-1]])
@@ -153,6 +177,23 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     face, bary, dist = _locate(*check_points_and_mesh(pts, tgt_dom, Ft, names=("edge samples", names[1], "Ft")))
     _check_same_surface(dist, Vs, location)
     return spread(c[edge] / q[edge, None], Ft, face, bary, Vt.shape[0])
+
+
+def _carrying(E, c, detail):
+    """Edge measure (k, 3) closest to ``c`` whose halves sum to ``detail`` (n, 3) at the vertices
+    of the edges ``E`` (k, 2): ``c + 2 (mu_i + mu_j)`` with ``Q mu = detail - halves of c``."""
+    n = detail.shape[0]
+    residual = detail.copy()
+    for end in (0, 1):
+        for j in range(3):
+            residual[:, j] -= 0.5 * np.bincount(E[:, end], weights=c[:, j], minlength=n)
+    ones = np.ones(E.shape[0])
+    adjacency = sp.coo_matrix((ones, (E[:, 0], E[:, 1])), shape=(n, n))
+    degree = np.bincount(E.ravel(), minlength=n).astype(np.float64)
+    # x^T Q x = sum over edges (x_i + x_j)^2: zero only on a 2-colourable graph, never with triangles
+    Q = (adjacency + adjacency.T + sp.diags(degree)).tocsc()
+    mu = factorize(Q).solve(residual)
+    return c + 2.0 * (mu[E[:, 0]] + mu[E[:, 1]])
 
 
 #: With ``location="closest"``, a target farther than this (fraction of the source's bbox
