@@ -240,7 +240,7 @@ def _minimal_command(parser):
         import numpy as np
 
         from . import minimal_surface, read_mesh, write_mesh
-        from .curvature._validate import check_mesh
+        from .curvature._validate import boundary_vertices, check_mesh
         from .curvature.errors import ConstraintError, counted
 
         resolve_input_output(args)
@@ -249,6 +249,11 @@ def _minimal_command(parser):
         if fixed.size == 0:
             raise ConstraintError(f"{args.input} is closed: a minimal surface needs a boundary to span "
                                   "(or vertices named with --fix).")
+        loose = np.setdiff1d(boundary_vertices(F), fixed)
+        if loose.size:                      # only with --fix: a free boundary has no minimal surface
+            raise ConstraintError(f"--fix leaves {counted(loose.size, 'boundary vertex', 'boundary vertices')} "
+                                  f"free (first: {', '.join(map(str, loose[:3]))}): a minimal surface spans a "
+                                  "fixed boundary (a free one shrinks towards nothing); add --fix-boundary.")
         progress = Progress(args.max_iterations, enabled=sys.stderr.isatty())
         X = minimal_surface(V, F, fixed, max_iterations=args.max_iterations, tol=args.tol,
                             step=args.step, backend=args.backend,

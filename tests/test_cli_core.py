@@ -242,6 +242,17 @@ def test_minimal_on_a_closed_mesh_fails_cleanly(tmp_path, capsys):
     assert not out.exists()
 
 
+def test_minimal_with_fix_that_leaves_the_boundary_free_names_fix_boundary(tmp_path, capsys):
+    # a free boundary has no minimal surface (it shrinks towards nothing): the library refuses it
+    # by naming a Python call; the command names its own option
+    out = tmp_path / "m.ply"
+    assert main(["minimal", NOSE, str(out), "--fix", "300"]) == 1
+    line = _error_line(capsys)
+    nb = boundary_vertices(read_mesh(NOSE)[1]).size
+    assert f"--fix leaves {nb} boundary vertices free" in line and line.endswith("add --fix-boundary.")
+    assert not out.exists()
+
+
 def test_unknown_backend_fails_cleanly(tmp_path, capsys):
     out = tmp_path / "x.ply"
     assert main(["reconstruct", NOSE, str(out), "--backend", "magic"]) == 1

@@ -2,6 +2,7 @@
 
 import doctest
 import importlib
+import re
 
 import numpy as np
 import pytest
@@ -287,3 +288,132 @@ def test_a_step_that_is_not_normal_or_full_is_refused(step):
     shown = "'half'" if isinstance(step, str) else r".* \((ndarray|list), not a single str\)"
     with pytest.raises(ValueError, match=rf"step={shown}; use 'normal' \(the step across the surface\) or 'full'"):
         minimal_surface(V, F, boundary_vertices(F), step=step)
+
+
+def test_a_neck_pinching_into_needles_is_refused_not_converged():
+    # two unit circles 2 apart span no catenoid. On this coarse grid the neck's triangles shrank
+    # into needles (largest |cot| 3.4e7, area 1.4e-7 of their start) without reaching the
+    # absolute zero-area threshold, and the result came back converged after 10 steps with a
+    # neck of radius 2e-7
+    V, F = cylinder(radius=1.0, height=2.0, n_around=24, n_along=8)
+    with pytest.raises(MeshError, match=r"^minimal surface iteration 9: 48 triangles collapsed into needles "
+                                        r"\(first: 72, 73, 74; an angle within 1e-6 rad .* no minimal surface "
+                                        r"of this topology \(e\.g\. two circles too far apart"):
+        minimal_surface(V, F, boundary_vertices(F))
+
+
+def test_healthy_results_keep_their_angles_clear_of_the_needle_threshold(load_mesh):
+    # the needle check (|cot| above 1e6 and 100 times the input's) must not touch real results:
+    # they stay below ~100 (the nose's after its 44 steps: under 20)
+    from curvdetail.curvature._geometry import corner_cotangents
+    from curvdetail.curvature.minimal_surface import DEGENERATE_COTANGENT
+
+    V, F = load_mesh("mannequin_nose.obj")
+    X = minimal_surface(V, F, boundary_vertices(F))
+    largest = np.abs(corner_cotangents(np.asarray(X), F, lengths=False)[0]).max()
+    assert X.converged and largest < 20 and DEGENERATE_COTANGENT == 1e6
+
+
+def test_an_input_sliver_is_not_taken_for_a_collapse():
+    # a bump with a flat rim, and a flap 1e-8 high on a rim edge: its |cot| is 1.25e7 in the
+    # input already (its vertices are fixed, it stays so). Only a growth past the input's counts
+    from curvdetail.curvature import boundary_edges
+    from curvdetail.curvature._geometry import corner_cotangents
+
+    V, F = grid(5, 5)
+    V[:, 2] = V[:, 0] * (1 - V[:, 0]) * V[:, 1] * (1 - V[:, 1])
+    a, b = next(e for e in boundary_edges(F) if set(e) == {1, 2})      # (0.25, 0) and (0.5, 0)
+    V = np.vstack([V, [0.375, -1e-8, 0.0]])
+    F = np.vstack([F, [b, a, 25]])                                       # wound as its neighbour
+    assert np.abs(corner_cotangents(V, F[-1:], lengths=False)[0]).max() > 1e7
+    X = minimal_surface(V, F, boundary_vertices(F), tol=1e-12)
+    assert X.converged and np.abs(X[:, 2]).max() < 1e-12
+
+
+def test_free_boundary_vertices_are_refused():
+    # a cylinder held at its middle ring only: the free rims shrank onto it, every vertex ended
+    # at z = 0 (area 0.10 of 6.27) and the result came back converged after 2 steps
+    V, F = cylinder(radius=1.0, height=1.0, n_around=32, n_along=17)
+    ring = np.flatnonzero(np.isclose(V[:, 2], 0.0))
+    with pytest.raises(ConstraintError, match=r"^64 boundary vertices are not fixed \(of 64; first: 0, 1, 2\): a "
+                                              r"surface with a free boundary has no minimal surface.*Fix the whole "
+                                              r"boundary too, e\.g\. np\.union1d\(fixed, boundary_vertices\(F\)\)"):
+        minimal_surface(V, F, ring)
+    b = boundary_vertices(F)
+    with pytest.raises(ConstraintError, match=r"^1 boundary vertex is not fixed \(of 64; first: 7\)"):
+        minimal_surface(V, F, np.union1d(ring, np.delete(b, 7)))
+    # the ring and both rims: three curves, a valid constraint
+    X = minimal_surface(V, F, np.union1d(ring, b))
+    assert X.converged and np.array_equal(X[ring], V[ring])
+
+
+def test_a_degenerating_disk_blames_the_iteration_not_the_boundary(load_mesh):
+    # a disk's boundary always spans a minimal surface; at tol=1e-6 the nose's vertices slide
+    # until a triangle degenerates. The message said the fixed vertices "span no minimal surface
+    # of this topology"; it now says where the run got to and what to change
+    V, F = load_mesh("mannequin_nose.obj")
+    with pytest.raises(MeshError) as error:
+        minimal_surface(V, F, boundary_vertices(F), tol=1e-6, max_iterations=2000)
+    message = str(error.value)
+    assert re.match(r"minimal surface iteration (\d+): 1 triangle collapsed into needles", message)
+    iteration = int(re.match(r"minimal surface iteration (\d+)", message).group(1))
+    assert 600 < iteration < 866                              # 866: the zero-area threshold
+    assert re.search(r"the step before moved the shape by \d\.\d\de-06 of the bbox diagonal \(normal to "
+                     r"the surface; tol 1e-06\)\. This piece is a disk, whose boundary always spans a "
+                     r"minimal surface: the iteration itself degraded the triangles", message)
+    assert f"max_iterations below {iteration}" in message and "no minimal surface of this" not in message
+
+
+def test_a_pinned_inner_vertex_is_named_as_the_cause(load_mesh):
+    V, F = load_mesh("mannequin_nose.obj")
+    with pytest.raises(MeshError, match=r"1 fixed vertex lies inside the surface \(first: 300\): a minimal "
+                                        r"surface cannot be held at isolated points.*around it into spikes"):
+        minimal_surface(V, F, np.union1d(boundary_vertices(F), [300]))
+
+
+def test_remaining_estimate_bounds_the_distance_to_the_limit_near_the_critical_height():
+    # two unit circles 1.32 apart, just below the largest height a catenoid spans (1.3255): the
+    # steps contract by only ~0.92, and the default tol stops 1.2e-3 of the diagonal (normal to
+    # the surface) from where the iteration converges, twelve times tol; the estimate says so
+    from curvdetail.curvature.minimal_surface import _vertex_normals
+
+    V, F = cylinder(radius=1.0, height=1.32, n_around=64, n_along=33)
+    b = boundary_vertices(F)
+    steps = []
+    X = minimal_surface(V, F, b, callback=lambda i, s: steps.append(s))
+    limit = minimal_surface(V, F, b, tol=1e-7, max_iterations=300)
+    assert X.converged and limit.converged and limit.iterations > 3 * X.iterations
+    distance = np.abs(np.einsum("ij,ij->i", X - limit, _vertex_normals(np.asarray(limit), F))).max()
+    distance /= bbox_diagonal(V)
+    assert X.contraction == steps[-1] / steps[-2] and 0.9 < X.contraction < 0.95
+    assert distance > 10 * 1e-4 and 0.8 * distance < X.remaining_estimate < 1.2 * distance
+
+
+def test_remaining_estimate_on_the_regular_catenoid_is_below_tol():
+    # away from the critical height the steps contract by 0.38: the last step bounds the rest
+    V, F = cylinder(radius=1.0, height=1.0, n_around=64, n_along=33)
+    steps = []
+    X = minimal_surface(V, F, boundary_vertices(F), callback=lambda i, s: steps.append(s))
+    rho = steps[-1] / steps[-2]
+    assert X.iterations == 7 and X.contraction == rho and 0.35 < rho < 0.42
+    assert X.remaining_estimate == pytest.approx(X.last_step * rho / (1 - rho), rel=1e-12)
+    assert X.remaining_estimate < 1e-4
+
+
+def test_figures_survive_copy_slicing_arithmetic_and_pickling(load_mesh):
+    # a MinimalSurfaceResult lost its figures on .copy(), arithmetic and pickling (the results of
+    # a ProcessPoolExecutor)
+    import copy
+    import pickle
+
+    V, F = load_mesh("mannequin_nose.obj")
+    X = minimal_surface(V, F, boundary_vertices(F), max_iterations=3, tol=1e-12)
+    figures = {name: getattr(X, name) for name in ("iterations", "converged", "last_step", "last_full_step",
+                                                   "contraction", "remaining_estimate")}
+    assert figures["iterations"] == 3 and figures["converged"] is False
+    copies = [X.copy(), copy.deepcopy(X), X[:10], 2.0 * X] + [pickle.loads(pickle.dumps(X, protocol=p))
+                                                              for p in range(2, pickle.HIGHEST_PROTOCOL + 1)]
+    for Y in copies:
+        assert {name: getattr(Y, name) for name in figures} == figures
+    for Y in copies[:2] + copies[4:]:
+        assert np.array_equal(Y, X) and Y.flags.writeable

@@ -4,24 +4,74 @@ import numpy as np
 
 from ._geometry import corner_cotangents
 from ._validate import (check_choice, ZERO_AREA_RELATIVE, as_count, as_index_set, as_positive_number, bbox_centre,
-                        bbox_diagonal, check_every_component_fixed, misoriented_edges, vertex_components)
+                        bbox_diagonal, boundary_vertices, check_every_component_fixed, misoriented_edges,
+                        undirected_edges, vertex_components)
 from .cotan_laplacian import _assemble_upper, checked_cotan_triangle
-from .errors import ConstraintError, MeshError, first_indices
+from .errors import ConstraintError, MeshError, counted, first_indices, them
 from .reconstruct import _FreeSystemLayout
 from .sparse_solver import factorize
 
 
 class MinimalSurfaceResult(np.ndarray):
-    """(n, 3) positions with ``iterations``, ``converged``, ``last_step`` (the last step's largest
-    displacement as ``step`` measures it: by default its part normal to the surface) and
-    ``last_full_step`` (its largest displacement, tangential sliding included), both relative to
-    the bbox diagonal of the vertex's piece, attached."""
+    """(n, 3) positions with the iteration's figures attached:
+
+    ``iterations``          steps taken
+    ``converged``           the last step fell below ``tol``: a bound on that step, *not* on the
+                            distance to where the iteration is heading (see ``remaining_estimate``)
+    ``last_step``           the last step's largest displacement as ``step`` measures it (by
+                            default its part normal to the surface)
+    ``last_full_step``      its largest displacement, tangential sliding included
+    ``contraction``         ``last_step`` over the step before (nan after fewer than two steps)
+    ``remaining_estimate``  how much farther the steps would still add up to, were they to keep
+                            contracting by ``contraction``: ``last_step * rho / (1 - rho)`` (inf
+                            where the steps do not contract, 0 where nothing was free)
+
+    The steps are relative to the bbox diagonal of the vertex's piece. The figures survive
+    ``copy()``, slicing, arithmetic (the result keeps its operand's figures) and pickling.
+    """
+
+    _FIGURES = ("iterations", "converged", "last_step", "last_full_step", "contraction", "remaining_estimate")
+
+    def __array_finalize__(self, obj):
+        # views, copies and ufunc results start from ``obj``'s figures (None from a plain array)
+        for name in self._FIGURES:
+            setattr(self, name, getattr(obj, name, None))
+
+    def __reduce__(self):
+        # ndarray's pickle state is the array's alone: the figures ride along at its end
+        constructor, arguments, state = super().__reduce__()
+        return constructor, arguments, state + (tuple(getattr(self, name, None) for name in self._FIGURES),)
+
+    def __setstate__(self, state):
+        if len(state) == 5:                 # ndarray's own state: pickled before the figures rode along
+            super().__setstate__(state)
+            return
+        *array_state, figures = state
+        super().__setstate__(tuple(array_state))
+        for name, value in zip(self._FIGURES, figures):
+            setattr(self, name, value)
 
 
-#: Default stopping tolerance of :func:`minimal_surface`: the shape moves by less than 1e-4 of the
-#: bbox diagonal in a step. The cotangent minimal surface itself is only second-order accurate
-#: (the 64 x 33 catenoid is off by 1.5e-4 of its diagonal), so iterating further buys nothing.
+#: Default stopping tolerance of :func:`minimal_surface`: the last step moved the shape by less
+#: than 1e-4 of the bbox diagonal (0.01 %). That bounds the step, not the distance to the
+#: iteration's limit, which the steps approach at their contraction rate: on the 64 x 33
+#: catenoid (steps contracting by 0.38) the shape stops 3.6e-5 of its diagonal from that limit,
+#: near the critical height (two unit circles 1.32 apart, 0.92) 1.3e-3. On irregular meshes a
+#: slow drift (contraction ~0.98) that the first steps hide goes on: the ear and the terrain stop
+#: after 3 steps 3.1e-3 and 2.2e-3 of the diagonal from their surfaces after 400 steps. That drift
+#: is the triangles degrading, not the shape settling (the nose's collapse after ~700 steps): a
+#: smaller ``tol`` follows it, a larger one stops before it.
 DEFAULT_TOL = 1e-4
+
+#: Largest ``|cot|`` of a corner in a usable result: an angle within 1e-6 rad of 0 or 180 degrees.
+#: Results on real patches (trunk, camelhead, mannequin_disk_1k, the nose after 500 steps) stay
+#: below ~100; a pinching neck or a collapsing free rim passes 1e3, 1e4, ... within a step or two
+#: (the 24 x 8 cylinder of height 2 reached 3.4e7 and was returned as converged).
+DEGENERATE_COTANGENT = 1e6
+
+#: A triangle counts as degenerated only where its ``|cot|`` also grew this many times over the
+#: input's: an input sliver that the checks accept (down to ZERO_AREA_RELATIVE) is not refused.
+DEGENERATE_GROWTH = 100.0
 
 
 def _vertex_normals(X, F, face_cross=None, aligned=False):
@@ -76,7 +126,7 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, step="n
 
     Each step solves the free rows ``L_ff X_f = -L_fc X_c`` with the cotangent weights of the
     current surface (a cotangent-harmonic step; Pinkall & Polthier 1993), then recomputes the
-    weights. It stops when the shape has settled: when the largest displacement of a step
+    weights. It stops when a step is small: when the largest displacement of a step
     *normal to the surface* (projected on the area-weighted vertex normals of the new surface) is
     below ``tol`` times the bbox diagonal of the vertex's connected piece (the mesh's, for one
     piece), or after ``max_iterations`` steps. ``step="full"`` compares the whole displacement
@@ -89,6 +139,22 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, step="n
     after 400, nearly all of it tangential, while the normal part is below 1e-4 from step ~40
     on. On a symmetric grid (the catenoid) a tangential drift of ~2.4e-7 per step goes on forever
     while the normal step falls to 1e-11. The full step is reported as ``last_full_step``.
+
+    A small step is not a small error: the steps contract by a factor ``rho`` each, and after a
+    last step ``s`` the iteration still has up to ``s rho / (1 - rho)`` to go, reported as
+    ``remaining_estimate`` (``rho``, the last two steps' ratio, as ``contraction``). With the
+    default ``tol`` the 64 x 33 catenoid (rho 0.38) stops 3.6e-5 of its diagonal from the
+    iteration's limit; two unit circles 1.32 apart, near the largest height a catenoid spans
+    (rho 0.92), 1.3e-3 (estimated 1.2e-3). On irregular meshes a slower drift that the first
+    steps hide follows (rho ~0.98; the estimate misses it): the ear and the terrain, stopped
+    after 3 steps, lie 3.1e-3 and 2.2e-3 of the diagonal from their surfaces after 400 steps.
+    That drift degrades the triangles (the nose's collapse after ~700 steps at ``tol=1e-6``), so
+    chasing it with a smaller ``tol`` gains no accuracy against the smooth minimal surface.
+
+    The iteration refuses results it has ruined: a step that collapses triangles (zero area, or
+    an angle within 1e-6 rad of 0 or 180 degrees that the input did not have) raises MeshError
+    saying where it got to and the likely cause (a disk's boundary always spans a minimal
+    surface: there the iteration itself wore the triangles down).
 
     Parameters
     ----------
@@ -110,13 +176,17 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, step="n
     Returns
     -------
     X : (n, 3) float array (a :class:`MinimalSurfaceResult` with ``.iterations``,
-        ``.converged``, ``.last_step`` and ``.last_full_step``)
+        ``.converged``, ``.last_step``, ``.last_full_step``, ``.contraction`` and
+        ``.remaining_estimate``; they survive copies and pickling)
 
     Raises
     ------
     MeshError         malformed mesh, or triangles collapsed during the iteration (the boundary
-                      spans no minimal surface of this topology, e.g. two circles too far apart)
-    ConstraintError   bad fixed set or a piece with no fixed vertex
+                      spans no minimal surface of this topology, e.g. two circles too far apart
+                      for a catenoid; fixed vertices inside the surface; or, on a disk, the
+                      iteration's own sliding: the message says which)
+    ConstraintError   bad fixed set, a piece with no fixed vertex, or a boundary vertex left free
+                      (a free boundary has no minimal surface)
     ValueError        ``max_iterations`` not a whole number >= 1, ``tol`` not a positive number,
                       ``step`` not "normal" or "full"
     SolverError       an unknown or uninstalled ``backend``
@@ -143,13 +213,14 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, step="n
         raise ConstraintError("no fixed vertices: a minimal surface needs a fixed boundary; pass e.g. "
                               "boundary_vertices(F).")
     check_every_component_fixed(F, n, fixed, adjacency=U)
+    is_free = np.ones(n, dtype=bool)
+    is_free[fixed] = False
+    _check_boundary_fixed(F, is_free)
     # the step is measured along vertex normals, which reversed triangles cancel: the iteration
     # ran to max_iterations "not converged". Where triangles are not consistently oriented (or
     # cannot be: a Moebius strip), the normals are summed sign-aligned instead (1M vertices: the
     # check ~0.9 s, a fifth of a step)
     aligned = step == "normal" and misoriented_edges(F).shape[0] > 0
-    is_free = np.ones(n, dtype=bool)
-    is_free[fixed] = False
     free = np.flatnonzero(is_free)
     diag = bbox_diagonal(V)
     # steps are measured against the diagonal of each vertex's own piece: against the whole
@@ -162,10 +233,10 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, step="n
     X = V.copy()
     converged = free.size == 0
     measured = full_step = 0.0 if converged else np.inf
+    previous = np.nan
     it = 0
     while not converged and it < max_iterations:
         if it > 0:                          # weights of the current surface
-            cot, _, _ = corner_cotangents(X, F, lengths=False)
             U, diagonal = _assemble_upper(X, F, cot, check_manifold=False)
         system, L_fc = layout.values(U, diagonal)
         # the pattern of L_ff never changes: the solver keeps its ordering and symbolic analysis
@@ -181,19 +252,21 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, step="n
         cross = np.cross(X_new[F[:, 1]] - X_new[F[:, 0]], X_new[F[:, 2]] - X_new[F[:, 0]])
         dbl = np.sqrt(np.einsum("ij,ij->i", cross, cross))
         collapsed = np.flatnonzero(dbl <= 2.0 * ZERO_AREA_RELATIVE * diag ** 2)
+        if collapsed.size == 0:
+            # the next step's weights; an area check alone is absolute: a pinching neck of needles
+            # (area 1e-7 of their start) passed it and came back "converged"
+            cot, _, _ = corner_cotangents(X_new, F, lengths=False)
+            if np.abs(cot).max() > DEGENERATE_COTANGENT:
+                collapsed = _degenerated_triangles(V, F, cot)
         if collapsed.size:
-            raise MeshError(
-                f"minimal surface iteration {it + 1}: {collapsed.size} triangles collapsed (first: "
-                f"{first_indices(collapsed)}); the fixed vertices span no minimal surface of this "
-                "topology (e.g. two circles too far apart for a catenoid)."
-            )
+            raise MeshError(_collapse_message(it + 1, collapsed, dbl, V, F, fixed, U, measured, step, tol))
         move = X_new - X
         full_step = float((np.linalg.norm(move, axis=1) / scale).max())
         if step == "normal":
             normals = _vertex_normals(X_new, F, cross, aligned=aligned)
-            measured = float((np.abs(np.einsum("ij,ij->i", move, normals)) / scale).max())
+            measured, previous = float((np.abs(np.einsum("ij,ij->i", move, normals)) / scale).max()), measured
         else:
-            measured = full_step
+            measured, previous = full_step, measured
         X = X_new
         it += 1
         converged = measured < tol
@@ -201,4 +274,80 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, step="n
             callback(it, measured)
     out = X.view(MinimalSurfaceResult)
     out.iterations, out.converged, out.last_step, out.last_full_step = it, bool(converged), measured, full_step
+    out.contraction, out.remaining_estimate = _remaining_estimate(measured, previous if it >= 2 else np.nan)
     return out
+
+
+def _remaining_estimate(last, previous):
+    """``(rho, last * rho / (1 - rho))`` with ``rho = last / previous``: the contraction of the
+    last two steps and how far steps contracting at that rate would still go (the error bound of
+    a contraction); ``(nan, inf)`` without a step before, ``(nan, 0)`` after none at all or a
+    step of exactly 0 (a fixed point: nothing is left to go)."""
+    if last == 0.0:
+        return (np.nan if np.isnan(previous) else 0.0), 0.0
+    if not previous > 0.0:              # nan: one step only
+        return np.nan, np.inf
+    rho = last / previous
+    return rho, (last * rho / (1.0 - rho) if rho < 1.0 else np.inf)
+
+
+def _check_boundary_fixed(F, is_free):
+    """Raise ConstraintError if a boundary vertex is free: a free rim has no minimal surface (the
+    area falls towards zero as the rim shrinks onto the fixed vertices), and the iteration
+    flattened it instead (a cylinder held at its middle ring: every vertex at z = 0, area 0.1 of
+    6.3, "converged" after 2 steps)."""
+    boundary = boundary_vertices(F)
+    loose = boundary[is_free[boundary]]
+    if loose.size:
+        raise ConstraintError(
+            f"{counted(loose.size, 'boundary vertex', 'boundary vertices', verb='are')} not fixed (of "
+            f"{boundary.size}; first: {first_indices(loose)}): a surface with a free boundary has no "
+            "minimal surface (it shrinks onto the fixed vertices until its triangles collapse). Fix the "
+            "whole boundary too, e.g. np.union1d(fixed, boundary_vertices(F))."
+        )
+
+
+def _degenerated_triangles(V, F, cot):
+    """Triangles whose largest ``|cot|`` passes DEGENERATE_COTANGENT and grew DEGENERATE_GROWTH
+    times over the input's, increasing (the input's cotangents of the candidates only)."""
+    largest = np.abs(cot).max(axis=1)
+    candidates = np.flatnonzero(largest > DEGENERATE_COTANGENT)
+    rest, _, _ = corner_cotangents(V, F[candidates], lengths=False)
+    return candidates[largest[candidates] > DEGENERATE_GROWTH * np.abs(rest).max(axis=1)]
+
+
+def _collapse_message(iteration, triangles, dbl, V, F, fixed, adjacency, last_step, step, tol):
+    """The MeshError text for triangles that collapsed in step ``iteration``: what happened, how far
+    the iteration had got, and the likely cause from the piece's topology (the first triangle's)."""
+    zero_area = bool(np.all(dbl[triangles] <= 2.0 * ZERO_AREA_RELATIVE * bbox_diagonal(V) ** 2))
+    how = ("to zero area", "") if zero_area else ("into needles", "; an angle within 1e-6 rad of 0 or 180 degrees")
+    text = (f"minimal surface iteration {iteration}: {counted(triangles.size, 'triangle')} collapsed {how[0]} "
+            f"(first: {first_indices(triangles)}{how[1]})")
+    if iteration > 1:
+        measure = "normal to the surface" if step == "normal" else "whole displacement"
+        text += (f"; the step before moved the shape by {last_step:.2e} of the bbox diagonal ({measure}; "
+                 f"tol {tol:g})")
+    labels, _ = vertex_components(F, V.shape[0], adjacency=adjacency)
+    piece = labels[F[triangles[0], 0]]
+    in_piece = labels == piece
+    piece_faces = F[in_piece[F[:, 0]]]
+    boundary = boundary_vertices(piece_faces)
+    inner_fixed = np.setdiff1d(fixed[in_piece[fixed]], boundary)
+    edges = np.unique(undirected_edges(piece_faces), axis=0).shape[0]
+    euler = np.count_nonzero(in_piece) - edges + piece_faces.shape[0]       # 1: a disk (a boundary, genus 0)
+    larger_tol = f"a larger tol, e.g. the default {DEFAULT_TOL:g}" if tol < DEFAULT_TOL else "a larger tol"
+    if inner_fixed.size:
+        return (f"{text}. {counted(inner_fixed.size, 'fixed vertex', 'fixed vertices', verb='lie')} inside the "
+                f"surface (first: {first_indices(inner_fixed)}): a minimal surface cannot be held at isolated "
+                f"points, and the iteration pulls the triangles around {them(inner_fixed.size)} into spikes. "
+                f"Fix whole curves (e.g. the boundary only), or stop earlier ({larger_tol}, or max_iterations "
+                f"below {iteration}).")
+    if euler == 1 and boundary.size:
+        return (f"{text}. This piece is a disk, whose boundary always spans a minimal surface: the "
+                "iteration itself degraded the triangles, sliding vertices within the surface to lower "
+                f"the discrete area. Stop it earlier ({larger_tol}, or max_iterations below {iteration}) "
+                "or remesh the input more evenly (e.g. isotropic remeshing) and try again.")
+    return (f"{text}. The fixed vertices may span no minimal surface of this topology (e.g. two circles "
+            "too far apart for a catenoid: the neck pinches off); or the iteration degraded the "
+            "triangles, sliding vertices within the surface (then a larger tol or fewer max_iterations "
+            "stop it earlier, or remesh the input more evenly).")
