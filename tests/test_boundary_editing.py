@@ -148,7 +148,7 @@ def test_the_mesh_is_checked_and_its_laplacian_assembled_once(monkeypatch):
 
 
 @pytest.mark.parametrize("damage, message", [
-    (lambda V, F: (V, np.vstack([F, F[:1]])), "shared by more than two triangles"),         # a doubled triangle
+    (lambda V, F: (V, np.vstack([F, F[:1]])), "repeats the three vertices of an earlier one"),  # a doubled triangle
     (lambda V, F: (np.vstack([V, [0.5, 0.5, 1.0]]), np.vstack([F, [[F[40, 0], F[40, 1], V.shape[0]]]])),
      "shared by more than two triangles"),                                                  # a fin
 ])

@@ -438,3 +438,36 @@ def test_a_row_mode_that_is_not_all_or_free_is_refused(rows):
     shown = "'some'" if isinstance(rows, str) else r".* \((ndarray|list), not a single str\)"
     with pytest.raises(ValueError, match=rf"rows={shown} is not a row mode; use 'all'"):
         Reconstructor(V, F, b, rows=rows)
+
+
+_SHARED_RECONSTRUCTOR_SCRIPT = """
+import sys
+from concurrent.futures import ThreadPoolExecutor
+import numpy as np
+from curvdetail.curvature import Reconstructor, boundary_vertices, curvature_detail
+from curvdetail.curvature.testing import grid
+V, F = grid(100, 100)
+V[:, 2] = np.sin(5 * V[:, 0]) * V[:, 1]
+b = boundary_vertices(F)
+D = curvature_detail(V, F)
+R = Reconstructor(V, F, b, rows=sys.argv[1], backend=sys.argv[2])
+serial = [R.solve(D * (1 + k), V[b]) for k in range(3)]
+with ThreadPoolExecutor(2) as pool:
+    threaded = list(pool.map(lambda k: R.solve(D * (1 + k % 3), V[b]), range(200)))
+print(max(np.abs(X - serial[k % 3]).max() for k, X in enumerate(threaded)))
+"""
+
+
+@pytest.mark.parametrize("rows", ROWS)
+def test_threads_sharing_one_reconstructor_get_the_serial_answers(rows):
+    # in a child process: PARDISO's handle used by two threads at once crashed the process ("auto"
+    # picks PARDISO for this 10k system where it is installed; test_sparse_solver runs every
+    # backend's shared factor in threads)
+    backend = "auto"
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-c", _SHARED_RECONSTRUCTOR_SCRIPT, rows, backend],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, (done.returncode, done.stderr[-2000:])
+    assert float(done.stdout.split()[-1]) < 1e-12           # grid of unit size

@@ -360,3 +360,99 @@ def test_backend_names_are_case_insensitive(monkeypatch, name):
     assert resolve_backend(name, size=10) == name.strip().lower()
     monkeypatch.setenv("CURVDETAIL_SOLVER", name)
     assert resolve_backend("AUTO", size=10) == name.strip().lower()
+
+
+def _nearly_singular_nonsymmetric():
+    """A 50 x 50 nonsymmetric matrix whose row 7 is twice row 3 plus 1e-13 on the diagonal
+    (condition number 2e14), a right-hand side and numpy's dense solution."""
+    A = (sp.random(50, 50, density=0.2, random_state=1) + 3.0 * sp.eye(50)).tolil()
+    A[7, :] = A[3, :] * 2
+    A[7, 7] += 1e-13
+    A = A.tocsr()
+    b = np.random.default_rng(0).normal(size=50)
+    return A, b, np.linalg.solve(A.toarray(), b)
+
+
+@pytest.mark.skipif("pardiso" not in available_backends(), reason="PARDISO (pypardiso) not installed")
+def test_pardiso_perturbed_pivots_are_not_taken_for_a_solution(monkeypatch):
+    # PARDISO replaced a pivot by 1e-13 (iparm[13] = 1) and its solution was 14 % off the dense one;
+    # SuperLU's is 9e-5 off (cond 2e14: the problem's own sensitivity is ~0.05)
+    A, b, dense = _nearly_singular_nonsymmetric()
+    with pytest.raises(SolverError, match="PARDISO had to perturb 1 pivot of this nonsymmetric matrix: it is "
+                                          "singular or nearly so.*backend='splu'"):
+        factorize(A, symmetric=False, backend="pardiso")
+    monkeypatch.delenv("CURVDETAIL_SOLVER", raising=False)
+    monkeypatch.setattr(sparse_solver, "SMALL_SYSTEM_NNZ", 0)         # "auto" picks PARDISO first
+    fac = factorize(A, symmetric=False)
+    assert fac.backend == "splu"                                        # taken over, with pivoting
+    assert np.abs(fac.solve(b) - dense).max() < 1e-3 * np.abs(dense).max()
+    # refactoring: an ordinary matrix of the same pattern stays with PARDISO, the nearly singular one
+    # goes to SuperLU again
+    B = (A + 5.0 * sp.eye(50)).tocsr()
+    fac = factorize(B, symmetric=False)
+    assert fac.backend == "pardiso" and fac._pardiso.iparm[13] == 0
+    fac.refactor(A)
+    assert fac.backend == "splu"
+    assert np.abs(fac.solve(b) - dense).max() < 1e-3 * np.abs(dense).max()
+    fac.refactor(B)
+    x = fac.solve(b)
+    assert np.abs(B @ x - b).max() < 1e-11 * np.abs(b).max()
+
+
+@pytest.mark.skipif("pardiso" not in available_backends(), reason="PARDISO (pypardiso) not installed")
+def test_an_exactly_singular_nonsymmetric_matrix_is_refused_not_solved(monkeypatch):
+    # row 7 = 2 row 3: PARDISO perturbed a pivot and returned entries of 4.6e13 with a residual of 0.37
+    A, b, _ = _nearly_singular_nonsymmetric()
+    A = A.tolil()
+    A[7, 7] = 2 * A[3, 7]
+    A = A.tocsr()
+    monkeypatch.delenv("CURVDETAIL_SOLVER", raising=False)
+    monkeypatch.setattr(sparse_solver, "SMALL_SYSTEM_NNZ", 0)
+    with pytest.raises(SolverError, match="singular"):
+        factorize(A, symmetric=False).solve(b)
+
+
+# Child process for the shared-factor threading test: a crash (PARDISO's handle used by two
+# threads at once segfaulted) then ends the child, not pytest. It prints the largest difference
+# between the threaded and the serial solutions, relative to the solutions' size.
+_SHARED_FACTOR_SCRIPT = """
+import sys
+from concurrent.futures import ThreadPoolExecutor
+import numpy as np
+from curvdetail.curvature.sparse_solver import factorize
+from curvdetail.curvature.testing import grid
+from curvdetail.curvature.cotan_laplacian import cotan_laplacian
+V, F = grid(100, 100)
+V[:, 2] = np.sin(5 * V[:, 0]) * V[:, 1]
+L = cotan_laplacian(V, F)
+inner = np.flatnonzero((V[:, 0] > 0) & (V[:, 0] < 1) & (V[:, 1] > 0) & (V[:, 1] < 1))
+A = L[inner][:, inner].tocsr()
+fac = factorize(A, symmetric=sys.argv[2] == "symmetric", backend=sys.argv[1])
+rhs = [np.random.default_rng(k).normal(size=(A.shape[0], 1 + k % 3)) for k in range(4)]
+serial = [fac.solve(b) for b in rhs]
+with ThreadPoolExecutor(4) as pool:
+    threaded = list(pool.map(lambda k: fac.solve(rhs[k % 4]), range(400)))
+print(max(np.abs(x - serial[k % 4]).max() / np.abs(serial[k % 4]).max() for k, x in enumerate(threaded)))
+"""
+
+
+def _solve_in_threads_sharing_one_factor(backend, symmetric):
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-c", _SHARED_FACTOR_SCRIPT, backend,
+                           "symmetric" if symmetric else "nonsymmetric"],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, (done.returncode, done.stderr[-2000:])
+    # the same factor and right-hand sides: the same answers, whichever thread solved them
+    assert float(done.stdout.split()[-1]) < 1e-12
+
+
+@pytest.mark.parametrize("backend", every_backend())
+def test_threads_sharing_one_factorization_solve_as_serial_solves(backend):
+    _solve_in_threads_sharing_one_factor(backend, symmetric=True)
+
+
+@pytest.mark.parametrize("backend", every_backend(exclude=("cholmod", "banded")))
+def test_threads_sharing_one_nonsymmetric_factorization_solve_as_serial_solves(backend):
+    _solve_in_threads_sharing_one_factor(backend, symmetric=False)

@@ -141,6 +141,47 @@ def test_non_manifold_edges_are_counted_and_listed_in_order_by_every_entry_point
         entry(V, F)
 
 
+@pytest.mark.parametrize("op", OPERATORS + [check_mesh])
+@pytest.mark.parametrize("second", [[0, 1, 2], [0, 2, 1], [1, 2, 0], [2, 1, 0]])
+def test_an_isolated_pair_of_duplicate_triangles_is_refused(op, second):
+    # same order, reversed, rotated: accepted before, with twice the area (each edge on exactly two
+    # triangles passes the non-manifold check)
+    V = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
+    with pytest.raises(MeshError, match=r"^F: 1 triangle repeats the three vertices of an earlier one \(first "
+                                        r"pairs: \(0, 1\)\): a repeated triangle counts its area and curvature "
+                                        r"twice\. Remove the duplicates, e\.g\. with pymeshlab's "
+                                        r"meshing_remove_duplicate_faces\.$"):
+        op(V, [[0, 1, 2], second])
+
+
+@pytest.mark.parametrize("entry", [check_mesh, cotan_laplacian, curvature_detail, mixed_voronoi_area,
+                                   lambda V, F: reconstruct(V, F, np.zeros_like(V), [0], V[[0]])])
+def test_duplicates_inside_a_mesh_are_named_as_such_not_as_non_manifold_edges(entry):
+    # a copy of an interior triangle puts three triangles on its edges: "not manifold, repair
+    # the non-manifold edges" was the message
+    V, F = grid(5, 5)
+    F = np.vstack([F, F[[7]][:, ::-1], F[[3]], F[[7]][:, [1, 2, 0]]])     # 32 triangles before
+    with pytest.raises(MeshError, match=r"^F: 3 triangles repeat the three vertices of an earlier one \(first "
+                                        r"pairs: \(7, 32\), \(3, 33\), \(7, 34\)\): .* "
+                                        r"meshing_remove_duplicate_faces"):
+        entry(V, F)
+
+
+def test_repeated_triangles_finds_every_repeat_also_for_vertex_counts_beyond_its_key():
+    from curvdetail.curvature._validate import repeated_triangles
+
+    V, F = grid(6, 6)
+    assert repeated_triangles(F, V.shape[0]) is None
+    # triangles sharing two vertices with a third one elsewhere, the fan of vertex 0: no repeats
+    assert repeated_triangles(np.array([[0, 1, 2], [0, 2, 3], [0, 1, 3], [1, 2, 3]]), 4) is None
+    G = np.vstack([F, F[[9, 0, 9]][:, [2, 0, 1]]])
+    expected = [[9, F.shape[0]], [0, F.shape[0] + 1], [9, F.shape[0] + 2]]
+    assert repeated_triangles(G, V.shape[0]).tolist() == expected
+    # beyond 3e9 vertices the (middle, highest) key would overflow: the fallback sorts the rows
+    assert repeated_triangles(G, 4_000_000_000).tolist() == expected
+    assert repeated_triangles(F, 4_000_000_000) is None
+
+
 def test_unreferenced_vertices_are_refused_with_the_vertices():
     V, F = _square()
     V = np.vstack([V, [[5.0, 5, 5], [6.0, 6, 6]]])
@@ -297,12 +338,49 @@ def test_coordinates_whose_products_overflow_are_named(scale):
 
 def test_a_mesh_too_small_for_its_areas_is_named_by_its_size():
     V, F = grid(3, 3)
-    V[:, 2] = V[:, 0] ** 2
-    check_mesh(V * 1e-70, F)                                  # still fine
-    with pytest.raises(MeshError, match=r"the mesh is 1.*e-100 across .* scale it up"):
-        check_mesh(V * 1e-100, F)
-    with pytest.raises(MeshError, match=r"the mesh is 1.*e-200 across .* scale it up"):
-        check_mesh(V * 1e-200, F)                              # its squared extent underflows
+    V[:, 2] = V[:, 0] ** 2                                    # 1.73 across
+    check_mesh(V * 1e-60, F)                                  # still fine
+    for scale in (1e-61, 1e-100, 1e-200):                    # 1e-200: its squared extent underflows
+        with pytest.raises(MeshError, match=rf"the mesh is 1.73e-{-np.log10(scale):.0f} across \(bbox "
+                                            r"diagonal\), below 1e-60: .* scale it up, e\.g\. to unit size"):
+            check_mesh(V * scale, F)
+    with pytest.raises(MeshError, match="the mesh is 0 across .* all 9 vertices lie at one point"):
+        check_mesh(V * 0.0, F)
+
+
+@pytest.mark.parametrize("op", OPERATORS)
+def test_a_mesh_whose_areas_lose_digits_to_subnormals_is_refused_not_answered_inexactly(load_mesh, op):
+    # the nose (0.91 across) scaled by 1e-78: its squared cross products fall into the subnormals,
+    # and K came back 9.7e-5 off without a word (reconstruct 4.9e-7); at 1e-75 np.errstate(all="raise")
+    # met an underflow inside the cotangents instead of a MeshError
+    V, F = load_mesh("mannequin_nose.obj")
+    exact = op(V, F)
+    exact = exact[0] if isinstance(exact, tuple) else exact
+    for scale in (1e-75, 1e-78):
+        with np.errstate(all="raise"), pytest.raises(MeshError, match=r"the mesh is 9.08e-\d+ across"):
+            op(V * scale, F)
+    # just above the limit the answer is exact: K scales as 1 / length, A as length^2, L as 1
+    scaled = op(V * 1e-59, F)
+    scaled = scaled[0] if isinstance(scaled, tuple) else scaled
+    power = {cotan_laplacian: 0, mixed_voronoi_area: 2, mean_curvature_normal: -1, curvature_detail: 1}[op]
+    if op is cotan_laplacian:
+        exact, scaled = exact.toarray(), scaled.toarray()
+    assert np.abs(scaled / 1e-59 ** power - exact).max() <= 1e-12 * np.abs(exact).max()
+
+
+def test_a_cross_product_component_that_underflows_is_no_error():
+    # a triangle almost in a coordinate plane squares a component of 1e-170: numpy's underflow,
+    # negligible next to the other components, raised FloatingPointError under np.errstate(all="raise")
+    V, F = grid(4, 4)
+    V[5, 2] = 1e-170
+    b = boundary_vertices(F)
+    with np.errstate(all="raise"):
+        check_mesh(V, F)
+        L = cotan_laplacian(V, F)
+        X = reconstruct(V, F, curvature_detail(V, F), b, V[b])
+    inner = np.setdiff1d(np.arange(V.shape[0]), b)
+    assert np.abs((L @ V[:, :2])[inner]).max() < 1e-14         # flat: x and y are harmonic inside
+    assert np.abs(X - V).max() < 1e-14
 
 
 def test_the_core_is_exact_across_its_range_of_scales():

@@ -9,6 +9,7 @@ offers no way to keep them. Here the arrays are handed to MKL once converted, ze
 
 import ctypes
 import os
+import threading
 
 import numpy as np
 
@@ -92,6 +93,11 @@ class PardisoFactor:
         iparm[24] = 2 if symmetric else 0
         iparm[34] = 1   # zero-based indices
         self.iparm = iparm
+        # PARDISO's handle (pt), iparm and the solve's work arrays are one state that every phase
+        # reads and writes: two threads in it at once corrupt it (two threads solving with one
+        # shared Reconstructor crashed the process in phase 33). MKL releases the GIL, so each
+        # factor serializes its own calls; different factors still run in parallel.
+        self._lock = threading.Lock()
         self._holds_memory = True                     # from the first call on, even a failed one
         # 11: ordering and symbolic analysis (reads the pattern only); 12: both phases
         self._call(11 if analyze_only else 12, np.zeros(n), np.zeros(n))
@@ -99,10 +105,19 @@ class PardisoFactor:
     def factor_values(self, data):
         """Numeric factorization (phase 22) with ``data``, the values of the analysed pattern in
         its order."""
-        self._data = np.ascontiguousarray(data, dtype=np.float64)
-        self._call(22, np.zeros(self._n), np.zeros(self._n))
+        data = np.ascontiguousarray(data, dtype=np.float64)
+        with self._lock:                               # a solve in another thread reads _data
+            self._data = data
+            self._call_unlocked(22, np.zeros(self._n), np.zeros(self._n))
 
     def _call(self, phase, b, x, columns=1):
+        """One PARDISO call with this factor's handle, one thread at a time (see ``_lock``)."""
+        with self._lock:
+            if not self._holds_memory:                 # MKL would read the released handle
+                raise PardisoError("the factor was freed; factor the matrix again")
+            self._call_unlocked(phase, b, x, columns)
+
+    def _call_unlocked(self, phase, b, x, columns=1):
         error = ctypes.c_int32(0)
         one = ctypes.c_int32(1)
         _function()(self._pt.ctypes.data_as(ctypes.POINTER(ctypes.c_int64)), ctypes.byref(one),
@@ -129,9 +144,13 @@ class PardisoFactor:
 
     def free(self):
         """Release MKL's memory for this factor (also done when the object is collected)."""
-        if getattr(self, "_holds_memory", False):
-            self._holds_memory = False
-            self._call(-1, np.zeros(0), np.zeros(0))
+        lock = getattr(self, "_lock", None)
+        if lock is None:                               # __init__ failed before the first call
+            return
+        with lock:
+            if self._holds_memory:
+                self._holds_memory = False
+                self._call_unlocked(-1, np.zeros(0), np.zeros(0))
 
     def __del__(self):
         try:

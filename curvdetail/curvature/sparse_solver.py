@@ -206,6 +206,8 @@ class Factorization:
         self.upper = bool(upper)
         full_nnz = 2 * A.nnz - A.shape[0] if upper else A.nnz     # as stored in full (about)
         self.backend = resolve_backend(backend, symmetric=symmetric, size=A.shape[0], nnz=full_nnz)
+        self._automatic = _chosen_automatically(backend)    # may another backend take over?
+        self._partial_pivoting = False                        # SuperLU's, once it took over from PARDISO
         factorization_count += 1
         # PARDISO's ordering and symbolic analysis of A's pattern, where a PendingFactorization
         # has run them already; refactor reuses the same
@@ -279,6 +281,27 @@ class Factorization:
         except PardisoError as exc:
             raise SolverError(f"PARDISO could not factor the matrix ({exc}); it may be singular.") from None
         self._solve = self._pardiso.solve
+        perturbed = int(self._pardiso.iparm[13])
+        if perturbed and not self.symmetric:
+            self._replace_perturbed_pardiso(A, perturbed)
+
+    def _replace_perturbed_pardiso(self, A, perturbed):
+        """PARDISO's nonsymmetric factorization pivots statically: a pivot below 1e-13 of the
+        (scaled, matched) matrix is replaced by that size (``iparm[13]`` counts them), so the
+        factors are of a nearby matrix, and its two automatic refinement steps do not make up for
+        it on a nearly singular one (a 50 x 50 one: 14 % off the dense solution, SuperLU 9e-5).
+        ``"auto"`` factors such a matrix again with SuperLU's partial pivoting; a named PARDISO
+        reports it. Ordinary matrices never get here (the CurvatureEditor's (I - C) systems of ten
+        test meshes: no perturbed pivot), so their solves cost nothing more."""
+        self._pardiso.free()
+        self._pardiso = None
+        if not self._automatic:
+            raise SolverError(f"PARDISO had to perturb {perturbed} pivot{'s' if perturbed > 1 else ''} of this "
+                              "nonsymmetric matrix: it is singular or nearly so, and the solution would be off by "
+                              "more than rounding. Use backend='splu' (LU with partial pivoting) or 'auto'.")
+        self.backend = "splu"
+        self._partial_pivoting = True
+        self._factor_splu(A)
 
     def _factor_cholmod(self, A):
         from sksparse import cholmod
@@ -330,8 +353,11 @@ class Factorization:
 
     def _factor_splu(self, A):
         try:
-            lu = spla.splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-                           options={"SymmetricMode": True})
+            if self._partial_pivoting:         # a nonsymmetric matrix PARDISO could not pivot
+                lu = spla.splu(A.tocsc(), permc_spec="COLAMD")
+            else:
+                lu = spla.splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                               options={"SymmetricMode": True})
         except RuntimeError as exc:
             raise SolverError(f"SuperLU could not factor the matrix ({exc}); it is singular.") from None
         self._solve = lu.solve
