@@ -94,7 +94,7 @@ def test_coefficients_are_invariant_under_rotation_and_uniform_scale(load_mesh, 
     assert abs(C2 - C).max() < 1e-8
 
 
-@pytest.mark.parametrize("scale", [1e-60, 1e70])
+@pytest.mark.parametrize("scale", [1e-58, 1e70])
 def test_coefficients_at_extreme_scales_are_the_same_and_quiet(load_mesh, scale):
     # the closed-form cofactors overflow at 1e70 (G ~ 1e140 per entry): those rings take the SVD
     # path, without numpy's overflow warnings reaching the user
@@ -104,6 +104,13 @@ def test_coefficients_at_extreme_scales_are_the_same_and_quiet(load_mesh, scale)
         warnings.simplefilter("error")
         C2 = curvature_coefficients(scale * V, F)
     assert abs(C2 - C).max() < 1e-8
+
+
+def test_coefficients_of_a_mesh_too_small_for_its_areas_are_refused_by_name(load_mesh):
+    # 0.9e-60 across: the triangle areas (~1e-122 per face) are on their way to underflow
+    V, F = load_mesh("mannequin_nose.obj")
+    with pytest.raises(ValueError, match=r"below 1e-60: .* scale it up"):
+        curvature_coefficients(1e-60 * V, F)
 
 
 def test_coefficients_are_the_minimum_norm_solution(load_mesh, rng):
@@ -284,3 +291,91 @@ def test_rings_still_unresolved_at_max_ring_keep_their_widest_fit():
         assert C[i].indices.tolist() == ring2
         expected = np.linalg.pinv(D[ring2].T, rcond=1e-6) @ D[i]
         assert np.allclose(C[i, ring2].toarray().ravel(), expected, rtol=1e-9, atol=1e-12)
+
+
+def _tetrahedron():
+    # vertex 3's three neighbours' details have sigma_3 / sigma_1 = 0.277: truncated at rcond=0.3
+    V = np.array([[0, 0, 0], [1, 0, 0], [0.2, 1, 0], [0.3, 0.3, 0.15]], float)
+    F = np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]])
+    return V, F
+
+
+def test_a_ring_that_stops_growing_reports_the_ring_its_coefficients_span():
+    # a tetrahedron: every one-ring is the rest of the mesh, so the two-ring adds nothing. At
+    # rcond=0.3 vertex 3's truncated fit leaves a residual above the threshold; the row kept its
+    # one-ring coefficients but was reported as ring 3 (max_ring) and listed as widened
+    V, F = _tetrahedron()
+    D = curvature_detail(V, F)
+    C, info = curvature_coefficients(V, F, rcond=0.3, return_info=True)
+    assert info.residual[3] > info.rcond * info.scale[3]          # still unresolved
+    assert info.ring.tolist() == [1, 1, 1, 1] and info.widened_vertices.size == 0
+    narrow, narrow_info = curvature_coefficients(V, F, rcond=0.3, max_ring=1, return_info=True)
+    assert (C != narrow).nnz == 0 and np.array_equal(info.rank, narrow_info.rank)
+    expected = np.linalg.pinv(D[[0, 1, 2]].T, rcond=0.3) @ D[3]
+    assert np.allclose(C[3, [0, 1, 2]].toarray().ravel(), expected, rtol=1e-12)
+
+
+def test_a_ring_that_stops_growing_after_one_widening_reports_ring_two():
+    # the bent strip at rcond=0.2: corner 4's two-ring is its whole piece (vertices 0-3) and
+    # still leaves a residual above the threshold; the three-ring is the same set (reported 3)
+    V, F = _corner_strip()
+    C, info = curvature_coefficients(V, F, rcond=0.2, return_info=True)
+    assert info.residual[4] > info.rcond * info.scale[4]
+    assert info.ring[4] == 2 and info.widened_vertices.tolist() == [4]
+    assert C[4].indices.tolist() == [0, 1, 2, 3]
+    C2, info2 = curvature_coefficients(V, F, rcond=0.2, max_ring=2, return_info=True)
+    assert (C != C2).nnz == 0 and np.array_equal(info.ring, info2.ring)
+
+
+def test_rows_without_neighbours_stay_at_ring_one():
+    # rows with an empty pattern (only vertex 0 has neighbours) cannot fit their non-zero
+    # detail; widening adds nothing to them, and they were reported as ring max_ring
+    from curvdetail.curvature.curvature_coefficients import _coefficients
+
+    rng = np.random.default_rng(3)
+    D = rng.normal(size=(5, 3))
+    rows, cols = np.zeros(4, dtype=np.int64), np.arange(1, 5)
+    C, rank, _, ring = _coefficients(D, np.ones(5), rows, cols, 5, 1e-6, 1.0, max_ring=3)
+    assert ring.tolist() == [1, 1, 1, 1, 1]
+    assert C.nnz == 4 and C[0].indices.tolist() == [1, 2, 3, 4] and rank[1:].tolist() == [0, 0, 0, 0]
+    assert np.allclose(C @ D, np.r_[[D[0]], np.zeros((4, 3))])
+
+
+def test_edges_of_zero_cotangent_weight_stay_in_the_pattern():
+    # a flat grid's diagonals have cotangent weight 0 (two right angles), stored in L as explicit
+    # zeros; C's pattern, read off L's, still holds every mesh edge in both directions
+    from curvdetail.curvature.cotan_laplacian import cotan_laplacian
+
+    V, F = grid(6, 5)
+    L = cotan_laplacian(V, F).tocoo()
+    assert np.count_nonzero((L.data == 0) & (L.row != L.col)) == 2 * 20     # the 20 diagonals
+    edges = {tuple(e) for f in F for e in ((f[0], f[1]), (f[1], f[2]), (f[2], f[0]))}
+    edges |= {(j, i) for i, j in edges}
+    coo = curvature_coefficients(V, F).tocoo()
+    assert set(zip(coo.row.tolist(), coo.col.tolist())) == edges and coo.nnz == len(edges)
+
+
+def test_rows_sent_to_the_svd_without_eigenvalues_are_those_the_eigenvalues_send(rng):
+    # the shortcut tells from G's invariants which rows certainly go through the SVD; it must
+    # never take a row that G's eigenvalues would not send there (sigma_2 / sigma_1 near the
+    # band's ends: 1e-7 and 1e-3, over 35 orders of magnitude of scale)
+    from curvdetail.curvature.curvature_coefficients import SVD_BAND, _surely_in_svd_band
+
+    k = 200_000
+    Q = np.stack([_rotation(np.random.default_rng(s)) for s in range(64)])[rng.integers(0, 64, k)]
+    ratio_2 = np.exp(rng.uniform(np.log(1e-8), np.log(1e-2), k))
+    ratio_2[:20_000] = 1e-3 * (1 + rng.uniform(-3e-4, 3e-4, 20_000))       # at the band's top
+    ratio_2[20_000:40_000] = 1e-7 * np.exp(rng.uniform(-2, 2, 20_000))     # and its bottom
+    ratio_3 = ratio_2 * np.exp(rng.uniform(np.log(1e-6), 0, k))
+    sigma = np.c_[np.ones(k), ratio_2, ratio_3] * np.exp(rng.uniform(-20, 20, k))[:, None]
+    G = np.einsum("kab,kb,kcb->kac", Q, sigma ** 2, Q)
+    c00 = G[:, 1, 1] * G[:, 2, 2] - G[:, 1, 2] ** 2
+    c11 = G[:, 0, 0] * G[:, 2, 2] - G[:, 0, 2] ** 2
+    c22 = G[:, 0, 0] * G[:, 1, 1] - G[:, 0, 1] ** 2
+    sure = _surely_in_svd_band(c00, c11, c22, G[:, 0, 0] + G[:, 1, 1] + G[:, 2, 2])
+    s = np.sqrt(np.maximum(np.linalg.eigvalsh(G), 0.0))
+    in_band = ((s[:, :2] / s[:, 2:] > SVD_BAND[0]) & (s[:, :2] / s[:, 2:] < SVD_BAND[1])).any(axis=1)
+    assert not np.any(sure & ~in_band)
+    # inside, sigma_2 / sigma_1 in (1.5e-6, 7e-4) (q in [r^2, 2 r^2] within (2e-12, 1e-6)): all taken
+    inner = (ratio_2 > 1.5e-6) & (ratio_2 < 7e-4)
+    assert sure[inner].all() and inner.sum() > 50_000

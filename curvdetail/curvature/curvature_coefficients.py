@@ -36,7 +36,9 @@ class CoefficientInfo:
     scale : (n,) float array         the reference ``s_i`` of the relative threshold
     rcond : float                    the threshold used
     ring : (n,) int array            the ring each vertex's coefficients span: 1 (the one-ring)
-                                     but where the one-ring could not represent the detail
+                                     but where the one-ring could not represent the detail (a
+                                     ring that stopped growing counts once: the narrowest ring
+                                     with the row's pattern)
     widened_vertices : (w,) int array   the vertices with ``ring > 1``, increasing
     """
 
@@ -81,7 +83,7 @@ def curvature_coefficients(V, F, *, rcond=DEFAULT_RCOND, max_ring=DEFAULT_MAX_RI
     Where a singular value lies between ~1e-7 and 1e-3 of the largest (near the threshold, or
     kept with a large weight), ``G_i``'s eigenvalues do not give it accurately (they carry
     ~1e-16 of the largest): those rings are pseudo-inverted through a batched SVD of the ring
-    matrix ``D_N`` itself (zero-padded to the largest ring).
+    matrix ``D_N`` itself (batched by ring size).
 
     Widening: where the detail does not lie in that span (the residual
     ``|D_i - sum_j C_ij D_j|`` is above ``rcond * s_i``: a valence-2 corner of a grid, whose two
@@ -90,7 +92,9 @@ def curvature_coefficients(V, F, *, rcond=DEFAULT_RCOND, max_ring=DEFAULT_MAX_RI
     editor's result then moved by up to 16 diagonals under a uniform scale of all constraints
     (terrainA_10k, two such corners). Those rows take the minimum-norm coefficients over the
     vertex's two-ring instead (without the vertex), then its three-ring, up to ``max_ring``;
-    ``max_ring=1`` keeps the one-ring everywhere (the paper's relations). The decision depends
+    ``max_ring=1`` keeps the one-ring everywhere (the paper's relations). A ring that stops
+    growing (it holds the vertex's whole connected piece already) is not widened further: the
+    row keeps that ring's fit, and ``info.ring`` reports that ring. The decision depends
     only on ratios, so it too is invariant.
 
     Parameters
@@ -140,9 +144,9 @@ def curvature_coefficients(V, F, *, rcond=DEFAULT_RCOND, max_ring=DEFAULT_MAX_RI
     n = V.shape[0]
     D = laplacian_product(L, V)
     A = _mixed_voronoi_area_unchecked(V, F)
-    rows, cols = _one_ring_pairs(F, n)
+    rows, cols, indptr = _one_ring_of_laplacian(L, F)
     C, rank, scale, ring = _coefficients(D, A, rows, cols, n, rcond, centroid_diameter(V),
-                                         want_scale=return_info, max_ring=max_ring)
+                                         want_scale=return_info, max_ring=max_ring, indptr=indptr)
     if not return_info:
         return C
     residual = np.linalg.norm(D - C @ D, axis=1)
@@ -169,6 +173,22 @@ def _one_ring_pairs(F, n):
     return rows, P.indices.astype(np.int64)
 
 
+def _one_ring_of_laplacian(L, F):
+    """The one-ring pairs as :func:`_one_ring_pairs` gives them, plus their row pointers (n + 1,),
+    read off the cotangent Laplacian's pattern: it stores every mesh edge in both directions
+    (explicit zeros kept) and every diagonal entry, sorted. That saves building the pattern
+    again from the triangles (0.3-0.5 s at 1M vertices); a Laplacian not stored so (unsorted or
+    duplicate indices, a diagonal entry missing) takes the triangles' route."""
+    n = L.shape[0]
+    if L.has_canonical_format:                      # sorted, no duplicates
+        rows = np.repeat(np.arange(n), np.diff(L.indptr))
+        off = L.indices != rows
+        if np.array_equal(rows[~off], np.arange(n)):                # every diagonal entry
+            return rows[off], L.indices[off].astype(np.int64), L.indptr - np.arange(n + 1)
+    rows, cols = _one_ring_pairs(F, n)
+    return rows, cols, _row_pointers(rows, n)
+
+
 #: Gram matrices with ``det(G) > WELL_CONDITIONED * trace(G)^3`` (hence ``cond(G) < 1e6``) are
 #: inverted in closed form; the others go through the eigendecomposition.
 WELL_CONDITIONED = 1e-6
@@ -184,13 +204,23 @@ def check_rcond(rcond):
     return number
 
 
-def _coefficients(D, A, rows, cols, n, rcond, size, *, want_scale=False, max_ring=1, adjacency=None):
+#: A ring goes through the SVD of its ring matrix where one of its singular value ratios
+#: ``sigma_k / sigma_1`` (from ``G_i``'s eigenvalues) lies in this band (see :func:`_coefficients`).
+SVD_BAND = (1e-7, 1e-3)
+
+
+def _coefficients(D, A, rows, cols, n, rcond, size, *, want_scale=False, max_ring=1, adjacency=None,
+                  indptr=None):
     """Batched truncated pseudo-inverse solve over the pattern (rows, cols), sorted by row.
 
     Rows whose fit leaves a residual above the threshold are widened by one ring of ``adjacency``
-    (the one-ring pairs; default (rows, cols)) at a time, ``max_ring - 1`` times at most.
+    (the one-ring pairs, sorted by row; default (rows, cols)) at a time, ``max_ring - 1`` times
+    at most, and no further once a widening adds no vertex (a whole small component, a vertex
+    without neighbours). ``indptr``: the pattern's row pointers where the caller has them.
     Returns (C, rank, scale or None, ring): ``C`` on the (widened) pattern, explicit zeros kept;
-    ``ring`` (n,) the number of rings each row spans (1 = the given pattern)."""
+    ``ring`` (n,) the number of rings each row's coefficients span (1 = the given pattern)."""
+    if indptr is None:
+        indptr = _row_pointers(rows, n)
     Dj = D[cols]
     # the 6 distinct entries of G_i = sum_j D_j D_j^T
     g = {}
@@ -214,90 +244,193 @@ def _coefficients(D, A, rows, cols, n, rcond, size, *, want_scale=False, max_rin
         # clears the threshold; cond(G) <= tr^3 / det keeps the adjugate accurate
         good = (det > WELL_CONDITIONED * tr ** 3) & \
                (np.sqrt(np.maximum(det, 0.0)) / tr > rcond * np.maximum(np.sqrt(tr), area_scale))
-    w = np.zeros((n, 3))
-    dg = det[good]
-    d0, d1, d2 = D[good, 0], D[good, 1], D[good, 2]
-    w[good, 0] = (c00[good] * d0 + c01[good] * d1 + c02[good] * d2) / dg
-    w[good, 1] = (c01[good] * d0 + c11[good] * d1 + c12[good] * d2) / dg
-    w[good, 2] = (c02[good] * d0 + c12[good] * d1 + c22[good] * d2) / dg
+        # on every row (the same operations as on the good rows alone); the others are
+        # overwritten below
+        d0, d1, d2 = D[:, 0], D[:, 1], D[:, 2]
+        w = np.stack([(c00 * d0 + c01 * d1 + c02 * d2) / det,
+                      (c01 * d0 + c11 * d1 + c12 * d2) / det,
+                      (c02 * d0 + c12 * d1 + c22 * d2) / det], axis=1)
     rank = np.full(n, 3, dtype=np.int64)
     scale = None
     if want_scale:
-        # sigma_1 of the well-conditioned rows: the largest eigenvalue of G is accurate
-        G = np.empty((n, 3, 3))
-        for a in range(3):
-            for b in range(a, 3):
-                G[:, a, b] = G[:, b, a] = g[a, b]
-        scale = np.maximum(np.sqrt(np.maximum(np.linalg.eigvalsh(G)[:, 2], 0.0)), area_scale)
+        # sigma_1 of the well-conditioned rows: the largest eigenvalue of G is accurate (the
+        # other rows take theirs from their fit below)
+        scale = area_scale.copy()
+        scale[good] = np.maximum(np.sqrt(np.maximum(np.linalg.eigvalsh(_gram(g, good))[:, 2], 0.0)),
+                                 area_scale[good])
     ring = np.ones(n, dtype=np.int64)
     hard = np.flatnonzero(~good)
     if hard.size:
-        G = np.empty((hard.size, 3, 3))
-        for a in range(3):
-            for b in range(a, 3):
-                G[:, a, b] = G[:, b, a] = g[a, b][hard]
-        lam, U = np.linalg.eigh(G)                  # ascending eigenvalues
-        sigma = np.sqrt(np.maximum(lam, 0.0))
-        w[hard], rank[hard], s_hard, residual = _fit(D[hard], U, sigma, area_scale[hard], rcond)
+        s_hard, residual = np.empty(hard.size), np.empty(hard.size)
         # G's eigenvalues carry ~1e-16 of the largest, so a singular value between ~1e-7 and
         # 1e-3 of the largest (near the threshold, or kept with a large weight 1 / sigma^2) is
         # known only to 1e-10 ... 1e-2 of itself: those rows (fandisk: 46 of them changed by up to
-        # 5e-5 under a rotation) go through the SVD of the ring matrix itself
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ratio = sigma[:, :2] / sigma[:, 2:]
-        redo = np.flatnonzero(((ratio > 1e-7) & (ratio < 1e-3)).any(axis=1))
+        # 5e-5 under a rotation) go through the SVD of the ring matrix itself. Rows certain to
+        # go there skip the eigendecomposition (a smooth surface's rings: nearly all of them)
+        sure = _surely_in_svd_band(c00[hard], c11[hard], c22[hard], tr[hard])
+        redo = sure.copy()
+        # G = 0 (every neighbour's detail is 0: a flat grid's inside) has no singular direction
+        # to keep: w = 0 and rank 0, as its eigendecomposition would give them, without it
+        zero = tr[hard] == 0.0
+        w[hard[zero]], rank[hard[zero]], s_hard[zero] = 0.0, 0, area_scale[hard[zero]]
+        residual[zero] = np.linalg.norm(D[hard[zero]], axis=1)
+        probe = np.flatnonzero(~sure & ~zero)
+        if probe.size:
+            lam, U = np.linalg.eigh(_gram(g, hard[probe]))          # ascending eigenvalues
+            sigma = np.sqrt(np.maximum(lam, 0.0))
+            w[hard[probe]], rank[hard[probe]], s_hard[probe], residual[probe] = _fit(
+                D[hard[probe]], U, sigma, area_scale[hard[probe]], rcond)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                ratio = sigma[:, :2] / sigma[:, 2:]
+            redo[probe] = ((ratio > SVD_BAND[0]) & (ratio < SVD_BAND[1])).any(axis=1)
+        redo = np.flatnonzero(redo)
         if redo.size:
-            indptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=n))])
-            pick = _rows_of(indptr, hard[redo])
-            w[hard[redo]], rank[hard[redo]], s_hard[redo], residual[redo] = _truncated_fit(
-                D, A, hard[redo], rows[pick], cols[pick], rcond, size)
+            rows_redo = hard[redo]
+            if rows_redo.size > n // 8:           # most rows (a smooth surface): one pass of masks
+                which = np.zeros(n, dtype=bool)
+                which[rows_redo] = True
+                cols_redo = cols[which[rows]]
+            else:
+                cols_redo = cols[_rows_of(indptr, rows_redo)]
+            w[rows_redo], rank[rows_redo], s_hard[redo], residual[redo] = _truncated_fit(
+                D, A, rows_redo, indptr[rows_redo + 1] - indptr[rows_redo], cols_redo, rcond, size,
+                area_scale=area_scale[rows_redo])
         if want_scale:
             scale[hard] = s_hard
         # widen the rings that cannot represent their own detail (a valence-2 corner's two
         # neighbours span a plane its detail leaves): the residual would otherwise be a constant
         # that no similarity of the constraints moves (see CurvatureEditor)
         grow = residual > rcond * s_hard
-        wide_rows, wide_cols = [], []
         if max_ring > 1 and grow.any():
-            ar, ac = adjacency if adjacency is not None else (rows, cols)
-            P = sp.csr_matrix((np.ones(ar.size, dtype=np.float32), (ar, ac)), shape=(n, n))
-            target = hard[grow]
-            R = sp.csr_matrix((np.ones(rows.size, dtype=np.float32), (rows, cols)), shape=(n, n))[target]
-            for extra in range(1, max_ring):
-                R = R + R @ P
-                R = R.tocoo()
-                r, c = target[R.row], R.col.astype(np.int64)
-                keep = r != c
-                R = sp.csr_matrix((np.ones(int(keep.sum()), dtype=np.float32), (R.row[keep], c[keep])),
-                                  shape=(target.size, n))
-                R.sort_indices()
-                r = target[np.repeat(np.arange(target.size), np.diff(R.indptr))]
-                c = R.indices.astype(np.int64)
-                w_t, rank_t, s_t, residual_t = _truncated_fit(D, A, target, r, c, rcond, size)
-                # a wider ring never fits worse: take it (its pattern replaces the narrower one)
-                w[target], rank[target], ring[target] = w_t, rank_t, extra + 1
-                if want_scale:
-                    scale[target] = s_t
-                still = residual_t > rcond * s_t
-                if extra == max_ring - 1 or not still.any():   # every row's widest fit is final
-                    wide_rows.append(r)
-                    wide_cols.append(c)
-                    break
-                done = ~still[np.searchsorted(target, r)]
-                wide_rows.append(r[done])
-                wide_cols.append(c[done])
-                target = target[still]
-                R = R[still]
-        if wide_rows:
-            narrow = ring[rows] == 1
-            rows = np.concatenate([rows[narrow]] + wide_rows)
-            cols = np.concatenate([cols[narrow]] + wide_cols)
-            Dj = D[cols]
+            wide = _widen(D, A, w, rank, scale, ring, hard[grow], rows, cols, indptr, n, rcond, size,
+                          max_ring, adjacency)
+            if wide is not None:
+                wide_rows, wide_cols = wide
+                wide_vals = np.einsum("ea,ea->e", D[wide_cols], w[wide_rows])
+                # the given pattern's entries of widened rows are left out below (their w is the
+                # wide ring's)
+                vals = np.einsum("ea,ea->e", Dj, w[rows])
+                return _splice(indptr, rows, cols, vals, ring > 1, wide_rows, wide_cols, wide_vals,
+                               n), rank, scale, ring
     # C_ij = D_j . w_i  (w_i = G_i^+ D_i)
     vals = np.einsum("ea,ea->e", Dj, w[rows])
-    C = sp.csr_matrix((vals, (rows, cols)), shape=(n, n))
-    C.sort_indices()
-    return C, rank, scale, ring
+    return sp.csr_matrix((vals, cols, indptr), shape=(n, n)), rank, scale, ring
+
+
+def _splice(indptr, rows, cols, vals, replaced, wide_rows, wide_cols, wide_vals, n):
+    """CSR (n, n) of the row-sorted pattern (``indptr``, ``rows``, ``cols``) and its ``vals``, with
+    the rows ``replaced`` (n,) bool taking the entries (``wide_rows``, ``wide_cols``,
+    ``wide_vals``) instead: each such row's entries are contiguous there, columns increasing.
+    Placed by position (no sort of the whole pattern, which a COO build would do)."""
+    order = np.argsort(wide_rows, kind="stable")
+    wide_cols, wide_vals = wide_cols[order], wide_vals[order]
+    new_counts = np.where(replaced, np.bincount(wide_rows, minlength=n), np.diff(indptr))
+    new_indptr = _cumulative(new_counts)
+    out_cols = np.empty(int(new_indptr[-1]), dtype=cols.dtype)
+    out_vals = np.empty(int(new_indptr[-1]))
+    kept = np.flatnonzero(~replaced[rows])
+    # a kept row's entries keep their order; the row moves by the change of its start
+    dest = kept + (new_indptr[:-1] - indptr[:-1])[rows[kept]]
+    out_cols[dest], out_vals[dest] = cols[kept], vals[kept]
+    dest = np.flatnonzero(np.repeat(replaced, new_counts))
+    out_cols[dest], out_vals[dest] = wide_cols, wide_vals
+    return sp.csr_matrix((out_vals, out_cols, new_indptr), shape=(n, n))
+
+
+def _surely_in_svd_band(c00, c11, c22, tr):
+    """Rows whose Gram matrix ``G`` certainly has ``sigma_2 / sigma_1`` inside :data:`SVD_BAND`
+    as ``G``'s eigenvalues give it, told from its invariants alone (no eigendecomposition: 1.4 s
+    at 1M vertices); (k,) bool. ``c00, c11, c22`` (k,): the diagonal cofactors, ``tr`` the trace.
+
+    With ``S = lambda_2 + lambda_3`` and ``q = (c00 + c11 + c22) / tr^2 = (lambda_1 S +
+    lambda_2 lambda_3) / tr^2``, ``lambda_2 / lambda_1`` lies in ``[q / 2, q]`` up to ``O(q^2)``
+    and roundoff (~1e-13 even at valence 1000, where the summed ``G`` may be indefinite by that
+    much; an eigensolver's eigenvalues are off by ~1e-15 of ``lambda_1``). The band kept here
+    leaves a margin of 1e-4 of the limit at the top and a factor 100 at the bottom; rows outside
+    it (non-finite ``q`` included) are decided by their eigenvalues."""
+    low, high = SVD_BAND
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        q = (c00 + c11 + c22) / tr ** 2
+        return (q > 200.0 * low ** 2) & (q < (1.0 - 1e-4) * high ** 2)
+
+
+def _widen(D, A, w, rank, scale, ring, target, rows, cols, indptr, n, rcond, size, max_ring, adjacency):
+    """Refit the rows ``target`` (increasing) over wider rings until their detail is represented,
+    the ring stops growing or ``max_ring`` is reached. Updates ``w``, ``rank``, ``scale`` (where
+    not None) and ``ring`` in place; returns the widened rows' pattern ``(rows, cols)`` (each row's
+    columns increasing), or None where no row took a wider ring."""
+    if adjacency is None:
+        P = sp.csr_matrix((np.ones(cols.size, dtype=bool), cols, indptr), shape=(n, n))
+    else:
+        ar, ac = adjacency
+        P = sp.csr_matrix((np.ones(ac.size, dtype=bool), ac, _row_pointers(ar, n)), shape=(n, n))
+    # the rows' current rings (without the vertex itself) as CSR pieces over ``target``
+    counts = indptr[target + 1] - indptr[target]
+    ring_cols = cols[_rows_of(indptr, target)]
+    wide_rows, wide_cols = [], []
+    for extra in range(1, max_ring):
+        R = sp.csr_matrix((np.ones(ring_cols.size, dtype=bool), ring_cols, _cumulative(counts)),
+                          shape=(target.size, n))
+        R = R + R @ P
+        R.sort_indices()
+        at = np.repeat(np.arange(target.size), np.diff(R.indptr))
+        keep = R.indices != target[at]
+        new_counts = np.bincount(at[keep], minlength=target.size)
+        new_cols = R.indices[keep].astype(np.int64)
+        # a ring that adds no vertex (the row's whole component already) keeps its narrower fit
+        grew = new_counts > counts
+        if extra > 1 and not grew.all():
+            stuck = np.flatnonzero(~grew)
+            wide_rows.append(np.repeat(target[stuck], counts[stuck]))
+            wide_cols.append(ring_cols[_rows_of(_cumulative(counts), stuck)])
+        if not grew.any():
+            break
+        if not grew.all():
+            moved = np.flatnonzero(grew)
+            new_cols = new_cols[_rows_of(_cumulative(new_counts), moved)]
+            target, new_counts = target[moved], new_counts[moved]
+        counts, ring_cols = new_counts, new_cols
+        w_t, rank_t, s_t, residual_t = _truncated_fit(D, A, target, counts, ring_cols, rcond, size)
+        # a wider ring never fits worse: take it (its pattern replaces the narrower one)
+        w[target], rank[target], ring[target] = w_t, rank_t, extra + 1
+        if scale is not None:
+            scale[target] = s_t
+        still = residual_t > rcond * s_t
+        if extra == max_ring - 1 or not still.any():     # every row's widest fit is final
+            wide_rows.append(np.repeat(target, counts))
+            wide_cols.append(ring_cols)
+            break
+        done = np.flatnonzero(~still)
+        wide_rows.append(np.repeat(target[done], counts[done]))
+        wide_cols.append(ring_cols[_rows_of(_cumulative(counts), done)])
+        carry = np.flatnonzero(still)
+        ring_cols = ring_cols[_rows_of(_cumulative(counts), carry)]
+        target, counts = target[carry], counts[carry]
+    if not wide_rows:
+        return None
+    return np.concatenate(wide_rows), np.concatenate(wide_cols)
+
+
+def _gram(g, which):
+    """The Gram matrices ``G_i`` (k, 3, 3) of the rows ``which`` (an index or a mask) from their
+    six distinct entries ``g``."""
+    G = np.empty((g[0, 0][which].size, 3, 3))
+    for a in range(3):
+        for b in range(a, 3):
+            G[:, a, b] = G[:, b, a] = g[a, b][which]
+    return G
+
+
+def _cumulative(counts):
+    """Row pointers (k + 1,) from per-row counts (k,)."""
+    indptr = np.zeros(counts.size + 1, dtype=np.int64)
+    np.cumsum(counts, out=indptr[1:])
+    return indptr
+
+
+def _row_pointers(rows, n):
+    """Row pointers (n + 1,) of a pattern sorted by row."""
+    return _cumulative(np.bincount(rows, minlength=n))
 
 
 def _rows_of(indptr, which):
@@ -307,29 +440,39 @@ def _rows_of(indptr, which):
     return starts + np.arange(int(counts.sum()))
 
 
-def _truncated_fit(D, A, target, rows, cols, rcond, size):
+def _truncated_fit(D, A, target, counts, cols, rcond, size, *, area_scale=None):
     """Truncated minimum-norm fit of ``D_i`` by its ring's details for the rows ``target``
-    (increasing; ``rows``/``cols`` their pattern, sorted by row), through batched SVDs of the
-    zero-padded ring matrices. Returns (w (t, 3), rank (t,), s_i (t,), residual (t,)), where
-    ``C_ij = D_j . w_i``.
+    (``counts`` (t,) ring sizes; ``cols`` the rings' vertices, row after row), through batched
+    SVDs of the zero-padded ring matrices. Returns (w (t, 3), rank (t,), s_i (t,),
+    residual (t,)), where ``C_ij = D_j . w_i``. ``area_scale`` (t,): the rings'
+    ``sqrt(sum_j A_j^2) / size`` where the caller has it.
 
     Rings are batched by size (up to 16, larger ones padded to the next power of two), not all
     padded to the largest: one pole of valence 1024 among 100k such rings made that 5 GB and
     13 s (now 0.3 GB and 0.8 s for the whole call)."""
-    at = np.searchsorted(target, rows)
-    counts = np.bincount(at, minlength=target.size)
-    first = np.concatenate([[0], np.cumsum(counts)[:-1]])
-    slot = np.arange(rows.size) - first[at]
-    area_scale = np.sqrt(np.bincount(at, weights=A[cols] ** 2, minlength=target.size)) / max(size, np.finfo(float).tiny)
+    if area_scale is None:
+        at = np.repeat(np.arange(target.size), counts)
+        area_scale = (np.sqrt(np.bincount(at, weights=A[cols] ** 2, minlength=target.size))
+                      / max(size, np.finfo(float).tiny))
     width = np.where(counts <= 16, np.maximum(counts, 3), 1 << np.ceil(np.log2(np.maximum(counts, 1))).astype(np.int64))
+    widths = np.unique(width)
+    entry_width = np.repeat(width, counts) if widths.size > 1 else None
     sigma, U = np.zeros((target.size, 3)), np.zeros((target.size, 3, 3))
-    for w in np.unique(width):
-        group = np.flatnonzero(width == w)
-        at_group = np.full(target.size, -1, dtype=np.int64)
-        at_group[group] = np.arange(group.size)
-        entry = at_group[at] >= 0
-        M = np.zeros((group.size, int(w), 3))
-        M[at_group[at[entry]], slot[entry]] = D[cols[entry]]
+    for w in widths:
+        w = int(w)
+        if entry_width is None:                      # one batch: every row, every entry
+            group, cols_group, counts_group = slice(None), cols, counts
+        else:
+            group = np.flatnonzero(width == w)
+            cols_group, counts_group = cols[entry_width == w], counts[group]
+        size_group = counts_group.size
+        if np.all(counts_group == w):                # no padding: the ring matrices as they lie
+            M = D[cols_group].reshape(size_group, w, 3)
+        else:
+            # entry e of the group's row r goes to slot e - first(r) of that row's padded block
+            shift = np.arange(size_group) * w - _cumulative(counts_group)[:-1]
+            M = np.zeros((size_group, w, 3))
+            M.reshape(-1, 3)[np.arange(cols_group.size) + np.repeat(shift, counts_group)] = D[cols_group]
         # M = D_N^T; D_N's left singular vectors are M's right ones
         with np.errstate(over="ignore", invalid="ignore"):
             _, sigma_g, Vt = np.linalg.svd(M, full_matrices=False)      # descending
@@ -343,8 +486,8 @@ def _fit(Di, U, sigma, area_scale, rcond):
     s_ref = np.maximum(sigma.max(axis=1), area_scale)
     keep = sigma > rcond * s_ref[:, None]
     proj = np.einsum("tab,ta->tb", U, Di)                            # U^T D_i
-    inv = np.zeros_like(sigma)
-    inv[keep] = 1.0 / sigma[keep] ** 2
+    with np.errstate(divide="ignore"):
+        inv = np.where(keep, 1.0 / sigma ** 2, 0.0)
     w = np.einsum("tab,tb->ta", U, proj * inv)
     fitted = np.einsum("tab,tb->ta", U, proj * keep)
     residual = np.linalg.norm(Di - fitted, axis=1)
