@@ -99,8 +99,8 @@ def _ply_counts(path):
             words = f.readline().split()
             if not words or words[0] == b"end_header":
                 break
-            if words[0] == b"element" and len(words) == 3 and words[2].isdigit():
-                found[words[1]] = int(words[2])
+            if words[0] == b"element" and len(words) == 3 and _whole(words[2]) is not None:
+                found[words[1]] = _whole(words[2])          # "3.0" as the reader and the scan read it
     return found.get(b"vertex"), found.get(b"face")
 
 
@@ -117,6 +117,21 @@ def _stl_counts(path):
     if not head.lstrip().startswith(b"solid"):
         return None, None
     return None, _streamed_counts(path, (b"endfacet",))[0]
+
+
+def _stl_ascii_counts(path):
+    """``(facets, vertex lines)`` of an ASCII STL file (``endfacet`` and ``vertex`` words followed
+    by a blank, streamed), or ``(None, None)`` for a binary one (its header count matches its
+    size) or one that is not STL."""
+    size = os.path.getsize(path)
+    with open(path, "rb") as f:
+        head = f.read(84)
+    if len(head) == 84 and size == 84 + 50 * int(np.frombuffer(head[80:84], dtype="<u4")[0]):
+        return None, None
+    if not head.lstrip().startswith(b"solid"):
+        return None, None
+    facets, spaced, tabbed = _streamed_counts(path, (b"endfacet", b"vertex ", b"vertex\t"))
+    return facets, spaced + tabbed
 
 
 _COUNTS = {".obj": _obj_counts, ".off": _off_counts, ".ply": _ply_counts, ".stl": _stl_counts}

@@ -25,7 +25,7 @@ import re
 import numpy as np
 
 from ._ctm_scan import ctm_problem
-from ._file_counts import _off_header, _whole
+from ._file_counts import _obj_counts, _off_header, _stl_ascii_counts, _whole
 from ._ply_scan import _ply_problem
 
 
@@ -70,21 +70,56 @@ def check_before_loading(path, error=ValueError):
     crashed the process), a file shorter than its sections (RAW: the rest was read from whatever
     memory held), and counts whose arrays OpenCTM sizes past 32 bits.
 
-    Other files pass unread. Returns the number of triangles an ASCII PLY file's faces make (a
-    polygon of k vertices k - 2; pymeshlab drops faces with a repeated index or the 'deleted'
-    flag bit, which the caller finds by comparing), else None."""
+    OBJ also (:func:`_obj_face_indices`): face vertex indices outside the file (0, past the last
+    ``v`` line, or negative past the vertices above the face; the loader wrote out of bounds or
+    read another vertex), corners that are no whole number and faces of fewer than 3 corners;
+    a UTF-8 byte order mark (the first line was lost; PLY: "damaged") and a carriage return no
+    newline follows (the lines it ends were lost). ASCII STL: facets of other than 3 ``vertex``
+    lines (the 4th was dropped). OFF: faces of fewer than 3 vertices (dropped). Binary PLY
+    (:func:`curvdetail._ply_scan._ply_binary_problem`): big-endian doubles in the vertex element
+    (read as garbage), a body shorter than the header's counts allow, and lists other than the
+    face indices that the reader cannot skip (vertex lists counted in other than (u)char; more
+    than 512 bytes of items in a row, which aborted the process).
+
+    Other files pass unread. Returns the number of triangles the faces of an ASCII PLY, ASCII
+    OFF or OBJ file make (a polygon of k vertices k - 2; pymeshlab drops triangles with a
+    repeated index, PLY faces with the 'deleted' flag bit, OBJ faces with texture indices out of
+    range, which the caller finds by comparing), else None."""
     extension = os.path.splitext(os.fspath(path))[1].lower()
     if extension in (".off", ".ply", ".obj") and _carriage_returns_only(path):
         raise error(f"{path!r} ends its lines with carriage returns alone (classic Mac OS), which pymeshlab "
                     "reads as one long line (it failed, or read a single vertex); convert the line ends to "
                     "newlines (e.g. tr '\\r' '\\n' < old > new) and read the file again.")
+    if extension in (".ply", ".obj") and _starts_with_bom(path):
+        raise error(f"{path!r} starts with a UTF-8 byte order mark (the bytes EF BB BF, which some editors "
+                    "write), which pymeshlab's " + ("PLY reader takes for a damaged header" if extension == ".ply"
+                                                   else "OBJ loader reads as part of the first line's keyword "
+                                                   "(that line, a vertex, was lost without a word)") +
+                    "; save the file as UTF-8 without a byte order mark (or ASCII) and read it again.")
+    if extension == ".obj":
+        lone = _obj_lone_carriage_return(path)
+        if lone is not None:
+            raise error(f"{path!r}: line {lone} ends in a carriage return not followed by a newline (a classic "
+                        "Mac OS line end among Unix or Windows ones), which pymeshlab's OBJ loader does not "
+                        "take for a line end: the lines it ends were read as one, and lost without a word; "
+                        "convert the line ends to newlines (e.g. tr '\\r' '\\n' < old > new, or dos2unix) and "
+                        "read the file again.")
+    if extension == ".stl":
+        facets, vertex_lines = _stl_ascii_counts(path)
+        if facets is not None and vertex_lines != 3 * facets:
+            raise error(f"{path!r} is an ASCII STL file of {facets} facets with {vertex_lines} vertex lines, not "
+                        f"3 a facet ({3 * facets}): pymeshlab's STL loader reads each facet as the triangle of "
+                        "its first 3 and drops the others without a word (a facet of 4 was read as one "
+                        "triangle); split such facets into triangles and read the file again.")
     if extension == ".off":
         if _off_is_binary(path):
             raise error(f"{path!r} is a binary OFF file ('OFF BINARY'), which pymeshlab's OFF reader "
                         "does not read; save it as ASCII OFF, PLY or OBJ and read that.")
-        problem = _off_rows_problem(path)
+        made = []
+        problem = _off_rows_problem(path, made)
         if problem:
             raise error(f"{path!r}: {problem}; fix the file and read it again.")
+        return made[0] if made else None
     elif extension == ".ctm":
         problem = ctm_problem(path)
         if problem:
@@ -125,6 +160,34 @@ def check_before_loading(path, error=ValueError):
                         "loader reads as further corners (a vertex index past the file's vertices, which "
                         "can crash the process); move the comment to a line of its own and read the file "
                         "again.")
+        problem, triangles = _obj_face_indices(path)
+        if problem:
+            raise error(f"{path!r}: {problem}.")
+        return triangles
+
+
+def _starts_with_bom(path):
+    """Whether the file starts with the UTF-8 byte order mark (EF BB BF)."""
+    with open(path, "rb") as f:
+        return f.read(3) == b"\xef\xbb\xbf"
+
+
+def _obj_lone_carriage_return(path):
+    """The 1-based line of the first carriage return in the file that no newline follows (but
+    for one as the file's last byte, which ends its last line), or None. Vectorized over the
+    bytes of a memory map."""
+    with _mapped(path) as data:
+        if data is None or data.find(b"\r") < 0:
+            return None
+        chars = np.frombuffer(data, dtype=np.uint8)
+        try:
+            returns = np.flatnonzero(chars[:-1] == 13)
+            lone = returns[chars[returns + 1] != 10]
+            if not lone.size:
+                return None
+            return int(np.count_nonzero(chars[:lone[0]] == 10)) + 1
+        finally:
+            del chars
 
 
 def _off_is_binary(path):
@@ -660,7 +723,7 @@ def _off_bad_coordinate_in(chars, low, region, at, kind, failed, token_starts, t
     return None
 
 
-def _off_rows_problem(path):
+def _off_rows_problem(path, made=None):
     """What is wrong with the rows of an ASCII OFF file, or None (also where it cannot tell: the
     loader and :func:`check_loaded` then judge): counts in the header that are not whole numbers,
     lines of blanks only among the rows, comments among the vertex values, vertex rows pymeshlab
@@ -676,7 +739,8 @@ def _off_rows_problem(path):
     Vectorized over the bytes (~1 s for a million vertices, against ~4.5 s for pymeshlab's own
     read): a face line whose index tokens are all unsigned digits, shorter than the vertex
     count's digits (or as long and below it), holds no index out of range, so only the other
-    lines (normally none) are parsed one by one."""
+    lines (normally none) are parsed one by one. Where nothing is wrong and ``made`` is a list,
+    the number of triangles the faces make (a polygon of k vertices k - 2) is appended to it."""
     with open(path, "rb") as f:
         data = f.read()
     header = _off_header(io.BytesIO(data))
@@ -816,12 +880,20 @@ def _off_rows_problem(path):
             return (f"face {face} is the row {text(faces[face])!r}, which is not a vertex count followed "
                     "by that many integer vertex indices (whole numbers: pymeshlab's reader takes 2.5 "
                     "as 2)")
+        k[face] = count
         if min(index) < 0 or max(index) >= nv:
             bad.append((face, index))
-    if not bad:
-        return None
-    return (f"{len(bad)} faces use vertex indices outside the file's {nv} vertices "
-            f"(first: face {bad[0][0]}, {bad[0][1]})")
+    if bad:
+        return (f"{len(bad)} faces use vertex indices outside the file's {nv} vertices "
+                f"(first: face {bad[0][0]}, {bad[0][1]})")
+    few = np.flatnonzero(k < 3)
+    if few.size:
+        return (f"face {few[0]} is the row {text(faces[few[0]])!r}, of {k[few[0]]} vertices, which pymeshlab's OFF "
+                f"reader drops without a word ({few.size} such faces); a face needs 3 or more vertices: fix or "
+                "remove it and the header's face count")
+    if made is not None:
+        made.append(int((k - 2).sum()))
+    return None
 
 
 def _off_comma(body, chars, visible, starts, rows, first_line):
@@ -938,3 +1010,171 @@ def _maybe_out_of_range(chars, starts, ends, nv):
         value = value * 10 + digit
     suspect[same[~digit_only | (value >= nv)]] = True
     return suspect
+
+
+#: Bytes at which pymeshlab's OBJ loader splits a line into words: space, tab, carriage return
+#: (and the newline that ends the line).
+_OBJ_SEPARATOR = np.zeros(256, dtype=bool)
+_OBJ_SEPARATOR[[9, 10, 13, 32]] = True
+#: Bytes that end a corner's vertex index: the separators, "/" (texture and normal indices
+#: follow) and "#" (a comment glued to the last corner: atoi stops there).
+_OBJ_INDEX_END = _OBJ_SEPARATOR.copy()
+_OBJ_INDEX_END[[35, 47]] = True
+_OBJ_WHOLE_INDEX = re.compile(rb"[+-]?[0-9]+(?:\.0*)?")
+
+
+def _obj_face_indices(path, size=1 << 20):
+    """``(problem, triangles)`` for the faces of an OBJ file: the message for the first face
+    whose vertex index pymeshlab's loader would read as another vertex or write out of bounds
+    with, or a face of fewer than 3 corners (dropped without a word), else None; and the number
+    of triangles the faces make (a polygon of k corners k - 2).
+
+    A corner's vertex index is its word up to the first ``/`` or ``#``. Positive indices count
+    from 1 to the file's number of ``v`` lines; negative ones back from the vertex before the
+    face (-1 is the last ``v`` line above it). pymeshlab reads the index with atoi and without a
+    range check: 0 or one past the last vertex wrote out of bounds (the process crashed at exit),
+    -9 with 5 vertices and 4294967299 (2**32 + 3) named real vertices. A face line is one whose
+    first word is ``f`` (pymeshlab reads indented ones too). Vectorized over the bytes in pieces
+    of about ``size`` bytes (whole lines), each copied out of a memory map (~0.7 s for a million
+    vertices, against ~2 s for pymeshlab's read); only words that are not plain digits are
+    looked at one by one."""
+    triangles = 0
+    vertices_before = 0                            # v lines before the piece
+    lines_before = 0
+    highest = []                                   # per piece: (largest index, its start, v lines, lines before)
+    with _mapped(path) as data:
+        if data is None:
+            return None, None
+        low = 0
+        while low < len(data):
+            high = min(low + size, len(data))
+            if high < len(data):
+                cut = data.rfind(b"\n", low, high)
+                high = cut + 1 if cut >= 0 else (data.find(b"\n", high) + 1 or len(data))
+                while high < len(data) and (data[high - 2:high] == b"\\\n" or data[high - 3:high] == b"\\\r\n"):
+                    high = data.find(b"\n", high) + 1 or len(data)   # a continued line stays whole
+            piece = data[low:high]
+            problem, made, vertex_lines, lines, largest = _obj_face_indices_in(
+                _joined(piece), None, vertices_before, lines_before)
+            if problem:
+                return problem, None
+            triangles += made
+            highest.append((largest, low, high, vertices_before, lines_before))
+            vertices_before += vertex_lines
+            lines_before += lines
+            low = high
+        # positive indices are checked against the file's count once it is known: the first piece
+        # with one past it is looked at again
+        for largest, low, high, before, lines in highest:
+            if largest > vertices_before:
+                return _obj_face_indices_in(_joined(data[low:high]), vertices_before, before, lines)[0], None
+    return None, triangles
+
+
+def _joined(piece):
+    """``piece`` with lines continued by a backslash joined to the next, as pymeshlab's OBJ loader
+    reads them (only face lines get here continued: others are refused before); the line numbers
+    after such a line are then a line short per join."""
+    if b"\\\n" not in piece and b"\\\r\n" not in piece:
+        return piece
+    return piece.replace(b"\\\r\n", b" ").replace(b"\\\n", b" ")
+
+
+def _obj_face_indices_in(piece, total, vertices_before, lines_before):
+    """:func:`_obj_face_indices` on ``piece`` (bytes, whole lines), with ``vertices_before`` v
+    lines and ``lines_before`` lines before the piece; positive indices are checked against
+    ``total`` vertices (None: not checked). Returns ``(problem, triangles, v lines, lines,
+    largest index)`` of the piece."""
+    if not piece.endswith(b"\n"):
+        piece += b"\n"
+    chars = np.frombuffer(piece, dtype=np.uint8)
+    newlines = np.flatnonzero(chars == 10)
+    starts = np.concatenate([[0], newlines[:-1] + 1])
+    lead = chars[starts]
+    second = chars[np.minimum(starts + 1, chars.size - 1)]
+    vertex_line = (lead == 118) & ((second == 32) | (second == 9))
+    vertex_lines = int(np.count_nonzero(vertex_line))
+    if b"f" not in piece:                          # no face line
+        return None, 0, vertex_lines, newlines.size, 0
+    # words: runs of bytes above 32 (pymeshlab splits at spaces, tabs and carriage returns; other
+    # control bytes end a word here, which at worst refuses a file it reads)
+    separator = chars <= 32
+    begins = ~separator
+    begins[1:] &= separator[:-1]
+    word_starts = np.flatnonzero(begins)
+    per_line = np.add.reduceat(begins.view(np.uint8), starts, dtype=np.int64)
+    word_line = np.repeat(np.arange(starts.size), per_line)
+    first_word = np.cumsum(per_line) - per_line                # each line's first word, where it has one
+    at = word_starts[np.minimum(first_word, word_starts.size - 1)]
+    face_line = (per_line > 0) & (chars[at] == 102) & separator[np.minimum(at + 1, chars.size - 1)]
+    if not face_line.any():
+        return None, 0, vertex_lines, newlines.size, 0
+    corner = face_line[word_line]
+    corner[first_word[face_line]] = False                      # the "f" itself
+    corners = word_starts[corner]
+    corner_line = word_line[corner]
+    faces = np.flatnonzero(face_line)
+    per_face = per_line[faces] - 1
+    ending = separator[1:] & ~separator[:-1]
+    ends = np.flatnonzero(np.append(ending, ~separator[-1]))[corner] + 1    # the words' ends
+    if b"/" in piece or b"#" in piece:                         # the vertex index ends at the first "/" or "#"
+        stops = np.flatnonzero((chars == 47) | (chars == 35))
+        word_of = np.cumsum(begins, dtype=np.int32)[stops] - 1
+        first = np.append(True, word_of[1:] != word_of[:-1])
+        stops, word_of = stops[first], word_of[first]
+        where = np.searchsorted(np.flatnonzero(corner), word_of)
+        hit = where < corners.size
+        hit[hit] = np.flatnonzero(corner)[where[hit]] == word_of[hit]
+        ends[where[hit]] = stops[hit]
+
+    def shown(line):
+        text = piece[starts[line]:newlines[line]].decode("utf-8", "replace").strip()
+        return f"line {lines_before + line + 1} ({text if len(text) <= 80 else text[:77] + '...'!r})"
+
+    signed = (chars[corners] == 45) | (chars[corners] == 43)
+    digits = ends - corners - signed
+    plain = (digits > 0) & (digits <= 18)
+    # bytes other than digits within an index (a sign after its first byte, ".", letters): few or none
+    other = ((chars - np.uint8(48)) > 9) & ~separator & (chars != 47) & (chars != 35)
+    other[at[face_line]] = False                               # the "f"s
+    other = np.flatnonzero(other)
+    if other.size:
+        owner = np.searchsorted(corners, other, side="right") - 1
+        inside = (owner >= 0) & (other < ends[np.maximum(owner, 0)])
+        inside &= (other != corners[np.maximum(owner, 0)]) | ~signed[np.maximum(owner, 0)]
+        plain[owner[inside]] = False
+    values = np.zeros(corners.size, dtype=np.int64)
+    for j in range(int(digits[plain].max(initial=0))):
+        digit = chars[np.maximum(ends - 1 - j, 0)].astype(np.int64) - 48
+        values += np.where(plain & (digits > j), digit * 10 ** j, 0)
+    for k in np.flatnonzero(~plain).tolist():                  # normally none: "2.0", "x", "", long
+        word = piece[corners[k]:ends[k]]
+        if not _OBJ_WHOLE_INDEX.fullmatch(word):
+            what = "no vertex index" if not word else f"the vertex index {word.decode('utf-8', 'replace')!r}"
+            return (f"{shown(corner_line[k])} has {what}, which pymeshlab's OBJ loader reads with atoi (up to the "
+                    "first character not a digit; nothing as 0, which names no vertex and was written out of "
+                    "bounds); write each corner as a whole vertex index (optionally /texture/normal indices)"
+                    ), 0, 0, 0, 0
+        number = int(word.split(b".", 1)[0].lstrip(b"+-"))
+        values[k] = number if number < 10 ** 18 else 10 ** 18
+    values[chars[corners] == 45] *= -1
+    before = vertices_before + np.cumsum(vertex_line) - vertex_line    # v lines above each line
+    outside = (values == 0) | (values < -before[corner_line])
+    if total is not None:
+        outside |= values > total
+    if outside.any():
+        k = int(np.flatnonzero(outside)[0])
+        above = int(before[corner_line[k]])
+        count = f"{total} v lines in all, {above} above the face" if total is not None else \
+            f"{above} v lines above the face"
+        return (f"{shown(corner_line[k])} names the vertex {int(values[k])}, which the file does not have "
+                f"({count}): pymeshlab's OBJ loader reads such an "
+                "index as another vertex or writes out of bounds with it (which can crash the process later); "
+                "OBJ vertex indices run from 1 to the number of v lines, or from -1 back over the vertices above "
+                "the face. Fix the face and read the file again"), 0, 0, 0, 0
+    few = np.flatnonzero(per_face < 3)
+    if few.size:
+        return (f"{shown(faces[few[0]])} is a face of {per_face[few[0]]} corners, which pymeshlab's OBJ loader "
+                f"drops without a word ({few.size} such faces here); a face needs 3 or more vertices (an edge is "
+                "an 'l' line): fix or remove it and read the file again"), 0, 0, 0, 0
+    return None, int((per_face - 2).sum()), vertex_lines, newlines.size, int(values.max(initial=0))

@@ -17,6 +17,12 @@ outputs already placed are taken back (new files removed, old ones put back) and
 names the output that failed. So a run writes all its outputs or none, and leaves every
 destination as it was when it writes none.
 
+Without ``overwrite`` a file is put in place by a hard link (then its temporary name removed),
+not a rename: the link fails where the destination exists, so a file another process made
+after the last check is never replaced. Where the file system refuses hard links (FAT, some
+network ones) it is renamed, and a file made in the moment between the check and the rename
+is replaced.
+
 What POSIX does not allow: the renames are one system call each, not one for all.
 
 - A process reading the destinations during the commit (a few system calls) may see some new
@@ -36,6 +42,7 @@ What POSIX does not allow: the renames are one system call each, not one for all
 """
 
 import contextlib
+import errno
 import os
 import tempfile
 import threading
@@ -96,7 +103,34 @@ def check_output_path(path, overwrite=False, *, hint=_FORMATS_HINT, error=MeshEr
         raise kind(f"cannot write {path!r}: folder {folder!r} is not writable.")
     if hint is not None and not os.path.splitext(path)[1]:
         raise error(f"cannot write {path!r}: no file extension to choose the format from ({hint}).")
+    _check_name_length(path, folder, error)
     return path
+
+
+#: ``tempfile.mkstemp``'s name for a temporary file: this prefix, 8 random characters, the suffix
+_TEMPORARY_PREFIX = ".curvdetail-"
+_RANDOM_CHARACTERS = 8
+
+
+def _check_name_length(path, folder, error):
+    """Raise ``error`` if the file name of ``path``, or that of its temporary file (the prefix,
+    8 characters and ``path``'s extension), is longer than ``folder``'s file system allows
+    (found now, not as ENAMETOOLONG at the rename after the work)."""
+    try:
+        name_max = os.pathconf(folder, "PC_NAME_MAX")
+    except (OSError, ValueError, AttributeError):       # no pathconf (Windows), or it cannot say
+        name_max = 255
+    if name_max is None or name_max <= 0:               # -1: no limit
+        return
+    name = len(os.fsencode(os.path.basename(path)))
+    temporary = len(_TEMPORARY_PREFIX) + _RANDOM_CHARACTERS + len(os.fsencode(os.path.splitext(path)[1]))
+    if name > name_max:
+        raise error(f"cannot write {path!r}: its file name is {name} bytes long, and the file system of "
+                    f"{folder!r} allows {name_max}; choose a shorter name.")
+    if temporary > name_max:
+        raise error(f"cannot write {path!r}: its extension is too long for the temporary file it is first "
+                    f"written to ({temporary} bytes; the file system of {folder!r} allows {name_max}); choose "
+                    "a shorter extension.")
 
 
 def _umask():
@@ -183,7 +217,8 @@ def atomic_outputs(outputs, *, overwrite=False):
             for tmp in temps:
                 if tmp is not None:
                     os.chmod(tmp, mode)
-            _commit([(tmp, path) for tmp, path in zip(temps, paths) if tmp is not None])
+            _commit([(tmp, path, out.flag) for tmp, path, out in zip(temps, paths, outputs) if tmp is not None],
+                    overwrite)
     finally:
         for tmp in temps:
             if tmp is not None:
@@ -202,7 +237,7 @@ def _check_distinct(paths):
 def _temporary(path):
     """An empty temporary file for ``path`` in its folder, with its extension, in :data:`PENDING`."""
     try:
-        fd, tmp = tempfile.mkstemp(prefix=".curvdetail-", suffix=os.path.splitext(path)[1],
+        fd, tmp = tempfile.mkstemp(prefix=_TEMPORARY_PREFIX, suffix=os.path.splitext(path)[1],
                                    dir=os.path.dirname(os.path.abspath(path)))
     except OSError as exc:        # its message would name the temporary file, not the output
         raise type(exc)(exc.errno, f"cannot write {path!r}: {exc.strerror}") from None
@@ -246,16 +281,16 @@ class _Aside:
             os.rmdir(self.folder)
 
 
-def _commit(pairs):
-    """Rename each ``(tmp, path)`` over ``path``, keeping the old files aside; on a failure take
-    back those done and raise, naming the output."""
+def _commit(outputs, overwrite):
+    """Put each ``(tmp, path, flag)``'s file at ``path`` (:func:`_place`), keeping the old files
+    aside; on a failure take back those done and raise, naming the output."""
     placed = []         # (tmp, path, its _Aside or None)
-    keep = len(pairs) > 1           # a single rename that fails has changed nothing
+    keep = len(outputs) > 1           # a single rename that fails has changed nothing
     try:
-        for tmp, path in pairs:
+        for tmp, path, flag in outputs:
             aside = _Aside(path) if keep and os.path.lexists(path) else None
             placed.append((tmp, path, aside))
-            os.replace(tmp, path)
+            _place(tmp, path, overwrite, flag)
     except BaseException as exc:    # KeyboardInterrupt too: half a commit is what this prevents
         stuck = _take_back(placed)
         if not isinstance(exc, OSError):
@@ -266,12 +301,48 @@ def _commit(pairs):
             aside.drop()
 
 
+#: errno values of a file system that refuses hard links (FAT, some network and FUSE ones)
+_NO_HARD_LINKS = {errno.EPERM, errno.EXDEV, errno.EMLINK, errno.ENOSYS, errno.ENOTSUP, errno.EOPNOTSUPP}
+
+
+def _place(tmp, path, overwrite, flag):
+    """Move the file ``tmp`` to ``path``: renamed over it with ``overwrite``; without, hard-linked
+    there (which fails, atomically, where ``path`` exists: a file another process made after
+    the check before the commit is not replaced) and ``tmp`` removed. Where the file system
+    refuses hard links, renamed after all: there a file made between the last check and the
+    rename is replaced."""
+    if not overwrite:
+        try:
+            os.link(tmp, path, follow_symlinks=False)
+        except FileExistsError:
+            raise FileExistsError(errno.EEXIST, f"it was made while the output was being written; pass {flag} "
+                                                "to replace it") from None
+        except OSError as exc:
+            if exc.errno not in _NO_HARD_LINKS:
+                raise
+        else:
+            with contextlib.suppress(OSError):      # the output is in place; a leftover name goes in the end
+                os.remove(tmp)
+            return
+    os.replace(tmp, path)
+
+
+def _placed(tmp, path):
+    """Whether :func:`_place` put ``tmp``'s file at ``path`` (renamed: ``tmp`` gone; linked: one file)."""
+    if not os.path.lexists(tmp):
+        return True
+    try:
+        return os.path.samefile(tmp, path)
+    except OSError:
+        return False
+
+
 def _take_back(placed):
     """Undo the renames of a failed commit, newest first; return the messages of the old files
     that could not be put back (where they are kept)."""
     stuck = []
     for tmp, path, aside in reversed(placed):
-        replaced = not os.path.lexists(tmp)             # os.replace either moved it or did nothing
+        replaced = _placed(tmp, path)                   # os.replace and os.link either did all or nothing
         try:
             if aside is not None:
                 aside.restore(replaced)

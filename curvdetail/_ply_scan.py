@@ -146,13 +146,119 @@ def _ply_problem(path):
             return header, None
         ascii_, elements, first_line = header
         if not ascii_:
-            return None, None
+            return _ply_binary_problem(f), None
         offset = f.tell()
         if offset >= os.fstat(f.fileno()).st_size:
             data = b""
         else:
             data = mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ)   # unmapped when unreferenced
     return _ply_body_problem(data, offset, elements, first_line)
+
+
+#: Bytes of each PLY type, by its first name.
+_PLY_SIZES = {b"char": 1, b"uchar": 1, b"short": 2, b"ushort": 2, b"int": 4, b"uint": 4, b"float": 4,
+              b"double": 8}
+
+
+def _ply_binary_problem(f):
+    """What pymeshlab's PLY reader would misread in a binary PLY file whose header (checked by
+    :func:`_ply_header`) ends where ``f`` stands, or None; from the header and the file's size:
+
+    - big-endian doubles in the vertex element: read as garbage (0.1 came back as -1.5e-180;
+      big-endian floats and little-endian doubles are read right);
+    - a body shorter than the header's counts allow (each list row at its count alone): a
+      225-byte file declaring 20 million vertices cost 1.6 GB and 3.3 s before "Unexpected EOF"."""
+    header_end = f.tell()
+    body = os.fstat(f.fileno()).st_size - header_end
+    fmt, elements = None, []
+    f.seek(0)
+    for raw in f:
+        words = raw.split()
+        if not words:
+            continue
+        if words[0] == b"end_header":
+            break
+        if words[0] == b"format":
+            fmt = words[1]
+        elif words[0] == b"element" and len(words) >= 3:
+            elements.append((words[1].decode("ascii", "replace"), _whole(words[2]) or 0, []))
+        elif words[0] == b"property" and elements:
+            types = [_PLY_TYPE_NAMES.get(w, w) for w in words[1:-1]]
+            elements[-1][2].append((words[-1].decode("ascii", "replace"), types))
+    for name, _, props in elements:
+        doubles = [prop for prop, types in props if types == [b"double"]]
+        if fmt == b"binary_big_endian" and name == "vertex" and doubles:
+            return (f"it is big-endian with vertex properties of type double ({', '.join(doubles)}), which "
+                    "pymeshlab's PLY reader misreads without a word (0.1 came back as -1.5e-180); save it as "
+                    "binary_little_endian or ASCII PLY")
+    least = 0
+    for name, count, props in elements:
+        row = sum(_PLY_SIZES.get(types[1] if types[0] == b"list" else types[0], 0) for _, types in props)
+        least += count * row
+    if least > body:
+        declared = ", ".join(f"{count} {name}" for name, count, _ in elements)
+        return (f"its header declares {declared} rows, which take at least {least} bytes, but only {body} follow "
+                "the header (the file is truncated, or the counts are wrong; pymeshlab would first take memory "
+                "for all of them)")
+    return _ply_list_rows_problem(f, fmt, elements, header_end)
+
+
+#: The most bytes of items an unread list of a binary PLY row may hold: past 512 pymeshlab's
+#: reader overflowed a buffer (65 doubles, 129 floats: "*** buffer overflow detected ***", the
+#: process aborted; 64 and 128 were read).
+_PLY_UNREAD_LIST_BYTES = 512
+
+
+def _ply_list_rows_problem(f, fmt, elements, offset):
+    """What pymeshlab's binary PLY reader would crash or fail on in the lists other than the face
+    indices, which it skips (``elements``: ``(name, count, [(property, types)])`` with a list's
+    types ``[b"list", count type, item type]``; the body starts at byte ``offset`` of ``f``), or
+    None: lists of the vertex element counted in other than char or uchar (it said "Unexpected
+    EOF" of a whole file), and rows whose items in such a list take more than
+    :data:`_PLY_UNREAD_LIST_BYTES` bytes. The rows are looked at through strided views where
+    each row's counts are those of the first (the usual file); where they differ, only the first
+    row is, and the elements after it are not."""
+    order = "<" if fmt == b"binary_little_endian" else ">"
+    for name, _, props in elements:
+        for prop, types in props:
+            if name == "vertex" and types[0] == b"list" and types[1] not in (b"char", b"uchar"):
+                return (f"its vertex list property {prop!r} has counts of type {types[1].decode('ascii', 'replace')}, "
+                        "which pymeshlab's binary PLY reader cannot skip (it reported the whole file as ending "
+                        "too soon, 'Unexpected EOF'); count it with uchar, or drop the property or save as ASCII")
+    if not any(types[0] == b"list" for _, _, props in elements for _, types in props):
+        return None
+    with mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ) as data:
+        for name, count, props in elements:
+            row, counts, lists = 0, [], []                        # the first row's layout
+            for prop, types in props:
+                if types[0] != b"list":
+                    row += _PLY_SIZES.get(types[0], 0)
+                    continue
+                size, item = _PLY_SIZES.get(types[1], 0), _PLY_SIZES.get(types[2], 0)
+                if not size or not item or offset + row + size > len(data):
+                    return None
+                dtype = np.dtype(order + {1: "u1", 2: "u2", 4: "u4"}[size])
+                n = int(np.frombuffer(data, dtype=dtype, count=1, offset=offset + row)[0])
+                lists.append((prop, row, dtype, n, item))
+                row += size + n * item
+            if not count:
+                continue
+            constant = offset + count * row <= len(data)
+            for prop, at, dtype, n, item in lists:
+                unread = not (name == "face" and prop in ("vertex_indices", "vertex_index"))
+                if constant:
+                    column = np.ndarray((count,), dtype=dtype, buffer=data, offset=offset + at, strides=(row,))
+                    constant = bool((column == n).all())
+                    del column
+                if unread and n * item > _PLY_UNREAD_LIST_BYTES:
+                    return (f"the first {name} row's list {prop!r} holds {n} items of {item} bytes, more than the "
+                            f"{_PLY_UNREAD_LIST_BYTES} bytes pymeshlab's binary PLY reader can skip (past that it "
+                            "overflowed a buffer and the process aborted); drop the property, shorten its lists, "
+                            "or save the file as ASCII PLY")
+            if not constant:
+                return None                                   # rows of varying size: not followed further
+            offset += count * row
+    return None
 
 
 #: Bytes per piece in which the ASCII PLY scan goes through a body (ending at a line's end): a

@@ -69,7 +69,13 @@ def read_mesh(path):
                         fewer than 3 or more than 255 vertices, a face row not on a line of
                         its own, rows with values missing or extra; CTM files with a
                         "Quality" map but no "Color" map or a map without a name (its CTM
-                        reader crashed the process on each), or shorter than their sections
+                        reader crashed the process on each), or shorter than their sections;
+                        OBJ face indices outside the file, faces of fewer than 3 corners, a
+                        UTF-8 byte order mark (OBJ, PLY) or a lone carriage return (OBJ);
+                        ASCII STL facets of other than 3 vertices; binary PLY files with
+                        big-endian double vertices, a body shorter than the header declares,
+                        or lists the reader cannot skip. After loading, the triangles of an
+                        OBJ, OFF or ASCII PLY file must be as many as its faces make
                         (see :func:`curvdetail._file_scan.check_before_loading`)
 
     Examples
@@ -127,13 +133,24 @@ def load_checked(ms, path, *, vertex_maps=True):
         # polygons are triangulated, so a header's face count cannot tell a dropped face
         raise MeshFileError(
             f"{path!r}: its faces make {triangles} triangles (a polygon of k vertices k - 2), but pymeshlab "
-            f"loaded {F.shape[0]}: its PLY loader drops, without a word, faces that repeat a vertex index and "
-            "faces whose 'flags' value has the 'deleted' bit (1) set. Fix or remove those faces (or their "
-            "flags) in the file and read it again.")
+            f"loaded {F.shape[0]}: {_DROPPED_TRIANGLES[os.path.splitext(path)[1].lower()]}. Fix or remove "
+            "those faces in the file and read it again.")
     if vertex_maps and os.path.splitext(path)[1].lower() == ".ctm":
         _set_ctm_vertex_maps(ms, path)
         mesh = ms.current_mesh()
     return mesh
+
+
+#: Why pymeshlab's loader drops triangles of a file's faces without a word, by format (what
+#: :func:`load_checked` says where fewer come back than the faces make).
+_DROPPED_TRIANGLES = {
+    ".ply": "its PLY loader drops faces that repeat a vertex index and faces whose 'flags' value has the "
+            "'deleted' bit (1) set (fix or remove the flags too)",
+    ".obj": "its OBJ loader drops triangles that repeat a vertex index (of a polygon too: 'f 1 2 2 3' "
+            "became one triangle) and those with a texture coordinate index past the file's vt lines",
+    ".off": "its OFF loader drops triangles that repeat a vertex index (of a polygon too: '4 0 1 1 2' "
+            "became one triangle)",
+}
 
 
 def _set_ctm_vertex_maps(ms, path):
@@ -240,6 +257,7 @@ def check_mesh_output(path, overwrite=False, *, hint=_MESH_HINT):
                       format pymeshlab writes
     """
     path = check_output_path(path, overwrite, hint=hint, error=MeshFileError)
+    _check_utf8(path)
     extension = os.path.splitext(path)[1].lower()
     if extension in POINT_FORMATS:
         raise MeshFileError(f"cannot write {path!r}: {extension} files hold points only, so the "
@@ -253,6 +271,21 @@ def check_mesh_output(path, overwrite=False, *, hint=_MESH_HINT):
         raise MeshFileError(f"cannot write {path!r}: pymeshlab does not write {extension} meshes "
                             f"({_WRITES[extension]}); {hint}")
     return path
+
+
+def _check_utf8(path):
+    """Raise MeshFileError if pymeshlab cannot be given ``path`` (a str from
+    :func:`os.fsdecode`): it takes paths as UTF-8 text, so a folder or file name holding other
+    bytes (``b'lat\\xe9'``, Latin-1) was refused with a TypeError, or, passed as bytes, written
+    under another name (the byte replaced by U+FFFD)."""
+    absolute = os.path.abspath(path)
+    try:
+        absolute.encode("utf-8")
+    except UnicodeEncodeError as exc:
+        bad = os.fsencode(absolute[exc.start:exc.end])
+        raise MeshFileError(f"cannot write {path!r}: its path holds bytes that are not UTF-8 ({bad!r} in "
+                            f"{os.fsencode(absolute)!r}), and pymeshlab takes paths as UTF-8 text only; rename the "
+                            "file or folder (or write elsewhere and move the file there).") from None
 
 
 def _why_not_written(extension):
@@ -317,6 +350,8 @@ _COORDINATES = {
     ".x3d": ("float32",),
     ".3mf": ("decimals", 6, 23, SINGLE_TOLERANCE, 1.0),    # float32, 6 decimals truncated
     ".idtf": ("decimals", 6, 52, SINGLE_TOLERANCE, 0.5),   # "%f"
+    ".dxf": ("decimals", 6, 52, SINGLE_TOLERANCE, 0.5),    # "%f" of the double (pymeshlab reads no .dxf:
+                                                           # measured in the text, 16777217 kept whole)
 }
 _SINGLE = (".stl", ".3ds", ".ctm", ".nxs", ".dae", ".json", ".wrl", ".x3d", ".3mf", ".idtf")
 _SIX_DIGITS = (".dae", ".json", ".wrl", ".x3d")
@@ -352,7 +387,10 @@ def check_coordinates(path, V, *, binary=True, lossless=True, **save_options):
     - .3mf (single precision, then 6 decimals truncated) and .idtf (6 decimals): as single
       precision, and refused where the decimals lose more than :data:`SINGLE_TOLERANCE` (1e-6)
       of the diagonal: meshes smaller than about 1 (.3mf) and 0.5 (.idtf).
+    - .dxf: the doubles as text with 6 decimals ("%f"; pymeshlab does not read .dxf, so this was
+      measured in the written text), refused as .idtf: meshes smaller than about 0.5.
     - .ctm with ``lossless=False`` and .nxz: compressed with a loss not bounded here; refused.
+    - any other extension (a format whose writer was never measured): refused.
 
     Where the diagonal is 0 (one point) the largest coordinate stands for it. Non-finite
     coordinates are refused (pymeshlab's loaders drop such vertices). The message names the
@@ -361,11 +399,15 @@ def check_coordinates(path, V, *, binary=True, lossless=True, **save_options):
     key = extension + (" ascii" if extension == ".ply" and not binary else "") + \
         (" lossy" if extension == ".ctm" and not lossless else "")
     kind = _COORDINATES.get(key)
-    where = f"cannot write {os.fspath(path)!r}"
+    where = f"cannot write {os.fsdecode(path)!r}"
     if isinstance(kind, str):
         raise MeshFileError(f"{where}: {kind}.")
+    if kind is None:        # a format pymeshlab writes that was never measured: its loss is not known
+        raise MeshFileError(f"{where}: how precisely pymeshlab writes {extension or 'extension-less'} coordinates "
+                            f"is not known here, so the mesh could be written with a loss nothing checks; write "
+                            f"{_SAFE}, or .obj, .off, .stl.")
     V = np.asarray(V, dtype=np.float64).reshape(-1, 3)
-    if kind is None or not V.size:
+    if not V.size:
         return
     finite = np.isfinite(V).all(axis=1)
     if not finite.all():
@@ -470,10 +512,20 @@ def write_mesh(path, V, F, *, quality=None, overwrite=False):
                       bounding-box diagonal: refused); OFF 16 significant digits (refused more
                       than about 2e6 diagonals from the origin); STL, 3DS, CTM, COLLADA, VRML,
                       X3D, JSON single precision (refused where a coordinate overflows, above
-                      3.4e38, or the mesh underflows it); ``quality`` with a .ctm path:
+                      3.4e38, or the mesh underflows it); DXF, 3MF, IDTF 6 decimals (refused
+                      for meshes smaller than about 1); ``quality`` with a .ctm path:
                       pymeshlab's CTM reader reads the quality from the colour map, and
                       crashed where there is none (without quality, a CTM file is written
-                      with neither, which it reads)
+                      with neither, which it reads); a path whose folder or file name is not
+                      UTF-8 (pymeshlab takes UTF-8 paths only: rename it)
+
+    Notes
+    -----
+    STL (and DXF) files store each triangle with its own three corners, not shared vertices:
+    reading an STL file back welds coincident corners into one vertex and cannot hold
+    unreferenced vertices, so ``read_mesh`` returns fewer vertices, renumbered (two separate
+    triangles of 7 vertices, sharing two corner positions, come back as 4 vertices, joined), and
+    float32 coordinates. Write .ply (or .obj, .off) for an exact round trip of ``V`` and ``F``.
 
     Examples
     --------
@@ -493,10 +545,10 @@ def write_mesh(path, V, F, *, quality=None, overwrite=False):
     """
     import pymeshlab
 
-    check_mesh_output(path, overwrite)
-    extension = os.path.splitext(os.fspath(path))[1].lower()
+    path = check_mesh_output(path, overwrite)     # a str from here on: bytes compared as b'.ply'
+    extension = os.path.splitext(path)[1].lower()
     if quality is not None and extension == ".ctm":
-        raise MeshFileError(f"cannot write {os.fspath(path)!r} with quality: {_CTM_QUALITY}; write {_SAFE} to keep "
+        raise MeshFileError(f"cannot write {path!r} with quality: {_CTM_QUALITY}; write {_SAFE} to keep "
                             "the quality, or pass quality=None to write the CTM file without it.")
     V = as_vertices(V)
     F = as_faces(F, V.shape[0])
@@ -597,9 +649,9 @@ def save_mesh(path, mesh, *, overwrite=False, _plain=None, **save_options):
         raise MeshFileError(f"save_mesh cannot save custom attributes ({', '.join(custom)}): pymeshlab "
                             "crashes exporting them from a copied mesh. Add the mesh to a MeshSet and "
                             "save it with curvdetail.filters.files.save_current_mesh.")
-    check_mesh_output(path, overwrite)
+    path = check_mesh_output(path, overwrite)     # a str from here on (the message's replace below)
     plain = _plain or {}         # options to set where the format has them (write_mesh's)
-    extension = os.path.splitext(os.fsdecode(path))[1].lower()
+    extension = os.path.splitext(path)[1].lower()
     if extension == ".ply" and mesh.has_vertex_scalar() and "save_vertex_quality" not in plain:
         options.setdefault("save_vertex_quality", True)
     if extension == ".ctm":
@@ -607,12 +659,12 @@ def save_mesh(path, mesh, *, overwrite=False, _plain=None, **save_options):
         colours = mesh.has_vertex_color() and options.get("save_vertex_color", plain.get("save_vertex_color", True))
         if not colours and mesh.has_vertex_scalar():
             if options.get("save_vertex_quality"):
-                raise MeshFileError(f"cannot write {os.fspath(path)!r} with save_vertex_quality=True and no vertex "
+                raise MeshFileError(f"cannot write {path!r} with save_vertex_quality=True and no vertex "
                                     f"colours: {_CTM_QUALITY}; save the colours too, or write {_SAFE}.")
             options["save_vertex_quality"] = False
     if extension == ".3ds":
         if options.get("save_face_color", True) is False:
-            raise MeshFileError(f"cannot write {os.fspath(path)!r} with save_face_color=False: {_3DS_FACE_COLOURS}; "
+            raise MeshFileError(f"cannot write {path!r} with save_face_color=False: {_3DS_FACE_COLOURS}; "
                                 "leave save_face_color on.")
         options["save_face_color"] = True
         plain = {k: v for k, v in plain.items() if k != "save_face_color"}
@@ -626,14 +678,14 @@ def save_mesh(path, mesh, *, overwrite=False, _plain=None, **save_options):
         try:
             _save(ms, tmp, options, plain)
         except Exception as exc:
-            raise MeshFileError(f"could not write {os.fspath(path)!r}: "
-                                f"{str(exc).replace(tmp, os.fspath(path))}") from None
+            raise MeshFileError(f"could not write {path!r}: "
+                                f"{str(exc).replace(tmp, path)}") from None
         if os.path.getsize(tmp) == 0:
-            raise MeshFileError(f"could not write {os.fspath(path)!r}: pymeshlab reported success but wrote "
+            raise MeshFileError(f"could not write {path!r}: pymeshlab reported success but wrote "
                                 f"nothing; {_MESH_HINT}")
         problem = ctm_problem(tmp) if extension == ".ctm" else None
         if problem:                              # what the options above should have kept out
-            raise MeshFileError(f"could not write {os.fspath(path)!r}: pymeshlab wrote a CTM file that read_mesh "
+            raise MeshFileError(f"could not write {path!r}: pymeshlab wrote a CTM file that read_mesh "
                                 f"refuses ({problem}); write {_SAFE}.")
 
 

@@ -604,3 +604,84 @@ def test_ctm_files_are_scanned_whatever_the_case_of_their_extension(tmp_path):
             check_before_loading(str(tmp_path / name))
     (tmp_path / "ok.ctm").write_bytes(data.replace(b"Quality", b"Color\0\0"))
     assert check_before_loading(str(tmp_path / "ok.ctm")) is None
+
+
+# OBJ face indices pymeshlab reads without a range check: 0 and one past the last vertex were
+# written out of bounds (valgrind: invalid writes; exit 139 at times), -9 with 5 vertices and
+# 4294967299 (2**32 + 3) with 3 named real vertices ([[1, 4, 2]], [[0, 1, 2]]).
+_OBJ_V5 = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\n"
+
+
+@pytest.mark.parametrize("text, message", [
+    (_OBJ_V5 + "f 1 2 3 4\nf 2 5 0\n", r"line 7 \('f 2 5 0'\) names the vertex 0, which the file does not have"),
+    (_OBJ_V5 + "f 1 2 3 4\nf 2 5 6\n", r"line 7 \('f 2 5 6'\) names the vertex 6.*\(5 v lines in all, 5 above"),
+    (_OBJ_V5 + "f 2 5 -6\n", r"line 6 \('f 2 5 -6'\) names the vertex -6"),
+    (_OBJ_V5 + "f 2 5 -9\n", r"names the vertex -9"),
+    ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4294967299\n", r"line 4 \('f 1 2 4294967299'\) names the vertex 4294967299"),
+    (_OBJ_V5 + "f 1 2 3 99\nf 2 5 3\n", r"line 6 \('f 1 2 3 99'\) names the vertex 99"),
+    # negative indices count back over the vertices above the face only
+    ("v 0 0 0\nv 1 0 0\nf -1 -2 -3\nv 0 1 0\n", r"line 3 \('f -1 -2 -3'\) names the vertex -3.*\(2 v lines above"),
+    (_OBJ_V5 + "f /1 2 3\n", r"line 6 \('f /1 2 3'\) has no vertex index"),
+    (_OBJ_V5 + "f 1x 2 3\n", r"has the vertex index '1x'"),
+    (_OBJ_V5 + "f 1 2\nf 1 2 3\n", r"line 6 \('f 1 2'\) is a face of 2 corners, which pymeshlab's OBJ loader drops"),
+])
+def test_obj_face_indices_outside_the_file_are_refused_before_loading(tmp_path, text, message):
+    path = tmp_path / "m.obj"
+    path.write_text(text)
+    with pytest.raises(ValueError, match=message):
+        check_before_loading(path)
+
+
+@pytest.mark.parametrize("text, triangles", [
+    (_OBJ_V5 + "f 1 2 3 4\nf 2 5 3\n", 3),
+    (_OBJ_V5 + "f 1 2 5 3 4\n", 3),                                      # a pentagon: 3 triangles
+    ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\nv 5 5 5\nf -4 -3 -1\n", 2),   # negative, interleaved
+    (_OBJ_V5 + "vt 0 0\nvn 0 0 1\nf 1/1/1 2/1/1 +3/1/1\nf 2//1 5//1 3.0//1\n  f 1 3 4#note\n", 3),
+    (_OBJ_V5 + "f 1 2 \\\n3\r\nf 1 3 \\\r\n4\n", 2),                    # continued face lines
+])
+def test_obj_faces_in_range_pass_and_give_their_triangles(tmp_path, text, triangles):
+    from curvdetail._file_scan import _obj_face_indices
+    path = tmp_path / "m.obj"
+    path.write_text(text)
+    assert check_before_loading(path) == triangles
+    for size in (1, 7, 20):                                              # pieces of a line or a few
+        assert _obj_face_indices(path, size=size) == (None, triangles)
+
+
+def test_obj_face_index_scan_finds_the_first_bad_line_across_pieces(tmp_path):
+    from curvdetail._file_scan import _obj_face_indices
+    path = tmp_path / "m.obj"
+    path.write_text(_OBJ_V5 + "f 1 2 3\n" * 50 + "f 1 2 6\n" + "f 1 2 7\n")
+    for size in (1, 64, 1 << 20):
+        problem, triangles = _obj_face_indices(path, size=size)
+        assert triangles is None and problem.startswith("line 56 ('f 1 2 6') names the vertex 6")
+
+
+@pytest.mark.parametrize("name, data, message", [
+    ("m.obj", b"\xef\xbb\xbfv 9 9 9\n" + _OBJ_V4.encode() + b"f 1 2 3\n", "starts with a UTF-8 byte order mark"),
+    ("m.ply", b"\xef\xbb\xbfply\nformat ascii 1.0\nelement vertex 0\nend_header\n", "byte order mark.*PLY reader"),
+    # a lone CR after LF lines: the lines it ends were read as one (the second triangle was lost)
+    ("m.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n# part two\rv 5 5 5\rv 6 5 5\rv 5 6 5\rf 4 5 6\r",
+     r"line 5 ends in a carriage return not followed by a newline"),
+    ("m.stl", b"solid q\nfacet normal 0 0 1\n outer loop\n vertex 0 0 0\n vertex 1 0 0\n vertex 1 1 0\n"
+              b" vertex 0 1 0\n endloop\nendfacet\nendsolid q\n", r"1 facets with 4 vertex lines, not 3 a facet"),
+    ("m.off", b"OFF\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n2 0 0\n4 0 1 2 3\n2 1 4\n",
+     r"face 1 is the row '2 1 4', of 2 vertices, which pymeshlab's OFF reader drops"),
+])
+def test_byte_order_marks_lone_carriage_returns_and_odd_facets_are_refused(tmp_path, name, data, message):
+    path = tmp_path / name
+    path.write_bytes(data)
+    with pytest.raises(ValueError, match=message):
+        check_before_loading(path)
+
+
+@pytest.mark.parametrize("name, data, triangles", [
+    ("m.obj", b"v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 3\r", 1),          # CRLF, a last CR alone
+    ("m.stl", b"solid q\nfacet normal 0 0 1\n outer loop\n vertex 0 0 0\n vertex 1 0 0\n vertex 1 1 0\n"
+              b" endloop\nendfacet\nendsolid q\n", None),
+    ("m.off", b"OFF\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n2 0 0\n4 0 1 2 3\n5 0 1 4 2 3\n", 5),
+])
+def test_files_the_new_checks_pass_give_their_triangles(tmp_path, name, data, triangles):
+    path = tmp_path / name
+    path.write_bytes(data)
+    assert check_before_loading(path) == triangles

@@ -266,3 +266,71 @@ def test_the_vertex_colour_formats_are_those_whose_writer_saves_vertex_colours(t
         has_option = False
     assert has_option == (extension in files.VERTEX_COLOUR_FORMATS)
     assert files.vertex_colours_kept_in(ms, "m" + extension) == has_option
+
+
+def test_a_bytes_path_keeps_what_a_str_path_keeps(tmp_path):
+    # b'.ply' != '.ply': the custom attributes and the quality were silently left out
+    ms = load_meshset(NOSE)
+    apply(ms, "compute_curvature_detail")
+    save_current_mesh(ms, tmp_path / "s.ply")
+    save_current_mesh(ms, os.fsencode(tmp_path / "b.ply"))
+    assert (tmp_path / "b.ply").read_bytes() == (tmp_path / "s.ply").read_bytes()
+    assert files.attributes_lost_in(ms, b"x.ply") == [] and files.save_options(ms, b"x.ply") == \
+        files.save_options(ms, "x.ply")
+
+
+def test_a_path_that_is_not_utf8_is_refused_with_the_fix(tmp_path):
+    # pymeshlab's own TypeError ("incompatible function arguments") went through
+    folder = os.path.join(os.fsencode(tmp_path), b"lat\xe9")
+    os.mkdir(folder)
+    ms = load_meshset(NOSE)
+    for path in (os.path.join(folder, b"d.ply"), os.fsdecode(os.path.join(folder, b"d.obj"))):
+        with pytest.raises(MeshFileError, match=r"not UTF-8 .* pymeshlab takes paths as UTF-8 text only; rename"):
+            save_current_mesh(ms, path)
+    assert os.listdir(folder) == []
+
+
+def _off_header(path):
+    return path.read_text().split("\n", 1)[0]
+
+
+def test_computed_normals_and_default_colours_are_not_saved(tmp_path):
+    # an OBJ without normals was saved to OFF as NOFF (the normals pymeshlab computes on load),
+    # a layer made from arrays as NCOFF (those and the white colours every such mesh gets)
+    import pymeshlab
+    from curvdetail.curvature.testing import icosphere
+
+    ms = load_meshset(NOSE)
+    save_current_mesh(ms, tmp_path / "n.off")
+    V, F = icosphere(subdivisions=1)
+    made = pymeshlab.MeshSet()
+    made.add_mesh(pymeshlab.Mesh(vertex_matrix=V, face_matrix=F.astype(np.int32)))
+    save_current_mesh(made, tmp_path / "m.off")
+    save_current_mesh(made, tmp_path / "m.obj")
+    assert _off_header(tmp_path / "n.off") == _off_header(tmp_path / "m.off") == "OFF"
+    rows = (tmp_path / "m.off").read_text().split("\n")
+    assert rows[1].split() == [str(len(V)), str(len(F)), "0"] and len(rows[2].split()) == 3
+    assert "vn " not in (tmp_path / "m.obj").read_text()
+    back = load_meshset(tmp_path / "m.off")
+    assert np.allclose(back.current_mesh().vertex_matrix(), V, atol=1e-15)
+
+
+def test_a_layers_own_normals_and_colours_are_saved(tmp_path):
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0.5]])
+    normals = np.array([[0.6, 0, 0.8], [0, 0.6, 0.8], [0, 0, 1], [0.8, 0, 0.6]])
+    (tmp_path / "vn.obj").write_text("".join(f"v {x} {y} {z}\n" for x, y, z in V)
+                                      + "".join(f"vn {x} {y} {z}\n" for x, y, z in normals)
+                                      + "f 1//1 2//2 3//3\nf 2//2 4//4 3//3\n")
+    (tmp_path / "c.off").write_text("COFF\n4 2 0\n" + "".join(f"{x} {y} {z} {10 * k} 20 30 255\n"
+                                                              for k, (x, y, z) in enumerate(V))
+                                    + "3 0 1 2\n3 1 3 2\n")
+    ms = load_meshset(tmp_path / "vn.obj")
+    save_current_mesh(ms, tmp_path / "vn.off")
+    assert _off_header(tmp_path / "vn.off") == "NOFF"
+    back = load_meshset(tmp_path / "vn.off")                       # kept: its meshes are views into it
+    assert np.allclose(back.current_mesh().vertex_normal_matrix(), normals)
+    ms = load_meshset(tmp_path / "c.off")
+    save_current_mesh(ms, tmp_path / "c2.off")
+    assert _off_header(tmp_path / "c2.off") == "COFF"
+    back = load_meshset(tmp_path / "c2.off")
+    assert np.allclose(back.current_mesh().vertex_color_matrix() * 255, [[10 * k, 20, 30, 255] for k in range(4)])

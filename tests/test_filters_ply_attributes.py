@@ -79,3 +79,15 @@ def test_ascii_vertex_blocks_with_blank_lines_or_hashes_give_nothing(tmp_path, b
     path = tmp_path / "a.ply"
     path.write_text(_ASCII_HEAD + body)
     assert read_ply_vertex_attributes(path) == {}
+
+
+def test_element_counts_written_as_whole_decimals_are_read_as_read_mesh_reads_them(tmp_path):
+    # "element vertex 3.0": read_mesh read it (as pymeshlab does), load_meshset failed in int()
+    from curvdetail.filters.files import load_meshset
+    path = tmp_path / "m.ply"
+    path.write_text("ply\nformat ascii 1.0\nelement vertex 3.0\nproperty float x\nproperty float y\n"
+                    "property float z\nproperty float quality_x\nelement face 1\n"
+                    "property list uchar int vertex_indices\nend_header\n0 0 0 5\n1 0 0 6\n0 1 0 7\n3 0 1 2\n")
+    assert read_mesh(path)[1].tolist() == [[0, 1, 2]]
+    assert load_meshset(path).current_mesh().face_matrix().tolist() == [[0, 1, 2]]
+    np.testing.assert_array_equal(read_ply_vertex_attributes(path)["quality_x"], [5, 6, 7])

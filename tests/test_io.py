@@ -355,16 +355,19 @@ def test_off_with_counts_on_the_header_line_and_colours_is_read(tmp_path):
     assert np.array_equal(V, _SQUARE) and np.array_equal(F, _SQUARE_FACES)
 
 
-@pytest.mark.parametrize("name, text", [
-    ("out_of_range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\nf 2 9 3\n"),
-    ("repeated.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\nf 2 2 3\n"),
+@pytest.mark.parametrize("name, text, message", [
+    # refused before loading now (pymeshlab wrote out of bounds with some such indices)
+    ("out_of_range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\nf 2 9 3\n",
+     r"line 7 \('f 2 9 3'\) names the vertex 9, which the file does not have"),
+    ("repeated.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\nf 2 2 3\n",
+     r"has 3 faces but pymeshlab loaded 2 triangles: at least 1 were dropped, most likely for vertex indices "
+     r"out of range or repeated"),
 ])
-def test_obj_faces_the_loader_drops_are_reported(tmp_path, name, text):
+def test_obj_faces_the_loader_drops_are_reported(tmp_path, name, text, message):
     # pymeshlab drops these faces without a word: the mesh would silently get a hole
     path = tmp_path / name
     path.write_text(text)
-    with pytest.raises(MeshFileError, match=r"has 3 faces but pymeshlab loaded 2 triangles: at least 1 "
-                                           r"were dropped, most likely for vertex indices out of range"):
+    with pytest.raises(MeshFileError, match=message):
         read_mesh(path)
 
 
@@ -1033,3 +1036,107 @@ def test_the_write_check_agrees_with_the_loss_measured_by_writing(tmp_path, ext)
                 refused = True
             assert not (loss > limit and not refused), (radius, offset, loss)
             assert not (loss < limit / 3 and refused), (radius, offset, loss)
+
+
+def test_a_bytes_path_writes_what_a_str_path_writes(tmp_path):
+    # b'.ply' != '.ply': write_mesh(b'x.ply', ...) wrote a quality of zeros a str path does not
+    V, F = icosphere(subdivisions=1)
+    write_mesh(str(tmp_path / "s.ply"), V, F)
+    write_mesh(os.fsencode(tmp_path / "b.ply"), V, F)
+    assert (tmp_path / "b.ply").read_bytes() == (tmp_path / "s.ply").read_bytes()
+    assert b"quality" not in (tmp_path / "b.ply").read_bytes()[:400]
+
+
+def test_a_failed_write_to_a_bytes_path_names_the_path(tmp_path, monkeypatch):
+    # the message replaced the temporary path by the bytes path: TypeError from str.replace
+    import curvdetail.io as io
+
+    def failing(ms, path, options, optional):
+        raise RuntimeError(f"Error encountered while exporting file {path}: disk full")
+
+    monkeypatch.setattr(io, "_save", failing)
+    mesh = pymeshlab.Mesh(vertex_matrix=np.eye(3), face_matrix=np.array([[0, 1, 2]], dtype=np.int32))
+    with pytest.raises(MeshFileError, match=r"could not write '.*m\.off': Error encountered while exporting file "
+                                            r".*m\.off: disk full"):
+        save_mesh(os.fsencode(tmp_path / "m.off"), mesh)
+    assert os.listdir(tmp_path) == []
+
+
+def test_a_path_that_is_not_utf8_is_refused_with_the_fix(tmp_path):
+    # pymeshlab takes UTF-8 paths only: a Latin-1 folder name raised TypeError from str.replace
+    # (write_mesh) or from pymeshlab's argument conversion
+    folder = os.path.join(os.fsencode(tmp_path), b"lat\xe9")
+    os.mkdir(folder)
+    V, F = icosphere(subdivisions=1)
+    mesh = pymeshlab.Mesh(vertex_matrix=V, face_matrix=F.astype(np.int32))
+    for write in (lambda p: write_mesh(p, V, F), lambda p: save_mesh(p, mesh)):
+        for path in (os.path.join(folder, b"a.ply"), os.fsdecode(os.path.join(folder, b"a.ply")),
+                     os.path.join(os.fsencode(tmp_path), b"caf\xe9.off")):
+            with pytest.raises(MeshFileError, match=r"its path holds bytes that are not UTF-8 \(b'\\xe9' in .*\), and "
+                                                    r"pymeshlab takes paths as UTF-8 text only; rename"):
+                write(path)
+    assert os.listdir(folder) == [] and os.listdir(tmp_path) == ["lat\udce9"]
+    write_mesh(tmp_path / "caf\u00e9.off", V, F)                    # UTF-8 names are written
+    assert np.allclose(read_mesh(tmp_path / "caf\u00e9.off")[0], V)
+
+
+def test_dxf_coordinates_are_checked_for_its_six_decimals(tmp_path):
+    # DXF went unchecked: three vertices 1e-7 apart were all written as 0.123457
+    V = np.array([[0.1234567, 0, 0], [0.1234568, 0, 0], [0.1234567, 1e-7, 0]])
+    with pytest.raises(MeshFileError, match=r"writes DXF coordinates with 6 decimals \(an error up to 5e-07\)"):
+        write_mesh(tmp_path / "tiny.dxf", V, np.array([[0, 1, 2]]))
+    assert os.listdir(tmp_path) == []
+    # pymeshlab reads no .dxf: the written text is the measure ("%f" of the double; 16777217 is no float32)
+    V = np.array([[0.1234567, 0, 0], [16777217.0, 2.5, 0], [3.0, 0.0000014, -7.25]])
+    write_mesh(tmp_path / "big.dxf", V, np.array([[0, 1, 2]]))
+    tokens = (tmp_path / "big.dxf").read_text().split("3DFACE")[1].split()
+    corners = {code: float(value) for code, value in zip(tokens[2::2], tokens[3::2]) if code[0] in "123"}
+    written = np.array([[corners[f"{axis}{k}"] for axis in "123"] for k in range(3)])
+    assert np.array_equal(written, np.round(V, 6))
+
+
+def test_every_format_write_mesh_takes_has_a_measured_precision(tmp_path):
+    # a format missing from the table (.dxf was) was written unchecked
+    import curvdetail.io as io
+    from curvdetail.io import check_coordinates
+
+    V, F = icosphere(subdivisions=1)
+    for ext in _SAVE_FORMATS:
+        if ext in io.POINT_FORMATS or ext in io.UNWRITTEN_FORMATS:
+            continue
+        assert io.check_mesh_output(str(tmp_path / f"m{ext}")).endswith(ext)       # written by write_mesh
+        assert ext in io._COORDINATES, ext
+        check_coordinates(f"m{ext}", V * 10.0)
+    assert os.listdir(tmp_path) == []
+
+
+def test_a_format_with_no_measured_precision_is_refused(tmp_path, monkeypatch):
+    import curvdetail.io as io
+
+    monkeypatch.setitem(io._WRITES, ".new", None)                    # as if pymeshlab wrote it
+    V, F = icosphere(subdivisions=1)
+    with pytest.raises(MeshFileError, match=r"how precisely pymeshlab writes \.new coordinates is not known here"):
+        write_mesh(tmp_path / "m.new", V, F)
+    assert os.listdir(tmp_path) == []
+
+
+@pytest.mark.parametrize("name, text", [
+    # a dropped triangle beside a polygon: the file's face count (2) no longer tells it
+    ("quad_repeated.off", "OFF\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n2 0 0\n4 0 1 2 3\n3 1 4 4\n"),
+    ("quad_repeated.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nf 1 2 3 4\nf 2 5 5\n"),
+    # a quad whose texture indices name 2 vt lines of 2: pymeshlab kept one of its 2 triangles
+    ("quad_vt.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nf 1/1 2/2 3/3 4/4\n"),
+])
+def test_triangles_dropped_beside_polygons_are_reported(tmp_path, name, text):
+    path = tmp_path / name
+    path.write_text(text)
+    with pytest.raises(MeshFileError, match=r"its faces make \d+ triangles \(a polygon of k vertices k - 2\), but "
+                                           r"pymeshlab loaded \d+: its (OBJ|OFF) loader drops"):
+        read_mesh(path)
+
+
+def test_polygons_with_all_their_triangles_are_read(tmp_path):
+    path = tmp_path / "poly.obj"
+    path.write_text("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nf 1 2 3 4\nf 2 5 3\n")
+    V, F = read_mesh(path)
+    assert F.shape == (3, 3) and V.shape == (5, 3)

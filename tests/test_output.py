@@ -411,3 +411,57 @@ def test_sigterm_during_a_commit_lets_it_finish(tmp_path):
     assert done.returncode == 128 + 15 and done.stdout == "", (done.stdout, done.stderr)
     assert ((out / "a.txt").read_text(), (out / "b.txt").read_text()) == ("new a", "new b")
     assert sorted(os.listdir(out)) == ["a.txt", "b.txt"]
+
+
+def test_a_file_name_too_long_for_the_file_system_is_refused_before_the_work(tmp_path):
+    # it passed the check and failed only at the rename after the work (OSError, ENAMETOOLONG)
+    name_max = os.pathconf(tmp_path, "PC_NAME_MAX")
+    too_long = "x" * (name_max - 3) + ".ply"
+    long_extension = "a." + "x" * (name_max - 15)            # fits; ".curvdetail-XXXXXXXX.xxx..." does not
+    for name, message in ((too_long, rf"its file name is {name_max + 1} bytes long, and the file system of "),
+                          (long_extension, rf"its extension is too long for the temporary file it is first written "
+                                           rf"to \({name_max + 6} bytes; the file system of ")):
+        with pytest.raises(MeshError, match=message + rf"'.*' allows {name_max}"):
+            with atomic_output(tmp_path / name, hint=None):
+                pytest.fail("the block must not run")
+    assert ("x" * (name_max - 4) + ".ply") == check_output_path(str(tmp_path / ("x" * (name_max - 4) + ".ply")))[
+        len(str(tmp_path)) + 1:]                                     # the longest name that fits passes
+    assert os.listdir(tmp_path) == []
+
+
+def test_a_file_made_by_another_process_during_the_commit_is_not_replaced(tmp_path, monkeypatch):
+    # made after the last check, just before the rename: os.replace put the output over it
+    path = tmp_path / "a.txt"
+    real_chmod = os.chmod
+
+    def chmod_then_another_process_writes(target, mode, **kwargs):  # between the check and the rename
+        real_chmod(target, mode, **kwargs)
+        if not path.exists():
+            path.write_text("another process's")
+
+    monkeypatch.setattr(os, "chmod", chmod_then_another_process_writes)
+    with pytest.raises(FileExistsError, match=r"cannot write '.*a\.txt': it was made while the output was being "
+                                              r"written; pass --overwrite \(overwrite=True\) to replace it; no "
+                                              r"output was written"):
+        with atomic_output(path, hint=None) as tmp:
+            _write(tmp, "ours")
+    assert path.read_text() == "another process's" and os.listdir(tmp_path) == ["a.txt"]
+
+
+@pytest.mark.parametrize("refusal", [1, 18, 95])       # EPERM (FAT), EXDEV, EOPNOTSUPP
+def test_where_hard_links_are_refused_a_new_output_is_renamed_into_place(tmp_path, monkeypatch, refusal):
+    def refused(*args, **kwargs):
+        raise OSError(refusal, os.strerror(refusal))
+
+    monkeypatch.setattr(os, "link", refused)
+    with atomic_outputs([Output(tmp_path / "a.txt", hint=None), Output(tmp_path / "b.txt", hint=None)]) as temps:
+        for tmp, text in zip(temps, ("new a", "new b")):
+            _write(tmp, text)
+    assert ((tmp_path / "a.txt").read_text(), (tmp_path / "b.txt").read_text()) == ("new a", "new b")
+    assert sorted(os.listdir(tmp_path)) == ["a.txt", "b.txt"]
+
+
+def test_a_new_output_is_one_file_with_no_second_name_left(tmp_path):
+    with atomic_output(tmp_path / "a.txt", hint=None) as tmp:
+        _write(tmp, "new")
+    assert os.stat(tmp_path / "a.txt").st_nlink == 1 and os.listdir(tmp_path) == ["a.txt"]

@@ -265,3 +265,94 @@ def test_ply_hexadecimal_reals_are_read_as_pymeshlab_reads_them(tmp_path):
     assert V.tolist() == [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
     with pytest.raises(ValueError, match="holds '0x1' where an integer"):
         check_before_loading(_ply(tmp_path, _PLY_HEAD + _PLY_V4 + "3 0 0x1 2\n3 0 2 3\n"))
+
+
+def _binary_ply(fmt, vertex_type, vertices, body_vertices=None):
+    import struct
+    order = "<" if fmt == "binary_little_endian" else ">"
+    code = {"float": "f", "double": "d"}[vertex_type]
+    header = (f"ply\nformat {fmt} 1.0\nelement vertex {vertices}\nproperty {vertex_type} x\n"
+              f"property {vertex_type} y\nproperty {vertex_type} z\nelement face 1\n"
+              "property list uchar int vertex_indices\nend_header\n").encode()
+    rows = [(0.1, 0.2, 0.3), (1, 0, 0), (0, 1, 0)][:vertices if body_vertices is None else body_vertices]
+    return header + b"".join(struct.pack(order + 3 * code, *row) for row in rows) + struct.pack(order + "B3i", 3, 0, 1, 2)
+
+
+def test_big_endian_double_vertices_are_refused_before_loading(tmp_path):
+    # pymeshlab read the big-endian double 0.1 as -1.5e-180 without a word
+    path = tmp_path / "be.ply"
+    path.write_bytes(_binary_ply("binary_big_endian", "double", 3))
+    with pytest.raises(ValueError, match=r"big-endian with vertex properties of type double \(x, y, z\).*"
+                                         r"save it as binary_little_endian or ASCII PLY"):
+        check_before_loading(path)
+
+
+@pytest.mark.parametrize("fmt, vertex_type", [("binary_big_endian", "float"), ("binary_little_endian", "double")])
+def test_binary_ply_pymeshlab_reads_right_is_read(tmp_path, fmt, vertex_type):
+    from curvdetail import read_mesh
+    path = tmp_path / "ok.ply"
+    path.write_bytes(_binary_ply(fmt, vertex_type, 3))
+    V, F = read_mesh(path)
+    np.testing.assert_allclose(V, [[0.1, 0.2, 0.3], [1, 0, 0], [0, 1, 0]], rtol=1e-7)
+    assert F.tolist() == [[0, 1, 2]]
+
+
+def test_binary_ply_shorter_than_its_header_s_counts_is_refused_before_loading(tmp_path):
+    # 20M vertices declared in a 225-byte file: pymeshlab took 1.6 GB and 3.3 s to say "Unexpected EOF"
+    path = tmp_path / "short.ply"
+    path.write_bytes(_binary_ply("binary_little_endian", "float", 20_000_000, body_vertices=3))
+    with pytest.raises(ValueError, match=r"declares 20000000 vertex, 1 face rows, which take at least 240000001 "
+                                         r"bytes, but only 49 follow the header"):
+        check_before_loading(path)
+    path.write_bytes(_binary_ply("binary_little_endian", "float", 5, body_vertices=3))  # 12 bytes short
+    with pytest.raises(ValueError, match=r"at least 61 bytes, but only 49 follow"):
+        check_before_loading(path)
+    path.write_bytes(_binary_ply("binary_little_endian", "float", 3))                    # exactly complete
+    assert check_before_loading(path) is None
+
+
+def _ply_with_a_list(count_type, item_type, items, element="vertex", vary=False):
+    import struct
+    count_code, item_code = {"uchar": "B", "int": "i", "ushort": "H"}[count_type], {"double": "d", "float": "f"}[item_type]
+    header = ("ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+              "property float z\n" + (f"property list {count_type} {item_type} feat\n" if element == "vertex" else "") +
+              "element face 1\nproperty list uchar int vertex_indices\n" +
+              (f"property list {count_type} {item_type} feat\n" if element == "face" else "") + "end_header\n")
+
+    def row(n):
+        return struct.pack("<" + count_code + item_code * n, n, *range(n))
+    sizes = [items, 1, 2] if vary else [items] * 3
+    body = b"".join(struct.pack("<3f", *v) + (row(n) if element == "vertex" else b"")
+                    for v, n in zip(((0, 0, 0), (1, 0, 0), (0, 1, 0)), sizes))
+    return header.encode() + body + struct.pack("<B3i", 3, 0, 1, 2) + (row(items) if element == "face" else b"")
+
+
+@pytest.mark.parametrize("count_type, item_type, items, element, vary, message", [
+    # more than 512 bytes of items: "*** buffer overflow detected ***", the process aborted
+    ("uchar", "double", 65, "vertex", False, r"the first vertex row's list 'feat' holds 65 items of 8 bytes, more than "
+                                             r"the 512 bytes"),
+    ("uchar", "float", 129, "vertex", True, r"list 'feat' holds 129 items of 4 bytes"),
+    ("uchar", "double", 100, "face", False, r"the first face row's list 'feat' holds 100 items of 8 bytes"),
+    # pymeshlab said "Unexpected EOF" (a damaged file) of these
+    ("int", "double", 2, "vertex", False, r"vertex list property 'feat' has counts of type int, which pymeshlab's "
+                                          r"binary PLY reader cannot skip"),
+    ("ushort", "double", 2, "vertex", False, r"has counts of type ushort"),
+])
+def test_binary_ply_lists_pymeshlab_cannot_skip_are_refused_before_loading(tmp_path, count_type, item_type, items,
+                                                                          element, vary, message):
+    path = tmp_path / "m.ply"
+    path.write_bytes(_ply_with_a_list(count_type, item_type, items, element, vary))
+    with pytest.raises(ValueError, match=message):
+        check_before_loading(path)
+
+
+@pytest.mark.parametrize("count_type, item_type, items, element", [
+    ("uchar", "double", 64, "vertex"), ("uchar", "float", 128, "vertex"), ("uchar", "double", 64, "face"),
+    ("int", "float", 2, "face"),
+])
+def test_binary_ply_lists_pymeshlab_skips_are_read(tmp_path, count_type, item_type, items, element):
+    from curvdetail import read_mesh
+    path = tmp_path / "m.ply"
+    path.write_bytes(_ply_with_a_list(count_type, item_type, items, element))
+    V, F = read_mesh(path)
+    assert V.tolist() == [[0, 0, 0], [1, 0, 0], [0, 1, 0]] and F.tolist() == [[0, 1, 2]]

@@ -4,7 +4,9 @@ Saving keeps what the format can hold: in PLY (binary, doubles) the vertex quali
 custom per-vertex attribute the filters wrote (``curvature_normal``, ``curvature_detail``,
 ``curvature_area``, ...; pymeshlab's PLY exporter options ``__ca_vp__<name>`` /
 ``__ca_vs__<name>``), read back by :func:`load_meshset`; OBJ, OFF and CTM hold the geometry and
-the vertex colours (:data:`VERTEX_COLOUR_FORMATS`), STL the geometry only. The file is written
+the vertex colours (:data:`VERTEX_COLOUR_FORMATS`), STL the geometry only. Vertex normals and
+colours are written only where the layer holds its own, not those pymeshlab computes or gives
+every mesh (:func:`vertex_normals_kept`, :func:`vertex_colours_kept_in`). The file is written
 from the MeshSet itself (pymeshlab crashes when a mesh with custom attributes is copied into
 another MeshSet and its attributes exported), to a temporary file in the same folder and
 renamed, so a failed save leaves nothing behind; an existing file is replaced only with
@@ -20,7 +22,7 @@ import weakref
 import numpy as np
 
 from .. import _output
-from ..io import MeshFileError, check_coordinates, check_mesh_output, input_path, load_checked, save_mesh
+from ..io import MeshFileError, _save, check_coordinates, check_mesh_output, input_path, load_checked, save_mesh
 from .meshset import WRITTEN_ATTRIBUTES, set_vertex_attribute, vertex_attribute
 from .ply_attributes import read_ply_vertex_attributes
 
@@ -90,10 +92,10 @@ def save_options(ms, path):
     never the quality: a "Quality" map without a "Color" one crashes pymeshlab's CTM reader, and
     with one it reads the colours' red channel as the quality (:mod:`curvdetail._ctm_scan`;
     :func:`load_meshset` reads the map itself, MeshLab and pymeshlab do not)."""
-    extension = os.path.splitext(os.fspath(path))[1].lower()
+    extension = os.path.splitext(os.fsdecode(path))[1].lower()      # a bytes one was b'.ply', never '.ply'
     if extension == ".ctm":
         return {"lossless": True, "save_vertex_quality": False,
-                "save_vertex_color": bool(ms.current_mesh().has_vertex_color())}
+                "save_vertex_color": vertex_colours_kept_in(ms, path)}     # not the white every built layer has
     if extension != ".ply":
         return {}
     mesh = ms.current_mesh()
@@ -115,7 +117,7 @@ def _attributes_on_current_mesh(ms):
 def attributes_lost_in(ms, path):
     """Names of the filters' custom attributes on the current mesh that ``path``'s format does
     not hold (all of them but for PLY), sorted."""
-    if os.path.splitext(os.fspath(path))[1].lower() == ".ply":
+    if os.path.splitext(os.fsdecode(path))[1].lower() == ".ply":
         return []
     return [name for name, _ in _attributes_on_current_mesh(ms)]
 
@@ -132,22 +134,44 @@ def vertex_colours_kept_in(ms, path):
     made from arrays, e.g. a filter's new layer, white ones, which say nothing) and the format
     holds them (:data:`VERTEX_COLOUR_FORMATS`)."""
     mesh = ms.current_mesh()
-    if os.path.splitext(os.fspath(path))[1].lower() not in VERTEX_COLOUR_FORMATS or not mesh.has_vertex_color():
+    if os.path.splitext(os.fsdecode(path))[1].lower() not in VERTEX_COLOUR_FORMATS or not mesh.has_vertex_color():
         return False
     return not bool(np.all(mesh.vertex_color_matrix() == 1.0))
+
+
+def vertex_normals_kept(ms):
+    """Whether :func:`save_current_mesh` writes the current mesh's vertex normals (where the
+    format holds them): they are not those pymeshlab derives from the geometry. pymeshlab gives
+    every mesh normals, computed (the angle-weighted sum of its faces' normals) where a file had
+    none and for a mesh made from arrays; written, they turned a plain OBJ into an OFF file
+    headed NOFF, and they say nothing a reader cannot compute. Normals pointing as the computed
+    ones do (any length) count as computed."""
+    import pymeshlab
+
+    mesh = ms.current_mesh()
+    normals = mesh.vertex_normal_matrix()
+    if normals.shape[0] == 0:
+        return False
+    computed = pymeshlab.Mesh(vertex_matrix=mesh.vertex_matrix(), face_matrix=mesh.face_matrix()).vertex_normal_matrix()
+    return not np.allclose(_unit(normals), _unit(computed), rtol=0.0, atol=1e-6)
+
+
+def _unit(vectors):
+    length = np.linalg.norm(vectors, axis=1, keepdims=True)
+    return np.divide(vectors, length, out=np.zeros(vectors.shape), where=length > 0)
 
 
 def save_current_mesh(ms, path, *, overwrite=False):
     """Atomically save the current mesh of ``ms`` (see the module docstring for what is kept).
     The layer itself is left as it is (.3ds: written from a copy, its faces given white where
-    they have no colour, as :func:`curvdetail.io.save_mesh` does).
+    they have no colour, as :func:`curvdetail.io.save_mesh` does). Vertex normals and colours
+    are written only where the layer really holds them (:func:`vertex_normals_kept`,
+    :func:`vertex_colours_kept_in`), not those pymeshlab computes or gives every mesh.
 
     Raises FileExistsError, MeshFileError (unknown or points-only format, a folder, missing
-    folder, pymeshlab failed)."""
-    import pymeshlab
-
-    check_output_path(path, overwrite)
-    if os.path.splitext(os.fspath(path))[1].lower() == ".3ds":
+    folder, a path that is not UTF-8, pymeshlab failed)."""
+    path = check_output_path(path, overwrite)        # a str from here on: a bytes one compared as b'.ply'
+    if os.path.splitext(path)[1].lower() == ".3ds":
         # from the layer itself the writer named the faces' material (no face colours) and set
         # their flags from uninitialised memory: the bytes differed from process to process.
         # 3DS holds no custom attributes, so the copy's (which crash an attribute export) stay unsaved.
@@ -155,9 +179,16 @@ def save_current_mesh(ms, path, *, overwrite=False):
         return
     options = save_options(ms, path)
     check_coordinates(path, ms.current_mesh().vertex_matrix(), **options)    # what the format cannot hold
+    # turned off where the format has the option (pymeshlab refuses one it lacks): what every
+    # mesh has, not the layer's own
+    optional = {}
+    if not vertex_normals_kept(ms):
+        optional["save_vertex_normal"] = False
+    if not vertex_colours_kept_in(ms, path):
+        optional["save_vertex_color"] = False
     with _output.atomic_output(path, overwrite=overwrite, hint=_HINT, error=MeshFileError) as tmp:
         try:
-            ms.save_current_mesh(tmp, **options)
-        except pymeshlab.PyMeshLabException as exc:
-            detail = " ".join(str(exc).replace(tmp, os.fspath(path)).split())
-            raise MeshFileError(f"could not write {os.fspath(path)!r}: {detail}") from None
+            _save(ms, tmp, options, optional)
+        except Exception as exc:
+            detail = " ".join(str(exc).replace(tmp, path).split()) or type(exc).__name__
+            raise MeshFileError(f"could not write {path!r}: {detail}") from None

@@ -12,6 +12,8 @@ import os
 
 import numpy as np
 
+from .._file_counts import _whole
+
 _SCALARS = {"char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1", "short": "i2", "int16": "i2",
             "ushort": "u2", "uint16": "u2", "int": "i4", "int32": "i4", "uint": "u4", "uint32": "u4",
             "float": "f4", "float32": "f4", "double": "f8", "float64": "f8"}
@@ -37,7 +39,11 @@ def _header(f):
         if words[0] == "format":
             fmt = words[1]
         elif words[0] == "element":
-            elements.append((words[1], int(words[2]), []))
+            # counts as pymeshlab's reader and the file scan read them ("3.0" is 3); others were refused
+            count = _whole(words[2].encode("ascii", "replace")) if len(words) >= 3 else None
+            if count is None or count < 0:
+                return None
+            elements.append((words[1], count, []))
         elif words[0] == "property" and elements:
             if words[1] == "list":
                 elements[-1][2].append((words[4], "list", _SCALARS.get(words[2]), _SCALARS.get(words[3])))
