@@ -207,3 +207,17 @@ def save_figure(fig, path, force, flag="--force", **savefig_options):
     fmt = os.path.splitext(path)[1].lstrip(".").lower() or "png"
     with atomic_output(path, overwrite=force, hint=None, error=FileNotFoundError, flag=flag) as tmp:
         fig.savefig(tmp, format=fmt, **savefig_options)
+
+
+def measured_conditions():
+    """``{"utc", "load_average", "peak_rss_gb"}``: when and under what load a script measured,
+    and this process's peak resident memory so far (``ru_maxrss``, as scripts/bench_*.py record
+    it), for its JSON; call it after the work."""
+    import datetime
+    import resource
+    import sys
+
+    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss    # KiB on Linux, bytes on macOS
+    return {"utc": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M:%S"),
+            "load_average": list(os.getloadavg()),
+            "peak_rss_gb": rss / 1024.0 ** (3 if sys.platform == "darwin" else 2)}

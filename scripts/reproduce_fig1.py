@@ -4,15 +4,20 @@
     deformed towards the reader;
 (b) cactus: three feature points (the tips of the two arms and the top) moved, everything
     else embedded from the precomputed curvature coefficients, the foot fixed;
-(c) mannequin_devil: the curvature details of the horn's tip scaled, with only the neck
-    boundary fixed in position, so that the whole head is reconstructed. The paper shortens the
-    curvature normals to lengthen the horn; with the detail D = K A constrained (rest areas),
-    D x 0.5 shortens the horn and D x 2 lengthens it, while the intensive curvature normal
-    |K| at the lengthened tip does get shorter (both are reported).
+(c) mannequin_devil: the curvature details of a horn's tip (the vertices within 3 % of the
+    diagonal of it) scaled, with only the neck boundary fixed in position, so that the whole
+    head is reconstructed. The paper shortens the curvature normals to lengthen the horn; with
+    the detail D = K A constrained (rest areas), D x 0.5 shortens the horn and D x 2 lengthens
+    it, while the intensive curvature normal |K| at the lengthened tip does get shorter (both
+    are reported, with the other horn's length and the head's height as controls).
 
-Feature points are found from the geometry (extreme vertices), the regions of interest by
-Euclidean distance. Every edit is one CurvatureEditor (constructor = all factoring) and one
-solve. Usage: python scripts/reproduce_fig1.py [--out out/fig1] [--docs docs] [--force]
+Feature points are found from the geometry (extreme vertices; the horn tips as the highest
+sharp local z-maxima on the face side, see ``horn_tips``), the regions of interest by
+Euclidean distance. The JSON holds each edit's settings (``config``, radii and moves as
+fractions of the bounding-box diagonal), sizes, and the run's time, load and peak memory.
+Every edit is one CurvatureEditor (constructor = all factoring) and one solve.
+
+Usage: python scripts/reproduce_fig1.py [--out out/fig1] [--docs docs] [--force]
 Writes OUT/fig1.json, OUT/fig1a.png, OUT/fig1b.png, OUT/fig1c.png (docs/editing_fig1.png with --docs),
 all together at the end (scripts/_outputs.py: none is written where one fails). Before any work,
 an existing one is refused unless --force is given (the picture in docs/ is in the repository:
@@ -37,14 +42,25 @@ from curvdetail.curvature._validate import bbox_diagonal
 
 Y_UP = np.array([[1.0, 0, 0], [0, 0, -1.0], [0, 1.0, 0]])   # display y-up models with z up
 
+#: the edits' settings; radii and moves are fractions of the bounding-box diagonal
+ELEPHANT = {"roi_radius": 0.25, "handle_radius": 0.04,
+            "left_ear_move": [-0.12, -0.05, 0.0],                 # lengthen the left ear
+            "right_ear_move": [0.0, 0.0, 0.15]}                   # right ear towards the reader
+CACTUS = {"handle_radius": 0.03, "foot_height": 0.12,             # foot: fraction of the height
+          "tip_moves": {"-y arm": [0.0, -0.1, 0.05], "+y arm": [0.1, 0.08, 0.0],
+                        "top": [-0.08, 0.0, 0.04]}}
+DEVIL = {"horn_radius": 0.03, "base_ring": [0.05, 0.06], "detail_scales": [0.5, 2.0],
+         "min_tip_curvature_over_median": 2.0}
+
 
 def near(V, i, radius):
     return np.flatnonzero(np.linalg.norm(V - V[i], axis=1) < radius)
 
 
-def summary(name, V, X, ed, seconds):
+def summary(name, V, F, X, ed, seconds, config):
     moved = np.linalg.norm(X - V, axis=1)
-    return {"model": name, "vertices": int(V.shape[0]), "roi": int(ed.roi.size),
+    return {"model": name, "vertices": int(V.shape[0]), "faces": int(F.shape[0]),
+            "config": config, "roi": int(ed.roi.size),
             "position_constrained": int(ed.position_constrained.size),
             "detail_constrained": int(ed.detail_constrained.size),
             "rank_deficient": ed.rank_deficient, "detail_islands": ed.detail_islands,
@@ -56,67 +72,107 @@ def elephant():
     V, F = read_mesh(os.path.join(MESHES, "elephant.obj"))       # y up, trunk towards +z
     diag = bbox_diagonal(V)
     left, right = int(np.argmin(V[:, 0])), int(np.argmax(V[:, 0]))  # the ear tips
-    roi = np.union1d(near(V, left, 0.25 * diag), near(V, right, 0.25 * diag))
-    hl, hr = near(V, left, 0.04 * diag), near(V, right, 0.04 * diag)
+    roi = np.union1d(near(V, left, ELEPHANT["roi_radius"] * diag),
+                     near(V, right, ELEPHANT["roi_radius"] * diag))
+    hl, hr = (near(V, i, ELEPHANT["handle_radius"] * diag) for i in (left, right))
     handles = np.concatenate([hl, hr])
     t = time.perf_counter()
     ed = CurvatureEditor(V, F, handles, handles, roi=roi)
     P = V[handles].copy()
-    P[:hl.size] += [-0.12 * diag, -0.05 * diag, 0.0]                # lengthen the left ear
-    P[hl.size:] += [0.0, 0.0, 0.15 * diag]                          # right ear towards the reader
+    P[:hl.size] += np.asarray(ELEPHANT["left_ear_move"]) * diag
+    P[hl.size:] += np.asarray(ELEPHANT["right_ear_move"]) * diag
     X = ed.solve(positions=P)
-    return V, F, X, summary("elephant", V, X, ed, time.perf_counter() - t), True
+    return V, F, X, summary("elephant", V, F, X, ed, time.perf_counter() - t, ELEPHANT), True
 
 
 def cactus():
     V, F = read_mesh(os.path.join(MESHES, "cactus.off"))           # z up
     diag = bbox_diagonal(V)
+    radius = CACTUS["handle_radius"] * diag
     tips = [int(np.argmin(V[:, 1])), int(np.argmax(V[:, 1])), int(np.argmax(V[:, 2]))]
-    foot = V[:, 2] < V[:, 2].min() + 0.12 * np.ptp(V[:, 2])
+    foot = V[:, 2] < V[:, 2].min() + CACTUS["foot_height"] * np.ptp(V[:, 2])
     roi = np.flatnonzero(~foot)
-    handles = np.unique(np.concatenate([near(V, i, 0.03 * diag) for i in tips]))
+    handles = np.unique(np.concatenate([near(V, i, radius) for i in tips]))
     t = time.perf_counter()
     ed = CurvatureEditor(V, F, handles, handles, roi=roi)           # coefficients precomputed here
     P = V[handles].copy()
-    for i, shift in zip(tips, ([0, -0.1, 0.05], [0.1, 0.08, 0.0], [-0.08, 0.0, 0.04])):
-        sel = np.linalg.norm(P - V[i], axis=1) < 0.03 * diag
+    for i, shift in zip(tips, CACTUS["tip_moves"].values()):
+        sel = np.linalg.norm(P - V[i], axis=1) < radius
         P[sel] += np.asarray(shift) * diag
     X = ed.solve(positions=P)
-    return V, F, X, summary("cactus", V, X, ed, time.perf_counter() - t), False
+    return V, F, X, summary("cactus", V, F, X, ed, time.perf_counter() - t, CACTUS), False
+
+
+def horn_tips(V, F, K):
+    """The two horn tips of mannequin_devil (z up, face towards -y): the two highest local
+    z-maxima (above every neighbour) on the face side (y below the middle) whose curvature normal
+    ``|K|`` is more than ``min_tip_curvature_over_median`` times the median, one on each side of
+    x = 0, the edited one first. The crown is higher than both but smooth (``|K|`` below the
+    median there). Raises ``ValueError`` where none is found, rather than edit something else."""
+    z = V[:, 2]
+    edges = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
+    highest_neighbour = np.full(V.shape[0], -np.inf)
+    np.maximum.at(highest_neighbour, edges[:, 0], z[edges[:, 1]])
+    np.maximum.at(highest_neighbour, edges[:, 1], z[edges[:, 0]])
+    curvature = np.linalg.norm(K, axis=1)
+    sharp = curvature > DEVIL["min_tip_curvature_over_median"] * np.median(curvature)
+    face_side = V[:, 1] < 0.5 * (V[:, 1].min() + V[:, 1].max())
+    candidates = np.flatnonzero((z > highest_neighbour) & sharp & face_side)
+    tips = []
+    for side in (V[:, 0] > 0, V[:, 0] < 0):
+        on_side = candidates[side[candidates]]
+        if on_side.size == 0:
+            raise ValueError("mannequin_devil: no sharp local z-maximum on the face side (y below the "
+                             "middle) at " + ("x > 0" if not tips else "x < 0") + "; the mesh is not "
+                             "the expected one (z up, face towards -y, horns on top): check "
+                             "$CURVDETAIL_MESHES/mannequin_devil.off.")
+        tips.append(int(on_side[np.argmax(z[on_side])]))
+    return tips
 
 
 def devil():
-    V, F = read_mesh(os.path.join(MESHES, "mannequin_devil.off"))  # z up, face towards +x
+    V, F = read_mesh(os.path.join(MESHES, "mannequin_devil.off"))  # z up, face towards -y
     diag = bbox_diagonal(V)
-    side = V[:, 1] > 0.25 * V[:, 1].max()
-    tip = int(np.flatnonzero(side)[np.argmax(V[side, 2])])          # tip of the +y horn
-    horn = near(V, tip, 0.03 * diag)
-    ring = np.setdiff1d(near(V, tip, 0.06 * diag), near(V, tip, 0.05 * diag))   # around its base
+    K0, _ = mean_curvature_normal(V, F)
+    tip, other = horn_tips(V, F, K0)                                # the x > 0 horn is edited
+    inner, outer = DEVIL["base_ring"]
+
+    def horn_length(X, i):
+        """Tip to the centre of the ring of vertices around the horn's base (rest distances)."""
+        ring = np.setdiff1d(near(V, i, outer * diag), near(V, i, inner * diag))
+        return np.linalg.norm(X[i] - X[ring].mean(0))
+
+    horn = near(V, tip, DEVIL["horn_radius"] * diag)
     neck = boundary_vertices(F)
     dc = np.concatenate([neck, horn])
     t = time.perf_counter()
     ed = CurvatureEditor(V, F, neck, dc)                            # whole head rebuilt
-    K0, _ = mean_curvature_normal(V, F)
     results = {}
-    for scale in (0.5, 2.0):
+    for scale in DEVIL["detail_scales"]:
         D = ed.detail[dc].copy()
         D[neck.size:] *= scale                                      # scale the horn's details
         X = ed.solve(details=D)
         K, _ = mean_curvature_normal(X, F)
         results[scale] = {
             "X": X,
-            "horn_length_ratio": float(np.linalg.norm(X[tip] - X[ring].mean(0))
-                                       / np.linalg.norm(V[tip] - V[ring].mean(0))),
+            "horn_length_ratio": float(horn_length(X, tip) / horn_length(V, tip)),
+            "other_horn_length_ratio": float(horn_length(X, other) / horn_length(V, other)),
+            "head_height_ratio": float(np.ptp(X[:, 2]) / np.ptp(V[:, 2])),
+            "max_move_fraction": float(np.linalg.norm(X - V, axis=1).max() / diag),
             "tip_curvature_normal_ratio": float(np.linalg.norm(K[horn], axis=1).mean()
                                                 / np.linalg.norm(K0[horn], axis=1).mean())}
-    X = results[2.0]["X"]
-    info = summary("mannequin_devil", V, X, ed, time.perf_counter() - t)
+    low, high = min(results), max(results)
+    X = results[high]["X"]
+    curvature = np.linalg.norm(K0, axis=1)
+    info = summary("mannequin_devil", V, F, X, ed, time.perf_counter() - t, DEVIL)
+    info.update(tip=tip, tip_position=V[tip].tolist(), other_tip=other,
+                horn_vertices=int(horn.size), tip_curvature_over_median=float(curvature[tip] / np.median(curvature)))
     for scale, r in results.items():
         info[f"detail_x{scale}"] = {k: v for k, v in r.items() if k != "X"}
-    info["extra_panel"] = (results[0.5]["X"],
-                           f"horn detail x0.5: horn length x{results[0.5]['horn_length_ratio']:.2f}")
-    info["edited_label"] = (f"horn detail x2: horn length x{results[2.0]['horn_length_ratio']:.2f},\n"
-                            f"|K| at the tip x{results[2.0]['tip_curvature_normal_ratio']:.2f}")
+    info["extra_panel"] = (results[low]["X"], f"horn detail x{low:g}: horn length "
+                                              f"x{results[low]['horn_length_ratio']:.2f}")
+    info["edited_label"] = (f"horn detail x{high:g}: horn length x{results[high]['horn_length_ratio']:.2f},\n"
+                            f"|K| at the tip x{results[high]['tip_curvature_normal_ratio']:.2f}")
     return V, F, X, info, False
 
 
@@ -126,13 +182,14 @@ def main(argv=None):
     ap.add_argument("--docs", default=None)
     ap.add_argument("--force", action="store_true", help="replace output files that exist")
     args = ap.parse_args(argv)
-    views = {"fig1a": (10, 0), "fig1b": (10, -90), "fig1c": (10, -30)}
+    # (elevation, azimuth); (c) shows both horns, the edited one in front
+    views = {"fig1a": (10, 0), "fig1b": (10, -90), "fig1c": (10, 20)}
     run = _outputs.Run(ap, [os.path.join(args.out, key + ".png") for key in views]
                        + [os.path.join(args.out, "fig1.json"),
                           os.path.join(args.docs, "editing_fig1.png") if args.docs else None],
                        args.force, makes=[args.out])
     require("elephant.obj", "cactus.off", "mannequin_devil.off")
-    report, docs_panels = [], []
+    report = []
     for key, make in (("fig1a", elephant), ("fig1b", cactus), ("fig1c", devil)):
         V, F, X, info, y_up = make()
         extra = info.pop("extra_panel", None)
@@ -146,26 +203,30 @@ def main(argv=None):
             panels.append((show(extra[0]), F, extra[1], np.linalg.norm(extra[0] - V, axis=1)))
         panels.append((show(X), F, label, moved))
         run.render_panels(os.path.join(args.out, key + ".png"), panels, elev=elev, azim=azim)
-        docs_panels += [(show(V), F, f"({key[-1]}) rest"), (show(X), F, f"({key[-1]}) edited", moved)]
         print(json.dumps(info))
     if args.docs:
-        # one small composite: rest / edited for each of (a), (b), (c); each pair its own camera
+        # one row per sub-figure, each picture at its own resolution (100 dpi, 4 in per panel):
+        # the labels stay readable
         import matplotlib
 
         matplotlib.use("Agg")
         import matplotlib.image as mpimg
         import matplotlib.pyplot as plt
 
-        fig, axes = plt.subplots(1, 3, figsize=(12, 3.2))
-        for ax, key in zip(axes, views):
-            ax.imshow(mpimg.imread(io.BytesIO(run.read(os.path.join(args.out, key + ".png")))))
+        pictures = [mpimg.imread(io.BytesIO(run.read(os.path.join(args.out, key + ".png")))) for key in views]
+        width = max(p.shape[1] for p in pictures)
+        fig, axes = plt.subplots(len(pictures), 1, figsize=(width / 100, sum(p.shape[0] for p in pictures) / 100),
+                                 gridspec_kw={"height_ratios": [p.shape[0] for p in pictures]})
+        for ax, picture in zip(axes, pictures):
+            ax.imshow(picture)
             ax.set_axis_off()
-        fig.tight_layout()
+        fig.subplots_adjust(left=0, right=1, bottom=0, top=1, hspace=0)
         try:
-            run.save_figure(fig, os.path.join(args.docs, "editing_fig1.png"), dpi=80)
+            run.save_figure(fig, os.path.join(args.docs, "editing_fig1.png"), dpi=100)
         finally:
             plt.close(fig)
-    run.write_json(os.path.join(args.out, "fig1.json"), report, indent=2)
+    run.write_json(os.path.join(args.out, "fig1.json"),
+                   {"edits": report, **_outputs.measured_conditions()}, indent=2)
     run.commit()
     return 0
 

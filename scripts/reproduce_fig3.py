@@ -2,25 +2,36 @@
 
 For every patch (mannequin_nose, mannequin_ear, elephant_trunk: the paper's Fig. 3 patches;
 terrainA_10k, camelhead, mannequin_disk_1k) the source is retriangulated once (isotropic, 1 % of
-the bbox diagonal) and every transfer configuration is run on that same target:
-transfer {conservative, pointwise} x rows {free, all} x location {closest, uv}. The default
-configuration is also run with decimation, and on terrainA_100k for the timing at 100k.
+the bbox diagonal: 5.4k-10.6k target vertices, from 640-11,381 source vertices) and every transfer
+configuration is run on that same target: transfer {conservative, pointwise} x rows {free, all}
+x location {closest, uv}. The default configuration is also run with decimation, and on
+terrainA_100k for the timing at 100k.
 
-Writes (paths relative to the repository):
-  out/fig3/results.json           every report
-  docs/fig3_table.md              the markdown tables (also copied into docs/remeshing.md,
-                                  between its <!-- fig3-table --> markers)
-  docs/fig3.png                   the Fig. 3 patches, default configuration
-With --quick (a subset) the tables go to out/fig3/table_quick.md and docs/ is left alone.
-The files are written all together at the end (scripts/_outputs.py: none is written where one
-fails); one that exists is refused before any work unless --force is given. The files in docs/
-are in the repository, so a full run (which refreshes them) takes --force.
+Usage: python scripts/reproduce_fig3.py [--out out/fig3] [--docs docs] [--readme README.md]
+                                        [--meshes DIR] [--quick] [--force]
+(DIR defaults to $CURVDETAIL_MESHES, else ../shared/meshes beside the repository; --out to
+out/fig3 in the repository.) Writes
+  OUT/results.json      every report, each with the retriangulation that made its target, the
+                        configurations that failed (with their error) and the peak memory
+  OUT/fig3_table.md     the markdown tables and the run's speed paragraph
+  OUT/fig3.png          the Fig. 3 patches, default configuration
+and with --docs DIR also DIR/fig3_table.md, DIR/fig3.png and the copy of the tables between
+the <!-- fig3-table --> markers of DIR/remeshing.md (where it has them); with --readme FILE the
+short table between FILE's <!-- fig3-readme-table --> markers. With --quick (a subset) only
+OUT/results.json and OUT/table_quick.md (--docs and --readme are refused: the committed files
+hold a full run). The files are written all together at the end (scripts/_outputs.py: none is
+written where one fails); one that exists is refused before any work unless --force is given,
+and so is a --docs folder that does not exist; a mesh missing from DIR stops the script before
+any work. The files in docs/ and README.md are in the repository: refreshing them is
+``--docs docs --readme README.md --force``.
 
-Usage: python scripts/reproduce_fig3.py [--meshes DIR] [--quick] [--force]
-(DIR defaults to $CURVDETAIL_MESHES, else ../shared/meshes beside the repository.)
+Exit status 0 when every configuration ran; 1 when one failed (everything is still written,
+the failure recorded in the JSON's ``failures`` and as a FAILED line in the tables); 2 for a
+refused output (a usage error).
 """
 
 import argparse
+import inspect
 import os
 import sys
 import time
@@ -29,16 +40,22 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import _outputs  # noqa: E402
+from _meshes import MESHES  # noqa: E402
 
 from curvdetail import read_mesh
+from curvdetail.curvature._validate import bbox_diagonal
 from curvdetail.remesh import retriangulate
 from curvdetail.remesh.experiment import run_experiment
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-#: where docs/remeshing.md holds its copy of the tables
-TABLE_BEGIN, TABLE_END = "<!-- fig3-table -->\n", "<!-- /fig3-table -->"
+#: where docs/remeshing.md holds its copy of the tables, and README.md its short table
+TABLE_MARKERS = ("<!-- fig3-table -->\n", "<!-- /fig3-table -->")
+README_MARKERS = ("<!-- fig3-readme-table -->\n", "<!-- /fig3-readme-table -->")
 PATCHES = ["mannequin_nose.obj", "mannequin_ear.obj", "elephant_trunk.obj", "terrainA_10k.obj",
            "camelhead.off", "mannequin_disk_1k.obj"]
+FIGURE_PATCHES = ("mannequin_nose.obj", "mannequin_ear.obj", "elephant_trunk.obj")
+PARAMETERIZATION_PATCHES = ("mannequin_nose.obj", "elephant_trunk.obj", "camelhead.off")
+PARAMETERIZATIONS = ("harmonic", "meshlab_harmonic", "lscm")
 CONFIGS = [  # (transfer, rows, location)
     ("conservative", "free", "closest"),
     ("conservative", "all", "closest"),
@@ -47,6 +64,17 @@ CONFIGS = [  # (transfer, rows, location)
     ("pointwise", "all", "closest"),
     ("pointwise", "all", "uv"),
 ]
+#: the retriangulation every transfer configuration of a patch shares, as passed to retriangulate
+SHARED_RETRIANGULATION = {"method": "isotropic", "target_edge": 0.01, "iterations": 10,
+                          "max_surface_distance": None, "surface_check": True}
+#: retriangulate's defaults, which run_experiment's own retriangulations take
+RETRIANGULATE_DEFAULTS = {name: p.default for name, p in inspect.signature(retriangulate).parameters.items()
+                          if p.default is not inspect.Parameter.empty}
+#: the default configuration run with decimation and on the 100k-vertex source:
+#: (method, mesh, target edge as a fraction of the bbox diagonal)
+EXTRA_RUNS = [("decimate", "mannequin_ear.obj", 0.03), ("decimate", "camelhead.off", 0.01),
+              ("decimate", "terrainA_10k.obj", 0.01)]
+EXTRA_RUNS_FULL = [("isotropic", "terrainA_100k.ply", 0.01), ("decimate", "terrainA_100k.ply", 0.01)]
 
 
 def pct(x, digits=3):
@@ -58,6 +86,11 @@ def _ratio(value, spec, suffix=""):
     return "n/a" if value is None else f"{value:{spec}}{suffix}"
 
 
+def _total(rep, t_retri=None):
+    """End-to-end seconds of a report, with a retriangulation made outside the experiment."""
+    return rep["seconds"]["total"] + (t_retri or 0.0)
+
+
 def row(name, rep, t_retri=None, method=None):
     """One table line; ``t_retri`` = the time of a retriangulation made outside the experiment
     (shared by several configurations), added to its stage times; ``method`` = how that
@@ -67,7 +100,7 @@ def row(name, rep, t_retri=None, method=None):
     improvement = rep["improvement_over_zero_detail"]          # None where an RMS is rounding
     ok = e["hausdorff_rms"] <= 1e-3 and e["hausdorff_max"] <= 1e-2 and (improvement is None or improvement >= 50)
     loc = o["location"] + (f" ({o['parameterization']})" if o["location"] == "uv" else "")
-    total = s["total"] + (t_retri or 0.0)
+    total = _total(rep, t_retri)
     t_retri = s["retriangulate"] if t_retri is None else t_retri
     return (f"| {name} | {rep['source']['vertices']:,} | {rep['target']['vertices']:,} | {method or o['method']} | "
             f"{o['transfer']} | {o['rows']} | {loc} | **{pct(e['hausdorff_rms'], 4)}** / {pct(e['hausdorff_max'])} | "
@@ -82,164 +115,332 @@ HEADER = ("| patch | source V | target V | retriangulation | transfer | rows | l
           "RMS / max (%) | zero-detail RMS / max (%) | floor RMS / max (%) | better than zero | RMS / floor | "
           "targets met | seconds: retriangulate / parameterize / transfer / reconstruct / evaluate / total |\n"
           "|---|---:|---:|---|---|---|---|---:|---:|---:|---:|---:|---|---|")
+README_HEADER = ("| patch | source V | target V | rebuilt RMS / max | zero detail RMS / max | floor RMS / max | "
+                 "better than zero detail | seconds |\n|---|---:|---:|---:|---:|---:|---:|---:|")
 
 
-def _with_table(doc, table):
-    """The text of ``doc`` with ``table`` between its markers, or None where there is no such
-    file or it has no markers (then it is not written)."""
+def readme_row(name, rep, t_retri=None):
+    """One line of README.md's short table (the same figures as :func:`row`'s)."""
+    e, b, f = rep["error"], rep["baseline_zero_detail"], rep["floor_retriangulated"]
+    return (f"| {name} | {rep['source']['vertices']:,} | {rep['target']['vertices']:,} | "
+            f"**{pct(e['hausdorff_rms'], 4)}** / {pct(e['hausdorff_max'])} | "
+            f"{pct(b['hausdorff_rms'], 2)} / {pct(b['hausdorff_max'], 1)} | "
+            f"{pct(f['hausdorff_rms'], 4)} / {pct(f['hausdorff_max'])} | "
+            f"{_ratio(rep['improvement_over_zero_detail'], ',.0f', 'x')} | {_total(rep, t_retri):.1f} |")
+
+
+def retriangulation_record(method, target_edge, diagonal, seconds, shared, **settings):
+    """What made a report's target, for the JSON: ``method``, ``target_edge`` (fraction of the
+    source's bbox diagonal) and ``target_edge_length`` (absolute), the other settings of
+    :func:`retriangulate` (``settings`` as passed, the rest its defaults), ``seconds``, and
+    ``shared``: True where the script made it once for all the patch's configurations (the
+    report's ``options.method`` then says "given"), False where ``run_experiment`` made it."""
+    relevant = ("iterations", "max_surface_distance", "surface_check") if method == "isotropic" else ("aggressiveness",)
+    record = {"method": method, "target_edge": target_edge, "target_edge_length": target_edge * diagonal}
+    record.update({name: settings.get(name, RETRIANGULATE_DEFAULTS[name]) for name in relevant})
+    record.update(seconds=None if seconds is None else round(seconds, 4), shared=shared)
+    return record
+
+
+def _with_table(doc, table, markers=TABLE_MARKERS):
+    """The text of ``doc`` with ``table`` between its ``markers``, or None where there is no
+    such file or it has no markers (then it is not written)."""
     if not os.path.exists(doc):
         return None
     with open(doc, encoding="utf-8") as fh:
         text = fh.read()
-    if TABLE_BEGIN not in text or TABLE_END not in text:
+    begin, end = markers
+    if begin not in text or end not in text:
         return None
-    return text[:text.index(TABLE_BEGIN) + len(TABLE_BEGIN)] + table + text[text.index(TABLE_END):]
+    return text[:text.index(begin) + len(begin)] + table + text[text.index(end):]
+
+
+def _missing_meshes(folder, names):
+    """The files of ``names`` that ``folder`` does not hold."""
+    return [name for name in names if not os.path.isfile(os.path.join(folder, name))]
+
+
+def speed_paragraph(timings, started, conditions):
+    """The run's speed, from the reports of the tables: ``timings`` maps a key
+    ("terrainA_10k", "camelhead", "terrainA_100k", "terrainA_100k decimate") to ``(report,
+    shared retriangulation seconds or None)``; keys that did not run are left out.
+    ``conditions``: scripts/_outputs.measured_conditions() at the end of the run."""
+    def total(key):
+        return _total(*timings[key])
+
+    def stage(key, name):
+        rep, t_retri = timings[key]
+        return t_retri if name == "retriangulate" and t_retri is not None else rep["seconds"][name]
+
+    parts, small = [], []
+    for key in ("terrainA_10k", "camelhead"):
+        if key in timings:
+            detail = key if key != "camelhead" else (
+                f"{key}, of which the isotropic remeshing {stage(key, 'retriangulate'):.1f} s and the "
+                f"evaluation {stage(key, 'evaluate'):.1f} s")
+            small.append(f"{total(key):.1f} s ({detail})")
+    if small:
+        parts.append("10k-vertex sources end to end " + " and ".join(small))
+    key = "terrainA_100k"
+    if key in timings:
+        parts.append(f"the 100k-vertex {key} {total(key):.1f} s (remeshing {stage(key, 'retriangulate'):.1f}, "
+                     f"transfer {stage(key, 'transfer'):.1f}, reconstruct {stage(key, 'reconstruct'):.2f}, "
+                     f"evaluate {stage(key, 'evaluate'):.1f})")
+    key = "terrainA_100k decimate"
+    if key in timings:
+        parts.append(f"decimated {total(key):.1f} s (decimation {stage(key, 'retriangulate'):.1f}, "
+                     f"evaluate {stage(key, 'evaluate'):.1f})")
+    return (f"**Speed** (this run, {started} UTC, {os.cpu_count()} cores shared with other work, load "
+            f"average {conditions['load_average'][0]:.1f} at its end; the default configuration, the "
+            "seconds of the tables above): " + "; ".join(parts) +
+            f". Peak memory of the whole run (one process): {conditions['peak_rss_gb']:.2f} GB.\n")
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    default_meshes = os.environ.get("CURVDETAIL_MESHES", os.path.join(ROOT, "..", "shared", "meshes"))
-    ap.add_argument("--meshes", default=default_meshes,
+    ap.add_argument("--out", default=os.path.join(ROOT, "out", "fig3"),
+                    help="folder for results.json, the tables and the picture (default: out/fig3 in the repository)")
+    ap.add_argument("--docs", default=None,
+                    help="also refresh DOCS/fig3_table.md, DOCS/fig3.png and the tables in DOCS/remeshing.md")
+    ap.add_argument("--readme", default=None,
+                    help="also refresh the short table between README's <!-- fig3-readme-table --> markers")
+    ap.add_argument("--meshes", default=MESHES,
                     help="folder of the public meshes (default: $CURVDETAIL_MESHES, else ../shared/meshes)")
     ap.add_argument("--quick", action="store_true",
-                    help="default configuration only, no 100k run; writes out/fig3/ only, not docs/")
-    ap.add_argument("--force", action="store_true",
-                    help="replace output files that exist (a full run refreshes the committed docs/ files)")
+                    help="default configuration only, no 100k run; writes OUT/results.json and "
+                         "OUT/table_quick.md only")
+    ap.add_argument("--force", action="store_true", help="replace output files that exist")
     args = ap.parse_args(argv)
     meshes = args.meshes
-    results_json = os.path.join(ROOT, "out", "fig3", "results.json")
+    if args.quick and (args.docs or args.readme):
+        ap.error("--docs and --readme refresh the committed tables and picture, which hold a full run; "
+                 "leave out --quick (or --docs / --readme).")
+    results_json = os.path.join(args.out, "results.json")
+    figure = docs_figure = doc = docs_table = None
     if args.quick:
-        table_file, doc, figure = os.path.join(ROOT, "out", "fig3", "table_quick.md"), None, None
+        table_file = os.path.join(args.out, "table_quick.md")
     else:
-        table_file = os.path.join(ROOT, "docs", "fig3_table.md")
-        doc = os.path.join(ROOT, "docs", "remeshing.md")     # the copy between its markers, if it has them
-        if _with_table(doc, "") is None:
-            doc = None
-        figure = os.path.join(ROOT, "docs", "fig3.png")
-    run = _outputs.Run(ap, [results_json, table_file, doc, figure], args.force,
-                       makes=[os.path.join(ROOT, "out", "fig3")])
+        table_file, figure = os.path.join(args.out, "fig3_table.md"), os.path.join(args.out, "fig3.png")
+        if args.docs is not None:
+            docs_table, docs_figure = os.path.join(args.docs, "fig3_table.md"), os.path.join(args.docs, "fig3.png")
+            doc = os.path.join(args.docs, "remeshing.md")     # the copy between its markers, if it has them
+            if _with_table(doc, "") is None:
+                doc = None
+    if args.readme is not None and _with_table(args.readme, "", README_MARKERS) is None:
+        why = ("does not exist" if not os.path.isfile(args.readme) else
+               f"has no {README_MARKERS[0].strip()} ... {README_MARKERS[1]} block to refresh")
+        ap.error(f"--readme {args.readme} {why}; name the repository's README.md, or leave out --readme.")
+    run = _outputs.Run(ap, [results_json, table_file, figure, docs_table, doc, docs_figure, args.readme],
+                       args.force, makes=[args.out])
     if not os.path.isdir(meshes):
         ap.error(f"mesh folder {meshes!r} does not exist; pass --meshes DIR or set CURVDETAIL_MESHES")
-    results, lines_main, lines_all = [], [], []
-    figure_inputs = {}
+    extra_runs = EXTRA_RUNS + ([] if args.quick else EXTRA_RUNS_FULL)
+    needed = dict.fromkeys(PATCHES + [name for _, name, _ in extra_runs])
+    missing = _missing_meshes(meshes, needed)
+    if missing:     # before any work (as _meshes.require, with --meshes as the fix)
+        sys.exit(f"{os.path.basename(sys.argv[0])}: {meshes!r} does not hold {', '.join(missing)}; pass "
+                 "--meshes DIR (or set CURVDETAIL_MESHES) naming the folder of the public meshes "
+                 "(../shared/meshes beside the repository).")
+
+    started = time.strftime("%Y-%m-%d %H:%M", time.gmtime())
+    results, failures, lines_main, lines_all, lines_readme = [], [], [], [], []
+    figure_inputs, timings = {}, {}
+
+    def record(rep, retriangulation):
+        peak = _outputs.measured_conditions()["peak_rss_gb"]       # the process's, so far
+        entry = dict(rep, retriangulation=retriangulation, peak_rss_gb_so_far=round(peak, 3))
+        if retriangulation["shared"]:
+            entry["seconds_retriangulate_shared"] = retriangulation["seconds"]
+        results.append(entry)
+
+    def failed(name, configuration, exc, retriangulation):
+        print(f"{name} {' '.join(map(str, configuration.values()))}: FAILED {exc}", file=sys.stderr)
+        failures.append({"source": name, "configuration": configuration,
+                         "error": f"{type(exc).__name__}: {exc}", "retriangulation": retriangulation})
+
     configs = CONFIGS[:1] if args.quick else CONFIGS
     for name in PATCHES:
         V, F = read_mesh(os.path.join(meshes, name))
         t = time.perf_counter()
-        Vt, Ft = retriangulate(V, F, method="isotropic", target_edge=0.01)
+        Vt, Ft = retriangulate(V, F, **SHARED_RETRIANGULATION)
         t_retri = time.perf_counter() - t
+        retri = retriangulation_record(diagonal=bbox_diagonal(V), seconds=t_retri, shared=True,
+                                       **SHARED_RETRIANGULATION)
         for transfer, rows, location in configs:
             try:
                 out = run_experiment(V, F, transfer=transfer, rows=rows, location=location, target=(Vt, Ft),
                                      source_path=name)
             except Exception as exc:  # a failure is a result too: record it
-                print(f"{name} {transfer} {rows} {location}: FAILED {exc}", file=sys.stderr)
+                failed(name, dict(transfer=transfer, rows=rows, location=location), exc, retri)
                 lines_all.append(f"| {name} | {V.shape[0]:,} | {Vt.shape[0]:,} | isotropic | {transfer} | {rows} | "
                                  f"{location} | FAILED: {exc} |")
                 continue
             rep = out["report"]
-            results.append(dict(rep, seconds_retriangulate_shared=round(t_retri, 4)))
-            line = row(name.rsplit(".", 1)[0], rep, t_retri, method="isotropic")
+            record(rep, retri)
+            short = name.rsplit(".", 1)[0]
+            line = row(short, rep, t_retri, method="isotropic")
             lines_all.append(line)
             if (transfer, rows, location) == CONFIGS[0]:
                 lines_main.append(line)
-                if name in ("mannequin_nose.obj", "mannequin_ear.obj", "elephant_trunk.obj"):
+                lines_readme.append(readme_row(short, rep, t_retri))
+                timings[short] = (rep, t_retri)
+                if name in FIGURE_PATCHES:
                     figure_inputs[name] = (V, F, out)
             print(line, flush=True)
     params = []
     if not args.quick:
-        for name in ("mannequin_nose.obj", "elephant_trunk.obj", "camelhead.off"):
+        for name in PARAMETERIZATION_PATCHES:
             V, F = read_mesh(os.path.join(meshes, name))
-            Vt, Ft = retriangulate(V, F, method="isotropic", target_edge=0.01)
-            for param in ("harmonic", "meshlab_harmonic", "lscm"):
+            t = time.perf_counter()     # made again, as above (the same target)
+            Vt, Ft = retriangulate(V, F, **SHARED_RETRIANGULATION)
+            t_retri = time.perf_counter() - t
+            retri = retriangulation_record(diagonal=bbox_diagonal(V), seconds=t_retri, shared=True,
+                                           **SHARED_RETRIANGULATION)
+            for param in PARAMETERIZATIONS:
                 try:
                     out = run_experiment(V, F, location="uv", parameterization=param, target=(Vt, Ft),
                                          source_path=name)
                 except Exception as exc:
-                    print(f"{name} uv {param}: FAILED {exc}", file=sys.stderr)
+                    failed(name, dict(transfer="conservative", rows="free", location="uv", parameterization=param),
+                           exc, retri)
                     params.append(f"| {name} | {V.shape[0]:,} | {Vt.shape[0]:,} | isotropic | conservative | free | "
                                   f"uv ({param}) | FAILED: {exc} |")
                     continue
                 rep = out["report"]
-                results.append(rep)
-                line = row(name.rsplit(".", 1)[0], rep, method="isotropic")
+                record(rep, retri)
+                line = row(name.rsplit(".", 1)[0], rep, t_retri, method="isotropic")
                 pi = rep["parameterization"]
                 params.append(line + f" {pi['flipped_source']} / {pi['flipped_target']} |")
                 print(params[-1], flush=True)
     extra = []
-    runs = [("decimate", "mannequin_ear.obj", 0.03), ("decimate", "camelhead.off", 0.01),
-            ("decimate", "terrainA_10k.obj", 0.01)]
-    if not args.quick:
-        runs += [("isotropic", "terrainA_100k.ply", 0.01), ("decimate", "terrainA_100k.ply", 0.01)]
-    for method, name, target_edge in runs:
+    for method, name, target_edge in extra_runs:
         V, F = read_mesh(os.path.join(meshes, name))
         try:
             out = run_experiment(V, F, method=method, target_edge=target_edge, source_path=name)
         except Exception as exc:
-            print(f"{name} {method}: FAILED {exc}", file=sys.stderr)
+            failed(name, dict(method=method, target_edge=target_edge), exc,
+                   retriangulation_record(method, target_edge, bbox_diagonal(V), None, False))
             extra.append(f"| {name} | {V.shape[0]:,} | - | {method} | FAILED: {exc} |")
             continue
         rep = out["report"]
-        results.append(rep)
-        line = row(name.rsplit(".", 1)[0] + (f" ({100 * target_edge:g} %)" if target_edge != 0.01 else ""), rep)
+        record(rep, retriangulation_record(method, target_edge, rep["source"]["bbox_diagonal"],
+                                                 rep["seconds"]["retriangulate"], False))
+        short = name.rsplit(".", 1)[0]
+        line = row(short + (f" ({100 * target_edge:g} %)" if target_edge != 0.01 else ""), rep)
         extra.append(line)
+        if name == "terrainA_100k.ply":
+            timings[short + (" decimate" if method == "decimate" else "")] = (rep, None)
+            if method == "isotropic":
+                lines_readme.append(readme_row(short, rep))
         print(line, flush=True)
-    run.write_json(results_json, results, indent=1)
+
+    conditions = _outputs.measured_conditions()     # utc (the end), load_average, peak_rss_gb
+    run.write_json(results_json, {
+        "started_utc": started, **conditions, "cpus": os.cpu_count(), "status": "failed" if failures else "ok",
+        "notes": ("reports: every configuration that ran, each with the retriangulation that made its "
+                  "target (shared: made once by the script for all the patch's configurations, given "
+                  "to run_experiment, whose options then say method 'given') and the process's peak "
+                  "memory after it (peak_rss_gb_so_far; one process runs everything); failures: the "
+                  "configurations that raised, with the error"),
+        "reports": results, "failures": failures}, indent=1)
     table = ("### Default configuration (isotropic 1 %, conservative transfer, free rows, closest-point location)\n\n"
              f"{HEADER}\n" + "\n".join(lines_main) +
              "\n\n### Every transfer configuration on the same targets\n\n" + f"{HEADER}\n" + "\n".join(lines_all) +
              "\n\n### Decimation, and a 100k-vertex source (default transfer)\n\n" + f"{HEADER}\n" + "\n".join(extra) +
              "\n")
     if params:
-        table += ("\n### Planar domains for the location (conservative transfer, free rows; retriangulation time "
-                  "not counted)\n\n" + HEADER.replace(" |\n|", " | flipped source / target |\n|", 1) + "---|\n"
+        table += ("\n### Planar domains for the location (conservative transfer, free rows; the same "
+                  "retriangulation, made again)\n\n"
+                  + HEADER.replace(" |\n|", " | flipped source / target |\n|", 1) + "---|\n"
                   + "\n".join(params) + "\n")
-    # --quick: a subset; the committed tables and figure in docs/ stay as they are
+    table += "\n" + speed_paragraph(timings, started, conditions)
     run.write_text(table_file, table)
+    if docs_table is not None:
+        run.write_text(docs_table, table)
     text = _with_table(doc, table) if doc else None
-    if text is not None:      # refresh the copy between the markers in docs/remeshing.md
+    if text is not None:      # refresh the copy between the markers in DOCS/remeshing.md
         run.write_text(doc, text)
+    if args.readme is not None:
+        run.write_text(args.readme, _with_table(
+            args.readme, f"Seconds end to end from the run of {started} UTC (the tables in docs/remeshing.md).\n\n"
+                         f"{README_HEADER}\n" + "\n".join(lines_readme) + "\n", README_MARKERS))
     if figure is not None and figure_inputs:
         with run.stage(figure) as tmp:
             _figure(figure_inputs, tmp)
+        if docs_figure is not None:
+            with run.stage(docs_figure) as tmp, open(tmp, "wb") as fh:
+                fh.write(run.read(figure))
     run.commit()
     print(table)
+    if failures:
+        print(f"{len(failures)} configuration(s) failed: "
+              + "; ".join(f"{f['source']} {f['error']}" for f in failures), file=sys.stderr)
+        return 1
+    return 0
+
+
+#: the rebuilt panels' colours, distance 0 to the row's largest: the plain panels' light
+#: blue-grey, then amber, then red (shaded like the plain panels, so the shape reads as well)
+DISTANCE_COLOURS = [(0.75, 0.78, 0.85), (0.98, 0.78, 0.30), (0.78, 0.08, 0.06)]
+LIGHT = np.array([0.3, -0.4, 0.87])     # curvdetail.remesh.figure._draw's
 
 
 def _figure(inputs, path, force=False):
+    """The Fig. 3 picture: one row per patch (source, rebuilt target coloured by each vertex's
+    distance to the source with a colour bar in % of the bbox diagonal, zero-detail baseline),
+    drawn as curvdetail.remesh.figure draws one experiment. ``inputs``: ``{name: (V, F,
+    run_experiment's dict)}``."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.cm import ScalarMappable
+    from matplotlib.colors import LinearSegmentedColormap, Normalize
 
     from curvdetail.remesh.figure import _draw, _view_frame
 
-    fig = plt.figure(figsize=(10, 3.2 * len(inputs)))
+    cmap = LinearSegmentedColormap.from_list("distance", DISTANCE_COLOURS)
+    fig = plt.figure(figsize=(10.5, 3.4 * len(inputs)))
     for r, (name, (V, F, out)) in enumerate(inputs.items()):
         rep = out["report"]
         R = _view_frame(V, F)
         centre = 0.5 * (V.max(0) + V.min(0))
         P = (V - centre) @ R.T
         scale = float((P.max(0) - P.min(0)).max())
+        diagonal = bbox_diagonal(V)
         e, b = rep["error"], rep["baseline_zero_detail"]
-        panels = [(V, F, None, f"{name.rsplit('.', 1)[0]}: {V.shape[0]:,} vertices"),
-                  (out["X"], out["Ft"], out["distance"],
-                   f"rebuilt, {rep['target']['vertices']:,} vertices\nRMS {pct(e['hausdorff_rms'])} %, "
-                   f"max {pct(e['hausdorff_max'], 2)} %"),
-                  (out["Z"], out["Ft"], None,
-                   f"zero detail\nRMS {pct(b['hausdorff_rms'], 2)} %, max {pct(b['hausdorff_max'], 1)} %")]
-        for c, (X, T, val, title) in enumerate(panels):
-            ax = fig.add_subplot(len(inputs), 3, 3 * r + c + 1, projection="3d")
-            _draw(ax, X, T, R, centre, scale, values=val,
-                  vmax=None if val is None else float(val.max()), title=title)
-    fig.suptitle("Fig. 3 patches rebuilt from transferred curvature detail (colour: distance to the source, "
-                 "0 to its max)\n% of the source bbox diagonal", fontsize=9)
+        axes = [fig.add_subplot(len(inputs), 3, 3 * r + c + 1, projection="3d") for c in range(3)]
+        _draw(axes[0], V, F, R, centre, scale, title=f"{name.rsplit('.', 1)[0]}: {V.shape[0]:,} vertices")
+        _draw(axes[2], out["Z"], out["Ft"], R, centre, scale,
+              title=f"zero detail\nRMS {pct(b['hausdorff_rms'], 2)} %, max {pct(b['hausdorff_max'], 1)} %")
+        X, T, distance = out["X"], out["Ft"], out["distance"]
+        _draw(axes[1], X, T, R, centre, scale,
+              title=f"rebuilt, {rep['target']['vertices']:,} vertices\nRMS {pct(e['hausdorff_rms'])} %, "
+                    f"max {pct(e['hausdorff_max'], 2)} %")
+        vmax = max(float(distance.max()), np.finfo(float).tiny)
+        Q = (X - centre) @ R.T
+        normal = np.cross(Q[T[:, 1]] - Q[T[:, 0]], Q[T[:, 2]] - Q[T[:, 0]])
+        normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), np.finfo(float).tiny)
+        shade = 0.35 + 0.65 * np.clip(np.abs(normal @ LIGHT), 0, 1)
+        colour = cmap(np.clip(distance[T].mean(1) / vmax, 0, 1))
+        colour[:, :3] *= shade[:, None]
+        surface = axes[1].collections[-1]
+        surface.set_facecolor(colour)
+        surface.set_edgecolor(colour)       # fills the hairline seams between triangles
+        surface.set_linewidth(0.3)
+        # in the panel's own lower margin, so that the rebuilt surface is drawn as large as the others
+        bar = fig.colorbar(ScalarMappable(Normalize(0, 100 * vmax / diagonal), cmap),
+                           cax=axes[1].inset_axes([0.15, 0.1, 0.7, 0.035]), orientation="horizontal")
+        bar.set_label("distance to the source, % of the bbox diagonal", fontsize=8)
+        bar.ax.tick_params(labelsize=7)
+    fig.subplots_adjust(hspace=0.25)
+    fig.suptitle("Fig. 3 patches rebuilt from transferred curvature detail (default configuration; all "
+                 "figures % of the source's bbox diagonal)", fontsize=10)
     try:
-        _outputs.save_figure(fig, path, force, dpi=70, bbox_inches="tight")
+        _outputs.save_figure(fig, path, force, dpi=80, bbox_inches="tight")
     finally:
         plt.close(fig)
 
 
 if __name__ == "__main__":
-    np.seterr(all="ignore")
-    main()
+    sys.exit(main())

@@ -210,7 +210,7 @@ def test_the_filter_warns_where_curvdetail_edit_exits_with_status_4(tmp_path, ca
 def test_detail_scale_below_1_shortens_a_protrusion_and_the_description_says_so():
     # the description said "a factor below 1 shortens them, which lengthens a protrusion"; the
     # detail D = K A is constrained, and the nose's tip details x0.5 shorten the nose (x0.80), x2
-    # lengthen it (x1.42), as the horn of mannequin_devil (scripts/reproduce_fig1.py)
+    # lengthen it (x1.42), as a horn of mannequin_devil (x0.48 / x2.04, scripts/reproduce_fig1.py)
     from curvdetail.curvature import boundary_vertices
 
     description = get_filter("apply_curvature_editing").parameter("detail_scale").description

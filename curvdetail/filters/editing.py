@@ -127,8 +127,8 @@ def _matrix(text):
         Parameter("detail_scale", "float", 1.0,
                   "factor on the handles' curvature details D = K A after the transform (1 keeps "
                   "them); below 1 flattens what the handles sit on, above 1 sharpens it "
-                  "(mannequin_devil, move_handles=false, the horn's tip as handles: x0.5 makes the "
-                  "horn 0.91-0.93 times as long, x2 1.19-1.23 times, region_radius 10-20 %)",
+                  "(mannequin_devil, move_handles=false, a horn's tip as handles: x0.5 makes the "
+                  "horn 0.49-0.50 times as long, x2 2.01-2.02 times, region_radius 10-20 %)",
                   positive=True),
         Parameter("move_handles", "bool", True,
                   "constrain the handles' positions to the transformed ones; false constrains "
