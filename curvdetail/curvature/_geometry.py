@@ -1,5 +1,6 @@
 """Per-triangle quantities shared by the cotangent Laplacian and the mixed Voronoi area."""
 
+import functools
 import os
 from concurrent.futures import ThreadPoolExecutor
 
@@ -10,6 +11,20 @@ import numpy as np
 THREADED_TRIANGLES = 200_000
 
 _pool = None
+
+
+def ignoring_underflow(function):
+    """``function`` run with numpy's underflow ignored, whatever the caller's ``np.seterr``.
+
+    Squares and products of a tiny coordinate or detail component (a triangle or ring almost in
+    a coordinate plane) underflow to zero next to the other components, which carry the result;
+    under ``np.seterr(all="raise")`` they raised FloatingPointError on valid meshes. The
+    caller's other settings (overflow, invalid, divide) stay as they are."""
+    @functools.wraps(function)
+    def quiet(*args, **kwargs):
+        with np.errstate(under="ignore"):
+            return function(*args, **kwargs)
+    return quiet
 
 
 def _thread_count():
@@ -43,7 +58,10 @@ def corner_cotangents(V, F, *, lengths=True):
     bounds = np.linspace(0, m, threads + 1).astype(int)
     blocks = [slice(a, b) for a, b in zip(bounds[:-1], bounds[1:])]
 
-    caller_errstate = np.geterr()     # numpy's error state is per thread: take the caller's along
+    # numpy's error state is per thread: take the caller's along. Underflow is no error here: the
+    # square of a tiny cross-product component (a triangle almost in a coordinate plane) is
+    # negligible next to the others (np.seterr(all="raise") raised on such a valid mesh)
+    caller_errstate = {**np.geterr(), "under": "ignore"}
 
     def block(s):
         with np.errstate(**caller_errstate):

@@ -7,7 +7,7 @@ import warnings
 
 import numpy as np
 
-from ._geometry import folded_triangles
+from ._geometry import folded_triangles, ignoring_underflow
 from ._validate import (MIN_DIAGONAL, ZERO_AREA_RELATIVE, _check_magnitude, _compact_ids, as_faces, as_values,
                         as_vertices, bbox_diagonal, boundary_edges, check_bool, check_choice, check_mesh,
                         check_oriented, face_double_areas, vertex_components)
@@ -18,6 +18,7 @@ from .errors import ConstraintError, FoldedTrianglesWarning, MeshError, counted,
 from .sparse_solver import factorize, resolve_backend
 
 
+@ignoring_underflow
 def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="one-ring",
                   rcond=DEFAULT_RCOND, backend="auto", return_info=False):
     """Move the boundary of a disk-topology patch and rebuild the surface from its detail.
@@ -271,8 +272,8 @@ def _check_provisional_surface(Vp, F, P, Q):
     else:
         what = "collapses part of the boundary loop (e.g. a vertex onto its neighbour)"
     raise ConstraintError(
-        f"the displacement {what}: {zero.size} triangles of the provisional surface whose detail gives the "
-        f"boundary's (boundary_detail='deformed') have zero area (first: {first_indices(zero)}), so the "
+        f"the displacement {what}: {counted(zero.size, 'triangle')} of the provisional surface whose detail gives the "
+        f"boundary's (boundary_detail='deformed') {'has' if zero.size == 1 else 'have'} zero area (first: {first_indices(zero)}), so the "
         "boundary's new curvature detail is undefined. Use a displacement that keeps the loop open, or "
         "boundary_detail='rest' (the boundary keeps its rest detail).")
 
@@ -376,7 +377,7 @@ def boundary_loop(F):
     _, first, counts = np.unique(corners, axis=0, return_index=True, return_counts=True)
     if np.any(counts > 1):
         twice = np.sort(first[counts > 1])
-        raise MeshError(f"{twice.size} triangles appear more than once (first: "
+        raise MeshError(f"{counted(twice.size, 'triangle', verb='appear')} more than once (first: "
                         f"{', '.join(map(str, twice[:3]))}), which takes their edges off the boundary; "
                         "remove the copies (e.g. pymeshlab's meshing_remove_duplicate_faces).")
     check_oriented(F)

@@ -5,6 +5,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from ._geometry import ignoring_underflow
 from ._validate import as_count, as_float, centroid_diameter, check_bool
 from .cotan_laplacian import checked_cotan_laplacian, laplacian_product
 from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
@@ -209,6 +210,7 @@ def check_rcond(rcond):
 SVD_BAND = (1e-7, 1e-3)
 
 
+@ignoring_underflow
 def _coefficients(D, A, rows, cols, n, rcond, size, *, want_scale=False, max_ring=1, adjacency=None,
                   indptr=None):
     """Batched truncated pseudo-inverse solve over the pattern (rows, cols), sorted by row.
@@ -486,7 +488,7 @@ def _fit(Di, U, sigma, area_scale, rcond):
     s_ref = np.maximum(sigma.max(axis=1), area_scale)
     keep = sigma > rcond * s_ref[:, None]
     proj = np.einsum("tab,ta->tb", U, Di)                            # U^T D_i
-    with np.errstate(divide="ignore"):
+    with np.errstate(divide="ignore", over="ignore"):      # sigma's that are not kept may be ~0
         inv = np.where(keep, 1.0 / sigma ** 2, 0.0)
     w = np.einsum("tab,tb->ta", U, proj * inv)
     fitted = np.einsum("tab,tb->ta", U, proj * keep)

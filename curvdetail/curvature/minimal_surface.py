@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ._geometry import corner_cotangents
+from ._geometry import corner_cotangents, ignoring_underflow
 from ._validate import (check_choice, ZERO_AREA_RELATIVE, as_count, as_index_set, as_positive_number, bbox_centre,
                         bbox_diagonal, boundary_vertices, check_every_component_fixed, misoriented_edges,
                         undirected_edges, vertex_components)
@@ -120,6 +120,7 @@ def _piece_diagonals(V, F, adjacency):
     return piece[labels]
 
 
+@ignoring_underflow
 def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, step="normal", backend="auto",
                     callback=None):
     """Minimal surface with the ``fixed`` vertices kept: the paper's validity check, ``D = 0``.
