@@ -15,6 +15,8 @@ import re
 
 import numpy as np
 
+from .curvature.errors import counted
+
 _CHUNK = 1 << 20
 _HEADER_LINES = 10_000
 
@@ -154,7 +156,7 @@ def check_loaded(path, n_vertices, F, error=ValueError):
     F = np.asarray(F)
     if F.size and (F.min() < 0 or F.max() >= n_vertices):
         bad = np.flatnonzero((F < 0).any(axis=1) | (F >= n_vertices).any(axis=1))
-        raise error(f"{path!r}: {bad.size} faces use vertex indices outside the file's {n_vertices} "
+        raise error(f"{path!r}: {counted(bad.size, 'face', verb='use')} vertex indices outside the file's {n_vertices} "
                     f"vertices (first: face {bad[0]}, {F[bad[0]].tolist()} 0-based); fix or remove "
                     "them in the file and read it again.")
     vertices, faces = declared_counts(path)

@@ -27,6 +27,7 @@ import numpy as np
 from ._ctm_scan import ctm_problem
 from ._file_counts import _obj_counts, _off_header, _stl_ascii_counts, _whole
 from ._ply_scan import _ply_problem
+from .curvature.errors import counted
 
 
 def check_before_loading(path, error=ValueError):
@@ -107,7 +108,7 @@ def check_before_loading(path, error=ValueError):
     if extension == ".stl":
         facets, vertex_lines = _stl_ascii_counts(path)
         if facets is not None and vertex_lines != 3 * facets:
-            raise error(f"{path!r} is an ASCII STL file of {facets} facets with {vertex_lines} vertex lines, not "
+            raise error(f"{path!r} is an ASCII STL file of {counted(facets, 'facet')} with {counted(vertex_lines, 'vertex line')}, not "
                         f"3 a facet ({3 * facets}): pymeshlab's STL loader reads each facet as the triangle of "
                         "its first 3 and drops the others without a word (a facet of 4 was read as one "
                         "triangle); split such facets into triangles and read the file again.")
@@ -786,7 +787,8 @@ def _off_rows_problem(path, made=None):
 
     def too_short():
         # pymeshlab fills the missing rows from what follows: a triangle came back twice
-        return (f"the header declares {nv} vertices and {nf} faces, but the file holds {rows.size} rows "
+        return (f"the header declares {counted(nv, 'vertex', 'vertices')} and {counted(nf, 'face')}, but the file "
+                f"holds {counted(rows.size, 'row')} "
                 f"after it (truncated, or the counts are wrong)" +
                 ("" if colours else _split_note(rows[:taken], per_row[:taken], per_vertex, first_line)))
 
@@ -833,7 +835,8 @@ def _off_rows_problem(path, made=None):
     if after.size:
         # pymeshlab stops after the declared faces: the rest was dropped without a word
         extra = after[0]
-        return (f"the header declares {nv} vertices and {nf} faces, but {after.size} more rows follow "
+        return (f"the header declares {counted(nv, 'vertex', 'vertices')} and {counted(nf, 'face')}, but "
+                f"{after.size} more {'row follows' if after.size == 1 else 'rows follow'} "
                 f"the last face (first: line {first_line + extra}, {text(extra)!r}), which pymeshlab's OFF reader "
                 "ignores without a word; fix the header's counts or remove those rows (comments and empty lines "
                 "may follow the faces)")
@@ -884,7 +887,7 @@ def _off_rows_problem(path, made=None):
         if min(index) < 0 or max(index) >= nv:
             bad.append((face, index))
     if bad:
-        return (f"{len(bad)} faces use vertex indices outside the file's {nv} vertices "
+        return (f"{counted(len(bad), 'face', verb='use')} vertex indices outside the file's {nv} vertices "
                 f"(first: face {bad[0][0]}, {bad[0][1]})")
     few = np.flatnonzero(k < 3)
     if few.size:

@@ -22,7 +22,7 @@ from ._output import atomic_output, check_output_path
 from .curvature._validate import affine_transform_problem, check_choice, check_transformed_values, real_word
 from .curvature.curvature_coefficients import DEFAULT_RCOND
 from .curvature.curvature_editor import CurvatureEditor
-from .curvature.errors import ConstraintError, first_indices
+from .curvature.errors import ConstraintError, counted, first_indices
 
 FIXED, FREE, HANDLE = 0, 1, 2
 HANDLE_DETAIL_MODES = ("transform", "free")
@@ -215,7 +215,7 @@ def edit_with_selection(V, F, status, T, *, handle_detail="transform", relations
                               "status per vertex.")
     bad = np.flatnonzero(~np.isin(status, (FIXED, FREE, HANDLE)))
     if bad.size:
-        raise ConstraintError(f"status: {bad.size} vertices have a status other than 0, 1, 2 (first: "
+        raise ConstraintError(f"status: {counted(bad.size, 'vertex', 'vertices', verb='have')} a status other than 0, 1, 2 (first: "
                               f"{first_indices(bad)}).")
     handles = np.flatnonzero(status == HANDLE)
     if handles.size == 0:

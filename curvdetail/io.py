@@ -15,7 +15,7 @@ from ._file_counts import check_loaded
 from ._file_scan import check_before_loading
 from ._output import atomic_output, check_output_path
 from .curvature._validate import as_faces, as_vertices
-from .curvature.errors import MeshError, first_indices
+from .curvature.errors import MeshError, counted, first_indices
 
 
 class MeshFileError(MeshError):
@@ -116,6 +116,7 @@ def load_checked(ms, path, *, vertex_maps=True):
     file holds them (:func:`_set_ctm_vertex_maps`: pymeshlab reads the quality from the colour
     map, and marks the layer as holding neither); without, they are left as pymeshlab read
     them (for callers that take the vertices and triangles only)."""
+    _check_utf8(path, "read")
     try:
         triangles = check_before_loading(path, error=MeshFileError)
     except OSError as exc:          # unreadable: named as the file's problem, as pymeshlab's are
@@ -273,19 +274,22 @@ def check_mesh_output(path, overwrite=False, *, hint=_MESH_HINT):
     return path
 
 
-def _check_utf8(path):
+def _check_utf8(path, action="write"):
     """Raise MeshFileError if pymeshlab cannot be given ``path`` (a str from
     :func:`os.fsdecode`): it takes paths as UTF-8 text, so a folder or file name holding other
-    bytes (``b'lat\\xe9'``, Latin-1) was refused with a TypeError, or, passed as bytes, written
-    under another name (the byte replaced by U+FFFD)."""
+    bytes (``b'lat\\xe9'``, Latin-1) was refused with a TypeError (on reading, reported as a
+    damaged file), or, passed as bytes, written under another name (the byte replaced by
+    U+FFFD). ``action``: "read" or "write", for the message."""
     absolute = os.path.abspath(path)
     try:
         absolute.encode("utf-8")
     except UnicodeEncodeError as exc:
         bad = os.fsencode(absolute[exc.start:exc.end])
-        raise MeshFileError(f"cannot write {path!r}: its path holds bytes that are not UTF-8 ({bad!r} in "
+        elsewhere = "copy the file elsewhere and read it there" if action == "read" else \
+            "write elsewhere and move the file there"
+        raise MeshFileError(f"cannot {action} {path!r}: its path holds bytes that are not UTF-8 ({bad!r} in "
                             f"{os.fsencode(absolute)!r}), and pymeshlab takes paths as UTF-8 text only; rename the "
-                            "file or folder (or write elsewhere and move the file there).") from None
+                            f"file or folder (or {elsewhere}).") from None
 
 
 def _why_not_written(extension):
@@ -412,7 +416,7 @@ def check_coordinates(path, V, *, binary=True, lossless=True, **save_options):
     finite = np.isfinite(V).all(axis=1)
     if not finite.all():
         bad = np.flatnonzero(~finite)
-        raise MeshFileError(f"{where}: {bad.size} vertices have NaN or infinite coordinates (first: "
+        raise MeshFileError(f"{where}: {counted(bad.size, 'vertex', 'vertices', verb='have')} NaN or infinite coordinates (first: "
                             f"{first_indices(bad)}), which pymeshlab's loaders drop (renumbering the rest); "
                             "fix them first.")
     low, high = V.min(axis=0), V.max(axis=0)
@@ -441,7 +445,7 @@ def check_coordinates(path, V, *, binary=True, lossless=True, **save_options):
             bad = np.flatnonzero(over)
             raise MeshFileError(
                 f"{where}: {name} holds coordinates in single precision, whose largest value is "
-                f"{_FLOAT32_MAX:.4g}; {bad.size} vertices exceed it (first: {first_indices(bad)}) and would be "
+                f"{_FLOAT32_MAX:.4g}; {counted(bad.size, 'vertex', 'vertices', verb='exceed')} it (first: {first_indices(bad)}) and would be "
                 f"written as inf. Write {_SAFE}, or scale the mesh down.")
         difference = single - V
         error = float(np.abs(difference).max())

@@ -173,7 +173,7 @@ def test_translated_frame_translates_a_rank_deficient_plane(plane_grid):
     (dict(position_constrained=[0], detail_constrained=[0, 1]), "has only 2 vertices"),
     (dict(position_constrained=[0], detail_constrained=[0], roi=[]), "roi is empty"),
     (dict(position_constrained=[0, 1], detail_constrained=[1], roi=np.arange(1, 100)), "outside the roi"),
-    (dict(position_constrained=[0], detail_constrained=[0], roi=np.arange(1, 100)), "outside the roi"),
+    (dict(position_constrained=[0], detail_constrained=[0], roi=np.arange(1, 100)), "1 vertex lies outside the roi"),
 ])
 def test_bad_constraint_sets_are_refused(plane_grid, kwargs, message):
     V, F = plane_grid

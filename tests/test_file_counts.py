@@ -71,7 +71,7 @@ def test_check_loaded_accepts_a_complete_load_and_names_what_is_missing(tmp_path
         check_loaded(str(path), 3, F[:1])
     with pytest.raises(ValueError, match=r"has 2 faces but pymeshlab loaded 1 triangles"):
         check_loaded(str(path), 4, F[:1])
-    with pytest.raises(KeyError, match=r"1 faces use vertex indices outside the file's 4 vertices "
+    with pytest.raises(KeyError, match=r"1 face uses vertex indices outside the file's 4 vertices "
                                        r"\(first: face 1, \[1, 4, 2\]"):
         check_loaded(str(path), 4, np.array([[0, 1, 2], [1, 4, 2]]), error=KeyError)
 

@@ -13,7 +13,7 @@ _OFF_VERTICES = "0 0 0\n1 0 0\n0 1 0\n1 1 0\n"
 
 
 @pytest.mark.parametrize("faces, message", [
-    ("3 0 1 2\n3 1 3 4\n", r"1 faces use vertex indices outside the file's 4 vertices \(first: face 1, \[1, 3, 4\]\)"),
+    ("3 0 1 2\n3 1 3 4\n", r"1 face uses vertex indices outside the file's 4 vertices \(first: face 1, \[1, 3, 4\]\)"),
     ("3 0 1 2\n3 1 3 -1\n", r"\(first: face 1, \[1, 3, -1\]\)"),
     ("3 0 1 2\n3 1 3 12\n", r"\(first: face 1, \[1, 3, 12\]\)"),            # more digits than 4
     ("3 9 1 2 0.25 0.5 0.75 1\n3 1 3 2\n", r"\(first: face 0, \[9, 1, 2\]\)"),  # colours after it
@@ -52,7 +52,7 @@ def test_off_indices_of_the_vertex_count_s_width_are_compared_by_value(tmp_path)
     path = tmp_path / "m.off"
     vertices = "0 0 0\n" * 100
     path.write_text("OFF\n100 2 0\n" + vertices + "3 97 98 99\n3 98 99 100\n")
-    with pytest.raises(ValueError, match=r"1 faces .* 100 vertices \(first: face 1, \[98, 99, 100\]\)"):
+    with pytest.raises(ValueError, match=r"1 face .* 100 vertices \(first: face 1, \[98, 99, 100\]\)"):
         check_before_loading(path)
 
 
@@ -79,7 +79,7 @@ def test_obj_without_indented_vertex_lines_passes(tmp_path, text):
 def test_a_short_or_odd_face_line_does_not_hide_a_bad_index_after_it(tmp_path):
     path = tmp_path / "m.off"
     path.write_text("off\n4 3 0\n" + _OFF_VERTICES + "2 0 1\n3 0 1 2\n3 1 3 7\n")
-    with pytest.raises(ValueError, match=r"1 faces use vertex indices .* \(first: face 2, \[1, 3, 7\]\)"):
+    with pytest.raises(ValueError, match=r"1 face uses vertex indices .* \(first: face 2, \[1, 3, 7\]\)"):
         check_before_loading(path)
 
 
@@ -219,9 +219,9 @@ _OFF_OK = "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n"
                                                          r"with a point"),
     ("m.off", _OFF_OK.replace("3 0 2 3", "3 0 2 3 0,5 0 0"), r"line 8 \('3 0 2 3 0,5 0 0'\) writes a number"),
     # face rows beyond the header's count were dropped
-    ("m.off", _OFF_OK + "3 1 2 3\n", r"the header declares 4 vertices and 2 faces, but 1 more rows follow the "
+    ("m.off", _OFF_OK + "3 1 2 3\n", r"the header declares 4 vertices and 2 faces, but 1 more row follows the "
                                      r"last face \(first: line 9, '3 1 2 3'\)"),
-    ("m.off", _OFF_OK.replace("4 2 0", "4 1 0"), r"declares 4 vertices and 1 faces, but 1 more rows follow"),
+    ("m.off", _OFF_OK.replace("4 2 0", "4 1 0"), r"declares 4 vertices and 1 face, but 1 more row follows"),
 ])
 def test_decimal_commas_and_extra_off_faces_are_refused(tmp_path, name, text, message):
     path = tmp_path / name
@@ -664,7 +664,7 @@ def test_obj_face_index_scan_finds_the_first_bad_line_across_pieces(tmp_path):
     ("m.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n# part two\rv 5 5 5\rv 6 5 5\rv 5 6 5\rf 4 5 6\r",
      r"line 5 ends in a carriage return not followed by a newline"),
     ("m.stl", b"solid q\nfacet normal 0 0 1\n outer loop\n vertex 0 0 0\n vertex 1 0 0\n vertex 1 1 0\n"
-              b" vertex 0 1 0\n endloop\nendfacet\nendsolid q\n", r"1 facets with 4 vertex lines, not 3 a facet"),
+              b" vertex 0 1 0\n endloop\nendfacet\nendsolid q\n", r"1 facet with 4 vertex lines, not 3 a facet"),
     ("m.off", b"OFF\n5 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n2 0 0\n4 0 1 2 3\n2 1 4\n",
      r"face 1 is the row '2 1 4', of 2 vertices, which pymeshlab's OFF reader drops"),
 ])

@@ -318,7 +318,7 @@ def test_obj_with_unreferenced_vertices_and_texture_lines_is_read_in_file_order(
 
 @pytest.mark.parametrize("name, text, message", [
     ("bad.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n3 0 1 2\n3 1 3 99\n",
-     "1 faces use vertex indices outside the file's 4 vertices (first: face 1, [1, 3, 99])"),
+     "1 face uses vertex indices outside the file's 4 vertices (first: face 1, [1, 3, 99])"),
     ("bad.obj", "v 0 0 0\n  v 1 0 0\nv 0 1 0\nv 1 1 0\nv 2 2 0\nf 1 2 3\nf 2 4 3\n",
      "1 vertex lines start with spaces or tabs (first: line 2)"),
 ])
@@ -1007,7 +1007,7 @@ def test_every_other_save_format_is_probed_and_written_safely_with_recycled_memo
 def test_save_mesh_refuses_non_finite_coordinates(tmp_path):
     V, F = icosphere(subdivisions=1)
     V[3, 1] = np.nan
-    with pytest.raises(MeshFileError, match=r"1 vertices have NaN or infinite coordinates \(first: 3\)"):
+    with pytest.raises(MeshFileError, match=r"1 vertex has NaN or infinite coordinates \(first: 3\)"):
         save_mesh(tmp_path / "m.obj", pymeshlab.Mesh(vertex_matrix=V, face_matrix=F.astype(np.int32)))
 
 
@@ -1078,6 +1078,23 @@ def test_a_path_that_is_not_utf8_is_refused_with_the_fix(tmp_path):
     assert os.listdir(folder) == [] and os.listdir(tmp_path) == ["lat\udce9"]
     write_mesh(tmp_path / "caf\u00e9.off", V, F)                    # UTF-8 names are written
     assert np.allclose(read_mesh(tmp_path / "caf\u00e9.off")[0], V)
+
+
+def test_a_file_in_a_folder_that_is_not_utf8_is_refused_by_its_path_not_called_damaged(tmp_path):
+    # the read went to pymeshlab and came back as "The file is damaged or incomplete, ...; export
+    # it again", for a sound file whose folder name holds a Latin-1 byte
+    folder = os.path.join(os.fsencode(tmp_path), b"lat\xe9")
+    os.mkdir(folder)
+    V, F = icosphere(subdivisions=1)
+    write_mesh(tmp_path / "a.obj", V, F)
+    os.rename(tmp_path / "a.obj", os.path.join(folder, b"a.obj"))
+    for path in (os.path.join(folder, b"a.obj"), os.fsdecode(os.path.join(folder, b"a.obj"))):
+        with pytest.raises(MeshFileError, match=r"cannot read .*: its path holds bytes that are not UTF-8 "
+                                                r"\(b'\\xe9' in .*\), .* rename the file or folder \(or copy the "
+                                                r"file elsewhere and read it there\)"):
+            read_mesh(path)
+    os.rename(os.path.join(folder, b"a.obj"), tmp_path / "a.obj")
+    assert np.allclose(read_mesh(tmp_path / "a.obj")[0], V)             # the same file, read
 
 
 def test_dxf_coordinates_are_checked_for_its_six_decimals(tmp_path):

@@ -11,7 +11,7 @@ from ._validate import (as_index_set, as_values, bbox_centre, bbox_diagonal, cen
 from .cotan_laplacian import checked_cotan_laplacian, laplacian_product
 from .curvature_coefficients import (DEFAULT_MAX_RING, DEFAULT_RCOND, _coefficients, _one_ring_pairs, check_max_ring,
                                      check_rcond)
-from .errors import ConstraintError, UndeterminedEditError, first_indices
+from .errors import ConstraintError, UndeterminedEditError, counted, first_indices
 from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
 from .reconstruct import refine_least_squares
 from .sparse_solver import SolverError, _chosen_automatically, factorize, resolve_backend
@@ -209,14 +209,14 @@ class CurvatureEditor:
             out = idx[~in_roi[idx]]
             if out.size:
                 raise ConstraintError(
-                    f"{name}: {out.size} vertices lie outside the roi (first: {first_indices(out)}); "
+                    f"{name}: {counted(out.size, 'vertex', 'vertices', verb='lie')} outside the roi (first: {first_indices(out)}); "
                     "vertices outside the roi are fixed already. Add them to the roi or drop them.")
         if whole and pc.size == 0:
             raise ConstraintError("position_constrained is empty and the roi is the whole mesh: the "
                                   "result is only determined up to a translation. Constrain at least "
                                   "one vertex per connected piece, or pass a smaller roi.")
         if whole and dc.size < 3:
-            state = "is empty" if dc.size == 0 else f"has only {dc.size} vertices"
+            state = "is empty" if dc.size == 0 else f"has only {counted(dc.size, 'vertex', 'vertices')}"
             raise ConstraintError(f"detail_constrained {state} and the roi is the whole mesh: the "
                                   "curvature stage is only determined up to a linear map (9 unknowns, "
                                   "3 per constrained detail). Constrain the details of at least three "
@@ -555,7 +555,7 @@ class CurvatureEditor:
         is_d[self._dc[:self._user_dc]] = True
         stray = h[~(is_p[h] | is_d[h])]
         if stray.size:
-            raise ConstraintError(f"handles: {stray.size} vertices are neither position- nor detail-"
+            raise ConstraintError(f"handles: {counted(stray.size, 'vertex', 'vertices', verb='are')} neither position- nor detail-"
                                   f"constrained (first: {first_indices(stray)}); only constrained "
                                   "values can change between solves.")
         Xk, Dk = self._positions(positions), self._details(details)

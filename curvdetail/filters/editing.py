@@ -193,8 +193,9 @@ def apply_curvature_editing(ms, *, handles, region_radius, transform, detail_sca
     seconds = time.perf_counter() - t
     moved = np.linalg.norm(X - V, axis=1)
     if not np.all(np.isfinite(moved)):      # checked before the MeshSet is touched
-        raise FilterParameterError(f"the edit moved {np.count_nonzero(~np.isfinite(moved))} vertices beyond "
-                                   "double precision; use a smaller transform or detail_scale.")
+        lost = counted(np.count_nonzero(~np.isfinite(moved)), "vertex", "vertices")
+        raise FilterParameterError(f"the edit moved {lost} beyond double precision; use a smaller transform or "
+                                   "detail_scale.")
     set_vertex_positions(ms, mid, X)
     set_vertex_quality(ms, mid, moved)
     diagonal = bbox_diagonal(V)
