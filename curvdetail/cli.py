@@ -84,8 +84,11 @@ class Progress:
         self._finish()
 
 
-def add_output_arguments(parser):
-    parser.add_argument("--overwrite", action="store_true", help="replace OUTPUT if it exists")
+def add_output_arguments(parser, also=()):
+    """``--overwrite``; ``also``: the options naming further outputs it replaces as well."""
+    files = " and ".join([", ".join(["OUTPUT", *also[:-1]]), *also[-1:]])
+    parser.add_argument("--overwrite", action="store_true",
+                        help=f"replace {files} if {'they exist' if also else 'it exists'}")
 
 
 #: how a refusal of an existing output says to replace it, on the command line
@@ -127,6 +130,11 @@ def resolve_input_output(args):
         from .data import example_path
 
         args.input, args.output = example_path(), args.input
+        if args.output is not None and os.path.realpath(args.output) == os.path.realpath(args.input):
+            # INPUT was not named: replacing it (--overwrite) would rewrite the package's own data
+            raise ValueError(f"{args.output} is the bundled example mesh that --example reads; writing "
+                             "there would change the installed package even with --overwrite. Name "
+                             "another file.")
     if args.input is None or args.output is None:
         raise ValueError("missing INPUT or OUTPUT (or use --example OUTPUT).")
     check_mesh_output(args.output, args.overwrite)
@@ -354,7 +362,7 @@ def _remesh_command(parser):
     parser.add_argument("--quiet", action="store_true",
                         help="no stage progress on stderr (notes and warnings, such as the one on a "
                              "target of minutes, are still said)")
-    add_output_arguments(parser)
+    add_output_arguments(parser, also=("--report", "--image"))
 
     def run(args):
         import json
@@ -608,9 +616,9 @@ def _run_command(parser):
 
     def run(args):
         from .filters import run_script
+        from .filters.mlx import check_script
 
-        if not os.path.isfile(args.script):
-            raise FileNotFoundError(f"filter script not found: {args.script}")
+        check_script(args.script)       # a folder, malformed XML or a bad step: before reading INPUT
         bar = Progress(0, enabled=sys.stderr.isatty())
 
         def step(k, total, name):
@@ -667,7 +675,7 @@ def _edit_command(parser):
                              "when handle details are rotated)")
     parser.add_argument("--image", metavar="PNG", help="also save a picture: rest (by status) | edited")
     add_backend_argument(parser)
-    add_output_arguments(parser)
+    add_output_arguments(parser, also=("--image",))
 
     def run(args):
         import numpy as np

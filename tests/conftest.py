@@ -46,6 +46,7 @@ def run_commit_interrupted_by(tmp_path, signal_name):
     script = tmp_path / "interrupted.py"
     script.write_text(
         "import os, signal, sys, threading\n"
+        "signal.signal(signal.SIGINT, signal.SIG_DFL)   # not ignored, as in a suite run with &\n"
         "from curvdetail import _output, cli\n"
         "from curvdetail._output import Output, atomic_outputs\n"
         "asked = threading.Event()\n"

@@ -265,6 +265,28 @@ def test_example_with_two_paths_is_refused(tmp_path, capsys):
     assert "with --example give only OUTPUT" in _error_line(capsys)
 
 
+@pytest.mark.parametrize("command", ["reconstruct", "minimal", "remesh"])
+def test_example_output_over_the_bundled_example_is_refused_even_with_overwrite(tmp_path, capsys,
+                                                                                  monkeypatch, command):
+    # --example OUTPUT naming the bundled mesh, with --overwrite, rewrote the package's own data
+    # file (its coordinates as read back, quality dropped); a copy stands in for it here
+    import shutil
+
+    import curvdetail.data
+    from curvdetail.data import example_path
+
+    example = tmp_path / "data" / "terrainA_1k.obj"
+    example.parent.mkdir()
+    shutil.copyfile(example_path(), example)
+    before = example.read_bytes()
+    monkeypatch.setattr(curvdetail.data, "example_path", lambda: str(example))
+    (tmp_path / "sub").mkdir()
+    spelled = tmp_path / "sub" / ".." / "data" / "terrainA_1k.obj"
+    assert main([command, "--example", str(spelled), "--overwrite"]) == 1
+    assert "is the bundled example mesh that --example reads" in _error_line(capsys)
+    assert example.read_bytes() == before
+
+
 def _existing_output_message(tmp_path, capsys, argv):
     out = tmp_path / "keep.ply"
     out.write_text("precious")
@@ -380,6 +402,9 @@ _BLOCKING_WRITE = 4 << 20
 
 _BLOCKING_CALL = (
     "import os, signal, sys\n"
+    "# a suite started in the background by a shell (cmd &) hands its children SIGINT ignored,\n"
+    "# which the CLI rightly leaves ignored: this run is one a terminal's Ctrl-C reaches\n"
+    "signal.signal(signal.SIGINT, signal.SIG_DFL)\n"
     "import curvdetail.io, curvdetail.remesh.experiment\n"
     "from curvdetail.cli import main\n"
     "busy = int(os.environ['CURVDETAIL_TEST_FD'])\n"

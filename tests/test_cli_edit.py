@@ -247,3 +247,21 @@ def test_an_output_without_quality_says_it_is_left_out(tmp_path, capsys, name):
     assert read_mesh(str(tmp_path / name))[0].shape == V.shape
     assert main(["edit", str(p["off"]), "--sel", str(p["sel"]), "--def", str(p["def"]), str(tmp_path / "o.ply")]) == 0
     assert capsys.readouterr().err == ""
+
+
+def test_overwrite_replaces_the_image_too_and_its_help_says_so(tmp_path, capsys):
+    # the help said "replace OUTPUT if it exists", but --overwrite replaces an existing --image
+    # as well (and remesh's --report and --image)
+    _, _, _, _, p = _case(tmp_path)
+    out, png = tmp_path / "out.ply", tmp_path / "old.png"
+    png.write_bytes(b"not a picture")
+    argv = ["edit", str(p["off"]), "--sel", str(p["sel"]), "--def", str(p["def"]), str(out), "--image", str(png)]
+    assert main(argv) == 1 and png.read_bytes() == b"not a picture" and not out.exists()
+    assert main(argv + ["--overwrite"]) == 0
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    capsys.readouterr()
+    for command, words in (("edit", "replace OUTPUT and --image if they exist"),
+                           ("remesh", "replace OUTPUT, --report and --image if they exist")):
+        with pytest.raises(SystemExit):
+            main([command, "--help"])
+        assert words in " ".join(capsys.readouterr().out.split())

@@ -490,3 +490,18 @@ def test_run_refuses_to_write_over_its_script_even_with_overwrite(capsys, tmp_pa
     assert err == (f"curvdetail: error: {output} is an input of this run (s.ply); writing there would destroy "
                    "it even with --overwrite. Name another file.\n")
     assert (tmp_path / "s.ply").read_text() == SCRIPT
+
+
+def test_run_names_a_folder_given_as_script(capsys, tmp_path):
+    # the command's own check called an existing folder "not found"
+    assert_failed(capsys, ["run", tmp_path, NOSE, tmp_path / "o.ply"],
+                  "is a folder; pass the path of a .mlx filter script", tmp_path / "o.ply")
+
+
+def test_run_checks_the_script_before_reading_input(capsys, tmp_path):
+    # a bad step was reported only after INPUT (and the --add meshes) had been read: here the
+    # missing input was reported, not the script's mistake
+    (tmp_path / "s.mlx").write_text(SCRIPT.replace('value="2"', 'value="two"'))
+    assert_failed(capsys, ["run", tmp_path / "s.mlx", tmp_path / "none.obj", tmp_path / "o.ply"],
+                  "step 3 (generate_minimal_surface): parameter 'max_iterations' expects an integer",
+                  tmp_path / "o.ply")

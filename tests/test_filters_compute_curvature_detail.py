@@ -52,6 +52,21 @@ def test_figures_are_range_and_percentiles_of_interior_h():
     assert figures["interior_vertices"] == 1089 - 128 and figures["boundary_vertices"] == 128
 
 
+def test_a_mesh_without_interior_vertices_has_no_h_figures():
+    # a strip of four triangles, every vertex on the boundary: the figures were the boundary
+    # vertices' H (geodesic curvature), which the description says are left out
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0.3], [0, 2, 0], [1, 2, 0]], float)
+    F = np.array([[0, 1, 3], [0, 3, 2], [2, 3, 5], [2, 5, 4]])
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(V, F))
+    figures = apply(ms, "compute_curvature_detail")
+    assert [figures[k] for k in ("curv_range_min", "curv_range_max", "10_percentile", "90_percentile")] \
+        == [None] * 4
+    assert figures["interior_vertices"] == 0 and figures["boundary_vertices"] == 6
+    # two triangles of area sqrt(1.09) / 2, one of sqrt(1.18) / 2, one of 1 / 2
+    assert figures["surface_area"] == pytest.approx(np.sqrt(1.09) + np.sqrt(1.18) / 2 + 0.5, rel=1e-12)
+
+
 def test_mean_curvature_is_positive_one_over_radius_on_a_sphere():
     # icosphere of radius 2 (2562 vertices): discrete H within 0.1 % of 1/R = 0.5
     V, F = icosphere(radius=2.0, subdivisions=4)

@@ -348,3 +348,32 @@ def test_a_native_float_with_an_underscore_is_refused(tmp_path):
     body = '<filter name="Taubin Smooth"><Param name="lambda" value="0_5" type="RichFloat"/></filter>'
     with pytest.raises(ScriptError, match=r"'lambda' \(RichFloat\) has value '0_5'"):
         run_script(meshset(), write(tmp_path, body))
+
+
+DUPLICATE = '<filter name="Duplicate Current layer"/>'
+
+
+@pytest.mark.parametrize("step, message", [
+    ('<filter name="generate_minimal_surface"><Param name="tol" value="small"/></filter>',
+     r"step 2 \(generate_minimal_surface\): parameter 'tol' expects a number"),
+    ('<filter name="generate_minimal_surface"><Param name="max_iteration" value="3"/></filter>',
+     r"step 2 \(generate_minimal_surface\): .*did you mean max_iterations"),
+    ('<filter name="generate_minimal_surface"><Param name="max_iterations" value="0"/></filter>',
+     r"step 2 \(generate_minimal_surface\): parameter 'max_iterations' is 0; it must be at least 1"),
+    ('<filter name="generate_minimal_surfaces"/>', r"step 2 .*did you mean generate_minimal_surface"),
+])
+def test_a_bad_later_step_of_ours_is_refused_before_the_first_step_runs(tmp_path, step, message):
+    # it was found only when its turn came, after the steps before it (minutes of remeshing)
+    # had changed the MeshSet: here the duplicate layer of step 1
+    ms = meshset()
+    with pytest.raises(ScriptError, match=message):
+        run_script(ms, write(tmp_path, DUPLICATE + "\n " + step))
+    assert ms.mesh_number() == 1
+
+
+def test_a_step_with_another_tag_is_named_by_its_tag_not_as_nameless(tmp_path):
+    # "<Filter name='x'>" was called "without a name"
+    path = write(tmp_path, '<Filter name="Select Border"/>')
+    with pytest.raises(ScriptError, match=r"step 1 is <Filter name='Select Border'>; a step is "
+                                          r"<filter name=\"\.\.\.\"> \(the tag in lower case"):
+        run_script(meshset(), path)

@@ -31,7 +31,8 @@ def signed_mean_curvature(V, F, K):
         area-weighted vertex normal; H > 0 on a sphere with outward normals) so that MeshLab can
         colour it. Returns the range and the 10/90 percentiles of H over the interior vertices,
         like pymeshlab's compute_scalar_by_discrete_curvature_per_vertex (boundary vertices carry
-        the boundary's geodesic curvature in K and are left out of the figures). H's sign needs
+        the boundary's geodesic curvature in K and are left out of the figures, which are None
+        where every vertex lies on the boundary). H's sign needs
         consistently oriented triangles: others are refused (meshing_re_orient_faces_coherently
         orients them). {PAPER},
         section "Curvature detail representation".
@@ -53,12 +54,15 @@ def compute_curvature_detail(ms):
     boundary = boundary_vertices(F)
     interior = np.ones(V.shape[0], dtype=bool)
     interior[boundary] = False
-    h = H[interior] if interior.any() else H
+    h = H[interior]
+    # no interior vertex (a strip): no figures of H, rather than the boundary's geodesic curvature
+    low, high, p10, p90 = ([float(x) for x in (h.min(), h.max(), *np.percentile(h, [10, 90]))]
+                           if h.size else [None] * 4)
     return {
-        "curv_range_min": float(h.min()),
-        "curv_range_max": float(h.max()),
-        "10_percentile": float(np.percentile(h, 10)),
-        "90_percentile": float(np.percentile(h, 90)),
+        "curv_range_min": low,
+        "curv_range_max": high,
+        "10_percentile": p10,
+        "90_percentile": p90,
         "surface_area": float(A.sum()),
         "interior_vertices": int(interior.sum()),
         "boundary_vertices": int(boundary.size),

@@ -64,7 +64,11 @@ def _steps(path):
                           "<FilterScript>.")
     steps = []
     for k, element in enumerate(root, start=1):
-        if element.tag not in ("filter", "xmlfilter") or not element.get("name"):
+        if element.tag not in ("filter", "xmlfilter"):
+            named = f" name={element.get('name')!r}" if element.get("name") else ""
+            raise ScriptError(f"{path}: step {k} is <{element.tag}{named}>; a step is <filter name=\"...\"> "
+                              "(the tag in lower case, as MeshLab writes it).")
+        if not element.get("name"):
             raise ScriptError(f"{path}: step {k} is <{element.tag}> without a name; expected "
                               "<filter name=\"...\">.")
         steps.append(element)
@@ -337,13 +341,15 @@ def run_script(ms, path, *, progress=None):
     FileNotFoundError   the script does not exist
     ScriptError         not a MeshSet, ``path`` not a path or a folder, malformed XML (or an
                         unknown encoding), a parameter given twice, a step name that is a typo of
-                        one of ours, a MeshLab filter that needs a mesh on an empty MeshSet, a
-                        parameter of a MeshLab step that MeshLab would misread without a word (a
-                        bool other than 'true'/'false', a number that does not parse, a RichAbsPerc
-                        without min and max, a name the filter does not have; all found before
-                        any step runs, except a name right but for its capitals, found after its
-                        step), or a step failed (the message names the step number and filter,
-                        then the reason)
+                        one of ours, a parameter of one of ours unknown or of the wrong type or
+                        range, a parameter of a MeshLab step that MeshLab would misread without a
+                        word (a bool other than 'true'/'false', a number that does not parse, a
+                        RichAbsPerc without min and max, a name the filter does not have): all
+                        these found before any step runs (:func:`check_script`), except a MeshLab
+                        parameter name right but for its capitals, found after its step; then, as
+                        the steps run, a MeshLab filter that needs a mesh on an empty MeshSet, or
+                        a step failed (the message names the step number and filter, then the
+                        reason)
 
     Examples
     --------
@@ -364,28 +370,69 @@ def run_script(ms, path, *, progress=None):
     if progress is not None and not callable(progress):
         raise ScriptError(f"progress={progress!r} is not callable; pass a function (step, total, name) or None.")
     results = []
-    path = _script_path(path)
-    steps = _steps(path)
-    for k, element in enumerate(steps, start=1):      # before any step changes the MeshSet
-        if element.get("name") not in _REGISTRY and element.tag == "filter":
-            _check_native_parameters(element, f"{os.path.basename(path)} step {k} ({element.get('name')})")
-    for k, element in enumerate(steps, start=1):
+    steps = check_script(path)              # every step, before any of them changes the MeshSet
+    for k, (element, where, params) in enumerate(steps, start=1):
         name = element.get("name")
         if progress is not None:
             progress(k, len(steps), name)
-        where = f"{os.path.basename(path)} step {k} ({name})"
-        if name in _REGISTRY:
-            params = _our_parameters(_REGISTRY[name], element, where)
+        if params is not None:
             try:
                 figures = apply(ms, name, **params)
             except ValueError as exc:
                 raise ScriptError(f"{where}: {exc}") from None
         else:
-            _refuse_a_near_miss(name, where)
             _run_native(ms, element, where)
             figures = {}
         results.append({"filter": name, "figures": figures})
     return results
+
+
+def check_script(path):
+    """Read a MeshLab filter script (.mlx) and check every step without running any: the
+    checks of :func:`run_script` that need no mesh, so that a typo in its last step is found
+    before its first one has taken minutes.
+
+    Of our filters: the name (a typo of one of ours gets the close matches), each parameter's
+    name and value (parsed by its type, checked as :func:`~curvdetail.filters.apply` checks
+    it); of MeshLab's: what MeshLab would misread without a word (see :func:`run_script`).
+    What needs the meshes (layer ids that exist, attributes, a mesh for a native step) is
+    checked as each step runs.
+
+    Parameters
+    ----------
+    path : str or os.PathLike   the script
+
+    Returns
+    -------
+    list of (element, where, params)   per step, in order: its XML element, the words that name
+                                       it in messages (``"s.mlx step 2 (name)"``) and, for one
+                                       of our filters, its parameters as given, typed (None for
+                                       one of MeshLab's)
+
+    Raises
+    ------
+    FileNotFoundError, ScriptError   as :func:`run_script`
+    """
+    from .dispatch import complete_parameters
+
+    path = _script_path(path)
+    checked = []
+    for k, element in enumerate(_steps(path), start=1):
+        name = element.get("name")
+        where = f"{os.path.basename(path)} step {k} ({name})"
+        params = None
+        if name in _REGISTRY:
+            params = _our_parameters(_REGISTRY[name], element, where)
+            try:
+                complete_parameters(_REGISTRY[name], params)
+            except ValueError as exc:
+                raise ScriptError(f"{where}: {exc}") from None
+        else:
+            _refuse_a_near_miss(name, where)
+            if element.tag == "filter":
+                _check_native_parameters(element, where)
+        checked.append((element, where, params))
+    return checked
 
 
 def _param_element(p, value):
