@@ -57,6 +57,24 @@ def test_polyline_projection_gives_arc_length_and_distance():
     assert np.allclose(poly.point_at(s), Y)
 
 
+def test_polyline_projection_is_exact_beside_one_long_segment_among_short_ones():
+    # a unit square whose bottom side is one segment and the other sides 30 each: the 8 nearest
+    # midpoints of a point on the bottom near a corner are all on the short side (it came back
+    # projected onto the corner, 0.1 away)
+    t = np.linspace(0.0, 1.0, 31)[:-1]
+    right = np.column_stack([np.ones(30), t, np.zeros(30)])
+    top = np.column_stack([1 - t, np.ones(30), np.zeros(30)])
+    left = np.column_stack([np.zeros(30), 1 - t, np.zeros(30)])
+    poly = Polyline(np.vstack([right, top, left, [[0.0, 0.0, 0.0]]]))
+    X = np.array([[0.9, 0.0, 0.0], [0.97, -0.01, 0.0], [0.5, 0.2, 0.0]])
+    Y, s, d = poly.project(X)
+    # hand-computed: straight down onto the bottom side, which runs from (0, 0) (arc length
+    # 3, after the right, top and left sides) back to (1, 0) at arc length 4
+    assert np.allclose(Y, [[0.9, 0, 0], [0.97, 0, 0], [0.5, 0, 0]], atol=1e-15)
+    assert np.allclose(d, [0.0, 0.01, 0.2], atol=1e-15)
+    assert np.allclose(s, [3.9, 3.97, 3.5], atol=1e-12)
+
+
 def test_patch_with_a_handle_is_refused_with_the_handle_count():
     # a torus (8 x 6 periodic grid) with one triangle removed: one boundary loop, but a handle
     n, m = 8, 6

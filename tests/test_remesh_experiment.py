@@ -490,3 +490,25 @@ def test_a_rebuild_at_rounding_is_not_said_to_be_worse_than_zero_detail():
         warnings.simplefilter("error", WorseThanZeroDetailWarning)
         _, report = remesh_experiment(V, F, target=(V, F))
     assert report["improvement_over_zero_detail"] is None
+
+
+@pytest.mark.parametrize("option, value", [("method", np.array(["isotropic", "decimate"])),
+                                           ("rows", np.array(["all"])), ("location", np.array(["closest"])),
+                                           ("transfer", ["pointwise"])])
+def test_an_array_or_list_for_an_option_is_refused_by_name_before_any_work(height_field, option, value):
+    # a 2-element array raised numpy's "truth value ... is ambiguous"; a 1-element one passed the
+    # check (``in`` compared it element-wise) and was refused only after the retriangulation
+    V, F = height_field
+    stages = []
+    with pytest.raises(ValueError, match=rf"{option}=.*\((ndarray|list), not a single str\) is not one of"):
+        remesh_experiment(V, F, target_edge=0.08, evaluate=False, progress=stages.append, **{option: value})
+    assert stages == []
+
+
+def test_numpy_strings_for_options_are_recorded_as_plain_strings(height_field):
+    # the report is JSON-ready: its options are the plain strings, whatever str subclass came in
+    V, F = height_field
+    _, report = remesh_experiment(V, F, target_edge=0.08, evaluate=False, transfer=np.str_("pointwise"),
+                                  rows=np.str_("all"))
+    assert type(report["options"]["transfer"]) is str and type(report["options"]["rows"]) is str
+    assert (report["options"]["transfer"], report["options"]["rows"]) == ("pointwise", "all")

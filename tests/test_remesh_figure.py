@@ -40,3 +40,19 @@ def test_figure_refuses_to_overwrite(tmp_path, result):
     with pytest.raises(FileExistsError):
         save_figure(str(path), V, F, r["X"], r["Ft"], r["Z"], r["distance"], r["report"])
     assert path.read_bytes() == b"keep"
+
+
+def test_an_unmeasured_report_or_mismatched_distances_are_refused_by_name(tmp_path, result):
+    # a report of evaluate=False raised KeyError('error'); its distance None a TypeError from
+    # len(); distances for another mesh came out as an IndexError inside the drawing
+    V, F, r = result
+    path = tmp_path / "f.png"
+    unmeasured = {k: v for k, v in r["report"].items() if k not in ("error", "baseline_zero_detail",
+                                                                    "floor_retriangulated")}
+    with pytest.raises(ValueError, match="report has no error, baseline_zero_detail, floor_retriangulated"):
+        save_figure(str(path), V, F, r["X"], r["Ft"], r["Z"], None, unmeasured)
+    with pytest.raises(ValueError, match=r"distance is None for \d+ rebuilt vertices"):
+        save_figure(str(path), V, F, r["X"], r["Ft"], r["Z"], None, r["report"])
+    with pytest.raises(ValueError, match=r"distance has shape \(3,\) for \d+ rebuilt vertices"):
+        save_figure(str(path), V, F, r["X"], r["Ft"], r["Z"], r["distance"][:3], r["report"])
+    assert not path.exists()

@@ -263,3 +263,51 @@ def test_far_points_get_the_closest_point_of_every_triangle_where_sizes_vary(rng
     X = np.einsum("kj,kjd->kd", b[np.arange(P.shape[0]), best], V[F[best]])
     assert dist == pytest.approx(d.min(axis=1), rel=1e-12)
     assert np.abs(interpolate(V, F, face, bary) - X).max() < 1e-9
+
+
+def test_one_point_in_space_is_located_as_exactly_as_in_a_batch():
+    # a square patch whose bottom side is one long edge: the triangles along it are large beside
+    # small ones. pymeshlab's search radius was a percentage of the points' bounding box, 0 for a
+    # single point, so a lone point found no face and went to the numpy engine, which misses the
+    # large triangle here (distance 0.059 against 0.0055)
+    from scipy.spatial import Delaunay
+
+    from conftest import triangle_brute_force
+
+    n = 60
+    t = np.linspace(0.0, 1.0, n + 1)[:-1]
+    ring = np.vstack([np.column_stack([np.ones(n), t]), np.column_stack([1 - t, np.ones(n)]),
+                      np.column_stack([np.zeros(n), 1 - t]), [[0.0, 0.0]]])
+    g = np.linspace(0.15, 0.85, 12)
+    X = np.vstack([ring, np.stack(np.meshgrid(g, g), axis=-1).reshape(-1, 2)])
+    F = Delaunay(X).simplices
+    V = np.column_stack([X, 0.05 * X[:, 0] * X[:, 1]])
+    P = np.array([[0.774408151263812, 0.00300842016378447, -0.005450218387754509]])
+    exact = triangle_brute_force(P, V, F)                     # every triangle measured
+    _, _, numpy_engine = locate(P, V, F, engine="numpy")
+    assert numpy_engine[0] > 10 * exact[0]                    # the case the grid must answer
+    face, bary, dist = locate(P, V, F)
+    assert dist[0] == pytest.approx(exact[0], rel=1e-12)
+    assert np.linalg.norm(bary[0] @ V[F[face[0]]] - P[0]) == pytest.approx(exact[0], rel=1e-12)
+
+
+def test_planar_points_outside_the_domain_get_the_nearest_triangle():
+    # the unit square with its bottom side one edge and the others 40 each: points just below the
+    # bottom are outside the domain, and the numpy engine they went to took triangles along the
+    # short sides (up to 0.069 too far); now the tree search measures them. Hand-computed: the
+    # closest point of the domain to (x, -y) is (x, 0), at distance y
+    from scipy.spatial import Delaunay
+
+    n = 40
+    t = np.linspace(0.0, 1.0, n + 1)[:-1]
+    ring = np.vstack([np.column_stack([np.ones(n), t]), np.column_stack([1 - t, np.ones(n)]),
+                      np.column_stack([np.zeros(n), 1 - t]), [[0.0, 0.0]]])
+    g = np.linspace(0.15, 0.85, 12)
+    U = np.vstack([ring, np.stack(np.meshgrid(g, g), axis=-1).reshape(-1, 2)])
+    F = Delaunay(U).simplices
+    rng = np.random.default_rng(0)
+    P = np.column_stack([rng.random(2000), -0.02 * rng.random(2000)])
+    face, bary, dist = locate(P, U, F)
+    assert np.abs(dist + P[:, 1]).max() < 1e-14
+    closest = np.einsum("ki,kid->kd", bary, U[F[face]])
+    assert np.abs(closest - np.column_stack([P[:, 0], np.zeros(len(P))])).max() < 1e-14

@@ -124,3 +124,34 @@ def test_a_method_that_is_not_a_parameterization_is_refused(method):
     shown = "'conformal'" if isinstance(method, str) else r".* \((ndarray|list), not a single str\)"
     with pytest.raises(ValueError, match=rf"method={shown} is not a parameterization; use one of harmonic"):
         parameterize(V, F, method=method)
+
+
+def test_target_boundary_vertices_lie_on_the_source_domain_boundary():
+    # disk(4) has 24 boundary vertices, its retriangulation 48: the target vertices between two
+    # source boundary vertices belong on the source's boundary edge (a chord of the unit
+    # circle) at their arc-length fraction. On the circle they lay up to 1 - cos(pi / 24) =
+    # 0.0086 outside the source's domain, and boundary_mismatch said 0.
+    from curvdetail.remesh import check_disk
+    from curvdetail.remesh._disk import Polyline
+
+    V, F = disk(n_rings=4)
+    V[:, 2] = 0.2 * (1 - (V[:, :2] ** 2).sum(1))
+    Vt, Ft = retriangulate(V, F, target_edge=0.04)
+    UVs, UVt, info = parameterize(V, F, Vt, Ft)
+    _, _, loop = check_disk(V, F)
+    _, _, loop_t = check_disk(Vt, Ft)
+    assert loop_t.size > loop.size                       # vertices between the source's ones
+    # in the domain: each target boundary vertex on the source's boundary polygon, at the same
+    # arc-length fraction as in space (both exact: the polygon's points are exact lerps)
+    dom = Polyline(np.column_stack([UVs[loop], np.zeros(loop.size)]))
+    _, s_dom, d_dom = dom.project(np.column_stack([UVt[loop_t], np.zeros(loop_t.size)]))
+    space = Polyline(V[loop])
+    _, s_space, _ = space.project(Vt[loop_t])
+    assert d_dom.max() < 1e-12
+    # each source edge's fraction: s_dom / |edge in the domain| = s_space / |edge in space|
+    seg = np.clip(np.searchsorted(space.s0, s_space, side="right") - 1, 0, loop.size - 1)
+    chord = np.linalg.norm(UVs[loop[(seg + 1) % loop.size]] - UVs[loop[seg]], axis=1)
+    frac_dom = (s_dom - dom.s0[seg]) / chord
+    frac_space = (s_space - space.s0[seg]) / space.length[seg]
+    assert np.abs(frac_dom - frac_space).max() < 1e-9
+    assert info["boundary_mismatch"] < 1e-12 and info["flipped_target"] == 0

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from curvdetail.curvature._validate import bbox_diagonal
+from curvdetail.curvature.testing import grid
 from curvdetail.remesh import RemeshError, retriangulate
 from curvdetail.remesh._disk import Polyline, check_disk
 
@@ -189,6 +190,8 @@ def test_a_method_that_is_not_one_str_is_refused_as_such(load_mesh, method):
     ({"method": "decimate", "aggressiveness": 11}, "from 0 to 10"),
     # bools were taken as 1, huge ints raised a TypeError, strings were parsed
     ({"iterations": True}, "iterations=True must be a whole number"),
+    # 2**31 raised pybind11's RuntimeError "Unable to cast Python instance of type int"
+    ({"iterations": 2 ** 31}, r"iterations=2147483648 is more than 1,000: each is a full pass"),
     ({"max_surface_distance": 10 ** 400}, "positive fraction"),
     ({"max_surface_distance": True}, "positive fraction"),
     ({"method": "decimate", "aggressiveness": 10 ** 30}, "from 0 to 10"),
@@ -353,3 +356,67 @@ def test_one_pinched_boundary_vertex_and_one_handle_are_counted_in_the_singular(
     F = np.concatenate([np.column_stack([a, b, d]), np.column_stack([a, d, c])])[1:]
     with pytest.raises(NotADiskError, match=r"Euler characteristic -1 \(1 handle\);"):
         check_disk(V, F)
+
+
+def _square_with_one_long_side(n=40, m=12):
+    """A curved unit-square patch (z = 0.1 y sin 3x) whose bottom side is one edge, the other
+    three ``n`` edges each, with an ``m`` x ``m`` grid of inner points (Delaunay)."""
+    from scipy.spatial import Delaunay
+
+    t = np.linspace(0.0, 1.0, n + 1)[:-1]
+    ring = np.vstack([np.column_stack([np.ones(n), t]), np.column_stack([1 - t, np.ones(n)]),
+                      np.column_stack([np.zeros(n), 1 - t]), [[0.0, 0.0]]])
+    g = np.linspace(0.15, 0.85, m)
+    X = np.vstack([ring, np.stack(np.meshgrid(g, g), axis=-1).reshape(-1, 2)])
+    F = Delaunay(X).simplices.astype(np.int64)
+    a, b, c = X[F[:, 0]], X[F[:, 1]], X[F[:, 2]]
+    cw = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]) < 0
+    F[cw] = F[cw][:, [0, 2, 1]]
+    return np.column_stack([X, 0.1 * X[:, 1] * np.sin(3 * X[:, 0])]), F
+
+
+def test_a_boundary_side_of_one_long_edge_is_split_along_it():
+    # the remesher splits the long bottom edge; its new vertices lie on it, but the 8 boundary
+    # segments with the nearest midpoints were all on the short sides, so they measured 0.13 of
+    # the diagonal off the boundary and the retriangulation was refused
+    V, F = _square_with_one_long_side()
+    Vt, Ft = retriangulate(V, F, method="isotropic", target_edge=0.03)
+    _, _, loop_t = check_disk(Vt, Ft)
+    bottom = loop_t[np.abs(Vt[loop_t, 1]) <= 1e-12]
+    # the bottom side is the x axis in z = 0 exactly: its vertices come back on it, inside it,
+    # and every other boundary vertex on the line x = 0, x = 1 or y = 1 (within rounding)
+    assert bottom.size > 20
+    assert np.abs(Vt[bottom, 2]).max() <= 1e-12 and Vt[bottom, 0].min() >= -1e-12 and Vt[bottom, 0].max() <= 1 + 1e-12
+    B = Vt[loop_t]
+    side = np.minimum.reduce([np.abs(B[:, 0]), np.abs(B[:, 0] - 1), np.abs(B[:, 1]), np.abs(B[:, 1] - 1)])
+    assert side.max() <= 1e-12
+
+
+def test_a_decimation_the_boundary_keeps_from_its_target_is_refused_not_returned_finer():
+    # a 200 x 3 strip: 402 of its 600 vertices are on the boundary, which decimation keeps, so it
+    # has at least 400 triangles; a 2 % target edge asks for 289 (2 area / (sqrt(3)/4 h^2)). It
+    # came back with 436 triangles, 1.5x the count asked for, as if it had reached it.
+    V, F = grid(200, 3)
+    V[:, 0] *= 20.0
+    V[:, 2] = 0.1 * np.sin(V[:, 0])
+    with pytest.raises(RemeshError, match=r"keeps every boundary vertex: the target edge asks for about 289 "
+                                          r"triangles, but a disk with the source's 402 boundary vertices has at "
+                                          r"least 400, and it falls short of a count below 500 \(1.25 x that\); "
+                                          r"decimation takes target edges from 1.21 % to 1.51 %"):
+        retriangulate(V, F, method="decimate", target_edge=0.02)
+
+
+@pytest.mark.parametrize("where", [0.0, 0.5, 1.0])
+def test_every_decimation_target_in_the_range_is_reached(load_mesh, where):
+    # the range ended at 50 estimated vertices (10.7 % on terrainA_1k), where decimation, which
+    # keeps the 128 boundary vertices, came back with 148 triangles for 102 asked
+    from curvdetail.curvature._validate import face_double_areas
+    from curvdetail.remesh.retriangulate import target_edge_range
+
+    V, F = load_mesh("terrainA_1k.obj")
+    lo, hi = target_edge_range(V, F, "decimate")
+    target_edge = float(np.exp(np.log(lo * 1.001) + where * (np.log(hi * 0.999) - np.log(lo * 1.001))))
+    Vt, Ft = retriangulate(V, F, method="decimate", target_edge=target_edge)
+    h = target_edge * bbox_diagonal(V)
+    asked = 0.5 * face_double_areas(V, F).sum() / (np.sqrt(3.0) / 4.0 * h * h)
+    assert Ft.shape[0] == pytest.approx(asked, rel=0.05)

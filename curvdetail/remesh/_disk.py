@@ -131,6 +131,11 @@ def _refuse(problem, advice):
     return exc
 
 
+#: Most point-segment pairs :meth:`Polyline.project` holds at once where it projects points
+#: onto more segments than their nearest (~200 bytes each while held).
+PROJECT_PAIRS = 500_000
+
+
 class Polyline:
     """A closed polyline (the source boundary) with arc-length coordinates and projection.
 
@@ -147,17 +152,47 @@ class Polyline:
         self.s0 = np.concatenate([[0.0], np.cumsum(self.length)[:-1]])
         self.total = float(self.length.sum())
         self._tree = cKDTree(0.5 * (self.P + self.Q))
+        self._half_longest = 0.5 * float(self.length.max()) if self.length.size else 0.0
 
     def project(self, X, k=8):
-        """Closest points on the polyline.
+        """Closest points on the polyline, exact (to rounding) whatever the segment lengths.
+
+        The ``k`` segments with the nearest midpoints are tried first; a point whose result is
+        not certain from them (another segment, with its midpoint further than the k-th, could
+        still be closer when segments differ much in length) is projected onto every segment
+        long enough to be closer, ``PROJECT_PAIRS`` point-segment pairs at a time.
 
         Returns ``(Y, s, dist)``: projected points (m, 3), arc-length coordinate in [0, total)
         from the first point, and distance from ``X`` (m,).
         """
         X = np.asarray(X, dtype=np.float64)
-        k = min(k, self.P.shape[0])
-        _, cand = self._tree.query(X, k=k)
+        segments = self.P.shape[0]
+        k = min(k, segments)
+        mid, cand = self._tree.query(X, k=k)
         cand = cand.reshape(X.shape[0], k)
+        Y, s, d = self._closest(X, cand)
+        if k < segments:
+            # a segment whose midpoint is at least mid_k away is at least mid_k - (its half
+            # length) away: the candidates' best is certain where it is no further than
+            # mid_k - half the longest segment; elsewhere only the segments longer than
+            # 2 (mid_k - best) can be closer, and those are tried, PROJECT_PAIRS pairs at a time
+            slack = 1e-12 * max(self.total, np.finfo(float).tiny)
+            gap = mid.reshape(X.shape[0], k)[:, -1] - d
+            unsure = np.flatnonzero(gap < self._half_longest + slack)
+            unsure = unsure[np.argsort(gap[unsure], kind="stable")]
+            lo = 0
+            while lo < unsure.size:
+                reach = gap[unsure[lo]] - slack          # the smallest gap of the points from lo on
+                tried = np.flatnonzero(0.5 * self.length >= reach) if reach > 0 else np.arange(segments)
+                part = unsure[lo:lo + max(1, PROJECT_PAIRS // max(tried.size, 1))]
+                Y2, s2, d2 = self._closest(X[part], np.broadcast_to(tried, (part.size, tried.size)))
+                better = d2 < d[part]
+                Y[part[better]], s[part[better]], d[part[better]] = Y2[better], s2[better], d2[better]
+                lo += part.size
+        return Y, s, d
+
+    def _closest(self, X, cand):
+        """The closest point to each ``X[i]`` on the segments ``cand[i]`` (m, c): ``(Y, s, dist)``."""
         A, B = self.P[cand], self.Q[cand]
         AB = B - A
         denom = np.maximum((AB * AB).sum(-1), np.finfo(float).tiny)

@@ -6,7 +6,7 @@ import warnings
 
 import numpy as np
 
-from ..curvature._validate import bbox_diagonal, check_bool
+from ..curvature._validate import bbox_diagonal, check_bool, check_choice
 from ..curvature.boundary_editing import boundary_loop
 from ..curvature.reconstruct import ROW_MODES, Reconstructor
 from ..curvature.sparse_solver import resolve_backend
@@ -218,15 +218,7 @@ def _check_target_boundary(P, X, d):
     and the largest coordinate (float32 files far from the origin round by more than 1e-6 of a
     small diagonal)."""
     scale = max(d, float(np.abs(P).max()), float(np.abs(X).max()))
-    polyline = Polyline(P)
-    # the nearest-candidate projection's distances are upper bounds: only the points it does not
-    # clear are projected onto every segment (in chunks of ~2e6 point-segment pairs)
-    dist = polyline.project(X)[2] / scale
-    suspect = np.flatnonzero(dist > TARGET_BOUNDARY_TOLERANCE)
-    step = max(1, 2_000_000 // P.shape[0])
-    for lo in range(0, suspect.size, step):
-        chunk = suspect[lo:lo + step]
-        dist[chunk] = polyline.project(X[chunk], k=P.shape[0])[2] / scale
+    dist = Polyline(P).project(X)[2] / scale              # exact: every segment where it must be
     off = np.flatnonzero(dist > TARGET_BOUNDARY_TOLERANCE)
     if off.size:
         raise RemeshError(
@@ -273,8 +265,9 @@ def _ratios(report, engines):
 
 
 def _check_choice(name, value, choices):
-    if value not in choices:
-        raise ValueError(f"{name}={value!r} is not one of {', '.join(map(repr, choices))}.")
+    """``value`` as a str if it is one of ``choices``, else ValueError (an array or list is
+    refused by name: ``in`` compared it element-wise, and a one-element array passed)."""
+    return check_choice(value, name, choices, f" is not one of {', '.join(map(repr, choices))}.")
 
 
 def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="conservative", rows="free",
@@ -284,12 +277,12 @@ def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="cons
     retriangulated surface), ``Z`` (zero-detail baseline), ``Dt``, ``distance`` and
     ``zero_distance`` (the exact distance of each vertex of ``X``, of ``Z``, to the source: the
     ones the Hausdorff maxima are taken over; None when ``evaluate=False``) and ``report``."""
-    _check_choice("method", method, RETRIANGULATIONS)
-    _check_choice("transfer", transfer, TRANSFERS)
-    _check_choice("rows", rows, ROW_MODES)
-    _check_choice("location", location, LOCATIONS)
+    method = _check_choice("method", method, RETRIANGULATIONS)
+    transfer = _check_choice("transfer", transfer, TRANSFERS)
+    rows = _check_choice("rows", rows, ROW_MODES)
+    location = _check_choice("location", location, LOCATIONS)
     if parameterization is not None:
-        _check_choice("parameterization", parameterization, PARAMETERIZATIONS)
+        parameterization = _check_choice("parameterization", parameterization, PARAMETERIZATIONS)
         if location != "uv":
             raise ValueError(f"parameterization={parameterization!r} applies to location='uv' only "
                              f"(location={location!r} uses no planar map); pass location='uv' or "

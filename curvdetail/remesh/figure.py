@@ -58,8 +58,25 @@ def save_figure(path, V, F, X, Ft, Z, distance, report, *, overwrite=False, dpi=
     X, Ft : rebuilt target
     Z : (p, 3) float array       zero-detail baseline positions (triangles ``Ft``)
     distance : (p,) float array  per-vertex distance of ``X`` to the source
-    report : dict                from :func:`remesh_experiment`
+    report : dict                from :func:`remesh_experiment`, measured (``evaluate=True``)
+
+    Raises
+    ------
+    ValueError         ``report`` without the measurements (a run with ``evaluate=False``), or
+                       ``distance`` not one finite value per vertex of ``X``
+    FileExistsError    ``path`` exists and ``overwrite`` is False
     """
+    missing = [key for key in ("error", "baseline_zero_detail", "floor_retriangulated") if key not in report]
+    if missing:
+        raise ValueError(f"report has no {', '.join(missing)}: the figure shows the measured errors; pass the "
+                         "report of a run with evaluate=True (remesh_experiment's default).")
+    X = np.asarray(X, dtype=np.float64)
+    got = "is None" if distance is None else f"has shape {np.shape(distance)}"
+    distance = np.asarray(distance if distance is not None else [], dtype=np.float64)
+    if distance.shape != (X.shape[0],) or not np.isfinite(distance).all():
+        raise ValueError(f"distance {got} for {X.shape[0]} rebuilt vertices: pass one finite "
+                         "distance per vertex of X (run_experiment's result['distance'], measured with "
+                         "evaluate=True).")
     import matplotlib
 
     matplotlib.use("Agg", force=False)

@@ -40,21 +40,24 @@ def locate(points, V, F, *, engine="auto", candidates=8, chunk=20_000):
     vertex's triangles in a second round where the first is not certain), exact closest point on
     each (Ericson's region tests, all in numpy); the candidates are certain only where triangle
     sizes vary little (a large triangle beside small ones can be missed). ``"auto"``: in the
-    plane matplotlib's trapezoid-map point location (C++) with the numpy engine for the points
-    it finds outside; in space pymeshlab's ``transfer_attributes_per_vertex`` (a uniform grid,
-    C++) for the nearest face, then the exact barycentric coordinates of the closest point in
-    that face. Points more than ``FAR_POINTS`` bbox diagonals outside the mesh's bounding box
-    skip both (pymeshlab's grid search slows down with the distance, without bound) for a
-    bounding-box tree search over every triangle that could hold the closest point (that of
+    plane matplotlib's trapezoid-map point location (C++); in space pymeshlab's
+    ``transfer_attributes_per_vertex`` (a uniform grid, C++, searching one diagonal of the mesh
+    around each point) for the nearest face; then the exact barycentric coordinates of the
+    closest point in that face. Points more than ``FAR_POINTS`` bbox diagonals outside the
+    mesh's bounding box skip both (pymeshlab's grid search slows down with the distance,
+    without bound), and the points they find no triangle for (planar points outside the
+    domain, points in space more than a diagonal from the surface) follow, for a bounding-box
+    tree search over every triangle that could hold the closest point (that of
     :func:`~curvdetail.remesh.evaluate.hausdorff`), all points at once.
 
     What is exact, to rounding: always, the closest point and distance within the triangle
-    returned; with ``"auto"``, the triangle itself for points more than ``FAR_POINTS`` from the
-    bounding box (the tree search, at any distance), points in space pymeshlab's grid finds a
-    face for (within its search radius of one diagonal) and planar points inside the domain.
-    The rest take the numpy engine's candidates: planar points outside the domain but within
-    ``FAR_POINTS`` of the box, points in space the grid finds no face for (within ``FAR_POINTS``
-    of the box but more than a diagonal from the surface), and every point with ``"numpy"``.
+    returned; with ``"auto"``, the triangle itself for planar points (the trapezoid map inside
+    the domain, the tree search outside it) and for points in space the tree search locates.
+    For the rest, pymeshlab's grid returns the closest face on and near the surface, but not
+    always away from it (a flat layer at the height of a wavy one and reaching past its edge:
+    up to 0.5 % of the diagonal too far; :func:`~curvdetail.remesh.evaluate.vertex_distance`
+    with ``far=True`` measures such points exactly). With ``"numpy"`` the triangle is the best
+    of the candidates above.
     Far away (from ~1e6 diagonals, facing a flat part) triangles whose distances differ by less
     than 1e-13 of the distance are ties: the distance is exact to that, and the closest point
     may be any of theirs.
@@ -118,10 +121,12 @@ def _locate(P, V, F, engine="auto", candidates=8, chunk=20_000):
     near, far = np.flatnonzero(gap <= FAR_POINTS), np.flatnonzero(gap > FAR_POINTS)
     if near.size:
         face[near] = _trifinder(P[near], V, F) if V.shape[1] == 2 else _nearest_face_meshlab(P[near], V, F)
-    if far.size:
-        face[far] = _nearest_face_tree(P[far], V, F)
-    bad = face < 0
-    face = np.where(bad, 0, face)
+    # and the points neither found (planar ones outside the domain, points in space more than a
+    # diagonal from the surface) the tree search too: the numpy engine's candidates miss a large
+    # triangle beside small ones (just outside a long boundary edge: 0.069 too far)
+    bad = np.flatnonzero(face < 0)             # the far points among them
+    if bad.size:
+        face[bad] = _nearest_face_tree(P[bad], V, F)
     bary, dist = np.empty((P.shape[0], 3)), np.empty(P.shape[0])
     # in blocks: the region formulas' temporaries for all points at once were the transfer's
     # peak (1.46M edge samples: 508 MB of 746 MB)
@@ -129,9 +134,6 @@ def _locate(P, V, F, engine="auto", candidates=8, chunk=20_000):
         part = slice(lo, lo + EXACT_BLOCK)
         b, d = _closest_barycentric(P[part, None, :], V[F[face[part]]][:, None])
         bary[part], dist[part] = b[:, 0], d[:, 0]
-    if bad.any():
-        f2, b2, d2 = _locate_kdtree(P[bad], V, F, candidates, chunk)
-        face[bad], bary[bad], dist[bad] = f2, b2, d2
     return face, bary, dist * scale
 
 
@@ -228,11 +230,13 @@ def _nearest_face_meshlab(P, V, F):
     ms = pymeshlab.MeshSet()
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=V, face_matrix=F.astype(np.int32)))
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=P))
-    # Every parameter explicitly: pymeshlab keeps values from earlier calls in one process.
+    # Every parameter explicitly: pymeshlab keeps values from earlier calls in one process. The
+    # search radius is absolute, one diagonal of the mesh (V is in its unit frame): a percentage
+    # is of the points' bounding box, 0 for one point, and a lone point found no face.
     ms.transfer_attributes_per_vertex(
         sourcemesh=0, targetmesh=1, vertexsampling=False, geomtransfer=False, normaltransfer=False,
         colortransfer=False, qualitytransfer=False, selectiontransfer=False, qualitydistance=False,
-        savebarycentric=True, upperbound=pymeshlab.PercentageValue(100.0), onselected=False)
+        savebarycentric=True, upperbound=pymeshlab.PureValue(1.0), onselected=False)
     face = np.rint(ms.mesh(1).vertex_custom_scalar_attribute_array("NearestFaceIndex")).astype(np.int64)
     face[(face < 0) | (face >= F.shape[0])] = -1
     return face

@@ -126,8 +126,11 @@ def parameterize(Vs, Fs, Vt=None, Ft=None, *, method="harmonic", backend="auto")
 
     The source boundary loop is walked from a common anchor (its smallest vertex index) and
     mapped to the unit circle by arc length; every target boundary vertex, which lies on the
-    source boundary polyline, goes to the circle point of its arc-length coordinate on that same
-    polyline, so both boundaries agree exactly. Interiors:
+    source boundary polyline, belongs where the source's map puts that point of the polyline:
+    on the source's boundary edge there in the domain (a chord of the circle, not the circle),
+    at its arc-length fraction along it. ``"harmonic"`` pins it there, so the target's
+    boundary vertices lie on the source's domain boundary exactly (on the circle, they would
+    lie outside the source's domain between its boundary vertices). Interiors:
 
     ``"harmonic"``         own cotangent harmonic map (one sparse factorization per mesh);
     ``"meshlab_harmonic"`` pymeshlab ``compute_texcoord_parametrization_harmonic``;
@@ -150,9 +153,11 @@ def parameterize(Vs, Fs, Vt=None, Ft=None, *, method="harmonic", backend="auto")
     -------
     UVs : (n_s, 2) float array     source domain positions
     UVt : (n_t, 2) float array or None
-    info : dict                    ``flipped_source``, ``flipped_target`` (counts) and
+    info : dict                    ``method``, ``flipped_source``, ``flipped_target`` (counts) and
                                    ``boundary_mismatch`` (largest distance, in the domain, between a
-                                   target boundary vertex and the source boundary curve there)
+                                   target boundary vertex and where the source's map puts its point
+                                   of the source boundary; 0 with ``"harmonic"``, which pins it there;
+                                   the last two only with a target)
 
     Raises
     ------
@@ -185,15 +190,16 @@ def parameterize(Vs, Fs, Vt=None, Ft=None, *, method="harmonic", backend="auto")
         return UVs, None, info
     Vt, Ft, loop_t = check_disk(Vt, Ft, "the target")
     _, s_t, _ = poly.project(Vt[loop_t])
+    # where the source's own map puts the target boundary points: along the source's boundary
+    # edges in the domain, by arc length (chords of the circle for "harmonic", not the circle:
+    # a target vertex between two source boundary vertices would lie outside the source's domain)
+    seg = np.clip(np.searchsorted(poly.s0, s_t, side="right") - 1, 0, loop_s.size - 1)
+    t = np.clip((s_t - poly.s0[seg]) / np.maximum(poly.length[seg], np.finfo(float).tiny), 0.0, 1.0)
+    expected = (1 - t)[:, None] * UVs[loop_s[seg]] + t[:, None] * UVs[loop_s[(seg + 1) % loop_s.size]]
     if method == "harmonic":
-        UVt = _harmonic_map(Vt, Ft, loop_t, circle(s_t, poly.total), backend=backend)
-        expected = circle(s_t, poly.total)
+        UVt = _harmonic_map(Vt, Ft, loop_t, expected, backend=backend)
     else:
         UVt = _meshlab_uv(Vt, Ft, method)
-        # where the source's own map puts the target boundary points (along its boundary)
-        seg = np.clip(np.searchsorted(poly.s0, s_t, side="right") - 1, 0, loop_s.size - 1)
-        t = (s_t - poly.s0[seg]) / np.maximum(poly.length[seg], np.finfo(float).tiny)
-        expected = (1 - t)[:, None] * UVs[loop_s[seg]] + t[:, None] * UVs[loop_s[(seg + 1) % loop_s.size]]
         UVt = _fit_similarity(UVt[loop_t], expected, UVt)
     info["flipped_target"] = int(flipped_triangles(UVt, Ft).size)
     info["boundary_mismatch"] = float(np.linalg.norm(UVt[loop_t] - expected, axis=1).max())
