@@ -136,7 +136,14 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="c
                                                ``location="uv"`` (None: "harmonic"); refused with
                                                ``location="closest"``, which uses no planar map
     backend : str                              sparse solver backend
-    evaluate : bool                            measure distances (the costly part on big meshes)
+    evaluate : bool                            measure distances (the costly part on big meshes).
+                                               The error and the floor are measured with
+                                               pymeshlab's engine (see :func:`hausdorff`): a fresh
+                                               process repeats their figures exactly, a second
+                                               call in the same process draws other face samples
+                                               (the bundled example's RMS: up to 1.1e-6 of the
+                                               diagonal, 0.8 %, apart over three calls; the
+                                               maxima, at vertices, stay the same)
     source_path : str or None                  recorded in the report
     progress : callable or None                called with each stage name as it starts
     target : tuple (Vt, Ft) or None            a ready retriangulation to use instead of making one
