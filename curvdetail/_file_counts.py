@@ -106,9 +106,11 @@ def _ply_counts(path):
     return found.get(b"vertex"), found.get(b"face")
 
 
-def _stl_counts(path):
+def _stl_counts(path, exact=False):
     """``(None, triangles)`` of an STL file: a binary file's header count (when the file size
-    matches it), or an ASCII file's ``endfacet`` lines; ``(None, None)`` if neither."""
+    matches it), or an ASCII file's ``endfacet`` words (``exact``: lines that start with one, which
+    takes ~10 times as long; a name such as "solid endfacet test" is then not counted);
+    ``(None, None)`` if neither."""
     size = os.path.getsize(path)
     with open(path, "rb") as f:
         head = f.read(84)
@@ -118,13 +120,17 @@ def _stl_counts(path):
                 return None, count
     if not head.lstrip().startswith(b"solid"):
         return None, None
-    return None, _streamed_counts(path, (b"endfacet",))[0]
+    if not exact:
+        return None, _streamed_counts(path, (b"endfacet",))[0]
+    return None, _streamed_line_starts(path, (rb"endfacet(?![^ \t\r\n])",))[0]
 
 
 def _stl_ascii_counts(path):
-    """``(facets, vertex lines)`` of an ASCII STL file (``endfacet`` and ``vertex`` words followed
-    by a blank, streamed), or ``(None, None)`` for a binary one (its header count matches its
-    size) or one that is not STL."""
+    """``(facets, vertex lines)`` of an ASCII STL file (lines that start with the word ``endfacet``
+    or with ``vertex`` and a blank, streamed), or ``(None, None)`` for a binary one (its header
+    count matches its size) or one that is not STL. The words are counted fast wherever they
+    stand, and only where those counts disagree (3 vertices a facet) again at the lines' starts
+    (~10 times as long)."""
     size = os.path.getsize(path)
     with open(path, "rb") as f:
         head = f.read(84)
@@ -133,7 +139,30 @@ def _stl_ascii_counts(path):
     if not head.lstrip().startswith(b"solid"):
         return None, None
     facets, spaced, tabbed = _streamed_counts(path, (b"endfacet", b"vertex ", b"vertex\t"))
-    return facets, spaced + tabbed
+    if spaced + tabbed == 3 * facets:
+        return facets, spaced + tabbed
+    # a name ("solid my vertex model") or a stray word: count the lines that start with them
+    return tuple(_streamed_line_starts(path, (rb"endfacet(?![^ \t\r\n])", rb"vertex[ \t]")))
+
+
+def _streamed_line_starts(path, patterns):
+    """Numbers of lines whose first word (after blanks) matches each of ``patterns`` (bytes
+    regexes, matched at that word), read in ``_CHUNK`` pieces of whole lines (never whole). Words
+    elsewhere in a line, as in a name on the ``solid`` line ("solid my vertex model") or after a
+    facet's normal, are not counted (pymeshlab reads the words of a facet by their place)."""
+    regexes = [re.compile(rb"(?:^|\n)[ \t]*" + pattern) for pattern in patterns]
+    counts = [0] * len(patterns)
+    tail = b""
+    with open(path, "rb") as f:
+        while True:
+            chunk = f.read(_CHUNK)
+            text = tail + chunk
+            cut = text.rfind(b"\n") + 1 if chunk else len(text)   # whole lines; all at the end
+            for i, regex in enumerate(regexes):
+                counts[i] += sum(1 for _ in regex.finditer(text, 0, cut))
+            tail = text[cut:]
+            if not chunk:
+                return counts
 
 
 _COUNTS = {".obj": _obj_counts, ".off": _off_counts, ".ply": _ply_counts, ".stl": _stl_counts}
@@ -168,6 +197,8 @@ def check_loaded(path, n_vertices, F, error=ValueError):
             "matches the file. Fix or remove those vertices (and their faces) in the file and "
             "read it again.")
     # polygons are triangulated, so a complete load has at least as many triangles as faces
+    if faces is not None and faces > F.shape[0] and os.path.splitext(os.fspath(path))[1].lower() == ".stl":
+        faces = _stl_counts(path, exact=True)[1]       # an ASCII file's "endfacet" in a name is no facet
     if faces is not None and faces > F.shape[0]:
         cause = _DROPPED_FACES.get(os.path.splitext(os.fspath(path))[1].lower(),
                                    "vertex indices out of range or repeated within a face")
@@ -175,3 +206,50 @@ def check_loaded(path, n_vertices, F, error=ValueError):
             f"{path!r} has {faces} faces but pymeshlab loaded {F.shape[0]} triangles: at least "
             f"{faces - F.shape[0]} were dropped, most likely for {cause}. Fix or remove those "
             "faces in the file and read it again.")
+
+
+def check_polygons(path, V, F, sizes, error=ValueError):
+    """Raise ``error`` if pymeshlab's loader cut a polygon face of ``path`` into triangles that
+    overlap or leave it. ``sizes`` holds the vertex count of each face of the file, in its
+    order; the loader makes k - 2 triangles of a face of k vertices, in the same order (the
+    caller has checked that the counts agree), here ``F`` over the vertices ``V``.
+
+    The loader cuts a PLY polygon, and an OBJ quad, as a fan from its first vertex (measured: the
+    quad ``f 1 2 3 4`` with (0, 0), (1, 0.5), (2, 0), (1, 2) came back as the triangles 1 2 3,
+    facing away, and 1 3 4, which covers the dent); an OFF quad along its shorter diagonal, which
+    need not lie inside it (the same quad with (1, 4) for (1, 2) was cut as the fan); larger OFF
+    and OBJ polygons by ear cutting, right for a planar polygon that does not cross itself. A
+    triangle facing against its polygon's vector area (the sum of its triangles', for a fan the
+    polygon's own: Newell's normal) cannot be part of a triangulation of it, and a fan whose
+    triangles all face with it covers the polygon once; so a polygon is refused where one of its
+    triangles faces against it (a concave polygon cut along a diagonal outside it, or one that
+    crosses itself or folds far from a plane). Zero-area triangles pass (collinear corners).
+    Vectorized over the triangles."""
+    sizes = np.asarray(sizes, dtype=np.int64)
+    if not sizes.size or sizes.max(initial=0) <= 3 or int((sizes - 2).sum()) != len(F):
+        return
+    polygon = sizes > 3
+    counts = sizes[polygon] - 2                                   # triangles of each polygon, in a run
+    T = np.asarray(F)[np.repeat(polygon, sizes - 2)].T
+    x, y, z = np.asarray(V, dtype=np.float64).T.copy()            # columns: gathers stay cheap
+    edges = [(c[T[1]] - c[T[0]], c[T[2]] - c[T[0]]) for c in (x, y, z)]
+    (ux, vx), (uy, vy), (uz, vz) = edges
+    areas = np.stack([uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx], axis=1)
+    normal = np.repeat(np.add.reduceat(areas, np.cumsum(counts) - counts, axis=0), counts, axis=0)
+    against = np.einsum("ij,ij->i", areas, normal) < 0
+    if not against.any():
+        return
+    maybe = np.flatnonzero(against)                               # rounding: not beyond 1e-9 of the sizes
+    along = np.einsum("ij,ij->i", areas[maybe], normal[maybe])
+    against[maybe] = along < -1e-9 * np.linalg.norm(areas[maybe], axis=1) * np.linalg.norm(normal[maybe], axis=1)
+    if not against.any():
+        return
+    polygons = np.unique(np.repeat(np.flatnonzero(polygon), counts)[against])
+    first = int(polygons[0])
+    raise error(
+        f"{path!r}: {counted(polygons.size, 'polygon face')} (first: face {first} counting from 0 in the "
+        f"file's order, of {sizes[first]} vertices) came out of pymeshlab's loader as triangles that "
+        "overlap or leave the polygon (a triangle faces the other way: the polygon is concave and was cut "
+        "along a diagonal outside it, or it crosses itself or is far from planar); triangulate the file's "
+        "polygons before reading it (e.g. Blender's Triangulate, or an exporter's triangulate option), or "
+        "write each concave polygon as triangles, and read the file again.")

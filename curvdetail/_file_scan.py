@@ -30,7 +30,7 @@ from ._ply_scan import _ply_problem
 from .curvature.errors import counted
 
 
-def check_before_loading(path, error=ValueError):
+def check_before_loading(path, error=ValueError, sizes=None):
     """Raise ``error`` for files that pymeshlab's loader would read into corrupt memory or
     misread without a word.
 
@@ -85,7 +85,9 @@ def check_before_loading(path, error=ValueError):
     Other files pass unread. Returns the number of triangles the faces of an ASCII PLY, ASCII
     OFF or OBJ file make (a polygon of k vertices k - 2; pymeshlab drops triangles with a
     repeated index, PLY faces with the 'deleted' flag bit, OBJ faces with texture indices out of
-    range, which the caller finds by comparing), else None."""
+    range, which the caller finds by comparing), else None. Where ``sizes`` is a list and the
+    faces of such a file are known, their vertex counts (an int array, in file order) are
+    appended to it (for :func:`curvdetail._file_counts.check_polygons`)."""
     extension = os.path.splitext(os.fspath(path))[1].lower()
     if extension in (".off", ".ply", ".obj") and _carriage_returns_only(path):
         raise error(f"{path!r} ends its lines with carriage returns alone (classic Mac OS), which pymeshlab "
@@ -120,13 +122,18 @@ def check_before_loading(path, error=ValueError):
         problem = _off_rows_problem(path, made)
         if problem:
             raise error(f"{path!r}: {problem}; fix the file and read it again.")
+        if sizes is not None and made:
+            sizes.append(made[1])
         return made[0] if made else None
     elif extension == ".ctm":
         problem = ctm_problem(path)
         if problem:
             raise error(f"{path!r}: {problem}.")
     elif extension == ".ply":
-        problem, triangles = _ply_problem(path)
+        found = []
+        problem, triangles = _ply_problem(path, found)
+        if sizes is not None and triangles is not None:
+            sizes.append(np.concatenate(found) if found else np.zeros(0, dtype=np.int64))
         if problem:
             raise error(f"{path!r}: {problem}; fix the file and read it again.")
         return triangles
@@ -140,9 +147,8 @@ def check_before_loading(path, error=ValueError):
         continued = _obj_continued_line(path)
         if continued is not None:
             raise error(f"{path!r}: line {continued[0]} ({continued[1]!r}) ends in a backslash, which "
-                        "pymeshlab's OBJ loader reads as a line continued on the next one, and then loses "
-                        "that line's vertex without a word (a vertex (0, 0, 0) took its place); remove the "
-                        "backslash and read the file again.")
+                        "pymeshlab's OBJ loader reads as a line continued on the next one, and then " +
+                        _OBJ_CONTINUED[continued[2]] + " and read the file again.")
         count, line = _obj_indented_vertices(path)
         if count:
             raise error(f"{path!r}: {count} vertex lines start with spaces or tabs (first: line {line}), "
@@ -161,9 +167,12 @@ def check_before_loading(path, error=ValueError):
                         "loader reads as further corners (a vertex index past the file's vertices, which "
                         "can crash the process); move the comment to a line of its own and read the file "
                         "again.")
-        problem, triangles = _obj_face_indices(path)
+        found = []
+        problem, triangles = _obj_face_indices(path, sizes=found)
         if problem:
             raise error(f"{path!r}: {problem}.")
+        if sizes is not None and triangles is not None:
+            sizes.append(np.concatenate(found) if found else np.zeros(0, dtype=np.int64))
         return triangles
 
 
@@ -242,12 +251,31 @@ def _obj_comma(path):
     return None
 
 
+#: What pymeshlab's OBJ loader does with a line continued by a backslash, by the kind
+#: :func:`_obj_continued_line` finds, and the fix.
+_OBJ_CONTINUED = {
+    "other": "loses that line's vertex without a word (a vertex (0, 0, 0) took its place); remove the "
+             "backslash",
+    "crlf": "misreads the face without a word (before a Windows line end, CR LF, the face was dropped or "
+            "lost a corner); join the face's lines into one",
+    "glued": "glues the backslash's word to the next line's first word ('f 1 2\\' and '3' were read as "
+             "'f 1 23'); put a space before the backslash or join the face's lines into one",
+}
+
+
 def _obj_continued_line(path):
-    """``(1-based line, its text)`` of the first line of an OBJ file that ends in a backslash and
-    is not a face line, or None. pymeshlab's loader joins such a line with the next one and loses
-    what that line held: a vertex line so continued, or a comment line before a vertex, cost the
-    next vertex, and a vertex (0, 0, 0) was appended in its place, without a word (measured). A
-    continued face line is read right. Found through a memory map; only such lines are looked at."""
+    """``(1-based line, its text, kind)`` of the first line of an OBJ file that ends in a
+    backslash and that pymeshlab's loader misreads, or None. The loader joins such a line with
+    the next one, the backslash removed and nothing put in its place (measured: ``f 1 2\\`` then
+    ``3`` was read as ``f 1 23``, ``f 1 2 \\`` then ``3`` as ``f 1 2 3``). Kinds: ``"other"``, a
+    line that is not part of a face (a vertex line so continued, or a comment line before a
+    vertex, cost the next vertex, and a vertex (0, 0, 0) was appended in its place, without a
+    word); ``"crlf"``, a face line whose backslash a carriage return follows (the face was
+    dropped or lost a corner), or one continued on a line that ends so (``f 1 2 \\`` then ``3``
+    and CR LF: dropped); ``"glued"``, a face line whose backslash follows a word and whose
+    next line starts with one (the two are read as one index). A face continued over lines
+    (``f 1 \\``, ``2 \\``, ``3``) is read right and passes. Found through a memory map; only
+    such lines are looked at."""
     found = []
     with _mapped(path) as data:
         if data is None:
@@ -256,17 +284,27 @@ def _obj_continued_line(path):
             at = data.find(ending)
             while at >= 0:
                 start = data.rfind(b"\n", 0, at) + 1
-                words = data[start:at + 1].split()
+                first = start                           # the first line of those it continues
+                while first >= 2 and data[first - 2:first] == b"\\\n":
+                    first = data.rfind(b"\n", 0, first - 1) + 1
+                words = data[first:at + 1].replace(b"\\\n", b"").split()
+                kind = None
                 if not words or words[0] != b"f":
-                    found.append((start, at + 1))
+                    kind = "other"
+                elif ending == b"\\\r\n" or data[at + 2:data.find(b"\n", at + 2)].endswith(b"\r"):
+                    kind = "crlf"                       # on this line or the next (measured: dropped)
+                elif at > start and data[at - 1:at] not in b" \t" and data[at + 2:at + 3] not in b" \t\n":
+                    kind = "glued"                      # (an empty slice is "in" any bytes: the file's end)
+                if kind is not None:
+                    found.append((start, at + 1, kind))
                     break
                 at = data.find(ending, at + len(ending))
         if not found:
             return None
-        start, end = min(found)
+        start, end, kind = min(found)
         text = data[start:end].decode("utf-8", "replace").strip()
         number = int(np.count_nonzero(np.frombuffer(data, dtype=np.uint8, count=start) == 10)) + 1
-    return number, text if len(text) <= 80 else text[:77] + "..."
+    return number, text if len(text) <= 80 else text[:77] + "...", kind
 
 
 def _obj_indented_vertices(path):
@@ -741,7 +779,8 @@ def _off_rows_problem(path, made=None):
     read): a face line whose index tokens are all unsigned digits, shorter than the vertex
     count's digits (or as long and below it), holds no index out of range, so only the other
     lines (normally none) are parsed one by one. Where nothing is wrong and ``made`` is a list,
-    the number of triangles the faces make (a polygon of k vertices k - 2) is appended to it."""
+    the number of triangles the faces make (a polygon of k vertices k - 2) is appended to it, and
+    then the faces' vertex counts (an int array, in file order)."""
     with open(path, "rb") as f:
         data = f.read()
     header = _off_header(io.BytesIO(data))
@@ -895,7 +934,7 @@ def _off_rows_problem(path, made=None):
                 f"reader drops without a word ({few.size} such faces); a face needs 3 or more vertices: fix or "
                 "remove it and the header's face count")
     if made is not None:
-        made.append(int((k - 2).sum()))
+        made += [int((k - 2).sum()), k]
     return None
 
 
@@ -1026,7 +1065,7 @@ _OBJ_INDEX_END[[35, 47]] = True
 _OBJ_WHOLE_INDEX = re.compile(rb"[+-]?[0-9]+(?:\.0*)?")
 
 
-def _obj_face_indices(path, size=1 << 20):
+def _obj_face_indices(path, size=1 << 20, sizes=None):
     """``(problem, triangles)`` for the faces of an OBJ file: the message for the first face
     whose vertex index pymeshlab's loader would read as another vertex or write out of bounds
     with, or a face of fewer than 3 corners (dropped without a word), else None; and the number
@@ -1040,7 +1079,8 @@ def _obj_face_indices(path, size=1 << 20):
     first word is ``f`` (pymeshlab reads indented ones too). Vectorized over the bytes in pieces
     of about ``size`` bytes (whole lines), each copied out of a memory map (~0.7 s for a million
     vertices, against ~2 s for pymeshlab's read); only words that are not plain digits are
-    looked at one by one."""
+    looked at one by one. Where ``sizes`` is a list, each piece's faces' corner counts (int
+    arrays, in file order) are appended to it."""
     triangles = 0
     vertices_before = 0                            # v lines before the piece
     lines_before = 0
@@ -1058,7 +1098,7 @@ def _obj_face_indices(path, size=1 << 20):
                     high = data.find(b"\n", high) + 1 or len(data)   # a continued line stays whole
             piece = data[low:high]
             problem, made, vertex_lines, lines, largest = _obj_face_indices_in(
-                _joined(piece), None, vertices_before, lines_before)
+                *_joined(piece), None, vertices_before, lines_before, sizes)
             if problem:
                 return problem, None
             triangles += made
@@ -1070,35 +1110,45 @@ def _obj_face_indices(path, size=1 << 20):
         # with one past it is looked at again
         for largest, low, high, before, lines in highest:
             if largest > vertices_before:
-                return _obj_face_indices_in(_joined(data[low:high]), vertices_before, before, lines)[0], None
+                return _obj_face_indices_in(*_joined(data[low:high]), vertices_before, before, lines)[0], None
     return None, triangles
 
 
 def _joined(piece):
-    """``piece`` with lines continued by a backslash joined to the next, as pymeshlab's OBJ loader
-    reads them (only face lines get here continued: others are refused before); the line numbers
-    after such a line are then a line short per join."""
-    if b"\\\n" not in piece and b"\\\r\n" not in piece:
-        return piece
-    return piece.replace(b"\\\r\n", b" ").replace(b"\\\n", b" ")
+    """``(piece, lines)``: ``piece`` with lines continued by a backslash joined to the next, as
+    pymeshlab's OBJ loader reads them (the backslash and the newline removed, nothing put in
+    their place; only face lines get here continued with LF line ends: others are refused
+    before), and ``(the 0-based line of piece each joined line starts on, the piece's lines)``
+    (None where nothing was joined). A backslash as the file's last byte continues onto nothing
+    and is dropped."""
+    if b"\\\n" not in piece and not piece.endswith(b"\\"):
+        return piece, None
+    chars = np.frombuffer(piece, dtype=np.uint8)
+    newlines = np.flatnonzero(chars == 10)
+    joins = np.flatnonzero(chars[np.maximum(newlines - 1, 0)] == 92) # 92: "\\"; lines that continue
+    lines = np.delete(np.arange(newlines.size + 1), joins + 1)
+    piece = piece.replace(b"\\\n", b"")
+    return (piece[:-1] if piece.endswith(b"\\") else piece), (lines, newlines.size)
 
 
-def _obj_face_indices_in(piece, total, vertices_before, lines_before):
-    """:func:`_obj_face_indices` on ``piece`` (bytes, whole lines), with ``vertices_before`` v
-    lines and ``lines_before`` lines before the piece; positive indices are checked against
-    ``total`` vertices (None: not checked). Returns ``(problem, triangles, v lines, lines,
-    largest index)`` of the piece."""
+def _obj_face_indices_in(piece, numbers, total, vertices_before, lines_before, sizes=None):
+    """:func:`_obj_face_indices` on ``piece`` (bytes, whole lines; continued lines joined, and
+    ``numbers`` as :func:`_joined` gives it: None where none were), with
+    ``vertices_before`` v lines and ``lines_before`` lines before the piece; positive indices are
+    checked against ``total`` vertices (None: not checked). Returns ``(problem, triangles, v
+    lines, lines, largest index)`` of the piece (lines as in the file)."""
     if not piece.endswith(b"\n"):
         piece += b"\n"
     chars = np.frombuffer(piece, dtype=np.uint8)
     newlines = np.flatnonzero(chars == 10)
+    first_lines, line_count = numbers if numbers is not None else (None, newlines.size)
     starts = np.concatenate([[0], newlines[:-1] + 1])
     lead = chars[starts]
     second = chars[np.minimum(starts + 1, chars.size - 1)]
     vertex_line = (lead == 118) & ((second == 32) | (second == 9))
     vertex_lines = int(np.count_nonzero(vertex_line))
     if b"f" not in piece:                          # no face line
-        return None, 0, vertex_lines, newlines.size, 0
+        return None, 0, vertex_lines, line_count, 0
     # words: runs of bytes above 32 (pymeshlab splits at spaces, tabs and carriage returns; other
     # control bytes end a word here, which at worst refuses a file it reads)
     separator = chars <= 32
@@ -1111,7 +1161,7 @@ def _obj_face_indices_in(piece, total, vertices_before, lines_before):
     at = word_starts[np.minimum(first_word, word_starts.size - 1)]
     face_line = (per_line > 0) & (chars[at] == 102) & separator[np.minimum(at + 1, chars.size - 1)]
     if not face_line.any():
-        return None, 0, vertex_lines, newlines.size, 0
+        return None, 0, vertex_lines, line_count, 0
     corner = face_line[word_line]
     corner[first_word[face_line]] = False                      # the "f" itself
     corners = word_starts[corner]
@@ -1132,7 +1182,8 @@ def _obj_face_indices_in(piece, total, vertices_before, lines_before):
 
     def shown(line):
         text = piece[starts[line]:newlines[line]].decode("utf-8", "replace").strip()
-        return f"line {lines_before + line + 1} ({text if len(text) <= 80 else text[:77] + '...'!r})"
+        number = lines_before + 1 + (line if first_lines is None else int(first_lines[line]))
+        return f"line {number} ({text if len(text) <= 80 else text[:77] + '...'!r})"
 
     signed = (chars[corners] == 45) | (chars[corners] == 43)
     digits = ends - corners - signed
@@ -1180,4 +1231,6 @@ def _obj_face_indices_in(piece, total, vertices_before, lines_before):
         return (f"{shown(faces[few[0]])} is a face of {per_face[few[0]]} corners, which pymeshlab's OBJ loader "
                 f"drops without a word ({few.size} such faces here); a face needs 3 or more vertices (an edge is "
                 "an 'l' line): fix or remove it and read the file again"), 0, 0, 0, 0
-    return None, int((per_face - 2).sum()), vertex_lines, newlines.size, int(values.max(initial=0))
+    if sizes is not None:
+        sizes.append(per_face)
+    return None, int((per_face - 2).sum()), vertex_lines, line_count, int(values.max(initial=0))

@@ -134,12 +134,13 @@ def _ply_header(f):
     return None
 
 
-def _ply_problem(path):
+def _ply_problem(path, sizes=None):
     """``(problem, triangles)``: what pymeshlab's PLY reader would misread or crash on in
     ``path`` (None if nothing): a header it misparses (:func:`_ply_header`), and in an ASCII file
     the rows (:func:`_ply_body_problem`); and the number of triangles the faces of an ASCII file
     make (a polygon of k vertices k - 2), None where not known. Binary files are read by their
-    types' sizes; only their header is checked."""
+    types' sizes; only their header is checked. Where ``sizes`` is a list, the vertex counts of an
+    ASCII file's faces (int arrays, in file order) are appended to it."""
     with open(path, "rb") as f:
         header = _ply_header(f)
         if header is None or isinstance(header, str):
@@ -152,7 +153,7 @@ def _ply_problem(path):
             data = b""
         else:
             data = mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ)   # unmapped when unreferenced
-    return _ply_body_problem(data, offset, elements, first_line)
+    return _ply_body_problem(data, offset, elements, first_line, sizes)
 
 
 #: Bytes of each PLY type, by its first name.
@@ -409,7 +410,7 @@ def _ply_odd_characters(padded, odd, token):
     return is_sign & at_start & digit_next, real
 
 
-def _ply_body_problem(data, offset, elements, first_line):
+def _ply_body_problem(data, offset, elements, first_line, sizes=None):
     """``(problem, triangles)``: what is wrong with the body of an ASCII PLY file (``data``,
     bytes or a memory map, from byte ``offset``) whose header declares ``elements``
     (:func:`_ply_header`) and whose body starts on line ``first_line`` (None if nothing), and
@@ -513,7 +514,7 @@ def _ply_body_problem(data, offset, elements, first_line):
         if rp + count > rows.size:
             return too_few(element, rows.size - rp, count, lines_=True)
         mine = rows[rp:rp + count]
-        problem, layout, made = _ply_list_rows(data, chars, element, props, mine, lines, line_of, text)
+        problem, layout, made = _ply_list_rows(data, chars, element, props, mine, lines, line_of, text, sizes)
         if problem:
             return problem, None
         if element == b"tristrips" or made is not None:
@@ -528,13 +529,14 @@ def _ply_body_problem(data, offset, elements, first_line):
     return _ply_values_problem(lines, layouts, words_of, line_of, text), triangles
 
 
-def _ply_list_rows(data, chars, element, props, rows, lines, line_of, text):
+def _ply_list_rows(data, chars, element, props, rows, lines, line_of, text, sizes=None):
     """Check the rows of an element with list properties (``props``), one per line of ``rows``
     (line numbers, in order): each a line of its own with exactly its values, its list counts
     whole numbers (and, for the faces' vertex indices, 3 to 255 of them). Returns ``(problem,
     None)`` or ``(None, (kinds, bounds))``: the kinds of a row's segments (a scalar, a list's
     count, its items: an int8 array) and each row's segment ends (in words from the line's
-    first; one row per line, one column per segment)."""
+    first; one row per line, one column per segment). The faces' vertex counts are appended to
+    ``sizes`` where it is a list."""
     segment_kinds = []
     for _, kind, is_list, item_kind in props:
         segment_kinds += [_PLY_INT, item_kind] if is_list else [kind]
@@ -585,6 +587,8 @@ def _ply_list_rows(data, chars, element, props, rows, lines, line_of, text):
                 n[bad] = 0
             if element == b"face" and prop in _PLY_FACE_LISTS:
                 made = (made or 0) + int((n - 2).sum())
+                if sizes is not None:
+                    sizes.append(n.copy())
                 few = np.flatnonzero((n < 3) & ~broken)
                 many = np.flatnonzero(n > _PLY_MAX_CORNERS)
                 if few.size:

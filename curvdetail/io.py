@@ -11,7 +11,7 @@ import re
 import numpy as np
 
 from ._ctm_scan import ctm_layout, ctm_problem, ctm_vertex_map
-from ._file_counts import check_loaded
+from ._file_counts import check_loaded, check_polygons, declared_counts
 from ._file_scan import check_before_loading
 from ._output import atomic_output, check_output_path
 from .curvature._validate import as_faces, as_vertices
@@ -63,7 +63,9 @@ def read_mesh(path):
                         that are not decimal numbers, which it reads as 0 or as their first
                         digits (OFF, OBJ: ``abc``, ``0.3abc``, ``0x1p3``, ``1d3``, a comment
                         among the coordinates); lines other than faces ending in a backslash
-                        (OBJ: the next line's vertex is lost); a PLY header pymeshlab
+                        (OBJ: the next line's vertex is lost), and face lines so continued
+                        with CR LF line ends or a backslash glued to both lines' words (the
+                        face was dropped or misread); a PLY header pymeshlab
                         misparses or crashes on, or face lists of types it does not read;
                         ASCII PLY values it would not read whole as their type, faces of
                         fewer than 3 or more than 255 vertices, a face row not on a line of
@@ -75,7 +77,10 @@ def read_mesh(path):
                         ASCII STL facets of other than 3 vertices; binary PLY files with
                         big-endian double vertices, a body shorter than the header declares,
                         or lists the reader cannot skip. After loading, the triangles of an
-                        OBJ, OFF or ASCII PLY file must be as many as its faces make
+                        OBJ, OFF or ASCII PLY file must be as many as its faces make, and
+                        none of a polygon's (OBJ, OFF, PLY) may face against it (a concave
+                        polygon cut along a diagonal outside it: triangulate such polygons
+                        first; :func:`curvdetail._file_counts.check_polygons`)
                         (see :func:`curvdetail._file_scan.check_before_loading`)
 
     Examples
@@ -109,7 +114,8 @@ def load_checked(ms, path, *, vertex_maps=True):
     """Load the mesh file ``path`` into the MeshSet ``ms`` as its new current layer and return
     that ``pymeshlab.Mesh``, with the checks pymeshlab's loader lacks: before it reads the file
     (:func:`curvdetail._file_scan.check_before_loading`) and after (what it dropped:
-    :func:`curvdetail._file_counts.check_loaded`, and the triangles an ASCII PLY's faces make).
+    :func:`curvdetail._file_counts.check_loaded`, and the triangles an ASCII PLY's faces make;
+    what it cut wrong: :func:`curvdetail._file_counts.check_polygons`).
     MeshFileError for each; ``path`` is expected to exist (see :func:`input_path`).
 
     With ``vertex_maps``, a CTM file's vertex colours and quality are set on the layer as the
@@ -118,7 +124,8 @@ def load_checked(ms, path, *, vertex_maps=True):
     them (for callers that take the vertices and triangles only)."""
     _check_utf8(path, "read")
     try:
-        triangles = check_before_loading(path, error=MeshFileError)
+        sizes = []                  # the vertex counts of the file's faces, where known
+        triangles = check_before_loading(path, error=MeshFileError, sizes=sizes)
     except OSError as exc:          # unreadable: named as the file's problem, as pymeshlab's are
         raise MeshFileError(f"could not read {path!r}: {exc.strerror or exc}.") from None
     cwd = os.getcwd()
@@ -136,6 +143,13 @@ def load_checked(ms, path, *, vertex_maps=True):
             f"{path!r}: its faces make {triangles} triangles (a polygon of k vertices k - 2), but pymeshlab "
             f"loaded {F.shape[0]}: {_DROPPED_TRIANGLES[os.path.splitext(path)[1].lower()]}. Fix or remove "
             "those faces in the file and read it again.")
+    if not sizes and os.path.splitext(path)[1].lower() == ".ply":
+        faces = declared_counts(path)[1]
+        if faces is not None and F.shape[0] > faces:   # a binary file's polygons, fanned in the file's order
+            polygons = mesh.polygonal_face_list()       # (the loader marks the fans' inner edges)
+            sizes = [np.fromiter(map(len, polygons), dtype=np.int64, count=len(polygons))]
+    if sizes:
+        check_polygons(path, mesh.vertex_matrix(), F, sizes[0], error=MeshFileError)
     if vertex_maps and os.path.splitext(path)[1].lower() == ".ctm":
         _set_ctm_vertex_maps(ms, path)
         mesh = ms.current_mesh()

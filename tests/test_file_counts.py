@@ -89,3 +89,19 @@ def test_declared_off_counts_read_whole_numbers_and_not_others(tmp_path):
     assert declared_counts(path) == (4, 2)
     path.write_text("OFF\n4.5 2 0\n")
     assert declared_counts(path) == (None, None)
+
+
+@pytest.mark.parametrize("chunk", [1, 3, 7, 64, 1 << 20])
+def test_stl_names_and_odd_words_are_not_counted_as_vertices_or_facets(tmp_path, monkeypatch, chunk):
+    # pymeshlab skips the solid line and reads the words of a facet by their place: only lines
+    # that start with "vertex" or "endfacet" are corners or facet ends (it read this file right)
+    facet = ("  facet normal 0 0 1\n    outer loop\n      vertex 0 0 0\n      vertex 1 0 0\n"
+             "\tvertex 0 1 0\n    endloop\n  endfacet\n")
+    path = tmp_path / "m.stl"
+    path.write_text("solid my vertex endfacet model\n" + facet * 2 + "endsolid my vertex\tendfacet model")
+    monkeypatch.setattr(_file_counts, "_CHUNK", chunk)
+    assert _file_counts._stl_ascii_counts(path) == (2, 6)
+    assert _file_counts._stl_counts(path, exact=True) == (None, 2)
+    check_loaded(str(path), 3, np.array([[0, 1, 2], [0, 1, 2]]))      # its 2 triangles: nothing dropped
+    with pytest.raises(ValueError, match="has 2 faces but pymeshlab loaded 1 triangles"):
+        check_loaded(str(path), 3, np.array([[0, 1, 2]]))

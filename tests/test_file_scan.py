@@ -637,7 +637,7 @@ def test_obj_face_indices_outside_the_file_are_refused_before_loading(tmp_path, 
     (_OBJ_V5 + "f 1 2 5 3 4\n", 3),                                      # a pentagon: 3 triangles
     ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\nv 5 5 5\nf -4 -3 -1\n", 2),   # negative, interleaved
     (_OBJ_V5 + "vt 0 0\nvn 0 0 1\nf 1/1/1 2/1/1 +3/1/1\nf 2//1 5//1 3.0//1\n  f 1 3 4#note\n", 3),
-    (_OBJ_V5 + "f 1 2 \\\n3\r\nf 1 3 \\\r\n4\n", 2),                    # continued face lines
+    (_OBJ_V5 + "f 1 2 \\\n3\nf 1 \\\n3 \\\n\\\n4\n", 2),                # continued face lines
 ])
 def test_obj_faces_in_range_pass_and_give_their_triangles(tmp_path, text, triangles):
     from curvdetail._file_scan import _obj_face_indices
@@ -685,3 +685,37 @@ def test_files_the_new_checks_pass_give_their_triangles(tmp_path, name, data, tr
     path = tmp_path / name
     path.write_bytes(data)
     assert check_before_loading(path) == triangles
+
+
+@pytest.mark.parametrize("text, message", [
+    # line numbers count the file's lines, continued ones too (they were a line short per join)
+    (_OBJ_V5 + "f 1 2 \\\n3\nf 2 5 9\n", r"line 8 \('f 2 5 9'\) names the vertex 9"),
+    (_OBJ_V5 + "f 1 \\\n2 \\\n3\nf 1 2\n", r"line 9 \('f 1 2'\) is a face of 2 corners"),
+    (_OBJ_V5 + "f 1 2 \\\n3\n" * 3 + "f 2 5 9\n", r"line 12 \('f 2 5 9'\) names the vertex 9"),
+    # pymeshlab joins the lines with nothing between: 'f 1 2\' and '3' were read as 'f 1 23'
+    # (no triangle); a face line continued with CR LF line ends was dropped (measured)
+    (_OBJ_V5 + "f 1 2\\\n3\n", r"line 6 \('f 1 2\\\\'\) ends in a backslash.*'f 1 23'"),
+    (_OBJ_V5 + "f 1 2 \\\r\n3\r\n", r"line 6 \('f 1 2 \\\\'\) ends in a backslash.*Windows line end"),
+    (_OBJ_V5 + "f 1 2 3\nf 1 3 \\\n4\r\n", r"line 7 \('f 1 3 \\\\'\) ends in a backslash.*Windows line end"),
+])
+def test_obj_continued_faces_are_refused_naming_their_line(tmp_path, text, message):
+    from curvdetail._file_scan import _obj_face_indices
+    path = tmp_path / "m.obj"
+    path.write_bytes(text.encode())
+    with pytest.raises(ValueError, match=message):
+        check_before_loading(path)
+    if "line 6" not in message and "line 7" not in message:
+        for size in (1, 7, 20):                                          # pieces of a line or a few
+            assert _obj_face_indices(path, size=size)[0].startswith(message.split(" \\(")[0])
+
+
+@pytest.mark.parametrize("text, triangles", [
+    # a face continued over several lines, and a backslash ending the file, are read right
+    ("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 \\\n2 \\\n\\\n3\nf 2 4 \\\n 3 \\", [[0, 1, 2], [1, 3, 2]]),
+    ("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2\\\n 4 3\n", [[0, 1, 3], [0, 3, 2]]),
+])
+def test_obj_faces_continued_over_lines_are_read_right(tmp_path, text, triangles):
+    from curvdetail.io import read_mesh
+    path = tmp_path / "m.obj"
+    path.write_bytes(text.encode())
+    assert read_mesh(path)[1].tolist() == triangles

@@ -1157,3 +1157,95 @@ def test_polygons_with_all_their_triangles_are_read(tmp_path):
     path.write_text("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nf 1 2 3 4\nf 2 5 3\n")
     V, F = read_mesh(path)
     assert F.shape == (3, 3) and V.shape == (5, 3)
+
+
+# A concave quad (a dart: the corner (1, 0.5) is dented in), counter-clockwise seen from +z.
+_DART = [(0, 0, 0), (1, 0.5, 0), (2, 0, 0), (1, 2, 0)]
+
+
+def _polygon_file(path, corners, face):
+    n = len(corners)
+    rows = "".join(f"{x} {y} {z}\n" for x, y, z in corners)
+    if path.suffix == ".obj":
+        text = "".join(f"v {row}" for row in rows.splitlines(True)) + "f " + " ".join(str(i + 1) for i in face) + "\n"
+    elif path.suffix == ".off":
+        text = f"OFF\n{n} 1 0\n{rows}{len(face)} " + " ".join(map(str, face)) + "\n"
+    else:
+        text = (f"ply\nformat ascii 1.0\nelement vertex {n}\nproperty float x\nproperty float y\nproperty float z\n"
+                "element face 1\nproperty list uchar int vertex_indices\nend_header\n" + rows
+                + f"{len(face)} " + " ".join(map(str, face)) + "\n")
+    path.write_text(text)
+
+
+@pytest.mark.parametrize("suffix, corners, start", [
+    # pymeshlab fans OBJ quads and PLY polygons from their first corner: the dart 1 2 3 4 came
+    # back as the triangles 1 2 3 (facing -z, outside the dart) and 1 3 4 (covering the dent)
+    (".obj", _DART, 0), (".obj", _DART, 2), (".ply", _DART, 0), (".ply", _DART, 2),
+    # it cuts OFF quads along the shorter diagonal: here 1 3, outside the taller dart
+    (".off", [(0, 0, 0), (1, 0.5, 0), (2, 0, 0), (1, 4, 0)], 0),
+    (".ply", [(0, 0, 0), (2, 0, 0), (2, 1, 0), (1, 1, 0), (1, 2, 0), (0, 2, 0)], 2),   # an L from a far corner
+])
+def test_concave_polygons_cut_wrong_by_the_loader_are_refused(tmp_path, suffix, corners, start):
+    from curvdetail.io import MeshFileError, read_mesh
+    path = tmp_path / ("m" + suffix)
+    n = len(corners)
+    _polygon_file(path, corners, [(start + i) % n for i in range(n)])
+    with pytest.raises(MeshFileError, match=rf"1 polygon face \(first: face 0 .* of {n} vertices\) came out of "
+                                            r"pymeshlab's loader as triangles that overlap or leave the polygon"
+                                            r".*triangulate the file's polygons"):
+        read_mesh(path)
+
+
+@pytest.mark.parametrize("suffix", [".obj", ".off", ".ply"])
+@pytest.mark.parametrize("corners, start", [
+    (_DART, 1),                                                   # fanned from the dent: right
+    ([(0, 0, 0), (2, 0, 0), (2, 1, 0), (1, 1, 0), (1, 2, 0), (0, 2, 0)], 0),     # an L, its fan right
+    ([(0, 0, 0), (1, 0, 0), (1.5, 1, 0), (1, 2, 0), (0, 2, 0)], 2),              # convex, from any corner
+    ([(0, 0, 0), (0, 1, 0), (0, 1, 1), (0, 0, 1)], 3),                            # convex, in the y-z plane
+])
+def test_polygons_the_loader_triangulates_right_pass_with_their_area(tmp_path, suffix, corners, start):
+    from curvdetail.io import read_mesh
+    path = tmp_path / ("m" + suffix)
+    n = len(corners)
+    _polygon_file(path, corners, [(start + i) % n for i in range(n)])
+    V, F = read_mesh(path)
+    P = np.asarray(corners, dtype=float)
+    ring = P[[(start + i) % n for i in range(n)]]
+    polygon = np.cross(ring, np.roll(ring, -1, axis=0)).sum(axis=0) / 2        # Newell's vector area
+    areas = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]) / 2
+    assert F.shape == (n - 2, 3)
+    # the triangles tile the polygon: each faces with it and their areas add up to its area
+    assert np.all(areas @ polygon > 0)
+    assert np.isclose(np.linalg.norm(areas, axis=1).sum(), np.linalg.norm(polygon))
+
+
+def test_ascii_stl_with_vertex_in_its_name_is_read(tmp_path):
+    # "vertex " in the solid line was counted as a corner, and the file refused as a facet of 4
+    from curvdetail.io import read_mesh
+    path = tmp_path / "m.stl"
+    path.write_text("solid my vertex model\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n"
+                    "   vertex 0 1 0\n  endloop\n endfacet\nendsolid my vertex model\n")
+    V, F = read_mesh(path)
+    assert V.tolist() == [[0, 0, 0], [1, 0, 0], [0, 1, 0]] and F.tolist() == [[0, 1, 2]]
+
+
+@pytest.mark.parametrize("quad, triangles", [
+    ([1, 2, 3, 0], [[4, 2, 3], [1, 2, 3], [1, 3, 0], [4, 3, 0]]),            # fanned from the dent: right
+    ([0, 1, 2, 3], None),                                                  # fanned across the dent
+])
+def test_binary_ply_of_triangles_and_quads_is_read_in_order_and_checked(tmp_path, quad, triangles):
+    # rows of 3 and 4 indices mixed; pymeshlab reads them right, and fans the quad
+    from curvdetail.io import MeshFileError, read_mesh
+    corners = np.array(_DART + [(1, 3, 0)], dtype="<f4")
+    faces = [[4, 2, 3], quad, [4, 3, 0]]
+    rows = b"".join(np.array([len(f)], "u1").tobytes() + np.array(f, "<i4").tobytes() for f in faces)
+    path = tmp_path / "m.ply"
+    path.write_bytes(b"ply\nformat binary_little_endian 1.0\nelement vertex 5\nproperty float x\nproperty float y\n"
+                     b"property float z\nelement face 3\nproperty list uchar int vertex_indices\nend_header\n"
+                     + corners.tobytes() + rows)
+    if triangles is None:
+        with pytest.raises(MeshFileError, match=r"1 polygon face \(first: face 1 .* of 4 vertices\) came out"):
+            read_mesh(path)
+    else:
+        V, F = read_mesh(path)
+        assert V.tolist() == corners.tolist() and F.tolist() == triangles
