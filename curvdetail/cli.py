@@ -180,7 +180,7 @@ def fixed_vertices(args, F, n):
 def _reconstruct_command(parser):
     add_input_output_arguments(parser, "mesh file (any format MeshLab reads)",
                                "rebuilt mesh; quality = distance to INPUT (.ply keeps it)")
-    parser.add_argument("--rows", choices=("all", "free"), default="all",
+    parser.add_argument("--rows", type=str.lower, choices=("all", "free"), default="all",
                         help="residual rows in E_Q: all vertices (the paper) or free ones only "
                              "(default: %(default)s)")
     add_fix_arguments(parser)
@@ -237,7 +237,7 @@ def _minimal_command(parser):
                         help="stop when no vertex moves more than TOL x the bbox diagonal of its piece "
                              "in a step, as --step measures it (by default normal to the surface: "
                              f"tangential sliding is not counted; default {DEFAULT_TOL:g})")
-    parser.add_argument("--step", choices=("normal", "full"), default="normal",
+    parser.add_argument("--step", type=str.lower, choices=("normal", "full"), default="normal",
                         help="what TOL is compared with: the step normal to the surface (default) or "
                              "the full vertex displacement, tangential sliding included")
     add_fix_arguments(parser)
@@ -333,20 +333,20 @@ def _percentage(text):
 def _remesh_command(parser):
     add_input_output_arguments(parser, "source mesh: a disk-topology patch (one boundary loop)",
                                "rebuilt target mesh; per-vertex quality = distance to SOURCE (.ply keeps it)")
-    parser.add_argument("--method", choices=("isotropic", "decimate"), default="isotropic",
+    parser.add_argument("--method", type=str.lower, choices=("isotropic", "decimate"), default="isotropic",
                         help="retriangulation: pymeshlab isotropic remeshing or fast-simplification "
                              "decimation (default: isotropic)")
     parser.add_argument("--target-edge", type=_percentage, default=1.0, metavar="PCT",
                         help="target edge length in %% of the source's bbox diagonal, e.g. 1 or 1%% "
                              "(default: 1)")
-    parser.add_argument("--transfer", choices=("conservative", "pointwise"), default="conservative",
+    parser.add_argument("--transfer", type=str.lower, choices=("conservative", "pointwise"), default="conservative",
                         help="detail transfer: conservative (edge curvature measure, default) or "
                              "pointwise (the paper: K interpolated times target area)")
-    parser.add_argument("--rows", choices=("all", "free"), default="free",
+    parser.add_argument("--rows", type=str.lower, choices=("all", "free"), default="free",
                         help="residual rows of the reconstruction energy (default: free)")
-    parser.add_argument("--location", choices=("closest", "uv"), default="closest",
+    parser.add_argument("--location", type=str.lower, choices=("closest", "uv"), default="closest",
                         help="locate points by 3D closest point (default) or in a shared planar domain")
-    parser.add_argument("--parameterization", choices=("harmonic", "meshlab_harmonic", "lscm"),
+    parser.add_argument("--parameterization", type=str.lower, choices=("harmonic", "meshlab_harmonic", "lscm"),
                         default=None, help="planar domain for --location uv (default: harmonic)")
     parser.add_argument("--no-surface-check", action="store_true",
                         help="isotropic remeshing without its surface-distance check of each collapse "
@@ -506,12 +506,32 @@ def _run_on_file(args, work, *, other_inputs=()):
     ms = load_meshset(args.input, *args.add)
     figures = work(ms)
     save_current_mesh(ms, args.output, overwrite=args.overwrite)
-    print(json.dumps(figures, indent=2, default=str))
+    figures = _plain_json(figures)
+    print(json.dumps(figures, indent=2, allow_nan=False, default=str))
     # documented, but the next step ("no attribute 'curvature_detail'") is confusing without it
     quality = ms.current_mesh().has_vertex_scalar() and not _keeps_quality(args.output)
     _note_geometry_only(args.output, attributes_lost_in(ms, args.output), quality=quality,
                         colours=vertex_colours_kept_in(ms, args.output))
     return figures
+
+
+def _plain_json(value):
+    """Figures as JSON's own values: numpy scalars and arrays as numbers and lists (default=str
+    printed np.int64(3) as "3" and an array as "[1. 2.]"), NaN and infinities as null (json
+    wrote NaN, which no JSON reader takes); other objects are left to ``default=str``."""
+    import numpy as np
+
+    if isinstance(value, dict):
+        return {(key.item() if isinstance(key, np.generic) else key): _plain_json(v) for key, v in value.items()}
+    if isinstance(value, np.ndarray):
+        return _plain_json(value.tolist())          # a list, or the one value of a 0-d array
+    if isinstance(value, (list, tuple)):
+        return [_plain_json(v) for v in value]
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not np.isfinite(value):
+        return None
+    return value
 
 
 def _keeps_quality(path):
@@ -666,10 +686,10 @@ def _edit_command(parser):
                         help="per-vertex status file: 0 fixed, 1 free, 2 handle ('#' comments)")
     parser.add_argument("--def", dest="transform", required=True, metavar="DEF",
                         help="4x4 handle transform applied to homogeneous handle positions")
-    parser.add_argument("--handle-detail", choices=("transform", "free"), default="transform",
+    parser.add_argument("--handle-detail", type=str.lower, choices=("transform", "free"), default="transform",
                         help="handles' curvature details: transformed by the linear part of DEF "
                              "(default) or solved like the free vertices'")
-    parser.add_argument("--relations", choices=("one-ring", "one+two-ring"), default="one-ring",
+    parser.add_argument("--relations", type=str.lower, choices=("one-ring", "one+two-ring"), default="one-ring",
                         help="curvature stage: the paper's one-ring coefficients (square system) or "
                              "one- and two-ring coefficients together (least squares; steadier "
                              "when handle details are rotated)")
@@ -772,10 +792,12 @@ def _check_image_and_distinct(image, output, *extras, inputs=(), other_inputs=()
     for k, r in enumerate(real):
         if r in real[:k]:
             raise ValueError(f"{outputs[k][0]} is given for two outputs; name a separate file for each.")
-    mesh_inputs = {os.path.realpath(p) for p in inputs if p is not None}
+    # (input, may OUTPUT replace it): an --add mesh that is INPUT's file as well is another input
+    # (it was replaced by OUTPUT over INPUT with --overwrite)
+    given_files = [(p, True) for p in inputs] + [(p, False) for p in other_inputs]
     for (path, is_mesh), r in zip(outputs, real):
-        for given in (*inputs, *other_inputs):
-            if given is not None and r == os.path.realpath(given) and not (is_mesh and r in mesh_inputs):
+        for given, replaceable in given_files:
+            if given is not None and r == os.path.realpath(given) and not (is_mesh and replaceable):
                 raise ValueError(f"{path} is an input of this run ({given}); writing there would "
                                  "destroy it even with --overwrite. Name another file.")
 
@@ -890,6 +912,23 @@ def _show_warning(message, category, filename, lineno, file=None, line=None):
 _default_showwarning = warnings.showwarning
 
 
+#: Advice that the library gives in its parameters' names (curvdetail.remesh knows no command
+#: line), in each command's words: the retriangulation's method is an option of ``remesh`` and a
+#: --param of ``apply`` (``run``'s script names it as the library does).
+_COMMAND_WORDS = {
+    "remesh": {'use method "isotropic"': "use --method isotropic"},
+    "apply": {'use method "isotropic"': "use --param method=isotropic"},
+}
+
+
+def _in_command_words(message, command):
+    """``message`` with the library's advice said in ``command``'s options (see
+    :data:`_COMMAND_WORDS`)."""
+    for library, words in _COMMAND_WORDS.get(command, {}).items():
+        message = message.replace(library, words)
+    return message
+
+
 def main(argv=None):
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -911,7 +950,7 @@ def main(argv=None):
     except (ValueError, OSError, RuntimeError) as exc:
         # the whole message: pymeshlab's first line alone ("Unable to open file") hid the reason
         message = str(exc).strip() or type(exc).__name__
-        _say(f"curvdetail: error: {message}")
+        _say(f"curvdetail: error: {_in_command_words(message, args.command)}")
         return 1
     finally:
         if stop_watching is not None:

@@ -608,3 +608,36 @@ def test_help_gives_the_defaults(command, capsys, says):
     with pytest.raises(SystemExit):
         main([command, "--help"])
     assert says in " ".join(capsys.readouterr().out.split())
+
+
+def _choice_options():
+    """(command, option, choices) of every option of every command that takes one of a few words."""
+    import argparse
+
+    from curvdetail.cli import build_parser
+
+    commands = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    return [(name, action.option_strings[0], action.choices)
+            for name, sub in commands.choices.items() for action in sub._actions
+            if action.choices and action.option_strings]
+
+
+def test_every_choice_option_takes_its_words_in_any_case():
+    # the filters take 'FREE' for rows=free; the command line refused --rows FREE ("invalid choice")
+    from curvdetail.cli import build_parser
+
+    options = _choice_options()
+    assert {(c, o) for c, o, _ in options} >= {("reconstruct", "--rows"), ("remesh", "--method"),
+                                               ("edit", "--relations"), ("minimal", "--step")}
+    for command, option, choices in options:
+        for choice in choices:
+            given = choice.upper() if choice.lower() == choice else choice.lower()
+            args = build_parser().parse_args([command, "a.obj", "b.ply", option, given]
+                                             + (["--sel", "s", "--def", "d"] if command == "edit" else []))
+            assert getattr(args, option[2:].replace("-", "_")) == choice, (command, option, given)
+
+
+def test_reconstruct_with_rows_in_capitals_is_the_free_rows_reconstruction(tmp_path, capsys):
+    assert main(["reconstruct", NOSE, str(tmp_path / "o.ply"), "--rows", "Free"]) == 0
+    out = capsys.readouterr().out
+    assert "rows=free" in out and float(out.split()[3]) < 1e-9     # "max vertex error E of the bbox diagonal"

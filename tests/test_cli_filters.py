@@ -505,3 +505,60 @@ def test_run_checks_the_script_before_reading_input(capsys, tmp_path):
     assert_failed(capsys, ["run", tmp_path / "s.mlx", tmp_path / "none.obj", tmp_path / "o.ply"],
                   "step 3 (generate_minimal_surface): parameter 'max_iterations' expects an integer",
                   tmp_path / "o.ply")
+
+
+# --- advice in each command's words, --add over INPUT, figures as JSON --------------------------
+
+def test_a_refused_decimation_names_the_param_that_apply_and_run_take(capsys, tmp_path):
+    # the advice was "--method isotropic", the option of `curvdetail remesh`, which apply refuses;
+    # under apply it is a --param, in a script the step's parameter (as the library names it)
+    rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "o.ply",
+                           "--param", "method=decimate", "--param", "target_edge=0.5%")
+    assert rc == 1 and "decimation can only coarsen" in err
+    assert err.rstrip().endswith("or use --param method=isotropic."), err
+    assert "--method" not in err and "command line" not in err
+    (tmp_path / "s.mlx").write_text('<!DOCTYPE FilterScript>\n<FilterScript>\n <filter name='
+                                    '"generate_curvature_remeshing"><Param name="method" value="decimate"/>'
+                                    '<Param name="target_edge" value="0.001"/></filter>\n</FilterScript>\n')
+    rc, out, err = run_cli(capsys, "run", tmp_path / "s.mlx", NOSE, tmp_path / "o.ply")
+    assert rc == 1 and "decimation can only coarsen" in err
+    assert 'or use method "isotropic".' in err and "--method" not in err and "--param" not in err, err
+    assert os.listdir(tmp_path) == ["s.mlx"]
+
+
+@pytest.mark.parametrize("command", ["apply", "run"])
+def test_an_added_layer_that_is_also_input_is_not_replaced_by_output_over_input(capsys, tmp_path, command):
+    # OUTPUT may replace INPUT with --overwrite, never an --add mesh: the same file named as INPUT,
+    # OUTPUT and --add was replaced (the exception for INPUT covered the --add as well)
+    mesh = tmp_path / "b.obj"
+    mesh.write_bytes(open(NOSE, "rb").read())
+    before = mesh.read_bytes()
+    (tmp_path / "s.mlx").write_text(SCRIPT)
+    first = ["apply", "compute_curvature_detail"] if command == "apply" else ["run", tmp_path / "s.mlx"]
+    rc, out, err = run_cli(capsys, *first, mesh, mesh, "--add", mesh, "--overwrite")
+    assert rc == 1 and "b.obj is an input of this run" in err and out == ""
+    assert mesh.read_bytes() == before
+    # OUTPUT over INPUT alone is still taken with --overwrite
+    rc, out, err = run_cli(capsys, *first, mesh, mesh, "--overwrite")
+    assert rc in (0, 3) and mesh.read_bytes() != before
+
+
+def test_figures_print_numpy_values_as_numbers_and_nan_as_null(capsys, tmp_path, monkeypatch):
+    # json.dumps(default=str) printed numpy integers, float32 and arrays as strings ("3",
+    # "[1. 2.]") and NaN as NaN, which strict JSON readers refuse
+    import curvdetail.filters
+
+    figures = {"count": np.int64(3), "ratio": np.float32(0.5), "flag": np.bool_(True), "nan": float("nan"),
+               "inf": np.float64(np.inf), "centre": np.array([1.0, 2.0, np.nan]), "scalar": np.array(2.5),
+               "pair": (np.int32(1), 2.0), "converged": np.bool_(False), "iterations": np.int64(7)}
+    monkeypatch.setattr(curvdetail.filters, "apply", lambda ms, name, **params: dict(figures))
+
+    def refuse(constant):
+        raise ValueError(f"{constant} is not JSON")
+
+    rc, out, err = run_cli(capsys, "apply", "compute_curvature_detail", NOSE, tmp_path / "o.ply")
+    got = json.loads(out, parse_constant=refuse)
+    assert got == {"count": 3, "ratio": 0.5, "flag": True, "nan": None, "inf": None, "centre": [1.0, 2.0, None],
+                   "scalar": 2.5, "pair": [1, 2.0], "converged": False, "iterations": 7}
+    assert type(got["count"]) is int and type(got["ratio"]) is float
+    assert rc == 3 and "after 7 steps" in err          # the not-converged note reads the plain figures

@@ -577,3 +577,113 @@ def test_max_ring_1_keeps_the_papers_one_ring_relations(load_mesh):
     assert np.abs(narrow.solve() - V).max() < 1e-8 * _diag(V)
     with pytest.raises(ValueError, match="max_ring"):
         CurvatureEditor(V, F, handles, handles, max_ring=0)
+
+
+_SHARED_EDITOR_SCRIPT = """
+import sys
+from concurrent.futures import ThreadPoolExecutor
+import numpy as np
+from curvdetail import CurvatureEditor, boundary_vertices
+from curvdetail.curvature.testing import grid
+V, F = grid(100, 100)
+V[:, 2] = np.sin(5 * V[:, 0]) * V[:, 1]
+b = boundary_vertices(F)
+ed = CurvatureEditor(V, F, b, b, rows=sys.argv[1], relations=sys.argv[2], backend="auto")
+P = [V[b] + [0.0, 0.0, 0.1 * k] for k in range(3)]
+Dk = [ed.detail[b] * (1 + k) for k in range(3)]
+serial = [ed.solve(positions=P[k], details=Dk[k]) for k in range(3)]
+hb = b[::7]                                       # handles: every 7th boundary vertex
+moved = [V[b].copy() for k in range(3)]
+for k in range(3):
+    moved[k][::7] += [0.0, 0.0, 0.05 * k]
+ed_fast = CurvatureEditor(V, F, b, b, rows=sys.argv[1], relations=sys.argv[2], backend="auto")
+serial_fast = [ed_fast.solve(positions=moved[k]) for k in range(3)]
+ed_fast.precompute_handles(hb)
+
+def work(k):
+    if k % 10 == 9:                               # re-precompute the same handles meanwhile
+        ed_fast.precompute_handles(hb)
+        return None
+    return (ed.solve(positions=P[k % 3], details=Dk[k % 3]), ed_fast.solve(positions=moved[k % 3]))
+
+with ThreadPoolExecutor(2) as pool:
+    threaded = list(pool.map(work, range(200)))
+scale = np.ptp(V, axis=0).max()
+print(max(max(np.abs(X - serial[k % 3]).max(), np.abs(Y - serial_fast[k % 3]).max()) / scale
+          for k, got in enumerate(threaded) if got is not None for X, Y in [got]))
+"""
+
+
+@pytest.mark.parametrize("rows, relations", [("all", "one-ring"), ("free", "one+two-ring")])
+def test_threads_sharing_one_editor_get_the_serial_answers(rows, relations):
+    # as test_reconstruct's shared Reconstructor, in a child process (a crash ends the child, not
+    # pytest): plain solves, and solves through precomputed handles while another thread
+    # precomputes them again (the response is the same linear map: equal up to rounding)
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-c", _SHARED_EDITOR_SCRIPT, rows, relations],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, (done.returncode, done.stderr[-2000:])
+    assert float(done.stdout.split()[-1]) < 1e-10
+
+
+def test_a_solve_while_another_thread_precomputes_handles_gives_the_serial_answer(plane_grid):
+    # a solve read the precomputed response twice: once to see that there is one, once to use it.
+    # precompute_handles in another thread cleared it in between, and the solve failed with
+    # "'NoneType' object is not subscriptable". The interleaving is forced: the solving thread
+    # stops where it takes the fast path until the other thread is inside precompute_handles'
+    # base solve (a trace function on each thread; only calls into this module are looked at)
+    import sys
+    import threading
+
+    V, F = plane_grid
+    V = V.copy()
+    V[:, 2] = np.sin(3 * V[:, 0]) * np.cos(2 * V[:, 1])
+    b = boundary_vertices(F)
+    ed = CurvatureEditor(V, F, b, b)
+    P = V[b].copy()
+    P[:3] += [0.0, 0.0, 0.2]
+    serial = ed.solve(positions=P)
+    ed.precompute_handles(b[:3])
+    in_fast_path, in_precompute, released = threading.Event(), threading.Event(), threading.Event()
+    editor_file = CurvatureEditor.__init__.__code__.co_filename
+
+    def tracer(name, reached, wait_for):
+        def trace(frame, event, arg):
+            if event == "call" and frame.f_code.co_filename == editor_file and frame.f_code.co_name == name:
+                if not reached.is_set():
+                    reached.set()
+                    wait_for.wait(5)
+            return None
+        return trace
+
+    results = {}
+
+    def solver():
+        sys.settrace(tracer("_fast_path", in_fast_path, in_precompute))
+        try:
+            results["X"] = ed.solve(positions=P)
+        except Exception as exc:                       # noqa: BLE001 - reported below
+            results["error"] = exc
+        finally:
+            sys.settrace(None)
+            released.set()
+
+    def precomputer():
+        in_fast_path.wait(5)
+        sys.settrace(tracer("_solve", in_precompute, released))
+        try:
+            ed.precompute_handles(b[:3])
+        finally:
+            sys.settrace(None)
+
+    threads = [threading.Thread(target=solver), threading.Thread(target=precomputer)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(30)
+    assert in_fast_path.is_set() and in_precompute.is_set()    # the interleaving happened
+    assert "error" not in results, repr(results.get("error"))
+    assert np.abs(results["X"] - serial).max() < 1e-12
+    assert np.abs(ed.solve(positions=P) - serial).max() < 1e-12

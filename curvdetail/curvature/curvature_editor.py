@@ -469,9 +469,12 @@ class CurvatureEditor:
         return_details = check_bool(return_details, "return_details")
         return self._solve(self._positions(positions), self._details(details), return_details)
 
-    def _solve(self, Xk, Dk, return_details=False):
-        if self._response is not None and not return_details:
-            fast = self._fast_path(Xk, Dk)
+    def _solve(self, Xk, Dk, return_details=False, fast_path=True):
+        # one read of the response: precompute_handles in another thread may replace it between
+        # two (a solve then read None and failed with a TypeError); each response is complete
+        response = self._response
+        if response is not None and fast_path and not return_details:
+            fast = self._fast_path(response, Xk, Dk)
             if fast is not None:
                 return fast
         D_R = self._D_R_rest.copy()
@@ -536,6 +539,8 @@ class CurvatureEditor:
         constraint values differ from the base only at ``handles`` cost one dense
         ``(free x h) @ (h x 3)`` product instead of two sparse back-substitutions; any other call
         falls back to the full solve. Exact up to roundoff (the response is the same linear map).
+        Threads may share the editor: a solve while another thread precomputes uses the previous
+        response or the full solve; of calls made at once, the last to finish stays.
 
         Parameters
         ----------
@@ -559,8 +564,7 @@ class CurvatureEditor:
                                   f"constrained (first: {first_indices(stray)}); only constrained "
                                   "values can change between solves.")
         Xk, Dk = self._positions(positions), self._details(details)
-        self._response = None
-        base = self._solve(Xk, Dk)
+        base = self._solve(Xk, Dk, fast_path=False)     # not another thread's response
         jp = np.flatnonzero(np.isin(self._pc, h))              # rows of positions that may change
         jd = np.flatnonzero(np.isin(self._dc[:self._user_dc], h))
         f = self._fp.size
@@ -585,12 +589,12 @@ class CurvatureEditor:
         keep_d[jd] = False
         G = np.zeros((self.n, jp.size + jd.size))           # response of every vertex
         G[self._fp] = np.hstack([Gp.reshape(f, jp.size), Gd.reshape(f, jd.size)])    # f may be 0
+        # one assignment of a complete response: a solve in another thread sees the old or the new
         self._response = {"X": base, "Xk": Xk.copy(), "Dk": Dk.copy(), "jp": jp, "jd": jd,
                           "G": G, "keep_p": keep_p, "keep_d": keep_d}
         return self
 
-    def _fast_path(self, Xk, Dk):
-        r = self._response
+    def _fast_path(self, r, Xk, Dk):
         if not (np.array_equal(Xk[r["keep_p"]], r["Xk"][r["keep_p"]])
                 and np.array_equal(Dk[r["keep_d"]], r["Dk"][r["keep_d"]])):
             return None

@@ -327,8 +327,9 @@ def _isotropic(V, F, h, iterations, max_dist, surface_check=True):
     return np.array(m.vertex_matrix(), dtype=np.float64), np.array(m.face_matrix(), dtype=np.int64)
 
 
-# shown by retriangulate, the generate_curvature_remeshing filter and `curvdetail remesh` alike
-_USE_ISOTROPIC = 'use method "isotropic" (--method isotropic on the command line)'
+# shown by retriangulate, the generate_curvature_remeshing filter and `curvdetail remesh` alike,
+# so it names the parameter only: the command line says it in each command's words
+_USE_ISOTROPIC = 'use method "isotropic"'
 
 
 #: fast-simplification collapses, in pass i of 100, every edge whose quadric error (a sum of
