@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from curvdetail import edit_boundary, sine_displacement
-from curvdetail.curvature.boundary_editing import boundary_loop
+from curvdetail.curvature.boundary_editing import boundary_loop, loop_of_boundary_edges
 from curvdetail.curvature.errors import ConstraintError, FoldedTrianglesWarning, MeshError
 from curvdetail.curvature.testing import cylinder, grid
 
@@ -58,6 +58,28 @@ def test_boundary_loop_follows_the_triangles_and_covers_the_boundary():
     # consecutive loop vertices form boundary edges oriented as in their triangle
     directed = {(int(f[a]), int(f[(a + 1) % 3])) for f in F for a in range(3)}
     assert all((int(p), int(q)) in directed for p, q in zip(loop, np.roll(loop, -1)))
+
+
+def test_the_loop_of_a_long_strip_is_every_vertex_in_order():
+    # a 2 x 100,000 strip: every vertex is on the boundary (the walk is no Python step per vertex)
+    V, F = grid(100_000, 2)
+    loop = boundary_loop(F)
+    assert loop.size == V.shape[0] and np.array_equal(np.sort(loop), np.arange(V.shape[0]))
+    edges = np.column_stack([loop, np.roll(loop, -1)])
+    # the loop's edges are the mesh's boundary edges, as its triangles orient them
+    assert np.array_equal(loop_of_boundary_edges(edges[np.random.default_rng(0).permutation(loop.size)]), loop)
+
+
+@pytest.mark.parametrize("edges, message", [
+    ([[0, 1], [1, 2], [2, 1]], r"the boundary walk from vertex 0 runs into vertex 1, which ends two boundary edges: "
+                               r"the boundary touches itself"),
+    ([[0, 1], [1, 0], [0, 2]], r"1 boundary vertex is on more than one boundary edge pair \(first: 0\)"),
+    ([[0, 1], [1, 2]], r"the boundary does not close: its edge into vertex 2 has no edge out of it"),
+    ([[0, 1], [1, 2], [2, 0], [3, 4], [4, 3]], r"the boundary has 5 edges but the loop through vertex 0 has 3"),
+])
+def test_boundary_edges_that_make_no_simple_loop_are_named(edges, message):
+    with pytest.raises(MeshError, match=message):
+        loop_of_boundary_edges(np.array(edges))
 
 
 def test_a_mesh_with_two_boundary_loops_is_refused():

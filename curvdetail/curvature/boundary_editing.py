@@ -6,6 +6,8 @@ import numbers
 import warnings
 
 import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import depth_first_order
 
 from ._geometry import folded_triangles, ignoring_underflow
 from ._validate import (MIN_DIAGONAL, ZERO_AREA_RELATIVE, _check_magnitude, _compact_ids, as_faces, as_values,
@@ -400,22 +402,28 @@ def loop_of_boundary_edges(E):
     starts, counts = np.unique(E[:, 0], return_counts=True)
     if np.any(counts > 1):
         bad = starts[counts > 1]
-        raise MeshError(f"{bad.size} boundary vertices are on more than one boundary edge pair (first: "
-                        f"{', '.join(map(str, bad[:3]))}); the boundary touches itself. Repair the "
-                        "mesh so that its boundary is one simple loop.")
-    nxt = dict(zip(E[:, 0].tolist(), E[:, 1].tolist()))
+        raise MeshError(f"{counted(bad.size, 'boundary vertex', 'boundary vertices', verb='are')} on more than one "
+                        f"boundary edge pair (first: {', '.join(map(str, bad[:3]))}); the boundary touches itself. "
+                        "Repair the mesh so that its boundary is one simple loop.")
+    # every vertex has at most one edge out: the walk from the smallest start is the depth-first
+    # order of the successor graph (no Python step per boundary vertex: a 1M-vertex strip's
+    # boundary is all of it)
+    n = int(E.max()) + 1
+    successor = sp.csr_matrix((np.ones(E.shape[0], dtype=np.int8), (E[:, 0], E[:, 1])), shape=(n, n))
     start = int(E[:, 0].min())
-    loop = [start]
-    cur = nxt[start]
-    while cur != start and len(loop) <= E.shape[0]:
-        loop.append(cur)
-        if cur not in nxt:
-            raise MeshError(f"the boundary does not close: its edge into vertex {cur} has no edge out of "
-                            "it (triangles oriented inconsistently, or a mesh that is not manifold). "
-                            "Check the mesh with check_mesh and orient it consistently.")
-        cur = nxt[cur]
-    if len(loop) != E.shape[0]:
+    loop = depth_first_order(successor, start, directed=True, return_predecessors=False)
+    last = int(loop[-1])
+    if successor.indptr[last + 1] == successor.indptr[last]:
+        raise MeshError(f"the boundary does not close: its edge into vertex {last} has no edge out of "
+                        "it (triangles oriented inconsistently, or a mesh that is not manifold). "
+                        "Check the mesh with check_mesh and orient it consistently.")
+    back = int(successor.indices[successor.indptr[last]])
+    if back != start:                           # the walk ran into itself elsewhere: a vertex ends two edges
+        raise MeshError(f"the boundary walk from vertex {start} runs into vertex {back}, which ends two boundary "
+                        "edges: the boundary touches itself. Repair the mesh so that its boundary is one simple "
+                        "loop.")
+    if loop.size != E.shape[0]:
         raise MeshError(f"the boundary has {E.shape[0]} edges but the loop through vertex {start} has "
-                        f"{len(loop)}: the patch has several boundary loops (holes). Fill the holes, "
+                        f"{loop.size}: the patch has several boundary loops (holes). Fill the holes, "
                         "e.g. with pymeshlab's meshing_close_holes, or cut a disk-topology patch.")
-    return np.asarray(loop, dtype=np.int64)
+    return loop.astype(np.int64, copy=False)
