@@ -437,8 +437,15 @@ def main(argv=None):
         if not args.markdown:
             parser.error("--rebuild-markdown needs a --markdown file")
         run = _outputs.Run(parser, [args.markdown], args.overwrite, OVERWRITE)
-        with open(args.out) as fh:
-            stored = json.load(fh)
+        try:
+            with open(args.out) as fh:
+                stored = json.load(fh)
+            stored["results"], stored["meta"]
+        except (OSError, ValueError, KeyError, TypeError) as exc:
+            reason = getattr(exc, "strerror", None) or (f"no {exc} entry" if isinstance(exc, KeyError) else str(exc))
+            parser.error(f"--rebuild-markdown reads the results of earlier runs from --out {args.out!r}, which "
+                         f"cannot be used ({reason}); run the benchmark first "
+                         "(it writes that file), or pass --out with the JSON an earlier run wrote.")
         run.write_text(args.markdown, markdown_text(args.markdown, stored["results"], stored["meta"]))
         run.commit()
         return 0

@@ -134,6 +134,24 @@ def test_bench_reconstruct_rebuild_markdown_refuses_an_existing_file_without_ove
     assert md.read_text() == BENCH_DOC
 
 
+@pytest.mark.parametrize("stored", [None, "{not json", '{"meta": {}}'])
+def test_bench_reconstruct_rebuild_markdown_without_usable_results_says_so(tmp_path, capsys, stored):
+    # on a fresh checkout (no earlier run) it stopped with FileNotFoundError's traceback
+    md = tmp_path / "bench.md"
+    md.write_text(BENCH_DOC)
+    out = tmp_path / "bench.json"
+    if stored is not None:
+        out.write_text(stored)
+    module = load("bench_reconstruct")
+    with pytest.raises(SystemExit) as exit_:
+        module.main(["--rebuild-markdown", "--out", str(out), "--markdown", str(md), "--overwrite"])
+    assert exit_.value.code == 2
+    message = capsys.readouterr().err
+    assert "--rebuild-markdown reads the results of earlier runs from --out" in message
+    assert "run the benchmark first" in message
+    assert md.read_text() == BENCH_DOC
+
+
 def test_bench_reconstruct_rebuild_markdown_with_overwrite_rewrites_only_the_block(tmp_path):
     md = tmp_path / "bench.md"
     md.write_text(BENCH_DOC)
