@@ -106,18 +106,27 @@ def _ply_counts(path):
     return found.get(b"vertex"), found.get(b"face")
 
 
+def _stl_binary_count(path):
+    """``(count, head)``: the triangle count of a binary STL file's header where the file's size
+    matches it (else None), and the file's first 84 bytes (an ASCII file starts with "solid")."""
+    size = os.path.getsize(path)
+    with open(path, "rb") as f:
+        head = f.read(84)
+    if len(head) == 84:
+        count = int(np.frombuffer(head[80:84], dtype="<u4")[0])
+        if size == 84 + 50 * count:
+            return count, head
+    return None, head
+
+
 def _stl_counts(path, exact=False):
     """``(None, triangles)`` of an STL file: a binary file's header count (when the file size
     matches it), or an ASCII file's ``endfacet`` words (``exact``: lines that start with one, which
     takes ~10 times as long; a name such as "solid endfacet test" is then not counted);
     ``(None, None)`` if neither."""
-    size = os.path.getsize(path)
-    with open(path, "rb") as f:
-        head = f.read(84)
-        if len(head) == 84:
-            count = int(np.frombuffer(head[80:84], dtype="<u4")[0])
-            if size == 84 + 50 * count:
-                return None, count
+    count, head = _stl_binary_count(path)
+    if count is not None:
+        return None, count
     if not head.lstrip().startswith(b"solid"):
         return None, None
     if not exact:
@@ -131,12 +140,8 @@ def _stl_ascii_counts(path):
     count matches its size) or one that is not STL. The words are counted fast wherever they
     stand, and only where those counts disagree (3 vertices a facet) again at the lines' starts
     (~10 times as long)."""
-    size = os.path.getsize(path)
-    with open(path, "rb") as f:
-        head = f.read(84)
-    if len(head) == 84 and size == 84 + 50 * int(np.frombuffer(head[80:84], dtype="<u4")[0]):
-        return None, None
-    if not head.lstrip().startswith(b"solid"):
+    count, head = _stl_binary_count(path)
+    if count is not None or not head.lstrip().startswith(b"solid"):
         return None, None
     facets, spaced, tabbed = _streamed_counts(path, (b"endfacet", b"vertex ", b"vertex\t"))
     if spaced + tabbed == 3 * facets:

@@ -25,7 +25,7 @@ import re
 import numpy as np
 
 from ._ctm_scan import ctm_problem
-from ._file_counts import _obj_counts, _off_header, _stl_ascii_counts, _whole
+from ._file_counts import _off_header, _stl_ascii_counts, _whole
 from ._ply_scan import _ply_problem
 from .curvature.errors import counted
 
@@ -99,14 +99,6 @@ def check_before_loading(path, error=ValueError, sizes=None):
                                                    else "OBJ loader reads as part of the first line's keyword "
                                                    "(that line, a vertex, was lost without a word)") +
                     "; save the file as UTF-8 without a byte order mark (or ASCII) and read it again.")
-    if extension == ".obj":
-        lone = _obj_lone_carriage_return(path)
-        if lone is not None:
-            raise error(f"{path!r}: line {lone} ends in a carriage return not followed by a newline (a classic "
-                        "Mac OS line end among Unix or Windows ones), which pymeshlab's OBJ loader does not "
-                        "take for a line end: the lines it ends were read as one, and lost without a word; "
-                        "convert the line ends to newlines (e.g. tr '\\r' '\\n' < old > new, or dos2unix) and "
-                        "read the file again.")
     if extension == ".stl":
         facets, vertex_lines = _stl_ascii_counts(path)
         if facets is not None and vertex_lines != 3 * facets:
@@ -138,6 +130,13 @@ def check_before_loading(path, error=ValueError, sizes=None):
             raise error(f"{path!r}: {problem}; fix the file and read it again.")
         return triangles
     elif extension == ".obj":
+        lone = _obj_lone_carriage_return(path)
+        if lone is not None:
+            raise error(f"{path!r}: line {lone} ends in a carriage return not followed by a newline (a classic "
+                        "Mac OS line end among Unix or Windows ones), which pymeshlab's OBJ loader does not "
+                        "take for a line end: the lines it ends were read as one, and lost without a word; "
+                        "convert the line ends to newlines (e.g. tr '\\r' '\\n' < old > new, or dos2unix) and "
+                        "read the file again.")
         comma = _obj_comma(path)
         if comma is not None:
             raise error(f"{path!r}: line {comma[0]} ({comma[1]!r}) writes a number with a comma, which "
@@ -1054,14 +1053,6 @@ def _maybe_out_of_range(chars, starts, ends, nv):
     return suspect
 
 
-#: Bytes at which pymeshlab's OBJ loader splits a line into words: space, tab, carriage return
-#: (and the newline that ends the line).
-_OBJ_SEPARATOR = np.zeros(256, dtype=bool)
-_OBJ_SEPARATOR[[9, 10, 13, 32]] = True
-#: Bytes that end a corner's vertex index: the separators, "/" (texture and normal indices
-#: follow) and "#" (a comment glued to the last corner: atoi stops there).
-_OBJ_INDEX_END = _OBJ_SEPARATOR.copy()
-_OBJ_INDEX_END[[35, 47]] = True
 _OBJ_WHOLE_INDEX = re.compile(rb"[+-]?[0-9]+(?:\.0*)?")
 
 

@@ -22,6 +22,7 @@ A script makes one :class:`Run` right after parsing its arguments, naming every 
 """
 
 import contextlib
+import io
 import json
 import os
 import shlex
@@ -137,6 +138,28 @@ class Run:
 
         with self.stage(path) as tmp:
             render_panels(tmp, panels, **options)
+
+    def stack_pictures(self, path, sources, dpi=100):
+        """Keep for ``path`` the pictures kept for ``sources`` (PNG), one row each, top to bottom,
+        each at its own resolution (``dpi`` pixels per inch): the labels stay readable."""
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.image as mpimg
+        import matplotlib.pyplot as plt
+
+        pictures = [mpimg.imread(io.BytesIO(self.read(source))) for source in sources]
+        width = max(p.shape[1] for p in pictures)
+        fig, axes = plt.subplots(len(pictures), 1, figsize=(width / dpi, sum(p.shape[0] for p in pictures) / dpi),
+                                 gridspec_kw={"height_ratios": [p.shape[0] for p in pictures]})
+        for ax, picture in zip(axes, pictures):
+            ax.imshow(picture)
+            ax.set_axis_off()
+        fig.subplots_adjust(left=0, right=1, bottom=0, top=1, hspace=0)
+        try:
+            self.save_figure(fig, path, dpi=dpi)
+        finally:
+            plt.close(fig)
 
     def read(self, path):
         """The content kept for ``path`` (bytes), e.g. a picture that a composite reuses."""

@@ -25,7 +25,6 @@ refreshing it is ``--docs docs --force``), and so is a --docs folder that does n
 """
 
 import argparse
-import io
 import json
 import os
 import sys
@@ -205,26 +204,9 @@ def main(argv=None):
         run.render_panels(os.path.join(args.out, key + ".png"), panels, elev=elev, azim=azim)
         print(json.dumps(info))
     if args.docs:
-        # one row per sub-figure, each picture at its own resolution (100 dpi, 4 in per panel):
-        # the labels stay readable
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.image as mpimg
-        import matplotlib.pyplot as plt
-
-        pictures = [mpimg.imread(io.BytesIO(run.read(os.path.join(args.out, key + ".png")))) for key in views]
-        width = max(p.shape[1] for p in pictures)
-        fig, axes = plt.subplots(len(pictures), 1, figsize=(width / 100, sum(p.shape[0] for p in pictures) / 100),
-                                 gridspec_kw={"height_ratios": [p.shape[0] for p in pictures]})
-        for ax, picture in zip(axes, pictures):
-            ax.imshow(picture)
-            ax.set_axis_off()
-        fig.subplots_adjust(left=0, right=1, bottom=0, top=1, hspace=0)
-        try:
-            run.save_figure(fig, os.path.join(args.docs, "editing_fig1.png"), dpi=100)
-        finally:
-            plt.close(fig)
+        # one row per sub-figure, each picture at its own resolution (100 dpi, 4 in per panel)
+        run.stack_pictures(os.path.join(args.docs, "editing_fig1.png"),
+                           [os.path.join(args.out, key + ".png") for key in views])
     run.write_json(os.path.join(args.out, "fig1.json"),
                    {"edits": report, **_outputs.measured_conditions()}, indent=2)
     run.commit()

@@ -29,6 +29,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ._validate import shown_choice
+from .errors import counted
 
 BACKENDS = ("pardiso", "cholmod", "splu", "banded")
 
@@ -296,7 +297,7 @@ class Factorization:
         self._pardiso.free()
         self._pardiso = None
         if not self._automatic:
-            raise SolverError(f"PARDISO had to perturb {perturbed} pivot{'s' if perturbed > 1 else ''} of this "
+            raise SolverError(f"PARDISO had to perturb {counted(perturbed, 'pivot')} of this "
                               "nonsymmetric matrix: it is singular or nearly so, and the solution would be off by "
                               "more than rounding. Use backend='splu' (LU with partial pivoting) or 'auto'.")
         self.backend = "splu"

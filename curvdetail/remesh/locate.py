@@ -118,7 +118,7 @@ def _locate(P, V, F, engine="auto", candidates=8, chunk=20_000):
         return face, bary, dist * scale
     face = np.full(P.shape[0], -1, dtype=np.int64)
     gap = _box_gap(P, V)
-    near, far = np.flatnonzero(gap <= FAR_POINTS), np.flatnonzero(gap > FAR_POINTS)
+    near = np.flatnonzero(gap <= FAR_POINTS)       # the far ones are left to the tree search below
     if near.size:
         face[near] = _trifinder(P[near], V, F) if V.shape[1] == 2 else _nearest_face_meshlab(P[near], V, F)
     # and the points neither found (planar ones outside the domain, points in space more than a

@@ -4,8 +4,8 @@ import math
 
 import numpy as np
 
-from ..curvature._validate import (check_choice, as_count, as_float, as_positive_number, bbox_diagonal, check_bool,
-                                   face_double_areas)
+from ..curvature._validate import (check_choice, as_count, as_float, as_positive_number, bbox_diagonal, boundary_edges,
+                                   check_bool, face_double_areas)
 from ..curvature.errors import counted
 from ._disk import NotADiskError, Polyline, RemeshError, check_disk
 
@@ -96,8 +96,6 @@ def edge_for_vertices(V, F, count):
 
 def _boundary_vertex_count(F):
     """Boundary vertices of the disk ``F`` (its boundary edges: one loop)."""
-    from ..curvature._validate import boundary_edges
-
     return int(boundary_edges(np.asarray(F, dtype=np.int64)).shape[0])
 
 
@@ -108,10 +106,12 @@ def _boundary_vertex_count(F):
 DECIMATION_BOUNDARY_MARGIN = 1.25
 
 
-def _fewest_decimated_faces(F):
+def _fewest_decimated_faces(F, boundary=None):
     """The fewest triangles a decimation of the disk ``F`` is asked for (see
-    ``DECIMATION_BOUNDARY_MARGIN``)."""
-    return int(math.ceil(DECIMATION_BOUNDARY_MARGIN * (_boundary_vertex_count(F) - 2)))
+    ``DECIMATION_BOUNDARY_MARGIN``); ``boundary``: its boundary vertex count where known."""
+    if boundary is None:
+        boundary = _boundary_vertex_count(F)
+    return int(math.ceil(DECIMATION_BOUNDARY_MARGIN * (boundary - 2)))
 
 
 def _decimation_refines(count, faces):
@@ -284,7 +284,7 @@ def retriangulate(V, F, *, method="isotropic", target_edge=0.01, iterations=10, 
             # what was found, not the advice to the owner of a mesh (repair it, cut a disk out)
             raise RemeshError(f"{getattr(exc, 'problem', exc)}; try another target edge.") from None
     else:
-        Ut, Ft, loop_t = _decimate(unit, F, target_edge, aggressiveness)
+        Ut, Ft, loop_t = _decimate(unit, F, target_edge, aggressiveness, loop.size)
     Vt = Ut * d + center
     if method == "decimate":
         Vt = _restore_kept_vertices(V, Vt, d)
@@ -356,8 +356,9 @@ def _decimation_scale(agg):
 DECIMATION_SHORTFALL = 1.25
 
 
-def _decimate(V, F, h, agg):
-    """Decimate the unit-frame patch ``V`` to an equilateral target edge ``h``."""
+def _decimate(V, F, h, agg, boundary):
+    """Decimate the unit-frame patch ``V`` to an equilateral target edge ``h`` (``boundary``: the
+    number of its boundary vertices, which the decimation keeps)."""
     import fast_simplification
 
     area = 0.5 * face_double_areas(V, F).sum()
@@ -366,12 +367,11 @@ def _decimate(V, F, h, agg):
         raise RemeshError(
             f"decimation can only coarsen: the target edge asks for about {target_faces:,} triangles "
             f"but the source has {F.shape[0]:,}; {_range_advice(V, F, 'decimate', why=False)}.")
-    fewest = _fewest_decimated_faces(F)
+    fewest = _fewest_decimated_faces(F, boundary)
     if target_faces < fewest:
-        kept = _boundary_vertex_count(F)
         raise RemeshError(
             f"decimation keeps every boundary vertex: the target edge asks for about {target_faces:,} triangles, but "
-            f"a disk with the source's {kept:,} boundary vertices has at least {kept - 2:,}, and it falls short of a "
+            f"a disk with the source's {boundary:,} boundary vertices has at least {boundary - 2:,}, and it falls short of a "
             f"count below {fewest:,} ({DECIMATION_BOUNDARY_MARGIN:g} x that); "
             f"{_range_advice(V, F, 'decimate', why=False)}.")
     last = None
