@@ -183,17 +183,18 @@ def declared_counts(path):
     return counts(path) if counts is not None else (None, None)
 
 
-def check_loaded(path, n_vertices, F, error=ValueError):
+def check_loaded(path, n_vertices, F, error=ValueError, counts=None):
     """Raise ``error`` if the loaded mesh (``n_vertices``, triangles ``F``) lost vertices or faces
     of ``path`` or holds face indices out of range; each message names the file, the counts, the
-    likely cause and the fix."""
+    likely cause and the fix. ``counts``: the file's ``(vertices, faces)`` where the caller has
+    them (as :func:`declared_counts` returns them, which is called where None)."""
     F = np.asarray(F)
     if F.size and (F.min() < 0 or F.max() >= n_vertices):
         bad = np.flatnonzero((F < 0).any(axis=1) | (F >= n_vertices).any(axis=1))
         raise error(f"{path!r}: {counted(bad.size, 'face', verb='use')} vertex indices outside the file's {n_vertices} "
                     f"vertices (first: face {bad[0]}, {F[bad[0]].tolist()} 0-based); fix or remove "
                     "them in the file and read it again.")
-    vertices, faces = declared_counts(path)
+    vertices, faces = declared_counts(path) if counts is None else counts
     if vertices is not None and vertices > n_vertices:     # more than declared: a misread count
         raise error(
             f"{path!r} has {vertices} vertices but pymeshlab loaded {n_vertices}: "

@@ -125,7 +125,8 @@ def load_checked(ms, path, *, vertex_maps=True):
     _check_utf8(path, "read")
     try:
         sizes = []                  # the vertex counts of the file's faces, where known
-        triangles = check_before_loading(path, error=MeshFileError, sizes=sizes)
+        counts = []                 # the file's (vertices, faces), where the scan counted them
+        triangles = check_before_loading(path, error=MeshFileError, sizes=sizes, counts=counts)
     except OSError as exc:          # unreadable: named as the file's problem, as pymeshlab's are
         raise MeshFileError(f"could not read {path!r}: {exc.strerror or exc}.") from None
     cwd = os.getcwd()
@@ -136,7 +137,7 @@ def load_checked(ms, path, *, vertex_maps=True):
         raise MeshFileError(load_failure(path, exc)) from None
     mesh = ms.current_mesh()
     F = mesh.face_matrix()
-    check_loaded(path, mesh.vertex_number(), F, error=MeshFileError)
+    check_loaded(path, mesh.vertex_number(), F, error=MeshFileError, counts=counts[0] if counts else None)
     if triangles is not None and F.shape[0] and F.shape[0] != triangles:
         # polygons are triangulated, so a header's face count cannot tell a dropped face
         raise MeshFileError(

@@ -105,3 +105,56 @@ def test_stl_names_and_odd_words_are_not_counted_as_vertices_or_facets(tmp_path,
     check_loaded(str(path), 3, np.array([[0, 1, 2], [0, 1, 2]]))      # its 2 triangles: nothing dropped
     with pytest.raises(ValueError, match="has 2 faces but pymeshlab loaded 1 triangles"):
         check_loaded(str(path), 3, np.array([[0, 1, 2]]))
+
+
+_SCANNED_OBJ = [
+    b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    b"v 0 0 0\r\nv\t1 0 0\r\nv 0 1 0\r\nf\t1 2 3\r\nf 1 2 3",               # CR LF, tabs, no last newline
+    b"# c\nvt 0 0\nvn 0 0 1\nv 0 0 0\nv 1 0 0\nv 0 1 0\n f 1 2 3\nfoo\nf 1/1 2/1 3/1\n",   # indented f: not counted
+    b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 \\\n3 4\nf 1 \\\n2 \\\n3\n",   # faces continued over lines
+    b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 \\\n\t3\nf 3 2 1\\",                  # a tab after the join; a last "\\"
+]
+
+
+@pytest.mark.parametrize("size", [1 << 20, 8])
+@pytest.mark.parametrize("text", _SCANNED_OBJ)
+def test_counts_the_scan_hands_on_are_those_declared_counts_reads(tmp_path, monkeypatch, text, size):
+    # read_mesh gives check_loaded the counts check_before_loading found instead of reading the file
+    # again: they must be declared_counts' own, lines joined by a backslash and pieces notwithstanding
+    from curvdetail import _file_scan
+    path = tmp_path / "m.obj"
+    path.write_bytes(text)
+    monkeypatch.setattr(_file_scan, "_obj_face_indices",
+                        lambda p, sizes=None, counts=None, _f=_file_scan._obj_face_indices: _f(p, size, sizes, counts))
+    counts = []
+    _file_scan.check_before_loading(str(path), counts=counts)
+    assert counts == [declared_counts(str(path))]
+
+
+@pytest.mark.parametrize("text, facets", [
+    (b"solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n"
+     b"endsolid t\n", 1),
+    (b"solid endfacet vertex\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\n"
+     b"endfacet\nendsolid t\n", 1),                                   # words in the name: lines counted
+])
+def test_stl_facets_the_scan_hands_on_lead_check_loaded_to_the_same_verdict(tmp_path, text, facets):
+    from curvdetail._file_scan import check_before_loading
+    path = str(tmp_path / "m.stl")
+    with open(path, "wb") as f:
+        f.write(text)
+    counts = []
+    check_before_loading(path, counts=counts)
+    assert counts == [(None, facets)]
+    for loaded in (facets, facets - 1):                                 # complete, and one dropped
+        F = np.zeros((loaded, 3), dtype=np.int64)
+        try:
+            check_loaded(path, 3, F)
+            expected = None
+        except ValueError as exc:
+            expected = str(exc)
+        try:
+            check_loaded(path, 3, F, counts=counts[0])
+            got = None
+        except ValueError as exc:
+            got = str(exc)
+        assert got == expected

@@ -719,3 +719,33 @@ def test_obj_faces_continued_over_lines_are_read_right(tmp_path, text, triangles
     path = tmp_path / "m.obj"
     path.write_bytes(text.encode())
     assert read_mesh(path)[1].tolist() == triangles
+
+
+@pytest.mark.parametrize("piece", [1, 2, 3, 5, 1 << 18])
+def test_word_edges_in_pieces_are_the_runs_of_the_whole_array(piece):
+    # the OFF scan finds its words in pieces of the file's bytes (to keep them in cache): the
+    # starts and ends must be those of the whole array, at the pieces' seams and the array's ends
+    from curvdetail._file_scan import _word_edges
+    rng = np.random.default_rng(5)
+    for visible in [np.zeros(0, bool), np.ones(1, bool), np.zeros(1, bool), np.ones(7, bool),
+                    *(rng.random(n) < 0.6 for n in (2, 9, 40, 1000))]:
+        padded = np.concatenate([[False], visible, [False]])
+        expected = np.flatnonzero(padded[1:] != padded[:-1])
+        assert np.array_equal(_word_edges(visible, piece), expected)
+
+
+def test_off_index_out_of_range_is_found_past_the_first_pieces_of_indices(tmp_path):
+    # a large file's face indices are checked in pieces of 65536: the last face's is found
+    import curvdetail
+    from curvdetail.curvature.testing import grid
+    V, F = grid(120, 120)
+    path = tmp_path / "m.off"
+    curvdetail.write_mesh(str(path), V, F)
+    text = path.read_bytes().rstrip(b"\n").rsplit(b"\n", 1)[0] + b"\n3 0 1 %d\n" % len(V)
+    path.write_bytes(text)
+    with pytest.raises(ValueError, match=rf"1 face uses vertex indices outside the file's {len(V)} vertices "
+                                         rf"\(first: face {len(F) - 1}, \[0, 1, {len(V)}\]\)"):
+        check_before_loading(str(path))
+    path.write_bytes(text.replace(b"\n3 0 1 %d\n" % len(V), b"\n3 0 1 %d 9 9 9\n" % len(V)))   # a colour: other path
+    with pytest.raises(ValueError, match=rf"\(first: face {len(F) - 1}, \[0, 1, {len(V)}\]\)"):
+        check_before_loading(str(path))
