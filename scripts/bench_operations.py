@@ -12,7 +12,12 @@ mesh), each case in its own subprocess so that its peak RSS is its own:
 * ``hausdorff`` with pymeshlab's engine against the kd-tree engine (1M samples each way);
 * ``locate`` of the target's vertices on the source: pymeshlab's grid ("auto") against the
   numpy engine in space, matplotlib's trapezoid map ("auto") against the numpy engine in the
-  plane.
+  plane;
+* ``read_mesh`` (pymeshlab's load with the checks before and after it) against a bare
+  ``pymeshlab.MeshSet().load_new_mesh`` and its vertex and face matrices, per format (OBJ, OFF,
+  PLY, STL as ``write_mesh`` writes them: ASCII OBJ and OFF, binary PLY and STL); the grid's
+  files are written once per size, by a subprocess of their own, into a scratch folder, and
+  only the reading is timed.
 
 Usage::
 
@@ -30,6 +35,7 @@ import platform
 import resource
 import subprocess
 import sys
+import tempfile
 import time
 
 import numpy as np
@@ -44,7 +50,14 @@ CASES = {
     "hausdorff": ("meshlab", "kdtree"),
     "locate_3d": ("auto", "numpy"),
     "locate_2d": ("auto", "numpy"),
+    "read_obj": ("read_mesh", "pymeshlab"),
+    "read_off": ("read_mesh", "pymeshlab"),
+    "read_ply": ("read_mesh", "pymeshlab"),
+    "read_stl": ("read_mesh", "pymeshlab"),
 }
+READ_FORMATS = ("obj", "off", "ply", "stl")
+#: The environment variable naming the scratch folder of the read cases' files (set by main).
+FILES = "BENCH_OPERATIONS_FILES"
 
 
 def grid_surface(side):
@@ -69,8 +82,46 @@ def _edge_measure_by_rows(V, F):
     return E, meas
 
 
+def mesh_file(folder, size, extension):
+    """The grid's file of one format in the read cases' scratch folder."""
+    return os.path.join(folder, f"grid_{size}.{extension}")
+
+
+def write_files(folder, size):
+    """Write the grid of ``size`` in each of ``READ_FORMATS`` into ``folder`` (in a subprocess of
+    its own, so that no case's peak RSS holds the writing)."""
+    from curvdetail import write_mesh
+
+    V, F = grid_surface(SIDES[size])
+    for extension in READ_FORMATS:
+        write_mesh(mesh_file(folder, size, extension), V, F, overwrite=True)
+
+
+def run_read_case(case, variant, size):
+    """Time reading the grid's file of the case's format: ``read_mesh`` or bare pymeshlab."""
+    import pymeshlab
+
+    from curvdetail import read_mesh
+
+    path = mesh_file(os.environ[FILES], size, case[len("read_"):])
+    out = {"file_mb": os.path.getsize(path) / 1e6}
+    t = time.perf_counter()
+    if variant == "read_mesh":
+        V, F = read_mesh(path)
+    else:
+        ms = pymeshlab.MeshSet()
+        ms.load_new_mesh(path)
+        V, F = ms.current_mesh().vertex_matrix(), ms.current_mesh().face_matrix()
+    out["seconds"] = time.perf_counter() - t
+    out.update(vertices=int(V.shape[0]), faces=int(F.shape[0]),
+               peak_rss_gb=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0 ** 2)
+    return out
+
+
 def run_case(case, variant, size):
     """Time one variant of one case in this process; a dict of figures."""
+    if case.startswith("read_"):
+        return run_read_case(case, variant, size)
     from curvdetail import CurvatureEditor, boundary_vertices
     from curvdetail.remesh import hausdorff, locate
     from curvdetail.remesh.transfer import _edge_curvature_measure
@@ -128,9 +179,13 @@ def main(argv=None):
     ap.add_argument("--force", action="store_true", help="replace OUT if it exists")
     ap.add_argument("--timeout", type=int, default=900, help="seconds per case")
     ap.add_argument("--child", nargs=3, help=argparse.SUPPRESS)
+    ap.add_argument("--write-files", nargs=2, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.child:
         print("RESULT " + json.dumps(run_case(*args.child)), flush=True)
+        return 0
+    if args.write_files:
+        write_files(*args.write_files)
         return 0
     sizes = [s for s in args.sizes.split(",") if s]
     cases = [c for c in args.cases.split(",") if c]
@@ -139,20 +194,40 @@ def main(argv=None):
         ap.error(f"unknown size or case: {', '.join(unknown)}")
     run = _outputs.Run(ap, [args.out], args.force, makes=[os.path.dirname(os.path.abspath(args.out))])
     results = []
-    for size in sizes:
-        for case in cases:
-            for variant in CASES[case]:
-                r = in_subprocess(case, variant, size, args.timeout)
-                r.update(case=case, variant=variant, size=size, load_average=os.getloadavg()[0])
-                results.append(r)
-                shown = ", ".join(f"{k} {v:.3g}" if isinstance(v, float) else f"{k} {v}"
-                                  for k, v in r.items() if k not in ("case", "variant", "size"))
-                print(f"{size} {case} [{variant}]: {shown}", flush=True)
+    with tempfile.TemporaryDirectory(prefix="bench_operations_") as folder:
+        os.environ[FILES] = folder                             # for the read cases' subprocesses
+        for size in sizes:
+            run_cases(cases, size, args.timeout, folder, results)
     report = {"machine": {"cpu": platform.processor() or platform.machine(), "cores": os.cpu_count()},
               "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "results": results}
     run.write_json(args.out, report, indent=2, end="\n")
     run.commit()
     return 0
+
+
+def run_cases(cases, size, timeout, folder, results):
+    """Run ``cases`` at ``size``, each variant in its own subprocess, appending to ``results``."""
+    written = None
+    for case in cases:
+        if case.startswith("read_") and written is None:
+            cmd = [sys.executable, os.path.abspath(__file__), "--write-files", folder, size]
+            try:
+                done = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+                written = done.returncode == 0 or (done.stderr.strip().splitlines() or ["no output"])[-1]
+            except subprocess.TimeoutExpired:
+                written = f"writing the files took over {timeout} s"
+        for variant in CASES[case]:
+            if case.startswith("read_") and written is not True:
+                r = {"error": f"the grid's files were not written: {written}"}
+            else:
+                r = in_subprocess(case, variant, size, timeout)
+            r.update(case=case, variant=variant, size=size, load_average=os.getloadavg()[0])
+            results.append(r)
+            shown = ", ".join(f"{k} {v:.3g}" if isinstance(v, float) else f"{k} {v}"
+                              for k, v in r.items() if k not in ("case", "variant", "size"))
+            print(f"{size} {case} [{variant}]: {shown}", flush=True)
+    for extension in READ_FORMATS if written is True else ():  # the 1M grid's are ~350 MB in all
+        os.remove(mesh_file(folder, size, extension))
 
 
 if __name__ == "__main__":
