@@ -199,6 +199,21 @@ def isotropic_calls(monkeypatch):
     return calls
 
 
+def square_with_one_long_side(n, m=12):
+    """A planar unit-square patch ``(X (k, 2), F)`` whose bottom side is one edge and the other
+    three ``n`` edges each, with an ``m`` x ``m`` grid of inner points, triangulated by Delaunay
+    (triangles as scipy orders them): long triangles along the bottom beside small ones, where a
+    search by the nearest few candidates goes wrong."""
+    from scipy.spatial import Delaunay
+
+    t = np.linspace(0.0, 1.0, n + 1)[:-1]
+    ring = np.vstack([np.column_stack([np.ones(n), t]), np.column_stack([1 - t, np.ones(n)]),
+                      np.column_stack([np.zeros(n), 1 - t]), [[0.0, 0.0]]])
+    g = np.linspace(0.15, 0.85, m)
+    X = np.vstack([ring, np.stack(np.meshgrid(g, g), axis=-1).reshape(-1, 2)])
+    return X, Delaunay(X).simplices
+
+
 def triangle_brute_force(P, V, F):
     """Distance from each point of ``P`` to the surface ``(V, F)``, every triangle measured
     (the package's point-triangle formula, checked against Ericson's in test_remesh_evaluate)."""

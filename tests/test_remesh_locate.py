@@ -270,17 +270,9 @@ def test_one_point_in_space_is_located_as_exactly_as_in_a_batch():
     # small ones. pymeshlab's search radius was a percentage of the points' bounding box, 0 for a
     # single point, so a lone point found no face and went to the numpy engine, which misses the
     # large triangle here (distance 0.059 against 0.0055)
-    from scipy.spatial import Delaunay
+    from conftest import square_with_one_long_side, triangle_brute_force
 
-    from conftest import triangle_brute_force
-
-    n = 60
-    t = np.linspace(0.0, 1.0, n + 1)[:-1]
-    ring = np.vstack([np.column_stack([np.ones(n), t]), np.column_stack([1 - t, np.ones(n)]),
-                      np.column_stack([np.zeros(n), 1 - t]), [[0.0, 0.0]]])
-    g = np.linspace(0.15, 0.85, 12)
-    X = np.vstack([ring, np.stack(np.meshgrid(g, g), axis=-1).reshape(-1, 2)])
-    F = Delaunay(X).simplices
+    X, F = square_with_one_long_side(60)
     V = np.column_stack([X, 0.05 * X[:, 0] * X[:, 1]])
     P = np.array([[0.774408151263812, 0.00300842016378447, -0.005450218387754509]])
     exact = triangle_brute_force(P, V, F)                     # every triangle measured
@@ -296,15 +288,9 @@ def test_planar_points_outside_the_domain_get_the_nearest_triangle():
     # bottom are outside the domain, and the numpy engine they went to took triangles along the
     # short sides (up to 0.069 too far); now the tree search measures them. Hand-computed: the
     # closest point of the domain to (x, -y) is (x, 0), at distance y
-    from scipy.spatial import Delaunay
+    from conftest import square_with_one_long_side
 
-    n = 40
-    t = np.linspace(0.0, 1.0, n + 1)[:-1]
-    ring = np.vstack([np.column_stack([np.ones(n), t]), np.column_stack([1 - t, np.ones(n)]),
-                      np.column_stack([np.zeros(n), 1 - t]), [[0.0, 0.0]]])
-    g = np.linspace(0.15, 0.85, 12)
-    U = np.vstack([ring, np.stack(np.meshgrid(g, g), axis=-1).reshape(-1, 2)])
-    F = Delaunay(U).simplices
+    U, F = square_with_one_long_side(40)
     rng = np.random.default_rng(0)
     P = np.column_stack([rng.random(2000), -0.02 * rng.random(2000)])
     face, bary, dist = locate(P, U, F)

@@ -362,14 +362,10 @@ def test_one_pinched_boundary_vertex_and_one_handle_are_counted_in_the_singular(
 def _square_with_one_long_side(n=40, m=12):
     """A curved unit-square patch (z = 0.1 y sin 3x) whose bottom side is one edge, the other
     three ``n`` edges each, with an ``m`` x ``m`` grid of inner points (Delaunay)."""
-    from scipy.spatial import Delaunay
+    from conftest import square_with_one_long_side
 
-    t = np.linspace(0.0, 1.0, n + 1)[:-1]
-    ring = np.vstack([np.column_stack([np.ones(n), t]), np.column_stack([1 - t, np.ones(n)]),
-                      np.column_stack([np.zeros(n), 1 - t]), [[0.0, 0.0]]])
-    g = np.linspace(0.15, 0.85, m)
-    X = np.vstack([ring, np.stack(np.meshgrid(g, g), axis=-1).reshape(-1, 2)])
-    F = Delaunay(X).simplices.astype(np.int64)
+    X, F = square_with_one_long_side(n, m)
+    F = F.astype(np.int64)
     a, b, c = X[F[:, 0]], X[F[:, 1]], X[F[:, 2]]
     cw = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0]) < 0
     F[cw] = F[cw][:, [0, 2, 1]]
