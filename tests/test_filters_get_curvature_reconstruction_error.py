@@ -7,6 +7,7 @@ import pymeshlab
 import pytest
 
 from curvdetail.curvature._validate import bbox_diagonal
+from curvdetail.curvature.errors import MeshError
 from curvdetail.curvature.testing import grid
 from curvdetail.filters import FilterError, apply
 from curvdetail.remesh import hausdorff, vertex_distance
@@ -208,3 +209,18 @@ def test_figures_are_those_hausdorff_measures_itself(monkeypatch):
     assert np.array_equal(ms.mesh(1).vertex_scalar_array(), given_distance)
     assert (figures["max"], figures["rms"], figures["sampled_to_target_max"]) == \
         (given["max"], given["rms"], given["a_to_b_max"] / figures["diagonal"])
+
+
+@pytest.mark.parametrize("stray_layer", [0, 1])
+def test_a_layer_the_checks_refuse_is_named_by_role_and_layer(stray_layer):
+    # the measuring functions name their arguments (V, Vs, Fs); the filter user needs the layer
+    V, F = grid(6, 6)
+    stray = np.vstack([V, [[3.0, 3.0, 3.0]]])
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(stray if stray_layer == 0 else V, F.astype(np.int32)), "source")
+    ms.add_mesh(pymeshlab.Mesh(stray if stray_layer == 1 else V + [0.0, 0.0, 0.01], F.astype(np.int32)), "")
+    role = "targetmesh (layer 0, 'source')" if stray_layer == 0 else "sampledmesh (layer 1)"
+    with pytest.raises(MeshError) as info:
+        apply(ms, "get_curvature_reconstruction_error", sampledmesh=1, targetmesh=0, samplenum=1000)
+    assert str(info.value) == (f"{role}: 1 vertex is not used by any triangle (first: 36); remove it, "
+                               "e.g. with pymeshlab's meshing_remove_unreferenced_vertices.")

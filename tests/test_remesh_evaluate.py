@@ -103,6 +103,24 @@ def test_vertex_distance_refuses_a_collapsed_or_overflowing_surface(far):
         vertex_distance(V, V * 1e155, F, far=far)
 
 
+@pytest.mark.parametrize("far", [False, True])
+def test_vertex_distance_refuses_unreferenced_source_vertices_as_hausdorff_does(far):
+    # vertex_distance measured against a surface with stray vertices (hausdorff refused it): the
+    # distances came out right, but relative to a bounding box the strays stretch, so a stray
+    # 1e6 away made the clean triangles "zero area"
+    V, F = grid(5, 5)
+    P = V + [0.0, 0.0, 0.3]
+    stray = np.vstack([[[0.5, 0.5, 2.0]], V, [[3.0, 0.0, 0.0]]])
+    with pytest.raises(MeshError, match=r"2 vertices are not used by any triangle \(first: 0, 26\)"):
+        hausdorff(P, F, stray, F + 1)
+    with pytest.raises(MeshError, match=r"^Vs: 2 vertices are not used by any triangle \(first: 0, 26\); "
+                                        r"remove them, e\.g\. with pymeshlab's meshing_remove_unreferenced"):
+        vertex_distance(P, stray, F + 1, far=far)
+    with pytest.raises(MeshError, match=r"^Vs: 1 vertex is not used by any triangle \(first: 25\); remove it"):
+        vertex_distance(P, np.vstack([V, [[0.5, 0.5, 1.0]]]), F, far=far)
+    assert np.allclose(vertex_distance(P, V, F, far=far), 0.3)      # the same surface without them
+
+
 def test_surfaces_of_fewer_than_eight_triangles_are_measured():
     # the kd-tree engine asked for 8 neighbours and got missing-neighbour indices (IndexError)
     V, F = grid(2, 3)                               # 4 triangles

@@ -1,6 +1,7 @@
 """Filter ``get_curvature_reconstruction_error``: two-sided Hausdorff distance between two layers."""
 
-from ..curvature._validate import bbox_diagonal
+from ..curvature._validate import bbox_diagonal, check_mesh
+from ..curvature.errors import MeshError
 from .errors import FilterError
 from .meshset import layer_id, mesh_arrays, set_vertex_quality
 from .parameters import Parameter
@@ -49,8 +50,12 @@ def get_curvature_reconstruction_error(ms, *, sampledmesh, targetmesh, samplenum
     Vb, Fb = mesh_arrays(ms, target)
     # the sampled layer's vertices searched once, exactly: the quality and hausdorff's maxima
     # (which takes them as they are, in its own frame: the same figures as measuring them there)
-    distance = vertex_distance(Va, Vb, Fb, far=True)
-    h = hausdorff(Va, Fa, Vb, Fb, samples=samplenum or None, a_vertex_distance=distance)
+    try:
+        distance = vertex_distance(Va, Vb, Fb, far=True)
+        h = hausdorff(Va, Fa, Vb, Fb, samples=samplenum or None, a_vertex_distance=distance)
+    except MeshError as exc:
+        raise _naming_the_layer(exc, ms, ("sampledmesh", sampled, Va, Fa),
+                                ("targetmesh", target, Vb, Fb)) from None
     if set_quality:
         set_vertex_quality(ms, sampled, distance)
     diag = bbox_diagonal(Vb)
@@ -69,3 +74,17 @@ def get_curvature_reconstruction_error(ms, *, sampledmesh, targetmesh, samplenum
         "sampledmesh": sampled,
         "targetmesh": target,
     }
+
+
+def _naming_the_layer(exc, ms, *layers):
+    """``exc`` told of the layer it is about (the measuring functions name their arguments, which
+    a filter user never sees): the first of ``layers`` (role, id, V, F) that the mesh checks refuse
+    gives its own message; ``exc`` as it is where none does. Error path only."""
+    for role, layer, V, F in layers:
+        try:
+            check_mesh(V, F)
+        except MeshError as problem:
+            label = ms.mesh(layer).label()
+            named = f"layer {layer}, {label!r}" if label else f"layer {layer}"
+            return type(problem)(f"{role} ({named}): {problem}")
+    return exc

@@ -8,9 +8,21 @@ import numpy as np
 from .._output import atomic_output, check_output_path
 
 
+#: Below this fraction of the triangles' total area, the area-weighted mean normal is taken as
+#: zero (a closed surface, a symmetric patch: rounding alone, pointing anywhere).
+FLAT_NORMAL_RELATIVE = 1e-9
+
+
 def _view_frame(V, F):
-    """Rotation taking the patch's area-weighted mean normal to +z (we look down on it)."""
-    n = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]).sum(0)
+    """Rotation taking the patch's area-weighted mean normal to +z (we look down on it); where the
+    normals cancel (a closed surface, a symmetric patch), the direction in which the vertices
+    spread least (the last right singular vector of the centred points; sign: its largest
+    component positive)."""
+    normals = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+    n = normals.sum(0)
+    if not np.linalg.norm(n) > FLAT_NORMAL_RELATIVE * np.linalg.norm(normals, axis=1).sum():
+        n = np.linalg.svd(V - V.mean(0), full_matrices=False)[2][-1]
+        n = -n if n[np.argmax(np.abs(n))] < 0 else n
     z = n / max(np.linalg.norm(n), np.finfo(float).tiny)
     a = np.array([1.0, 0.0, 0.0]) if abs(z[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
     x = np.cross(a, z)
