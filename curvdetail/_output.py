@@ -62,9 +62,9 @@ PENDING = set()
 #: (the old files kept aside would be left in hidden folders, and the outputs a mix).
 COMMIT_LOCK = threading.Lock()
 
-#: how a refusal of an existing output says to replace it by default: the CLI's option and
-#: Python's argument (the CLI passes ``flag="--overwrite"``, the scripts their own option)
-OVERWRITE_FLAG = "--overwrite (overwrite=True)"
+#: how a refusal of an existing output says to replace it by default: Python's argument (the
+#: CLI says ``--overwrite`` instead, see ``cli._in_command_words``; the scripts name their own option)
+OVERWRITE_FLAG = "overwrite=True"
 
 
 def check_output_path(path, overwrite=False, *, hint=_FORMATS_HINT, error=MeshError, flag=OVERWRITE_FLAG):

@@ -12,6 +12,7 @@ handles' motion, ``apply`` / ``run`` when an editing filter did.
 
 import argparse
 import contextlib
+import functools
 import os
 import signal
 import sys
@@ -381,7 +382,8 @@ def _remesh_command(parser):
                              "diagonal, e.g. 1 for 1 %.")
         # first: an output over an input is refused even with --overwrite, which the existing-
         # file check below would suggest
-        _check_image_and_distinct(args.image, args.output, args.report, inputs=[args.input])
+        _check_image_and_distinct(args.image, args.output, ("--report", args.report),
+                                  inputs=[("INPUT", args.input)])
         for extra in (args.report, args.image):
             if extra is not None:
                 check_output_path(extra, args.overwrite, hint=None, error=FileNotFoundError, flag=OVERWRITE)
@@ -491,7 +493,7 @@ def _run_on_file(args, work, *, other_inputs=()):
     """Check OUTPUT, load INPUT (and --add meshes) into a MeshSet, ``work(ms)``, print its figures
     as JSON, save the current mesh (quality and curvature attributes kept in PLY); returns the
     figures. OUTPUT may replace INPUT (with --overwrite), never an --add mesh or one of
-    ``other_inputs`` (the script of ``run``)."""
+    ``other_inputs`` (``(option, path)`` pairs: the script of ``run``)."""
     import json
 
     from . import _output
@@ -499,7 +501,8 @@ def _run_on_file(args, work, *, other_inputs=()):
                                 vertex_colours_kept_in)
     from .io import MeshFileError
 
-    _check_image_and_distinct(None, args.output, inputs=[args.input], other_inputs=[*args.add, *other_inputs])
+    _check_image_and_distinct(None, args.output, inputs=[("INPUT", args.input)],
+                              other_inputs=[*(("--add", p) for p in args.add), *other_inputs])
     # an existing file refused in the command line's words, then the filters' checks (format hint)
     _output.check_output_path(args.output, args.overwrite, hint=None, error=MeshFileError, flag=OVERWRITE)
     check_output_path(args.output, args.overwrite)
@@ -651,7 +654,7 @@ def _run_command(parser):
             finally:
                 bar.close()
 
-        steps = _run_on_file(args, work, other_inputs=[args.script])
+        steps = _run_on_file(args, work, other_inputs=[("SCRIPT", args.script)])
         script = os.path.basename(args.script)
         return _not_converged_status([(f"{script} step {k} ({done['filter']})", done["figures"])
                                       for k, done in enumerate(steps, start=1)], args.output)
@@ -709,8 +712,8 @@ def _edit_command(parser):
         from .curvature.errors import UndeterminedEditError, counted, first_indices
         from .io import MeshFileError
 
-        _check_image_and_distinct(args.image, args.output, inputs=[args.mesh],
-                                  other_inputs=[args.sel, args.transform])
+        _check_image_and_distinct(args.image, args.output, inputs=[("MESH", args.mesh)],
+                                  other_inputs=[("--sel", args.sel), ("--def", args.transform)])
         check_mesh_output(args.output, args.overwrite)
         if args.image:
             check_output_path(args.image, args.overwrite, hint=None, error=FileNotFoundError, flag=OVERWRITE)
@@ -783,23 +786,34 @@ def _check_image_and_distinct(image, output, *extras, inputs=(), other_inputs=()
     no output may replace an input file, with one exception: OUTPUT, the mesh, may replace the
     input mesh (``inputs``) when --overwrite asks for it (checked with the output's other
     conditions). The picture or report over the input mesh, or anything over the other input
-    files (``other_inputs``: selections, transforms), is refused even with --overwrite."""
+    files (``other_inputs``: selections, transforms), is refused even with --overwrite.
+    ``extras``, ``inputs`` and ``other_inputs`` are ``(option, path)`` pairs, the option (or
+    argument, ``INPUT``) that named the file, said in the refusal."""
     if image is not None and not image.lower().endswith(".png"):
         raise ValueError(f"--image {image}: only PNG pictures are written; end the name in .png.")
-    # (path, may it replace the input mesh)
-    outputs = [(p, p == output) for p in (image, output, *extras) if p is not None]
-    real = [os.path.realpath(p) for p, _ in outputs]
+    # (option, path, may it replace the input mesh)
+    outputs = [(name, p, name == "OUTPUT") for name, p in (("--image", image), ("OUTPUT", output), *extras)
+               if p is not None]
+    real = [os.path.realpath(p) for _, p, _ in outputs]
     for k, r in enumerate(real):
         if r in real[:k]:
-            raise ValueError(f"{outputs[k][0]} is given for two outputs; name a separate file for each.")
-    # (input, may OUTPUT replace it): an --add mesh that is INPUT's file as well is another input
-    # (it was replaced by OUTPUT over INPUT with --overwrite)
-    given_files = [(p, True) for p in inputs] + [(p, False) for p in other_inputs]
-    for (path, is_mesh), r in zip(outputs, real):
-        for given, replaceable in given_files:
+            first = outputs[real.index(r)][0]
+            raise ValueError(f"{outputs[k][1]} is given for two outputs ({first} and {outputs[k][0]}); "
+                             "name a separate file for each.")
+    # (option, input, may OUTPUT replace it): an --add mesh that is INPUT's file as well is
+    # another input (it was replaced by OUTPUT over INPUT with --overwrite)
+    given_files = [(name, p, True) for name, p in inputs] + [(name, p, False) for name, p in other_inputs]
+    for (name, path, is_mesh), r in zip(outputs, real):
+        for given_name, given, replaceable in given_files:
             if given is not None and r == os.path.realpath(given) and not (is_mesh and replaceable):
-                raise ValueError(f"{path} is an input of this run ({given}); writing there would "
-                                 "destroy it even with --overwrite. Name another file.")
+                # where the file is INPUT as well, --overwrite lets OUTPUT replace that one only
+                also = [n for n, g, ok in given_files
+                        if is_mesh and ok and g is not None and r == os.path.realpath(g)]
+                only = (f" (which lets OUTPUT replace {also[0]}, never a file also given as {given_name})"
+                        if also else "")
+                raise ValueError(f"{path} is an input of this run ({given_name} {given}); writing {name} "
+                                 f"there would destroy it even with --overwrite{only}. Name another "
+                                 f"file for {name}.")
 
 
 def build_parser():
@@ -893,18 +907,19 @@ def _watch_sigterm():
     return stop
 
 
-def _show_warning(message, category, filename, lineno, file=None, line=None):
+def _show_warning(message, category, filename, lineno, file=None, line=None, *, command=None):
     """A LongRunWarning (a filter in a script about to take minutes) or a
     WorseThanZeroDetailWarning (a remeshing that failed) as a note line; a FoldedTrianglesWarning
-    or AmplifiedEditWarning (an edit that folded or amplified) as a warning line."""
+    or AmplifiedEditWarning (an edit that folded or amplified) as a warning line; the library's
+    advice said in ``command``'s options (:func:`_in_command_words`)."""
     from .curvature.errors import FoldedTrianglesWarning
     from .filters.editing import AmplifiedEditWarning
     from .remesh import LongRunWarning, WorseThanZeroDetailWarning
 
     if issubclass(category, (LongRunWarning, WorseThanZeroDetailWarning)):
-        _say(f"note: {message}")
+        _say(f"note: {_in_command_words(str(message), command)}")
     elif issubclass(category, (FoldedTrianglesWarning, AmplifiedEditWarning)):
-        _say(f"curvdetail: warning: {message}")
+        _say(f"curvdetail: warning: {_in_command_words(str(message), command)}")
     else:
         _default_showwarning(message, category, filename, lineno, file, line)
 
@@ -914,17 +929,25 @@ _default_showwarning = warnings.showwarning
 
 #: Advice that the library gives in its parameters' names (curvdetail.remesh knows no command
 #: line), in each command's words: the retriangulation's method is an option of ``remesh`` and a
-#: --param of ``apply`` (``run``'s script names it as the library does).
+#: --param of ``apply``, as are the filters' ``evaluate``, ``surface_check`` and ``target_edge``
+#: of a long run's note (``run``'s script names them as the library does).
 _COMMAND_WORDS = {
     "remesh": {'use method "isotropic"': "use --method isotropic"},
-    "apply": {'use method "isotropic"': "use --param method=isotropic"},
+    "apply": {'use method "isotropic"': "use --param method=isotropic",
+              "(evaluate=False ": "(--param evaluate=false ",
+              "(surface_check=False ": "(--param surface_check=false ",
+              "pymeshlab.PercentageValue(1) is 1 %": "--param target_edge=1% is 1 %"},
 }
+
+#: Advice of every command: an existing output is replaced with --overwrite, Python's
+#: ``overwrite=True`` (the filters and write_mesh) being no use in a shell.
+_EVERY_COMMANDS_WORDS = {"pass overwrite=True": "pass --overwrite"}
 
 
 def _in_command_words(message, command):
     """``message`` with the library's advice said in ``command``'s options (see
-    :data:`_COMMAND_WORDS`)."""
-    for library, words in _COMMAND_WORDS.get(command, {}).items():
+    :data:`_COMMAND_WORDS`, :data:`_EVERY_COMMANDS_WORDS`)."""
+    for library, words in (*_COMMAND_WORDS.get(command, {}).items(), *_EVERY_COMMANDS_WORDS.items()):
         message = message.replace(library, words)
     return message
 
@@ -935,7 +958,7 @@ def main(argv=None):
     stop_watching = _watch_sigterm()
     try:
         with warnings.catch_warnings():
-            warnings.showwarning = _show_warning
+            warnings.showwarning = functools.partial(_show_warning, command=args.command)
             return int(args._run(args) or 0)
     except KeyboardInterrupt:
         _say("curvdetail: interrupted")

@@ -560,7 +560,7 @@ def write_mesh(path, V, F, *, quality=None, overwrite=False):
     >>> write_mesh(path, V, F)
     Traceback (most recent call last):
     ...
-    FileExistsError: ... exists; pass --overwrite (overwrite=True) to replace it.
+    FileExistsError: ... exists; pass overwrite=True to replace it.
     """
     import pymeshlab
 

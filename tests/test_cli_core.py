@@ -308,6 +308,25 @@ def test_every_command_refuses_an_existing_output_with_one_message(tmp_path, cap
     assert set(messages.values()) == {"curvdetail: error: OUTPUT exists; pass --overwrite to replace it."}, messages
 
 
+def test_an_output_made_during_the_run_is_refused_in_the_command_lines_words(tmp_path, capsys, monkeypatch):
+    # the check before the work says --overwrite; a file made meanwhile was refused by write_mesh
+    # in Python's words, "--overwrite (overwrite=True)", now "overwrite=True", which the CLI says
+    # as its option
+    from curvdetail import Reconstructor
+
+    out = tmp_path / "o.ply"
+    solve = Reconstructor.solve
+
+    def solve_while_another_process_writes(self, *args, **kwargs):
+        out.write_text("another process's")
+        return solve(self, *args, **kwargs)
+
+    monkeypatch.setattr(Reconstructor, "solve", solve_while_another_process_writes)
+    assert main(["reconstruct", NOSE, str(out)]) == 1
+    assert _error_line(capsys) == f"curvdetail: error: {out} exists; pass --overwrite to replace it."
+    assert out.read_text() == "another process's" and os.listdir(tmp_path) == ["o.ply"]
+
+
 @pytest.mark.parametrize("option", ["--report", "--image"])
 def test_an_existing_report_or_picture_is_refused_in_the_command_lines_words(tmp_path, capsys, option):
     extra = tmp_path / ("keep.json" if option == "--report" else "keep.png")

@@ -113,7 +113,9 @@ def test_output_over_an_input_file_is_refused_even_with_overwrite(tmp_path, caps
     rc = main(["edit", str(paths["off"]), str(sel), "--sel", str(sel), "--def", str(paths["def"]),
                "--overwrite"])
     assert rc == 1
-    assert "selection.ply is an input of this run" in capsys.readouterr().err
+    # the refusal names the option that gave the file and the output that would replace it
+    assert (f"selection.ply is an input of this run (--sel {sel}); writing OUTPUT there would destroy it even "
+            "with --overwrite. Name another file for OUTPUT.") in capsys.readouterr().err
     assert sel.read_bytes() == before
     paths["sel"] = sel
     # the mesh over the input mesh is what --overwrite asks for

@@ -372,7 +372,7 @@ def test_apply_remeshing_with_a_big_target_is_announced_with_the_value_given(cap
     # what takes the time: the remeshing half or more (alone 554 s at 2.25M vertices), not
     # "the measurements most of it"
     assert rc == 0 and "Half of it or more is pymeshlab's isotropic remeshing" in err, err
-    assert "the measurements (evaluate false skips them)" in err and "measurements most of it" not in err
+    assert "the measurements (--param evaluate=false skips them)" in err and "measurements most of it" not in err
     # a decimation that will be refused (finer than the source) is refused without the note
     rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "r.ply",
                            "--param", "method=decimate", "--param", f"target_edge={length}")
@@ -381,6 +381,37 @@ def test_apply_remeshing_with_a_big_target_is_announced_with_the_value_given(cap
     rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "p.ply",
                            "--param", f"target_edge={length}", "--param", "evaluate=false")
     assert rc == 0 and "note:" not in err
+
+
+def test_the_long_run_note_of_apply_names_options_that_apply_takes(capsys, tmp_path, monkeypatch):
+    # the note said "evaluate false" and "surface_check false" (prose in the library's names) and
+    # pymeshlab.PercentageValue(1), none of which a shell takes; now each is an --param that can be
+    # pasted, and following it works: the run is taken and does what the note says
+    import re
+
+    from curvdetail import read_mesh
+    from curvdetail.curvature._validate import bbox_diagonal
+
+    monkeypatch.setattr(importlib.import_module("curvdetail.remesh.retriangulate"), "BIG_TARGET", 500)
+    length = round(0.03 * bbox_diagonal(read_mesh(NOSE)[0]), 6)
+    rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "o.ply",
+                           "--param", f"target_edge={length}")
+    assert rc == 0 and "hausdorff_max" in out
+    note = next(line for line in err.splitlines() if line.startswith("note: target_edge="))
+    assert "evaluate=False" not in note and "surface_check=False" not in note, note
+    assert "PercentageValue" not in note, note
+    advice = re.findall(r"--param (\S+=\S+)", note)
+    assert advice == ["surface_check=false", "evaluate=false", "target_edge=1%"], note
+    # pasted: evaluate=false and surface_check=false are taken, and nothing is measured
+    rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "q.ply",
+                           "--param", f"target_edge={length}", "--param", advice[0], "--param", advice[1])
+    assert rc == 0 and "error" not in json.loads(out) and "skips them" not in err, (out, err)
+    assert json.loads(out)["options"]["surface_check"] is False
+    # 1 % of the diagonal, as the note says (a smaller target than 3 %: announced again)
+    rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "r.ply",
+                           "--param", advice[2], "--param", advice[1])
+    assert rc == 0 and json.loads(out)["options"]["target_edge"] == pytest.approx(0.01), out
+    assert "% (1 % of the bbox diagonal) gives about" in err, err
 
 
 def test_a_script_step_with_a_big_target_is_announced_as_a_note(capsys, tmp_path, monkeypatch):
@@ -487,8 +518,8 @@ def test_run_refuses_to_write_over_its_script_even_with_overwrite(capsys, tmp_pa
         os.symlink("s.ply", tmp_path / "link.ply")
     rc, out, err = run_cli(capsys, "run", "s.ply", NOSE, output, "--overwrite")
     assert rc == 1 and out == ""
-    assert err == (f"curvdetail: error: {output} is an input of this run (s.ply); writing there would destroy "
-                   "it even with --overwrite. Name another file.\n")
+    assert err == (f"curvdetail: error: {output} is an input of this run (SCRIPT s.ply); writing OUTPUT there "
+                   "would destroy it even with --overwrite. Name another file for OUTPUT.\n")
     assert (tmp_path / "s.ply").read_text() == SCRIPT
 
 
@@ -536,7 +567,12 @@ def test_an_added_layer_that_is_also_input_is_not_replaced_by_output_over_input(
     (tmp_path / "s.mlx").write_text(SCRIPT)
     first = ["apply", "compute_curvature_detail"] if command == "apply" else ["run", tmp_path / "s.mlx"]
     rc, out, err = run_cli(capsys, *first, mesh, mesh, "--add", mesh, "--overwrite")
-    assert rc == 1 and "b.obj is an input of this run" in err and out == ""
+    assert rc == 1 and out == ""
+    # the refusal names the option that made the file an input, the output, and the fix (it
+    # named the file only, though INPUT alone may be replaced)
+    assert err == (f"curvdetail: error: {mesh} is an input of this run (--add {mesh}); writing OUTPUT there "
+                   "would destroy it even with --overwrite (which lets OUTPUT replace INPUT, never a file also "
+                   "given as --add). Name another file for OUTPUT.\n"), err
     assert mesh.read_bytes() == before
     # OUTPUT over INPUT alone is still taken with --overwrite
     rc, out, err = run_cli(capsys, *first, mesh, mesh, "--overwrite")

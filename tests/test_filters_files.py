@@ -46,11 +46,24 @@ def test_existing_output_is_kept_unless_overwrite(tmp_path):
     out = tmp_path / "d.ply"
     out.write_text("keep me")
     ms = load_meshset(NOSE)
-    with pytest.raises(FileExistsError, match="--overwrite"):
+    with pytest.raises(FileExistsError, match=r"d.ply exists; pass overwrite=True to replace it\.$"):
         save_current_mesh(ms, out)
     assert out.read_text() == "keep me"
     save_current_mesh(ms, out, overwrite=True)
     assert out.read_bytes().startswith(b"ply")
+
+
+def test_an_existing_script_is_refused_in_pythons_words(tmp_path):
+    # save_script said "--overwrite (overwrite=True)": the command line's option, no use in Python
+    from curvdetail.filters import save_script
+
+    path = tmp_path / "p.mlx"
+    path.write_text("keep me")
+    with pytest.raises(FileExistsError, match=r"p.mlx exists; pass overwrite=True to replace it\.$"):
+        save_script(path, ["compute_curvature_detail"])
+    assert path.read_text() == "keep me"
+    save_script(path, ["compute_curvature_detail"], overwrite=True)
+    assert "compute_curvature_detail" in path.read_text()
 
 
 def test_failed_save_leaves_no_file(tmp_path, monkeypatch):

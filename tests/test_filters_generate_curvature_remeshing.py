@@ -183,7 +183,7 @@ def test_a_big_target_is_said_beforehand_with_the_unit_of_a_plain_number(monkeyp
     assert round(percent, 2) == 6.55
     with pytest.warns(LongRunWarning, match=rf"target_edge=1\.0 \({percent:.3g} % of the bbox diagonal\) gives about "
                                             r"\d+ target vertices; this takes minutes\. Most of it is pymeshlab's "
-                                            r"isotropic remeshing \(surface_check false makes it 25-50 % faster\)\. "
+                                            r"isotropic remeshing \(surface_check=False makes it 25-50 % faster\)\. "
                                             r"A plain number is in model units"):
         apply(ms, "generate_curvature_remeshing", target_edge=1.0, evaluate=False)
     with warnings.catch_warnings():

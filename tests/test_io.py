@@ -65,7 +65,8 @@ def test_existing_file_is_not_overwritten(tmp_path, nose):
     V, F = nose
     path = tmp_path / "keep.obj"
     path.write_text("precious")
-    with pytest.raises(FileExistsError, match=r"keep.obj exists; pass --overwrite \(overwrite=True\)"):
+    # Python's argument, not the command line's option (the CLI says --overwrite)
+    with pytest.raises(FileExistsError, match=r"keep.obj exists; pass overwrite=True to replace it\.$"):
         write_mesh(path, V, F)
     assert path.read_text() == "precious"
 
@@ -431,7 +432,7 @@ def test_save_mesh_refuses_to_overwrite(tmp_path):
     path = tmp_path / "m.ply"
     path.write_text("x")
     mesh = pymeshlab.Mesh(vertex_matrix=np.eye(3), face_matrix=np.array([[0, 1, 2]], dtype=np.int32))
-    with pytest.raises(FileExistsError, match="m.ply exists; pass --overwrite"):
+    with pytest.raises(FileExistsError, match=r"m.ply exists; pass overwrite=True to replace it\.$"):
         save_mesh(path, mesh)
     assert path.read_text() == "x" and os.listdir(tmp_path) == ["m.ply"]
 

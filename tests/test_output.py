@@ -58,17 +58,17 @@ def test_atomic_output_failed_block_leaves_nothing_and_keeps_the_old_file(tmp_pa
 def test_atomic_output_refuses_an_existing_file_before_the_block(tmp_path):
     path = tmp_path / "a.txt"
     path.write_text("old")
-    with pytest.raises(FileExistsError, match="--overwrite"):
+    with pytest.raises(FileExistsError, match="pass overwrite=True"):
         with atomic_output(path):
             pytest.fail("the block must not run")
     assert os.listdir(tmp_path) == ["a.txt"]
 
 
 def test_a_refusal_names_the_callers_way_to_replace(tmp_path):
-    # the CLI and Python say --overwrite (overwrite=True); the scripts under scripts/ name their own flag
+    # Python says overwrite=True (the CLI translates it); the scripts under scripts/ name their own flag
     path = tmp_path / "old.json"
     path.write_text("kept")
-    with pytest.raises(FileExistsError, match=r"exists; pass --overwrite \(overwrite=True\) to replace it"):
+    with pytest.raises(FileExistsError, match=r"exists; pass overwrite=True to replace it"):
         check_output_path(path)
     with pytest.raises(FileExistsError, match=r"exists; pass --force to replace it\.$"):
         with atomic_output(path, hint=None, flag="--force"):
@@ -82,7 +82,7 @@ def test_a_refusal_names_the_callers_way_to_replace(tmp_path):
 def test_a_dangling_link_is_not_replaced_without_overwrite(tmp_path):
     link = tmp_path / "a.txt"
     os.symlink(tmp_path / "missing.txt", link)
-    with pytest.raises(FileExistsError, match="link to a missing file.*--overwrite"):
+    with pytest.raises(FileExistsError, match="link to a missing file.*pass overwrite=True"):
         with atomic_output(link):
             pytest.fail("the block must not run")
     assert os.path.islink(link)
@@ -441,7 +441,7 @@ def test_a_file_made_by_another_process_during_the_commit_is_not_replaced(tmp_pa
 
     monkeypatch.setattr(os, "chmod", chmod_then_another_process_writes)
     with pytest.raises(FileExistsError, match=r"cannot write '.*a\.txt': it was made while the output was being "
-                                              r"written; pass --overwrite \(overwrite=True\) to replace it; no "
+                                              r"written; pass overwrite=True to replace it; no "
                                               r"output was written"):
         with atomic_output(path, hint=None) as tmp:
             _write(tmp, "ours")

@@ -303,7 +303,7 @@ def test_a_long_run_is_not_announced_for_a_decimation_that_will_be_refused(load_
      ["Most of it is the measurements"]),
     ("isotropic", False, True, ["Most of it is pymeshlab's isotropic remeshing", "--no-surface-check"],
      ["evaluate", "measurements"]),
-    ("isotropic", True, False, ["surface_check false", "evaluate false skips them"], ["--no"]),
+    ("isotropic", True, False, ["surface_check=False", "evaluate=False skips them"], ["--no"]),
     ("decimate", True, True, ["Most of it is the measurements (--no-evaluate skips them)"], ["isotropic"]),
 ])
 def test_a_long_run_says_what_takes_the_time(method, evaluate, cli, says, not_says):

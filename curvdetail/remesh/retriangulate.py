@@ -77,8 +77,8 @@ def long_run_reason(method="isotropic", evaluate=True, cli=False):
     far from the source); to 2.25M the remeshing alone 554 s (it grows faster than the
     vertices, the measurements about with them). Decimation of a 490k-vertex grid to 251k: 92 s,
     of which the measurements 75 s, the transfer 13 s and the decimation 3 s."""
-    no_evaluate = "--no-evaluate" if cli else "evaluate false"
-    no_check = "--no-surface-check" if cli else "surface_check false"
+    no_evaluate = "--no-evaluate" if cli else "evaluate=False"
+    no_check = "--no-surface-check" if cli else "surface_check=False"
     if method == "decimate":
         return f"Most of it is the measurements ({no_evaluate} skips them); the decimation itself takes seconds."
     remeshing = f"pymeshlab's isotropic remeshing ({no_check} makes it 25-50 % faster)"
