@@ -230,7 +230,8 @@ def check_polygons(path, V, F, sizes, error=ValueError):
     triangles all face with it covers the polygon once; so a polygon is refused where one of its
     triangles faces against it (a concave polygon cut along a diagonal outside it, or one that
     crosses itself or folds far from a plane). Zero-area triangles pass (collinear corners).
-    Vectorized over the triangles."""
+    Vectorized over the triangles. The message names the first such face, and for an OBJ file its
+    line (:func:`curvdetail._file_scan._obj_face_line`, which reads the file again: only then)."""
     sizes = np.asarray(sizes, dtype=np.int64)
     if not sizes.size or sizes.max(initial=0) <= 3 or int((sizes - 2).sum()) != len(F):
         return
@@ -252,9 +253,14 @@ def check_polygons(path, V, F, sizes, error=ValueError):
         return
     polygons = np.unique(np.repeat(np.flatnonzero(polygon), counts)[against])
     first = int(polygons[0])
+    line = None
+    if os.path.splitext(os.fspath(path))[1].lower() == ".obj":    # found only now: a refusal reads the file again
+        from ._file_scan import _obj_face_line
+        line = _obj_face_line(path, first)
+    where = f", on line {line}" if line is not None else ""
     raise error(
         f"{path!r}: {counted(polygons.size, 'polygon face')} (first: face {first} counting from 0 in the "
-        f"file's order, of {sizes[first]} vertices) came out of pymeshlab's loader as triangles that "
+        f"file's order{where}, of {sizes[first]} vertices) came out of pymeshlab's loader as triangles that "
         "overlap or leave the polygon (a triangle faces the other way: the polygon is concave and was cut "
         "along a diagonal outside it, or it crosses itself or is far from planar); triangulate the file's "
         "polygons before reading it (e.g. Blender's Triangulate, or an exporter's triangulate option), or "

@@ -74,8 +74,10 @@ def check_before_loading(path, error=ValueError, sizes=None, counts=None):
     OBJ also (:func:`_obj_face_indices`): face vertex indices outside the file (0, past the last
     ``v`` line, or negative past the vertices above the face; the loader wrote out of bounds or
     read another vertex), corners that are no whole number and faces of fewer than 3 corners;
-    a UTF-8 byte order mark (the first line was lost; PLY: "damaged") and a carriage return no
-    newline follows (the lines it ends were lost). ASCII STL: facets of other than 3 ``vertex``
+    a UTF-8 byte order mark (the first line was lost; PLY: "damaged"), a carriage return no
+    newline follows (the lines it ends were lost), and lines ending in a backslash that the
+    loader joins with the next into something it misreads (:func:`_obj_continued_line`; faces
+    and vertices continued over lines it reads right pass). ASCII STL: facets of other than 3 ``vertex``
     lines (the 4th was dropped). OFF: faces of fewer than 3 vertices (dropped). Binary PLY
     (:func:`curvdetail._ply_scan._ply_binary_problem`): big-endian doubles in the vertex element
     (read as garbage), a body shorter than the header's counts allow, and lists other than the
@@ -154,7 +156,7 @@ def check_before_loading(path, error=ValueError, sizes=None, counts=None):
         if continued is not None:
             raise error(f"{path!r}: line {continued[0]} ({continued[1]!r}) ends in a backslash, which "
                         "pymeshlab's OBJ loader reads as a line continued on the next one, and then " +
-                        _OBJ_CONTINUED[continued[2]] + " and read the file again.")
+                        continued[2] + " and read the file again.")
         count, line = _obj_indented_vertices(path)
         if count:
             raise error(f"{path!r}: {count} vertex lines start with spaces or tabs (first: line {line}), "
@@ -261,59 +263,123 @@ def _obj_comma(path):
 
 
 #: What pymeshlab's OBJ loader does with a line continued by a backslash, by the kind
-#: :func:`_obj_continued_line` finds, and the fix.
+#: :func:`_obj_continued_line` finds, and the fix (a vertex misread: built there).
 _OBJ_CONTINUED = {
     "other": "loses that line's vertex without a word (a vertex (0, 0, 0) took its place); remove the "
              "backslash",
-    "crlf": "misreads the face without a word (before a Windows line end, CR LF, the face was dropped or "
-            "lost a corner); join the face's lines into one",
+    "counted": "reads the next line, which starts with a keyword, as part of this vertex, while it counts that "
+               "line on its own (the vertex or face it holds was lost and a vertex (0, 0, 0) appended, without "
+               "a word; after a 'vt' line so joined the process crashed); remove the backslash",
+    "crlf": "misreads the joined line without a word where a line it joins on ends in a Windows line end, CR LF "
+            "(it then drops the character before the backslash too: a face was dropped or lost a corner, "
+            "'v 1 0 5 \\' then '6' read as 'v 1 0 56'); join the lines into one, or end them in LF alone",
     "glued": "glues the backslash's word to the next line's first word ('f 1 2\\' and '3' were read as "
-             "'f 1 23'); put a space before the backslash or join the face's lines into one",
+             "'f 1 23'); put a space before the backslash or join the lines into one",
 }
+#: A backslash that ends a line (LF or CR LF): pymeshlab's OBJ loader joins the line with the next.
+_OBJ_CONTINUES = re.compile(rb"\\\r?\n")
 
 
 def _obj_continued_line(path):
-    """``(1-based line, its text, kind)`` of the first line of an OBJ file that ends in a
-    backslash and that pymeshlab's loader misreads, or None. The loader joins such a line with
-    the next one, the backslash removed and nothing put in its place (measured: ``f 1 2\\`` then
-    ``3`` was read as ``f 1 23``, ``f 1 2 \\`` then ``3`` as ``f 1 2 3``). Kinds: ``"other"``, a
-    line that is not part of a face (a vertex line so continued, or a comment line before a
-    vertex, cost the next vertex, and a vertex (0, 0, 0) was appended in its place, without a
-    word); ``"crlf"``, a face line whose backslash a carriage return follows (the face was
-    dropped or lost a corner), or one continued on a line that ends so (``f 1 2 \\`` then ``3``
-    and CR LF: dropped); ``"glued"``, a face line whose backslash follows a word and whose
-    next line starts with one (the two are read as one index). A face continued over lines
-    (``f 1 \\``, ``2 \\``, ``3``) is read right and passes. Found through a memory map; only
-    such lines are looked at."""
-    found = []
+    """``(1-based line, its text, what pymeshlab makes of it and the fix)`` for the first line of
+    an OBJ file that ends in a backslash and that pymeshlab's loader misreads, or None.
+
+    The loader (vcglib ``TokenizeNextLine``) reads a line, drops a carriage return at its end,
+    and while the line ends in a backslash removes it and appends the next line, nothing put in
+    between (``f 1 2\\`` then ``3`` was read as ``f 1 23``, ``f 1 2 \\`` then ``3`` as ``f 1 2
+    3``); where a line so appended ends in a carriage return, it removes one byte more of the
+    line before, and the carriage return stays. It counts the vertices beforehand, one per
+    ``v`` line as written. Kinds refused (:data:`_OBJ_CONTINUED`): ``"other"``, a line that is
+    neither a ``v`` line nor a face (a comment line before a vertex cost that vertex, and a
+    vertex (0, 0, 0) was appended in its place, without a word); ``"counted"``, a ``v`` line
+    continued on a line that starts with a letter (a ``v``, ``vt`` or ``f`` line, counted on its
+    own); ``"crlf"``, a line continued on a line that ends in CR LF (``f 1 2 \\`` then ``3`` CR
+    LF: dropped); ``"glued"``, a backslash glued to a word, the next line starting with one
+    (the two are read as one); and a ``v`` line whose joined x, y and z are not decimal numbers
+    (as a line of its own, see :func:`_obj_bad_coordinate`: ``v 1 0 \\`` then ``# c`` was read
+    as (1, 0, 0)). A face or vertex continued over lines that end in LF (the first may end in
+    CR LF: ``v 1 0 \\`` CR LF then ``5`` LF was read as (1, 0, 5)) is read right and passes.
+    Found through a memory map; only lines ending in a backslash and the lines they join are
+    looked at."""
     with _mapped(path) as data:
         if data is None or data.find(b"\\") < 0:      # no backslash (a byte's search: fast)
             return None
-        for ending in (b"\\\n", b"\\\r\n"):           # LF and CRLF line ends
-            at = data.find(ending)
-            while at >= 0:
-                start = data.rfind(b"\n", 0, at) + 1
-                first = start                           # the first line of those it continues
-                while first >= 2 and data[first - 2:first] == b"\\\n":
-                    first = data.rfind(b"\n", 0, first - 1) + 1
-                words = data[first:at + 1].replace(b"\\\n", b"").split()
-                kind = None
-                if not words or words[0] != b"f":
-                    kind = "other"
-                elif ending == b"\\\r\n" or data[at + 2:data.find(b"\n", at + 2)].endswith(b"\r"):
-                    kind = "crlf"                       # on this line or the next (measured: dropped)
-                elif at > start and data[at - 1:at] not in b" \t" and data[at + 2:at + 3] not in b" \t\n":
-                    kind = "glued"                      # (an empty slice is "in" any bytes: the file's end)
-                if kind is not None:
-                    found.append((start, at + 1, kind))
-                    break
-                at = data.find(ending, at + len(ending))
-        if not found:
-            return None
-        start, end, kind = min(found)
-        text = data[start:end].decode("utf-8", "replace").strip()
-        number = int(np.count_nonzero(np.frombuffer(data, dtype=np.uint8, count=start) == 10)) + 1
-    return number, text if len(text) <= 80 else text[:77] + "...", kind
+        done = 0                                      # the end of the lines joined so far
+        for match in _OBJ_CONTINUES.finditer(data):
+            if match.start() < done:                  # a line of a join looked at already
+                continue
+            start = data.rfind(b"\n", 0, match.start()) + 1
+            found = _obj_join_problem(data, start, match)
+            if isinstance(found, int):
+                done = found
+                continue
+            at, what = found
+            line_start = data.rfind(b"\n", 0, at) + 1
+            text = data[line_start:at + 1].decode("utf-8", "replace").strip()
+            number = int(np.count_nonzero(np.frombuffer(data, dtype=np.uint8, count=line_start) == 10)) + 1
+            return number, text if len(text) <= 80 else text[:77] + "...", what
+    return None
+
+
+def _obj_join_problem(data, start, match):
+    """The lines pymeshlab's OBJ loader joins from the line at byte ``start`` of ``data``, whose
+    backslash and line end ``match`` found: ``(the backslash's byte, what pymeshlab makes of
+    them and the fix)`` where it misreads them (see :func:`_obj_continued_line`), else the byte
+    after the last of them."""
+    first = data[start:match.start()]
+    vertex = first[:2] in (b"v ", b"v\t")
+    words = first.split()
+    if not vertex and (not words or words[0] != b"f"):
+        return match.start(), _OBJ_CONTINUED["other"]
+    joined = [first]
+    at, low = match.start(), match.end()              # the backslash, and the next line's start
+    while True:
+        newline = data.find(b"\n", low)
+        high = len(data) if newline < 0 else newline
+        line = data[low:high]
+        before = b"".join(joined)[-1:]
+        if vertex and line[:1].isalpha():
+            return at, _OBJ_CONTINUED["counted"]
+        if line.endswith(b"\r"):
+            return at, _OBJ_CONTINUED["crlf"]
+        if before not in b" \t" and line[:1] not in b" \t":   # (an empty slice is "in" any bytes)
+            return at, _OBJ_CONTINUED["glued"]
+        if newline < 0 or not line.endswith(b"\\"):
+            joined.append(line[:-1] if line.endswith(b"\\") else line)   # the file's last byte: on nothing
+            break
+        joined.append(line[:-1])                      # continued again
+        at, low = high - 1, newline + 1
+    if vertex:
+        misread = _obj_joined_vertex_problem(b"".join(joined))
+        if misread:
+            return match.start(), misread
+    return high + 1
+
+
+def _obj_joined_vertex_problem(joined):
+    """What pymeshlab's OBJ loader misreads in the ``v`` line ``joined`` (lines it joined at a
+    backslash) and the fix, or None: an x, y or z that is not a decimal number, inf or nan (a
+    comment glued to the z passes), a comma before any comment, or a control character."""
+    words = re.split(rb"[ \t\r]+", joined.strip(b" \t\r"))
+    reason = None
+    if _CONTROL.search(joined):
+        reason = "a control character"
+    elif b"," in b" ".join(joined.split(b"#", 1)[0].split()):
+        reason = "a number written with a comma (read only up to the comma)"
+    for rank, word in enumerate(words[1:4] if reason is None else (), 1):
+        number = word.split(b"#", 1)[0] if rank == 3 else word
+        if _NUMBER.fullmatch(number) is None:
+            reason = ("a comment among its coordinates, whose words pymeshlab reads as coordinates" if b"#" in word
+                      else f"the {'xyz'[rank - 1]} coordinate {word.decode('utf-8', 'replace')!r}, which is not a "
+                      "decimal number")
+            break
+    if reason is None:
+        return None
+    shown = joined.decode("utf-8", "replace").strip()
+    shown = shown if len(shown) <= 80 else shown[:77] + "..."
+    read = "(" + ", ".join(_atof(word) for word in words[1:4]) + ")"
+    return (f"reads the joined line {shown!r} as the vertex {read} without a word: it holds {reason}; write the "
+            "vertex on one line with its coordinates as decimal numbers (e.g. -1.5e-3)")
 
 
 def _obj_indented_vertices(path):
@@ -691,6 +757,12 @@ def _obj_bad_coordinate_in(chars, at, kind, digits, failed):
         keep = ~_after_hash(kind, failed, first)
         failed, newline, rank, first, end = failed[keep], newline[keep], rank[keep], first[keep], end[keep]
         keep = ~_special_words(chars, at[first] + 1, _number_end(chars, kind, at, first, end))
+        # a lone backslash ending the line: a v line continued on the next, whose joined values
+        # _obj_continued_line has checked
+        last = np.minimum(end + 1, kind.size - 1)
+        keep &= ~((at[end] - at[first] == 2) & (chars[at[first] + 1] == 92) &
+                  ((kind[end] == _NL) | ((kind[last] == _NL) & (at[last] == at[end] + 1) &
+                                         (chars[np.minimum(at[end], chars.size - 1)] == 13))))
         failed, newline, rank, first, end = failed[keep], newline[keep], rank[keep], first[keep], end[keep]
     hash_line, hash_rank, hash_vertex = placed(hashes)
     keep = hash_vertex & (hash_rank >= 1) & (hash_rank <= 2)   # a comment before the z
@@ -1139,14 +1211,7 @@ def _obj_face_indices(path, size=1 << 20, sizes=None, counts=None):
     with _mapped(path) as data:
         if data is None:
             return None, None
-        low = 0
-        while low < len(data):
-            high = min(low + size, len(data))
-            if high < len(data):
-                cut = data.rfind(b"\n", low, high)
-                high = cut + 1 if cut >= 0 else (data.find(b"\n", high) + 1 or len(data))
-                while high < len(data) and (data[high - 2:high] == b"\\\n" or data[high - 3:high] == b"\\\r\n"):
-                    high = data.find(b"\n", high) + 1 or len(data)   # a continued line stays whole
+        for low, high in _obj_pieces(data, size):
             piece = data[low:high]
             joined, numbers = _joined(piece)
             if numbers is not None:                # lines were joined: count the piece's own lines
@@ -1161,7 +1226,6 @@ def _obj_face_indices(path, size=1 << 20, sizes=None, counts=None):
             highest.append((largest, low, high, vertices_before, lines_before))
             vertices_before += vertex_lines
             lines_before += lines
-            low = high
         # positive indices are checked against the file's count once it is known: the first piece
         # with one past it is looked at again
         for largest, low, high, before, lines in highest:
@@ -1172,20 +1236,66 @@ def _obj_face_indices(path, size=1 << 20, sizes=None, counts=None):
     return None, triangles
 
 
+def _obj_pieces(data, size):
+    """``(low, high)``: the byte ranges of ``data`` (an OBJ file's bytes) in which
+    :func:`_obj_face_indices` reads it, about ``size`` bytes each and ending after a line that
+    is not continued by a backslash (the last one at the file's end)."""
+    low = 0
+    while low < len(data):
+        high = min(low + size, len(data))
+        if high < len(data):
+            cut = data.rfind(b"\n", low, high)
+            high = cut + 1 if cut >= 0 else (data.find(b"\n", high) + 1 or len(data))
+            while high < len(data) and (data[high - 2:high] == b"\\\n" or data[high - 3:high] == b"\\\r\n"):
+                high = data.find(b"\n", high) + 1 or len(data)       # a continued line stays whole
+        yield low, high
+        low = high
+
+
+def _obj_face_line(path, face, size=1 << 20):
+    """The 1-based line of an OBJ file on which its face ``face`` (0-based, counting the faces in
+    file order as :func:`_obj_face_indices` does: lines whose first word is ``f``, continued
+    lines joined) starts, or None where the file has fewer faces. For messages: it reads the
+    file once more, vectorized over the bytes of each piece up to the face's."""
+    lines_before = 0
+    with _mapped(path) as data:
+        if data is None:
+            return None
+        for low, high in _obj_pieces(data, size):
+            piece, numbers = _joined(data[low:high])
+            if not piece.endswith(b"\n"):
+                piece += b"\n"
+            chars = np.frombuffer(piece, dtype=np.uint8)
+            newlines = np.flatnonzero(chars == 10)
+            starts = np.concatenate([[0], newlines[:-1] + 1])
+            visible = np.flatnonzero(chars > 32)
+            first = visible[np.minimum(np.searchsorted(visible, starts), max(visible.size - 1, 0))] \
+                if visible.size else newlines                          # each line's first word
+            faces = np.flatnonzero((first >= starts) & (first < newlines) & (chars[first] == 102) &
+                                   (chars[np.minimum(first + 1, chars.size - 1)] <= 32))   # "f", a blank
+            if face < faces.size:
+                line = int(faces[face])
+                return lines_before + 1 + (line if numbers is None else int(numbers[0][line]))
+            face -= faces.size
+            lines_before += newlines.size if numbers is None else numbers[1]
+    return None
+
+
 def _joined(piece):
     """``(piece, lines)``: ``piece`` with lines continued by a backslash joined to the next, as
-    pymeshlab's OBJ loader reads them (the backslash and the newline removed, nothing put in
-    their place; only face lines get here continued with LF line ends: others are refused
-    before), and ``(the 0-based line of piece each joined line starts on, the piece's lines)``
-    (None where nothing was joined). A backslash as the file's last byte continues onto nothing
-    and is dropped."""
-    if b"\\" not in piece or (b"\\\n" not in piece and not piece.endswith(b"\\")):   # a byte's search first
-        return piece, None
+    pymeshlab's OBJ loader reads them (the backslash and the line end, LF or CR LF, removed,
+    nothing put in their place; lines so continued that it misreads, as continued lines ending
+    in CR LF, are refused before: :func:`_obj_continued_line`), and ``(the 0-based line of
+    piece each joined line starts on, the piece's lines)`` (None where nothing was joined). A
+    backslash as the file's last byte continues onto nothing and is dropped."""
+    if b"\\" not in piece or (b"\\\n" not in piece and b"\\\r\n" not in piece and not piece.endswith(b"\\")):
+        return piece, None                         # (a byte's search first)
     chars = np.frombuffer(piece, dtype=np.uint8)
     newlines = np.flatnonzero(chars == 10)
-    joins = np.flatnonzero(chars[np.maximum(newlines - 1, 0)] == 92) # 92: "\\"; lines that continue
+    before = chars[np.maximum(newlines - 1, 0)]
+    joins = np.flatnonzero((before == 92) | ((before == 13) & (chars[np.maximum(newlines - 2, 0)] == 92)))   # "\\"
     lines = np.delete(np.arange(newlines.size + 1), joins + 1)
-    piece = piece.replace(b"\\\n", b"")
+    piece = piece.replace(b"\\\r\n", b"").replace(b"\\\n", b"")
     return (piece[:-1] if piece.endswith(b"\\") else piece), (lines, newlines.size)
 
 

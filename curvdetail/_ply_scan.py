@@ -48,12 +48,16 @@ _PLY_WORDS = re.compile(rb"[+-]?(?:inf|infinity|nan)", re.IGNORECASE)
 _PLY_INTEGER = re.compile(rb"[+-]?[0-9]+")
 
 
-def _ply_header(f):
+def _ply_header(f, layout=None):
     """The header of a PLY file as pymeshlab's reader (vcglib plylib ``OpenRead``) parses it:
     ``(ascii, elements, first body line)`` with ``elements`` a list of ``(name, count,
     [(property name, kind, is list, item kind)])``; a str naming what it would misread or crash
     on; None where it refuses the header itself (it says so: no "ply", an unknown format,
-    keyword or type, a blank line) or the file is not PLY.
+    keyword or type, a blank line) or the file is not PLY. Where ``layout`` is a list and the
+    header is read, its format (``b"ascii"``, ``b"binary_little_endian"``, ...) and its elements
+    as :func:`_ply_binary_problem` sizes them are appended to it: ``[(name, count, [(property,
+    types)])]`` with the names as str and each property's type names (first names: ``int8`` is
+    ``char``; a list's ``[b"list", count type, item type]``).
 
     It reads the header with fgets into a 511-byte buffer (a longer line is read as several),
     splits each piece at spaces, tabs, carriage returns and newlines, and reads element counts
@@ -79,8 +83,10 @@ def _ply_header(f):
             words[1] not in (b"ascii", b"binary_little_endian", b"binary_big_endian"):
         return None
     ascii_ = words[1] == b"ascii"
+    fmt = words[1]
     line = 3
     elements = []
+    sized = []                                             # the elements as layout has them
     for piece in itertools.islice(lines, _HEADER_LINES):
         words = [w for w in re.split(rb"[ \t\r\n]+", piece) if w]
         here = line
@@ -90,6 +96,8 @@ def _ply_header(f):
         if words[0] in (b"comment", b"obj_info"):
             continue
         if words[0] == b"end_header":
+            if layout is not None:
+                layout += [fmt, sized]
             return ascii_, elements, line
         if len(words) >= 5 and words[:2] == [b"property", b"list"] and elements and elements[-1][0] == b"face" \
                 and words[4] in _PLY_FACE_TYPES:
@@ -118,7 +126,10 @@ def _ply_header(f):
                         f"{words[1].decode('ascii', 'replace')} elements, which is not a whole number "
                         "(pymeshlab's reader takes 4.5 as 4); write the number of rows")
             elements.append((words[1], count, []))
+            sized.append((words[1].decode("ascii", "replace"), count, []))
         elif words[0] == b"property" and elements and len(words) >= 3:
+            sized[-1][2].append((words[-1].decode("ascii", "replace"),
+                                 [_PLY_TYPE_NAMES.get(w, w) for w in words[1:-1]]))
             if words[1] == b"list":
                 if len(words) < 5 or words[2] not in _PLY_KINDS or words[3] not in _PLY_KINDS:
                     return None
@@ -142,12 +153,13 @@ def _ply_problem(path, sizes=None):
     types' sizes; only their header is checked. Where ``sizes`` is a list, the vertex counts of an
     ASCII file's faces (int arrays, in file order) are appended to it."""
     with open(path, "rb") as f:
-        header = _ply_header(f)
+        layout = []
+        header = _ply_header(f, layout)
         if header is None or isinstance(header, str):
             return header, None
         ascii_, elements, first_line = header
         if not ascii_:
-            return _ply_binary_problem(f), None
+            return _ply_binary_problem(f, *layout), None
         offset = f.tell()
         if offset >= os.fstat(f.fileno()).st_size:
             data = b""
@@ -161,9 +173,10 @@ _PLY_SIZES = {b"char": 1, b"uchar": 1, b"short": 2, b"ushort": 2, b"int": 4, b"u
               b"double": 8}
 
 
-def _ply_binary_problem(f):
+def _ply_binary_problem(f, fmt, elements):
     """What pymeshlab's PLY reader would misread in a binary PLY file whose header (checked by
-    :func:`_ply_header`) ends where ``f`` stands, or None; from the header and the file's size:
+    :func:`_ply_header`, which gives its format ``fmt`` and ``elements`` as its ``layout``) ends
+    where ``f`` stands, or None; from the header and the file's size:
 
     - big-endian doubles in the vertex element: read as garbage (0.1 came back as -1.5e-180;
       big-endian floats and little-endian doubles are read right);
@@ -171,21 +184,6 @@ def _ply_binary_problem(f):
       225-byte file declaring 20 million vertices cost 1.6 GB and 3.3 s before "Unexpected EOF"."""
     header_end = f.tell()
     body = os.fstat(f.fileno()).st_size - header_end
-    fmt, elements = None, []
-    f.seek(0)
-    for raw in f:
-        words = raw.split()
-        if not words:
-            continue
-        if words[0] == b"end_header":
-            break
-        if words[0] == b"format":
-            fmt = words[1]
-        elif words[0] == b"element" and len(words) >= 3:
-            elements.append((words[1].decode("ascii", "replace"), _whole(words[2]) or 0, []))
-        elif words[0] == b"property" and elements:
-            types = [_PLY_TYPE_NAMES.get(w, w) for w in words[1:-1]]
-            elements[-1][2].append((words[-1].decode("ascii", "replace"), types))
     for name, _, props in elements:
         doubles = [prop for prop, types in props if types == [b"double"]]
         if fmt == b"binary_big_endian" and name == "vertex" and doubles:

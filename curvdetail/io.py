@@ -62,10 +62,13 @@ def read_mesh(path):
                         passes); decimal commas (OFF, OBJ, ASCII PLY); vertex coordinates
                         that are not decimal numbers, which it reads as 0 or as their first
                         digits (OFF, OBJ: ``abc``, ``0.3abc``, ``0x1p3``, ``1d3``, a comment
-                        among the coordinates); lines other than faces ending in a backslash
-                        (OBJ: the next line's vertex is lost), and face lines so continued
-                        with CR LF line ends or a backslash glued to both lines' words (the
-                        face was dropped or misread); a PLY header pymeshlab
+                        among the coordinates); OBJ lines ending in a backslash, which it
+                        joins with the next, where it misreads them: other than faces and
+                        vertices (the next line's vertex is lost), a vertex joined with a line
+                        it counts apart (a v, vt or f line) or into x, y, z that are not
+                        decimal numbers, a continued line ending in CR LF, a backslash glued
+                        to both lines' words (a face or vertex continued over lines ending in
+                        LF, the first in CR LF too, passes); a PLY header pymeshlab
                         misparses or crashes on, or face lists of types it does not read;
                         ASCII PLY values it would not read whole as their type, faces of
                         fewer than 3 or more than 255 vertices, a face row not on a line of

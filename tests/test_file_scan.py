@@ -721,6 +721,81 @@ def test_obj_faces_continued_over_lines_are_read_right(tmp_path, text, triangles
     assert read_mesh(path)[1].tolist() == triangles
 
 
+def _pymeshlab_read(path):
+    import pymeshlab
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(str(path))
+    return ms.current_mesh().vertex_matrix().tolist(), ms.current_mesh().face_matrix().tolist()
+
+
+_V3 = [[0.0, 0.0, 0.0], [1.0, 0.0, 5.0], [0.0, 1.0, 0.0]]
+
+
+@pytest.mark.parametrize("data, vertices", [
+    # pymeshlab joins a v line ending in a backslash with the next line (the backslash and line end
+    # removed): 'v 1 0 \' then '5' is the vertex (1, 0, 5), the next line counted as no vertex
+    (b"v 0 0 0\nv 1 0 \\\n5\nv 0 1 0\nf 1 2 3\n", _V3),
+    (b"v 0 0 0\nv 1 \\\n0 \\\n5\nv 0 1 0\nf 1 2 3\n", _V3),                  # over three lines
+    (b"v 0 0 0\nv 1 0 \\\r\n5\nv 0 1 0\nf 1 2 3\n", _V3),                      # CR LF, then LF: read right
+    (b"v 0 0 0\nv 1 0 5 \\\n# x\nv 0 1 0\nf 1 2 3\n", _V3),                   # a comment after the z
+    (b"v 0 0 0\nv 0 1 0\nv 1 0 \\\n  5\nf 1 2 3\n", [[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 5.0]]),
+])
+def test_obj_vertex_lines_continued_on_values_are_read_as_pymeshlab_reads_them(tmp_path, data, vertices):
+    from curvdetail.io import read_mesh
+    path = tmp_path / "m.obj"
+    path.write_bytes(data)
+    V, F = read_mesh(path)
+    assert V.tolist() == vertices and F.tolist() == [[0, 1, 2]]
+    assert (V.tolist(), F.tolist()) == _pymeshlab_read(path)
+
+
+@pytest.mark.parametrize("data, triangles", [
+    # a face line ending in a backslash and CR LF, continued on a line ending in LF: pymeshlab drops
+    # the first CR and joins the lines ('f 1 3 \' then '2' is the face 1 3 2)
+    (b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 3 \\\r\n2\nf 2 4 3\n", [[0, 2, 1], [1, 3, 2]]),
+    (b"v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nv 1 1 0\r\nf 2 4 3\r\nf 1 3 \\\r\n2\n", [[1, 3, 2], [0, 2, 1]]),
+    (b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 \\\r\n4 3\n", [[0, 1, 3], [0, 3, 2]]),      # a quad, fanned
+    (b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 \\\r\n-2 -1\nv 1 1 0\nf 2 4 3\n", [[0, 1, 2], [1, 3, 2]]),
+])
+def test_obj_faces_continued_after_a_crlf_line_end_are_read_as_pymeshlab_reads_them(tmp_path, data, triangles):
+    from curvdetail.io import read_mesh
+    path = tmp_path / "m.obj"
+    path.write_bytes(data)
+    V, F = read_mesh(path)
+    assert F.tolist() == triangles
+    assert (V.tolist(), F.tolist()) == _pymeshlab_read(path)
+
+
+@pytest.mark.parametrize("data, message", [
+    # measured with pymeshlab: 'v 1 0 \' then '# x' was read as (1, 0, 0), then '5,5' as (1, 0, 5)
+    (b"v 0 0 0\nv 1 0 \\\n# x\nv 0 1 0\nf 1 2 3\n",
+     r"line 2 \('v 1 0 \\\\'\) ends in a backslash.*reads the joined line 'v 1 0 # x' as the vertex \(1, 0, 0\) "
+     r"without a word: it holds a comment among its coordinates"),
+    (b"v 0 0 0\nv 1 0 \\\n5,5\nv 0 1 0\nf 1 2 3\n", r"line 2 .*as the vertex \(1, 0, 5\).*written with a comma"),
+    (b"v 0 0 0\nv 1 \\\n0 abc\nv 0 1 0\nf 1 2 3\n", r"line 2 .*as the vertex \(1, 0, 0\).*z coordinate 'abc'"),
+    # a continued line ending in CR LF: one byte more was dropped, 'v 1 0 5 \' then '6' read as (1, 0, 56)
+    (b"v 0 0 0\nv 1 0 5 \\\n6\r\nv 0 1 0\nf 1 2 3\n", r"line 2 .*ends in a backslash.*Windows line end"),
+    # a vt or f line joined to a vertex: counted apart (the face was lost; the vt line crashed the process)
+    (b"v 0 0 0\nv 1 0 \\\nvt 0 0\nv 0 1 0\nf 1 2 3\n", r"line 2 .*ends in a backslash.*starts with a keyword"),
+    (b"v 0 0 0\nv 1 0 5\nv 0 1 0 \\\nf 1 2 3\n", r"line 3 .*ends in a backslash.*starts with a keyword"),
+])
+def test_obj_vertex_lines_continued_into_a_misread_are_refused_saying_how(tmp_path, data, message):
+    path = tmp_path / "m.obj"
+    path.write_bytes(data)
+    with pytest.raises(ValueError, match=message):
+        check_before_loading(path)
+
+
+@pytest.mark.parametrize("size", [1, 7, 20, 1 << 20])
+def test_obj_face_line_counts_the_files_lines_across_pieces(tmp_path, size):
+    # faces counted as the scan counts them (continued lines joined, indented ones too), lines as
+    # the file has them
+    from curvdetail._file_scan import _obj_face_line
+    path = tmp_path / "m.obj"
+    path.write_bytes(b"# c\n" + _OBJ_V5.encode() + b"f 1 2 \\\n3\n\n  f 1 3 4\nvt 0 0\nf 1 \\\r\n4 \\\n5\nf 2 3 5\n")
+    assert [_obj_face_line(path, k, size=size) for k in range(5)] == [7, 10, 12, 15, None]
+
+
 @pytest.mark.parametrize("piece", [1, 2, 3, 5, 1 << 18])
 def test_word_edges_in_pieces_are_the_runs_of_the_whole_array(piece):
     # the OFF scan finds its words in pieces of the file's bytes (to keep them in cache): the

@@ -1197,6 +1197,17 @@ def test_concave_polygons_cut_wrong_by_the_loader_are_refused(tmp_path, suffix, 
         read_mesh(path)
 
 
+def test_concave_obj_polygon_refusal_names_its_line(tmp_path):
+    # the face's line counts the file's lines: comments, blank and continued ones too
+    from curvdetail.io import MeshFileError, read_mesh
+    path = tmp_path / "m.obj"
+    path.write_text("# a dart\n" + "".join(f"v {x} {y} {z}\n" for x, y, z in _DART) + "v 1 3 0\n\n"
+                    "f 5 \\\n3 4\n# the dart, fanned across its dent\nf 1 2 3 4\n")
+    with pytest.raises(MeshFileError, match=r"1 polygon face \(first: face 1 counting from 0 in the file's order, "
+                                            r"on line 11, of 4 vertices\)"):
+        read_mesh(path)
+
+
 @pytest.mark.parametrize("suffix", [".obj", ".off", ".ply"])
 @pytest.mark.parametrize("corners, start", [
     (_DART, 1),                                                   # fanned from the dent: right
