@@ -19,7 +19,8 @@ import os
 import numpy as np
 
 from ._output import atomic_output, check_output_path
-from .curvature._validate import affine_transform_problem, check_choice, check_transformed_values, real_word
+from .curvature._validate import (affine_transform_problem, as_vertices, check_bool, check_choice,
+                                  check_transformed_values, real_word)
 from .curvature.curvature_coefficients import DEFAULT_RCOND
 from .curvature.curvature_editor import CurvatureEditor
 from .curvature.errors import ConstraintError, counted, first_indices
@@ -151,13 +152,31 @@ def write_selection(path, status, *, overwrite=False):
 
 
 def write_transform(path, T, *, overwrite=False):
-    """Write a ``.def`` file atomically (one comment line, 4 rows of 4 numbers)."""
-    T = np.asarray(T, dtype=np.float64)
-    if T.shape != (4, 4) or not np.all(np.isfinite(T)):
-        raise DeformationFileError(f"T has shape {T.shape}; a handle transform is a finite 4x4 matrix.")
+    """Write a ``.def`` file atomically (one comment line, 4 rows of 4 numbers, each written with
+    the 17 significant digits that read back as the same double). A matrix that
+    :func:`read_transform` would refuse (not affine, or a singular linear part) is not written."""
+    T = _as_transform(T, DeformationFileError)
     text = "# 4x4 handle transformation matrix\n" + "\n".join(
-        " ".join(f"{v:.9f}" for v in row) for row in T) + "\n"
+        " ".join(f"{v:.17g}" for v in row) for row in T) + "\n"
     _write_text(path, text, overwrite)
+
+
+def _as_transform(T, error):
+    """``T`` as a (4, 4) float array that :func:`read_transform` would accept (finite, affine, a
+    linear part that collapses no direction), else ``error`` naming what is wrong."""
+    try:
+        T = np.asarray(T, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise error(f"T could not be read as a 4x4 matrix of numbers ({exc}); a handle transform is a "
+                    "finite 4x4 matrix.") from None
+    if T.shape != (4, 4):
+        raise error(f"T has shape {T.shape}; a handle transform is a finite 4x4 matrix.")
+    if not np.all(np.isfinite(T)):
+        raise error("T holds NaN or infinite entries; a handle transform is a finite 4x4 matrix.")
+    problem = affine_transform_problem(T)
+    if problem:
+        raise error(f"the handle transform T: {problem}.")
+    return T
 
 
 def apply_transform(T, P):
@@ -193,9 +212,11 @@ def edit_with_selection(V, F, status, T, *, handle_detail="transform", relations
 
     Raises
     ------
+    MeshError         ``V`` not an (n, 3) array of finite numbers, or a malformed mesh
     ConstraintError   ``status`` of the wrong length or with values other than 0, 1, 2; no handle;
-                      no fixed vertex; a free region that touches neither
-    ValueError        unknown ``handle_detail``
+                      no fixed vertex; a free region that touches neither; ``T`` not a finite 4x4
+                      affine matrix with an invertible linear part (as :func:`read_transform` requires)
+    ValueError        unknown ``handle_detail``, ``return_editor`` not a bool
 
     Examples
     --------
@@ -208,7 +229,8 @@ def edit_with_selection(V, F, status, T, *, handle_detail="transform", relations
     True
     """
     handle_detail = check_choice(handle_detail, "handle_detail", HANDLE_DETAIL_MODES, "; use 'transform' or 'free'.")
-    V = np.asarray(V, dtype=np.float64)
+    return_editor = check_bool(return_editor, "return_editor")
+    V = as_vertices(V)
     status = np.asarray(status).reshape(-1)
     if status.size != V.shape[0]:
         raise ConstraintError(f"status has {status.size} entries for {V.shape[0]} vertices; give one "
@@ -224,9 +246,7 @@ def edit_with_selection(V, F, status, T, *, handle_detail="transform", relations
         raise ConstraintError("the selection has no fixed vertex (status 0); fix part of the mesh so "
                               "that the handle transform deforms rather than moves it.")
     roi = np.flatnonzero(status != FIXED)
-    T = np.asarray(T, dtype=np.float64)
-    if T.shape != (4, 4) or not np.all(np.isfinite(T)):
-        raise ConstraintError(f"T has shape {T.shape}; a handle transform is a finite 4x4 matrix.")
+    T = _as_transform(T, ConstraintError)
     dc = handles if handle_detail == "transform" else np.empty(0, dtype=np.int64)
     editor = CurvatureEditor(V, F, handles, dc, roi=roi, relations=relations, rcond=rcond,
                              backend=backend)

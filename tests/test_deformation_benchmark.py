@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from curvdetail import CurvatureEditor
-from curvdetail.curvature.errors import ConstraintError
+from curvdetail.curvature.errors import ConstraintError, MeshError
 from curvdetail.curvature.testing import grid
 from curvdetail.deformation_benchmark import (DeformationFileError, apply_transform,
                                               edit_with_selection, read_selection, read_transform,
@@ -129,7 +129,7 @@ def test_free_vertices_are_the_editors_solution_for_the_prescribed_constraints(m
 def test_a_transform_beyond_double_precision_is_named():
     V, F, status = _strip()
     with pytest.raises(ConstraintError, match="handle transform T gives the handles values of 3e\\+300"):
-        edit_with_selection(V, F, status, np.diag([1e300, 1.0, 1.0, 1.0]))
+        edit_with_selection(V, F, status, np.diag([1e300, 1e300, 1e300, 1.0]))
 
 
 def test_identity_transform_leaves_the_mesh_in_place(load_mesh):
@@ -193,3 +193,60 @@ def test_a_folder_or_latin1_text_is_named_as_such(tmp_path):
     p.write_bytes("# caf\xe9\n0\n".encode("latin-1"))
     with pytest.raises(DeformationFileError, match=r"byte 5 is not UTF-8 text.*save it as UTF-8"):
         read_selection(p, 1)
+
+
+@pytest.mark.parametrize("T, message", [
+    (np.array([[1.0, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0.5, 0, 0, 1]]), r"the last row is \[0\.5, 0\.0, 0\.0, 1\.0\]"),
+    (np.diag([1.0, 1.0, 0.0, 1.0]), "linear part is singular"),
+    (np.zeros((4, 4)), "the last row is"),
+])
+def test_a_transform_the_reader_refuses_is_refused_when_passed_directly(T, message):
+    # read_transform refuses a projective or collapsing matrix; given as an array, the last row was
+    # ignored (the handles moved by the top 3 rows alone) and a singular map flattened the handles
+    V, F, status = _strip()
+    with pytest.raises(ConstraintError, match=message):
+        edit_with_selection(V, F, status, T)
+
+
+@pytest.mark.parametrize("T, message", [([[1.0, 0.0], [0.0]], "could not be read as a 4x4 matrix"),
+                                        ("eye", "could not be read as a 4x4 matrix"), (None, r"has shape \(\)")])
+def test_a_transform_that_is_no_matrix_of_numbers_is_named(T, message):
+    # numpy's "setting an array element with a sequence" / "could not convert string to float"
+    V, F, status = _strip()
+    with pytest.raises(ConstraintError, match=r"^T " + message):
+        edit_with_selection(V, F, status, T)
+
+
+@pytest.mark.parametrize("V, message", [(3.0, r"V has shape \(\)"), ([[0.0, 1.0], [1.0]], "V could not be read"),
+                                        (np.zeros(3 * 588), r"V has shape \(1764,\)")])
+def test_vertices_that_are_no_position_array_are_refused_by_name(V, message):
+    # a scalar raised IndexError ("tuple index out of range"); flat coordinates were reported as a
+    # status of the wrong length ("588 entries for 1764 vertices")
+    _, F, status = _strip()
+    with pytest.raises(MeshError, match=message):
+        edit_with_selection(V, F, status, np.eye(4))
+
+
+def test_return_editor_must_be_a_bool():
+    # "no" is truthy: the call returned (X, editor) where X was asked for
+    V, F, status = _strip()
+    with pytest.raises(ValueError, match=r"return_editor='no' must be True or False"):
+        edit_with_selection(V, F, status, np.eye(4), return_editor="no")
+
+
+@pytest.mark.parametrize("T", [np.diag([1e-10, 1e-10, 1e-10, 1.0]), _similarity(0.3, 1.5, [1e-11, 2.0 / 3.0, 1e8])])
+def test_written_transforms_read_back_exactly(tmp_path, T):
+    # 9 decimals: a uniform scale of 1e-10 was written as zeros (the reader then refused it as
+    # singular), a rotation came back 5e-10 off (no longer orthogonal), a tiny shift as 0
+    p = tmp_path / "t.def"
+    write_transform(p, T)
+    assert np.array_equal(read_transform(p), T)
+
+
+@pytest.mark.parametrize("T, message", [(np.diag([1.0, 1.0, 0.0, 1.0]), "singular"),
+                                        (np.ones((4, 4)), "the last row"), ([[1, 0], [0]], "4x4")])
+def test_a_transform_the_reader_would_refuse_is_not_written(tmp_path, T, message):
+    p = tmp_path / "t.def"
+    with pytest.raises(DeformationFileError, match=message):
+        write_transform(p, T)
+    assert not p.exists()
