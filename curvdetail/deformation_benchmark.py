@@ -81,7 +81,7 @@ def read_selection(path, n_vertices=None):
     if bad:
         shown = ", ".join(f"line {no}: {text[:20]!r}" for no, text in bad[:3])
         raise DeformationFileError(
-            f"{path}: {len(bad)} lines are not a vertex status 0, 1 or 2 ({shown}); a .sel file "
+            f"{path}: {counted(len(bad), 'line', verb='are')} not a vertex status 0, 1 or 2 ({shown}); a .sel file "
             "holds one status per vertex (0 fixed, 1 free, 2 handle) after '#' comment lines.")
     if not rows:
         raise DeformationFileError(f"{path}: no vertex statuses found (only comments or blank lines).")

@@ -46,8 +46,8 @@ def test_transform_file_is_read_as_a_homogeneous_matrix(tmp_path):
 
 
 @pytest.mark.parametrize("text, message", [
-    ("# c\n0\n1\n3\n", "not a vertex status"),
-    ("# c\n0\nx\n1\n", "not a vertex status"),
+    ("# c\n0\n1\n3\n", r"1 line is not a vertex status 0, 1 or 2 \(line 4: '3'\)"),
+    ("# c\n0\nx\n1\n7\n", r"2 lines are not a vertex status 0, 1 or 2 \(line 3: 'x', line 5: '7'\)"),
     ("# only comments\n\n", "no vertex statuses"),
 ])
 def test_malformed_selection_is_refused_with_its_line(tmp_path, text, message):
