@@ -378,6 +378,34 @@ def test_an_edit_the_handles_do_not_determine_is_refused_with_the_filter_s_optio
     assert report["max_displacement"] < 1e-12
 
 
+def test_a_selected_piece_with_one_handle_is_refused_in_the_filter_s_terms():
+    # a second piece wholly selected, one handle on it: its details are fixed only up to a linear
+    # map; the filter moved it (its rest shape off by rounding of a singular system) and said nothing
+    from curvdetail.curvature.errors import UndeterminedEditError
+
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(os.path.join(DATA, "mannequin_nose.obj"))
+    V = ms.current_mesh().vertex_matrix().copy()
+    F = ms.current_mesh().face_matrix().copy()
+    n = V.shape[0]
+    V2, F2 = np.vstack([V, V + [3 * np.ptp(V, axis=0).max(), 0.0, 0.0]]), np.vstack([F, F + n])
+    ms.clear()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=V2, face_matrix=F2))
+    _select(ms, np.arange(2 * n) >= n)
+    T = np.eye(4)
+    T[2, 3] = 1.0
+    with pytest.raises(UndeterminedEditError, match="wholly inside the edited region with only 1 detail "
+                                                    "constraint.*Use more handles") as exc:
+        apply(ms, "apply_curvature_editing", handles=[n + 5], transform=T)
+    assert "roi" not in str(exc.value)
+    assert np.array_equal(ms.current_mesh().vertex_matrix(), V2)      # untouched
+    # three handles determine it: the translation moves the piece as a whole
+    apply(ms, "apply_curvature_editing", handles=[n + 5, n + 200, n + 400], transform=T)
+    X = ms.current_mesh().vertex_matrix()
+    assert np.array_equal(X[:n], V)
+    assert np.abs(X[n:] - (V2[n:] + [0.0, 0.0, 1.0])).max() < 1e-8 * np.linalg.norm(np.ptp(V, axis=0))
+
+
 @pytest.mark.parametrize("shape", [(2, 8), (16, 1), (1, 16)])
 def test_a_transform_array_of_another_shape_than_4x4_is_refused(shape):
     # every array was flattened: a 2x8 array (or 16x1, 1x16) passed and was read as a 4x4 matrix
