@@ -274,6 +274,7 @@ class CurvatureEditor:
         self._embedding(L, V, F, in_roi, pc, rows, cols, backend)
         self._response = None
         t3 = time.perf_counter()
+        self._undetermined_details = None         # (a message) see _check_rest_details
         self.rest_error = self._check_rest_state()
         self.timings = {"coefficients": t1 - t0, "curvature_setup": t2 - t1,
                         "embedding_setup": t3 - t2, "rest_check": time.perf_counter() - t3}
@@ -304,6 +305,8 @@ class CurvatureEditor:
             if dD.any():
                 dX = self._embed.solve(dD if self._A_T is None else self._A_T @ dD)
                 error = float(np.linalg.norm(dX, axis=1).max()) / bbox_diagonal(self.V)
+        elif self._curv is not None:
+            self._check_rest_details()
         if not error <= MAX_REST_ERROR:       # NaN included
             raise UndeterminedEditError(
                 f"the constraints do not determine the edit: solved with their rest values they give "
@@ -311,6 +314,27 @@ class CurvatureEditor:
                 f"is singular to working precision with these {self._user_dc} detail constraints: "
                 "groups of rings can turn together).", self._undetermined_advice())
         return error
+
+    def _check_rest_details(self):
+        """Every roi position given: the shape is exact whatever the curvature stage gives, so the
+        rest check looks at the details, which only :meth:`solve_details` and ``solve(...,
+        return_details=True)`` return: where the rest constraints give back details further than
+        :data:`MAX_REST_ERROR` of the roi's largest rest detail from the rest ones, those two raise
+        UndeterminedEditError (a flat grid with three detail constraints: 0.2 off, returned
+        without a word, as the shape's check had nothing to measure); positions are still solved."""
+        Du = self._curvature_solve(self.detail[self._dc])
+        scale = float(np.linalg.norm(self.detail[self.roi], axis=1).max())
+        error = float(np.linalg.norm(Du - self.detail[self._fd], axis=1).max())
+        if not error <= MAX_REST_ERROR * scale:       # NaN included
+            self._undetermined_details = (
+                f"the constraints do not determine the details: every position in the roi is given, and "
+                f"the rest detail constraints give back details {error / max(scale, np.finfo(float).tiny):.2g} "
+                f"of the largest rest detail off the rest ones (the curvature stage is singular to working "
+                f"precision with these {self._user_dc} detail constraints).")
+
+    def _refuse_undetermined_details(self):
+        if self._undetermined_details is not None:
+            raise UndeterminedEditError(self._undetermined_details, self._undetermined_advice())
 
     def _undetermined_advice(self):
         # on flat and near-flat regions the stacked relations are singular where the square
@@ -440,7 +464,15 @@ class CurvatureEditor:
         -------
         D : (n, 3) float array   given values at ``detail_constrained``, solved values elsewhere in
                                  the roi, rest values outside it
+
+        Raises
+        ------
+        UndeterminedEditError   every roi position is given (the positions are then determined)
+                                and the detail constraints do not determine the details (the rest
+                                values give them back more than MAX_REST_ERROR off); also from
+                                ``solve(..., return_details=True)``
         """
+        self._refuse_undetermined_details()
         Dk = self._details(details)
         D = self.detail.copy()
         D[self._dc] = Dk
@@ -470,6 +502,8 @@ class CurvatureEditor:
         """
         # "no" or 0 would otherwise count as an answer, and an array as numpy's ambiguous truth value
         return_details = check_bool(return_details, "return_details")
+        if return_details:
+            self._refuse_undetermined_details()
         return self._solve(self._positions(positions), self._details(details), return_details)
 
     def _solve(self, Xk, Dk, return_details=False, fast_path=True):
