@@ -516,3 +516,15 @@ def test_index_values_that_are_not_whole_numbers_are_named_with_the_first_and_it
                           "weights.")
     assert str(non_whole_index_error([np.inf], "fixed", ValueError)).startswith(
         "fixed: 1 value is not a whole number (first: inf, at position 0)")
+
+
+def test_an_index_set_of_more_than_one_dimension_is_refused_by_shape():
+    # boundary edges (k, 2) passed as fixed: flattened, every vertex appeared twice and the
+    # refusal spoke of repeated indices
+    E = np.array([[0, 1], [1, 2], [2, 0]])
+    with pytest.raises(ConstraintError, match=r"fixed has shape \(3, 2\); pass a 1-D array of vertex indices"):
+        as_index_set(E, 9, "fixed")
+    # a column or a row of indices is one list
+    assert as_index_set(np.array([[4], [1]]), 9, "fixed").tolist() == [4, 1]
+    assert as_index_set(np.array([[4, 1]]), 9, "fixed").tolist() == [4, 1]
+    assert as_index_set(np.int64(3), 9, "fixed").tolist() == [3]

@@ -467,6 +467,10 @@ def as_index_set(indices, n, name):
         if arr.shape != (n,):
             raise ConstraintError(f"{name} is a boolean mask of shape {arr.shape}; it must have shape ({n},).")
         return np.flatnonzero(arr)
+    if sum(d > 1 for d in arr.shape) > 1:
+        # an edge list (k, 2) or faces (m, 3): flattened, their shared vertices were called repeats
+        raise ConstraintError(f"{name} has shape {arr.shape}; pass a 1-D array of vertex indices (a "
+                              "column (k, 1) is taken too), e.g. np.unique(E) for the vertices of edges E.")
     arr = arr.reshape(-1)
     if arr.dtype == object and arr.size and all(isinstance(i, numbers.Integral) and not isinstance(i, bool)
                                                 for i in arr):
