@@ -512,3 +512,24 @@ def test_a_set_of_handles_is_taken_since_one_transform_moves_them_all():
     assert np.array_equal(_edited(frozenset(handles.tolist())), X)
     # another order gives the same edit up to the solvers' rounding
     assert np.abs(_edited(handles[::-1]) - X).max() < 1e-12 * np.linalg.norm(np.ptp(V, axis=0))
+
+
+def test_a_translation_with_move_handles_false_is_refused_as_doing_nothing():
+    # the details take the transform's linear part alone: the translation was dropped and the
+    # mesh came back unchanged, without a word
+    ms, V, d, handles = _meshset_with_roi()
+    shift = "1 0 0 0.1 0 1 0 0 0 0 1 0 0 0 0 1"
+    with pytest.raises(FilterParameterError, match="only translates, and move_handles=false .* nothing would move"):
+        apply(ms, "apply_curvature_editing", handles=" ".join(map(str, handles)), transform=shift,
+              move_handles=False)
+    assert np.array_equal(ms.current_mesh().vertex_matrix(), V)
+    # what the advice names works: the handles move by the translation
+    apply(ms, "apply_curvature_editing", handles=" ".join(map(str, handles)), transform=shift,
+          move_handles=True)
+    X = ms.current_mesh().vertex_matrix()
+    assert np.allclose(X[handles] - V[handles], [0.1, 0.0, 0.0], atol=1e-12)
+    # and so does a detail_scale with the handles left free to move (the details change)
+    ms2, V2, _, _ = _meshset_with_roi()
+    apply(ms2, "apply_curvature_editing", handles=" ".join(map(str, handles)), transform=shift,
+          move_handles=False, detail_scale=1.1)
+    assert np.abs(ms2.current_mesh().vertex_matrix() - V2).max() > 1e-4 * np.linalg.norm(np.ptp(V2, axis=0))

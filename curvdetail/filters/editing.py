@@ -152,6 +152,12 @@ def apply_curvature_editing(ms, *, handles, region_radius, transform, detail_sca
     if not move_handles and handle_detail == "free":
         raise FilterParameterError("move_handles=false with handle_detail='free' leaves the handles "
                                    "unconstrained; set one of them.")
+    if not move_handles and detail_scale == 1.0 and np.array_equal(T[:3, :3], np.eye(3)) and T[:3, 3].any():
+        # the details take the linear part alone: the translation would be dropped without a word
+        raise FilterParameterError("the transform only translates, and move_handles=false keeps the handles' "
+                                   "curvature normals alone, which a translation does not change: nothing "
+                                   "would move. Set move_handles=true to move the handles, or give a "
+                                   "rotation, scale or detail_scale to change their details.")
     selected = selected_vertices(ms, mid)
     radius = region_radius.resolve(bbox_diagonal(V))
     if radius > 0:
