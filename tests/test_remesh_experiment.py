@@ -512,3 +512,28 @@ def test_numpy_strings_for_options_are_recorded_as_plain_strings(height_field):
                                   rows=np.str_("all"))
     assert type(report["options"]["transfer"]) is str and type(report["options"]["rows"]) is str
     assert (report["options"]["transfer"], report["options"]["rows"]) == ("pointwise", "all")
+
+
+def test_a_planar_map_that_collapses_a_target_triangle_is_refused_by_the_option(monkeypatch):
+    # pymeshlab's float32 LSCM of camelhead decimated at 5 % put the three corners of a target
+    # triangle of ordinary 3D area on one line; the transfer then refused "Ft: 1 triangles have
+    # zero area" with advice to repair the mesh (a MeshError), where the map was at fault
+    import curvdetail.remesh.experiment as experiment
+    from curvdetail.remesh import parameterize
+
+    def collapsing(Vs, Fs, Vt, Ft, **kwargs):
+        UVs, UVt, info = parameterize(Vs, Fs, Vt, Ft, **kwargs)
+        interior = np.setdiff1d(np.arange(Vt.shape[0]), boundary_vertices(Ft))
+        t = int(np.flatnonzero(np.isin(Ft, interior).all(1))[0])
+        a, b, c = Ft[t]
+        UVt = UVt.copy()
+        UVt[c] = 0.25 * UVt[a] + 0.75 * UVt[b]           # on the line through the other two
+        return UVs, UVt, info
+
+    V, F = disk(n_rings=8)
+    V[:, 2] = 0.2 * (V[:, :2] ** 2).sum(1)
+    monkeypatch.setattr(experiment, "parameterize", collapsing)
+    with pytest.raises(RemeshError, match=r"^the lscm parameterization maps 1 triangle of the target "
+                                          r"\(first: \d+\) to zero area in the plane.*Use parameterization "
+                                          r"\"harmonic\" .* or location \"closest\""):
+        remesh_experiment(V, F, target=(V, F), location="uv", parameterization="lscm", evaluate=False)

@@ -155,3 +155,18 @@ def test_target_boundary_vertices_lie_on_the_source_domain_boundary():
     frac_space = (s_space - space.s0[seg]) / space.length[seg]
     assert np.abs(frac_dom - frac_space).max() < 1e-9
     assert info["boundary_mismatch"] < 1e-12 and info["flipped_target"] == 0
+
+
+@pytest.mark.parametrize("move", [lambda V: V + [0.0, 0.0, 0.5], lambda V: 2.0 * V])
+def test_a_target_whose_boundary_is_off_the_source_boundary_is_refused(move):
+    # it was mapped as if its boundary lay where its projections land: the disk lifted by 0.5
+    # got the source's own domain back, no flipped triangle and boundary_mismatch 0.0
+    from curvdetail.remesh import RemeshError
+
+    V, F = disk(n_rings=10)
+    with pytest.raises(RemeshError, match=r"^60 of 60 target boundary vertices are off the source's boundary "
+                                          r"polyline .*Pass one made by curvdetail\.remesh\.retriangulate\.$"):
+        parameterize(V, F, move(V), F)
+    # on it to rounding (a float32 copy: 3e-8 of the diagonal) it is taken
+    UVs, UVt, info = parameterize(V, F, V.astype(np.float32), F)
+    assert np.abs(UVt - UVs).max() < 1e-6 and info["boundary_mismatch"] < 1e-6

@@ -212,3 +212,29 @@ class Polyline:
         t = (s - self.s0[seg]) / np.maximum(self.length[seg], np.finfo(float).tiny)
         return self.P[seg] + t[:, None] * (self.Q[seg] - self.P[seg])
 
+
+
+#: A given target's boundary vertex further than this (x the larger of the source's bbox diagonal
+#: and its largest coordinate, for float32 files far from the origin) from the source's boundary
+#: polyline is refused: the reconstruction pins the target's boundary where it
+#: is, so a target off the source gives a large error that measures the target, not the method,
+#: and a parameterization would put it where its projection lands. retriangulate() puts them
+#: within 1e-12.
+TARGET_BOUNDARY_TOLERANCE = 1e-6
+
+
+def check_target_boundary(P, X, d, advice):
+    """RemeshError unless every target boundary vertex ``X`` lies on the source boundary
+    polyline ``P`` within ``TARGET_BOUNDARY_TOLERANCE`` times the larger of the diagonal ``d``
+    and the largest coordinate (float32 files far from the origin round by more than 1e-6 of a
+    small diagonal); ``advice``: the sentence that ends the message (what to pass instead)."""
+    scale = max(d, float(np.abs(P).max()), float(np.abs(X).max()))
+    dist = Polyline(P).project(X)[2] / scale              # exact: every segment where it must be
+    off = np.flatnonzero(dist > TARGET_BOUNDARY_TOLERANCE)
+    if off.size:
+        raise RemeshError(
+            f"{off.size} of {X.shape[0]} target boundary vertices {'is' if off.size == 1 else 'are'} off the "
+            "source's boundary polyline "
+            f"(up to {dist.max():.3g} of the larger of the source's bbox diagonal and its largest "
+            f"coordinate; allowed {TARGET_BOUNDARY_TOLERANCE:g}): the target must be a retriangulation of "
+            f"the source with its boundary vertices on the source's boundary. {advice}")

@@ -6,12 +6,15 @@ import warnings
 
 import numpy as np
 
-from ..curvature._validate import bbox_diagonal, check_bool, check_choice
+from ..curvature._validate import (ZERO_AREA_RELATIVE, bbox_diagonal, check_bool, check_choice,
+                                   face_double_areas)
 from ..curvature.boundary_editing import boundary_loop
+from ..curvature.errors import counted, first_indices
 from ..curvature.reconstruct import ROW_MODES, Reconstructor
 from ..curvature.sparse_solver import resolve_backend
-from ._disk import Polyline, RemeshError, check_disk
+from ._disk import TARGET_BOUNDARY_TOLERANCE, RemeshError, check_disk, check_target_boundary  # noqa: F401 (its home before)
 from .evaluate import hausdorff, vertex_distance
+from .locate import _unit_frame
 from .parameterize import METHODS as PARAMETERIZATIONS
 from .parameterize import parameterize
 from .retriangulate import METHODS as RETRIANGULATIONS
@@ -29,13 +32,6 @@ BASELINE_SAMPLES = 20000
 #: A rebuilt surface with a vertex further than this (x bbox diagonal) from the source is measured
 #: with the kd-tree engine as well (see :func:`hausdorff`).
 FAR_SURFACE = 0.02
-
-#: A given target's boundary vertex further than this (x the larger of the source's bbox diagonal
-#: and its largest coordinate, for float32 files far from the origin) from the source's boundary
-#: polyline is refused: the reconstruction pins the target's boundary where it
-#: is, so a target off the source gives a large error that measures the target, not the method.
-#: retriangulate() puts them within 1e-12.
-TARGET_BOUNDARY_TOLERANCE = 1e-6
 
 #: RMS distances (fractions of the source's bbox diagonal) below which a figure is rounding, not
 #: a measurement, by the engine that measured it (see :func:`hausdorff`): pymeshlab's works in
@@ -219,22 +215,22 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="c
     return (result["X"], result["Ft"]), result["report"]
 
 
-def _check_target_boundary(P, X, d):
-    """RemeshError unless every target boundary vertex ``X`` lies on the source boundary
-    polyline ``P`` within ``TARGET_BOUNDARY_TOLERANCE`` times the larger of the diagonal ``d``
-    and the largest coordinate (float32 files far from the origin round by more than 1e-6 of a
-    small diagonal)."""
-    scale = max(d, float(np.abs(P).max()), float(np.abs(X).max()))
-    dist = Polyline(P).project(X)[2] / scale              # exact: every segment where it must be
-    off = np.flatnonzero(dist > TARGET_BOUNDARY_TOLERANCE)
-    if off.size:
+def _check_planar_map(UV, F, which, parameterization):
+    """RemeshError where the planar map ``UV`` of the ``which`` mesh collapses triangles of ``F``
+    to zero area (as the transfer's location counts it): no point can be located in them. The
+    transfer refused them as zero-area triangles of the mesh, with advice to repair it (pymeshlab's
+    float32 LSCM of camelhead decimated at 5 % collapsed one whose 3D area is ordinary)."""
+    _, U, _ = _unit_frame(UV[:0], UV)
+    zero = np.flatnonzero(face_double_areas(np.column_stack([U, np.zeros(U.shape[0])]), F)
+                          <= 2.0 * ZERO_AREA_RELATIVE)
+    if zero.size:
+        other = ('parameterization "harmonic" (the default for location "uv") or '
+                 if parameterization != "harmonic" else "")
         raise RemeshError(
-            f"{off.size} of {X.shape[0]} target boundary vertices {'is' if off.size == 1 else 'are'} off the "
-            "source's boundary polyline "
-            f"(up to {dist.max():.3g} of the larger of the source's bbox diagonal and its largest "
-            f"coordinate; allowed {TARGET_BOUNDARY_TOLERANCE:g}): the target must be a retriangulation of "
-            "the source with its boundary vertices on the source's boundary. Pass one made by "
-            "curvdetail.remesh.retriangulate, or target=None to make it here.")
+            f"the {parameterization} parameterization maps {counted(zero.size, 'triangle')} of the {which} "
+            f"(first: {first_indices(zero)}) to zero area in the plane (below {ZERO_AREA_RELATIVE:g} of its "
+            f"diagonal squared), where the transfer cannot locate points; the mesh itself is fine there. "
+            f'Use {other}location "closest" (the default, no planar map).')
 
 
 def _ratios(report, engines):
@@ -324,12 +320,15 @@ def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="cons
         seconds["retriangulate"] = time.perf_counter() - t
     else:
         Vt, Ft, loop_given = check_disk(*target, "the target")
-        _check_target_boundary(V[loop_s], Vt[loop_given], d)
+        check_target_boundary(V[loop_s], Vt[loop_given], d, "Pass one made by "
+                              "curvdetail.remesh.retriangulate, or target=None to make it here.")
 
     uv, param_info = None, None
     if location == "uv":
         t = stage("parameterize")
         UVs, UVt, param_info = parameterize(V, F, Vt, Ft, method=parameterization, backend=backend)
+        for which, UV, T in (("source", UVs, F), ("target", UVt, Ft)):
+            _check_planar_map(UV, T, which, parameterization)
         uv = (UVs, UVt)
         seconds["parameterize"] = time.perf_counter() - t
 

@@ -3,11 +3,11 @@
 import numpy as np
 
 from ..curvature._validate import (check_choice, as_faces, as_index_set, as_values, as_vertices, check_every_component_fixed,
-                                  check_mesh)
+                                  bbox_diagonal, check_mesh)
 from ..curvature.cotan_laplacian import _cotan_laplacian_unchecked
 from ..curvature.errors import ConstraintError, MeshError
 from ..curvature.sparse_solver import factorize
-from ._disk import Polyline, check_disk
+from ._disk import Polyline, check_disk, check_target_boundary
 
 METHODS = ("harmonic", "meshlab_harmonic", "lscm")
 
@@ -162,6 +162,9 @@ def parameterize(Vs, Fs, Vt=None, Ft=None, *, method="harmonic", backend="auto")
     Raises
     ------
     MeshError, NotADiskError   either mesh malformed or not a disk
+    RemeshError                a target boundary vertex off the source's boundary polyline (by
+                               more than ``TARGET_BOUNDARY_TOLERANCE`` = 1e-6 of the larger of the
+                               bbox diagonal and the largest coordinate, as ``remesh_experiment``)
     ValueError                 unknown method; only one of ``Vt`` and ``Ft`` given
 
     Examples
@@ -189,6 +192,9 @@ def parameterize(Vs, Fs, Vt=None, Ft=None, *, method="harmonic", backend="auto")
     if Vt is None:
         return UVs, None, info
     Vt, Ft, loop_t = check_disk(Vt, Ft, "the target")
+    # off the polyline its vertices would be put where their projections land, silently
+    check_target_boundary(Vs[loop_s], Vt[loop_t], bbox_diagonal(Vs),
+                          "Pass one made by curvdetail.remesh.retriangulate.")
     _, s_t, _ = poly.project(Vt[loop_t])
     # where the source's own map puts the target boundary points: along the source's boundary
     # edges in the domain, by arc length (chords of the circle for "harmonic", not the circle:
