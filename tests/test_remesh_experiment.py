@@ -533,7 +533,7 @@ def test_a_planar_map_that_collapses_a_target_triangle_is_refused_by_the_option(
     V, F = disk(n_rings=8)
     V[:, 2] = 0.2 * (V[:, :2] ** 2).sum(1)
     monkeypatch.setattr(experiment, "parameterize", collapsing)
-    with pytest.raises(RemeshError, match=r"^the lscm parameterization maps 1 triangle of the target "
+    with pytest.raises(RemeshError, match=r"^the lscm parameterization of the target maps 1 triangle "
                                           r"\(first: \d+\) to zero area in the plane.*Use parameterization "
                                           r"\"harmonic\" .* or location \"closest\""):
         remesh_experiment(V, F, target=(V, F), location="uv", parameterization="lscm", evaluate=False)

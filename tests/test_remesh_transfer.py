@@ -155,6 +155,28 @@ def test_malformed_uv_is_named_as_uv():
 
 
 @pytest.mark.parametrize("method", ["conservative", "pointwise"])
+@pytest.mark.parametrize("which", [0, 1])
+def test_a_planar_map_that_squashes_a_triangle_is_named_as_the_maps_doing(method, which):
+    # the mesh is fine (a curved grid); the map puts a vertex on the line through two of its
+    # triangle's corners: before, "Fs: 1 triangles have zero area" with advice to repair the mesh
+    V, F = grid(6, 6)
+    V[:, 2] = 0.3 * V[:, 0] ** 2
+    UV = [V[:, :2].copy(), V[:, :2].copy()]
+    a, b, c = F[12]
+    UV[which][c] = 0.5 * (UV[which][a] + UV[which][b])
+    name = ["uv\\[0\\] \\(UVs\\)", "uv\\[1\\] \\(UVt\\)"][which]
+    with pytest.raises(MeshError, match=rf"^the planar map {name} maps 1 triangle \(first: 12\) to zero area in "
+                                        r"the plane .*the mesh itself may be fine there\. Use another "
+                                        r"parameterization .*or location='closest'\.$"):
+        transfer_curvature(V, F, V, F, method=method, location="uv", uv=tuple(UV))
+    # the same maps unsquashed transfer the detail exactly (the same triangulation)
+    UV[which][c] = V[c, :2]
+    D = transfer_curvature(V, F, V, F, method=method, location="uv", uv=tuple(UV))
+    expected = curvature_detail(V, F)
+    assert np.abs(D - expected).max() < 1e-12 * np.abs(expected).max()
+
+
+@pytest.mark.parametrize("method", ["conservative", "pointwise"])
 def test_a_target_that_is_not_the_same_surface_is_refused(load_mesh, method):
     # the closest point of a far target would silently give it the wrong detail
     V, F = load_mesh("mannequin_nose.obj")

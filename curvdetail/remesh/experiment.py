@@ -6,22 +6,19 @@ import warnings
 
 import numpy as np
 
-from ..curvature._validate import (ZERO_AREA_RELATIVE, bbox_diagonal, check_bool, check_choice,
-                                   face_double_areas)
+from ..curvature._validate import bbox_diagonal, check_bool, check_choice
 from ..curvature.boundary_editing import boundary_loop
-from ..curvature.errors import counted, first_indices
 from ..curvature.reconstruct import ROW_MODES, Reconstructor
 from ..curvature.sparse_solver import resolve_backend
 from ._disk import TARGET_BOUNDARY_TOLERANCE, RemeshError, check_disk, check_target_boundary  # noqa: F401 (its home before)
 from .evaluate import hausdorff, vertex_distance
-from .locate import _unit_frame
 from .parameterize import METHODS as PARAMETERIZATIONS
 from .parameterize import parameterize
 from .retriangulate import METHODS as RETRIANGULATIONS
 from .retriangulate import check_target_edge, retriangulate
 from .transfer import LOCATIONS
 from .transfer import METHODS as TRANSFERS
-from .transfer import transfer_curvature
+from .transfer import squashed_in_plane, transfer_curvature
 
 #: Face samples per direction for the zero-detail baseline. It lies ~10 % of the bbox diagonal
 #: from the source, where pymeshlab's grid search is slow (minutes); it is measured with
@@ -217,20 +214,13 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="c
 
 def _check_planar_map(UV, F, which, parameterization):
     """RemeshError where the planar map ``UV`` of the ``which`` mesh collapses triangles of ``F``
-    to zero area (as the transfer's location counts it): no point can be located in them. The
-    transfer refused them as zero-area triangles of the mesh, with advice to repair it (pymeshlab's
-    float32 LSCM of camelhead decimated at 5 % collapsed one whose 3D area is ordinary)."""
-    _, U, _ = _unit_frame(UV[:0], UV)
-    zero = np.flatnonzero(face_double_areas(np.column_stack([U, np.zeros(U.shape[0])]), F)
-                          <= 2.0 * ZERO_AREA_RELATIVE)
-    if zero.size:
-        other = ('parameterization "harmonic" (the default for location "uv") or '
-                 if parameterization != "harmonic" else "")
-        raise RemeshError(
-            f"the {parameterization} parameterization maps {counted(zero.size, 'triangle')} of the {which} "
-            f"(first: {first_indices(zero)}) to zero area in the plane (below {ZERO_AREA_RELATIVE:g} of its "
-            f"diagonal squared), where the transfer cannot locate points; the mesh itself is fine there. "
-            f'Use {other}location "closest" (the default, no planar map).')
+    (:func:`~.transfer.squashed_in_plane`), named as the parameterization's doing with the
+    experiment's options (pymeshlab's float32 LSCM of camelhead decimated at 5 % collapsed one
+    whose 3D area is ordinary; the transfer called it a zero-area triangle of the mesh)."""
+    other = ('parameterization "harmonic" (the default for location "uv") or '
+             if parameterization != "harmonic" else "")
+    squashed_in_plane(UV, F, f"the {parameterization} parameterization of the {which}",
+                      f'Use {other}location "closest" (the default, no planar map).', RemeshError)
 
 
 def _ratios(report, engines):

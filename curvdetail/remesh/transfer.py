@@ -3,12 +3,13 @@
 import numpy as np
 import scipy.sparse as sp
 
-from ..curvature._validate import _edge_keys, as_count, as_values, check_choice, bbox_diagonal, check_mesh
-from ..curvature.errors import MeshError
+from ..curvature._validate import (ZERO_AREA_RELATIVE, _edge_keys, as_count, as_values, check_choice, bbox_diagonal,
+                                   check_mesh, face_double_areas)
+from ..curvature.errors import MeshError, counted, first_indices
 from ..curvature.mean_curvature_normal import mean_curvature_normal
 from ..curvature.mixed_voronoi_area import mixed_voronoi_area
 from ..curvature.sparse_solver import factorize
-from .locate import _as_coordinates, _locate, check_points_and_mesh, interpolate, spread
+from .locate import _as_coordinates, _locate, _unit_frame, check_points_and_mesh, interpolate, spread
 
 METHODS = ("conservative", "pointwise")
 LOCATIONS = ("closest", "uv")
@@ -153,6 +154,9 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     if location == "uv":
         src_dom, tgt_dom = _check_uv(uv, Vs.shape[0], Vt.shape[0])
         names = ("uv[0] (UVs)", "uv[1] (UVt)")
+        for name, UV, T in zip(names, (src_dom, tgt_dom), (Fs, Ft)):
+            squashed_in_plane(UV, T, f"the planar map {name}", "Use another parameterization (e.g. "
+                              "parameterize(..., method='harmonic')), or location='closest'.", MeshError)
     elif uv is not None:
         raise ValueError("uv is only used with location='uv'; pass location='uv' to locate in the shared "
                          "domain, or drop uv for the 3D closest point.")
@@ -212,6 +216,23 @@ def _check_same_surface(dist, Vs, location):
                         f"apart (more than {100 * SAME_SURFACE:.0f} %): location='closest' needs two "
                         "triangulations of the same surface. Align them, or locate in a shared "
                         "parameterization with location='uv'.")
+
+
+def squashed_in_plane(UV, F, what, advice, error):
+    """``error`` where the planar map ``UV`` (n, 2) collapses triangles of ``F`` to zero area (as
+    :func:`~.locate.locate` counts it: below ``ZERO_AREA_RELATIVE`` of the map's bbox diagonal
+    squared), where no point can be located; ``what`` names the map, ``advice`` ends the message.
+    Said as the map's doing: the mesh may be fine there, and locate's own refusal names the
+    mesh's triangles with advice to repair it."""
+    if np.ptp(UV, axis=0).max() == 0:
+        raise error(f"{what} puts all {UV.shape[0]} vertices at one point. {advice}")
+    _, U, _ = _unit_frame(UV[:0], UV)
+    zero = np.flatnonzero(face_double_areas(np.column_stack([U, np.zeros(U.shape[0])]), F)
+                          <= 2.0 * ZERO_AREA_RELATIVE)
+    if zero.size:
+        raise error(f"{what} maps {counted(zero.size, 'triangle')} (first: {first_indices(zero)}) to zero "
+                    f"area in the plane (below {ZERO_AREA_RELATIVE:g} of its diagonal squared), where no "
+                    f"point can be located; the mesh itself may be fine there. {advice}")
 
 
 def _check_uv(uv, n_s, n_t):
