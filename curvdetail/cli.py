@@ -930,13 +930,41 @@ _default_showwarning = warnings.showwarning
 #: Advice that the library gives in its parameters' names (curvdetail.remesh knows no command
 #: line), in each command's words: the retriangulation's method is an option of ``remesh`` and a
 #: --param of ``apply``, as are the filters' ``evaluate``, ``surface_check`` and ``target_edge``
-#: of a long run's note (``run``'s script names them as the library does).
+#: of a long run's note, the solver backend, minimal_surface's ``tol`` and ``max_iterations``, the
+#: editing filter's ``relations`` and ``handle_detail``, and a second layer is an --add mesh of
+#: ``apply`` (``run``'s script names them as the library does).
 _COMMAND_WORDS = {
-    "remesh": {'use method "isotropic"': "use --method isotropic"},
+    "reconstruct": {"or use backend='auto'": "or use --backend auto"},
+    "minimal": {"or use backend='auto'": "or use --backend auto",
+                # a collapse's advice (curvdetail.curvature.minimal_surface)
+                "a larger tol": "a larger --tol", "or max_iterations below": "or --max-iterations below",
+                "fewer max_iterations": "a smaller --max-iterations"},
+    "remesh": {'use method "isotropic"': "use --method isotropic",
+               "or use backend='auto'": "or use --backend auto"},
+    "edit": {"or use backend='auto'": "or use --backend auto"},
     "apply": {'use method "isotropic"': "use --param method=isotropic",
               "(evaluate=False ": "(--param evaluate=false ",
               "(surface_check=False ": "(--param surface_check=false ",
-              "pymeshlab.PercentageValue(1) is 1 %": "--param target_edge=1% is 1 %"},
+              "pymeshlab.PercentageValue(1) is 1 %": "--param target_edge=1% is 1 %",
+              "or use backend='auto'": "or use --param backend=auto",
+              # apply_curvature_editing's warning: what to try
+              "try relations='one+two-ring'": "try --param relations=one+two-ring",
+              "try relations='one-ring'": "try --param relations=one-ring",
+              ", handle_detail='free'": ", --param handle_detail=free",
+              # a filter of two layers given one: apply loads the second with --add
+              "load or generate the retriangulation as another layer (e.g. sourcemesh=0, targetmesh=1)":
+                  "load the retriangulation as another layer with --add MESH (e.g. --param sourcemesh=0 "
+                  "--param targetmesh=1, the defaults with one --add)",
+              "name two different layers (e.g. sampledmesh=1, targetmesh=0)":
+                  "name two different layers, loading the second with --add MESH (e.g. --param sampledmesh=1 "
+                  "--param targetmesh=0, the defaults with one --add)",
+              # apply runs one filter: a selection is made by an earlier step of a script
+              "Select vertices to keep (e.g. with compute_selection_by_condition_per_vertex) "
+              "or fix the boundary.":
+                  "Select vertices to keep in a `curvdetail run` script (e.g. with "
+                  "compute_selection_by_condition_per_vertex before this step), rebuild from the mesh's own "
+                  "detail with `curvdetail reconstruct INPUT OUTPUT --fix I ...`, or fix the boundary "
+                  "(--param fix_boundary=true)."},
 }
 
 #: Advice of every command: an existing output is replaced with --overwrite, Python's

@@ -660,3 +660,30 @@ def test_reconstruct_with_rows_in_capitals_is_the_free_rows_reconstruction(tmp_p
     assert main(["reconstruct", NOSE, str(tmp_path / "o.ply"), "--rows", "Free"]) == 0
     out = capsys.readouterr().out
     assert "rows=free" in out and float(out.split()[3]) < 1e-9     # "max vertex error E of the bbox diagonal"
+
+
+def test_a_collapsing_minimal_surface_is_told_what_to_change_in_options(tmp_path, capsys):
+    # the library's advice came through in its parameters' names ("a larger tol, or max_iterations
+    # below 18"), which `curvdetail minimal` does not take: its options are --tol and --max-iterations
+    out = tmp_path / "m.ply"
+    assert main(["minimal", NOSE, str(out), "--fix", "300", "--fix-boundary"]) == 1
+    line = _error_line(capsys)
+    assert "1 fixed vertex lies inside the surface (first: 300)" in line, line
+    assert "a larger --tol" in line and "--max-iterations below " in line, line
+    assert "max_iterations" not in line and "larger tol" not in line, line
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("command", ["reconstruct", "minimal", "remesh"])
+def test_a_backend_that_is_not_installed_is_told_in_options(tmp_path, capsys, monkeypatch, command):
+    # "or use backend='auto'" is Python; the command line option is --backend auto
+    import curvdetail.curvature.sparse_solver as solver
+
+    monkeypatch.setattr(solver, "available_backends", lambda: ("splu", "banded"))
+    out = tmp_path / "o.ply"
+    quiet = ["--quiet"] if command == "remesh" else []
+    assert main([command, NOSE, str(out), "--backend", "pardiso"] + quiet) == 1
+    line = _error_line(capsys)
+    assert "solver backend 'pardiso' is not installed" in line, line
+    assert line.endswith("or use --backend auto."), line
+    assert not out.exists()

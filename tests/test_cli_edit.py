@@ -267,3 +267,18 @@ def test_overwrite_replaces_the_image_too_and_its_help_says_so(tmp_path, capsys)
         with pytest.raises(SystemExit):
             main([command, "--help"])
         assert words in " ".join(capsys.readouterr().out.split())
+
+
+def test_a_backend_that_is_not_installed_is_told_in_options(tmp_path, capsys, monkeypatch):
+    # "or use backend='auto'" is Python; edit's option is --backend auto
+    import curvdetail.curvature.sparse_solver as solver
+
+    monkeypatch.setattr(solver, "available_backends", lambda: ("splu", "banded"))
+    V, F, status, T, p = _case(tmp_path)
+    out = tmp_path / "out.ply"
+    assert main(["edit", str(p["off"]), "--sel", str(p["sel"]), "--def", str(p["def"]), str(out),
+                 "--backend", "pardiso"]) == 1
+    err = capsys.readouterr().err
+    assert "solver backend 'pardiso' is not installed" in err, err
+    assert err.rstrip().endswith("or use --backend auto."), err
+    assert not out.exists()

@@ -598,3 +598,56 @@ def test_figures_print_numpy_values_as_numbers_and_nan_as_null(capsys, tmp_path,
                    "scalar": 2.5, "pair": [1, 2.0], "converged": False, "iterations": 7}
     assert type(got["count"]) is int and type(got["ratio"]) is float
     assert rc == 3 and "after 7 steps" in err          # the not-converged note reads the plain figures
+
+
+@pytest.mark.parametrize("name, words", [
+    ("transfer_curvature_detail", "sourcemesh and targetmesh are both layer 0"),
+    ("get_curvature_reconstruction_error", "sampledmesh and targetmesh are both layer 0"),
+])
+def test_a_second_layer_missing_from_apply_names_add(capsys, tmp_path, name, words):
+    # `apply FILTER INPUT OUTPUT` without --add holds one layer; the advice ("load or generate the
+    # retriangulation as another layer (e.g. sourcemesh=0, targetmesh=1)") named neither --add,
+    # the way apply loads a layer, nor --param
+    rc, out, err = run_cli(capsys, "apply", name, NOSE, tmp_path / "o.ply")
+    assert rc == 1 and out == "" and words in err, err
+    assert "--add MESH" in err and "--param " in err, err
+    assert "(e.g. sourcemesh=0" not in err and "(e.g. sampledmesh=1" not in err, err
+    assert not os.path.exists(tmp_path / "o.ply")
+
+
+def test_an_editing_warning_from_apply_gives_its_advice_as_params(capsys, tmp_path):
+    # the warning's advice was "try relations='one+two-ring', handle_detail='free', ...": Python
+    # keywords, where apply takes --param relations=one+two-ring (the rest of the line is kept)
+    rc, out, err = run_cli(capsys, "apply", "apply_curvature_editing", NOSE, tmp_path / "o.ply",
+                           "--param", "handles=300 301 302", "--param", "region_radius=30%",
+                           "--param", "transform=1 0 0 0 0 1 0 0 0 0 1 0.5 0 0 0 1")
+    assert rc == 4 and json.loads(out)["folded_triangles"] > 0
+    assert "curvdetail: warning: apply_curvature_editing" in err and "folded over" in err, err
+    assert ("try --param relations=one+two-ring, --param handle_detail=free, more handles or a larger "
+            "region") in err, err
+    assert "relations='" not in err.split("folded over")[1] and "handle_detail='" not in err, err
+
+
+def test_a_backend_that_is_not_installed_is_told_as_a_param(capsys, tmp_path, monkeypatch):
+    import curvdetail.curvature.sparse_solver as solver
+
+    monkeypatch.setattr(solver, "available_backends", lambda: ("splu", "banded"))
+    assert_failed(capsys, ["apply", "generate_minimal_surface", NOSE, tmp_path / "o.ply", "--param",
+                           "backend=pardiso"], "is not installed", tmp_path / "o.ply")
+    rc, out, err = run_cli(capsys, "apply", "generate_minimal_surface", NOSE, tmp_path / "o.ply",
+                           "--param", "backend=pardiso")
+    assert err.rstrip().endswith("or use --param backend=auto."), err
+
+
+def test_a_closed_mesh_rebuilt_by_apply_is_told_how_to_fix_vertices(capsys, tmp_path):
+    # the advice "Select vertices to keep (e.g. with compute_selection_by_condition_per_vertex)"
+    # names a pymeshlab filter that `apply` (one filter) cannot run before this one; a `run`
+    # script can, or `curvdetail reconstruct --fix` from the mesh's own detail
+    detail = tmp_path / "d.ply"
+    rc, out, err = run_cli(capsys, "apply", "compute_curvature_detail", SPOT, detail)
+    assert rc == 0
+    assert_failed(capsys, ["apply", "apply_curvature_reconstruction", detail, tmp_path / "r.ply"],
+                  "no vertex to keep fixed", tmp_path / "r.ply")
+    rc, out, err = run_cli(capsys, "apply", "apply_curvature_reconstruction", detail, tmp_path / "r.ply")
+    assert "in a `curvdetail run` script" in err and "curvdetail reconstruct INPUT OUTPUT --fix" in err, err
+    assert "--param fix_boundary=true" in err, err
