@@ -739,3 +739,26 @@ def test_a_solve_while_another_thread_precomputes_handles_gives_the_serial_answe
     assert "error" not in results, repr(results.get("error"))
     assert np.abs(results["X"] - serial).max() < 1e-12
     assert np.abs(ed.solve(positions=P) - serial).max() < 1e-12
+
+
+def test_a_backend_the_one_ring_stage_cannot_use_is_refused_as_such_before_the_work(monkeypatch):
+    # the banded Cholesky (symmetric positive definite only) was tried on the nonsymmetric
+    # one-ring stage after the coefficients, and its refusal called an undetermined edit
+    from curvdetail.curvature import sparse_solver as solver
+    import curvdetail.curvature.curvature_editor as editor_module
+
+    V, F = grid(12, 12)
+    V[:, 2] = 0.1 * np.sin(3 * V[:, 0])
+    b = boundary_vertices(F)
+    def no_coefficients(*args, **kwargs):
+        raise AssertionError("the coefficients were computed before the backend was refused")
+    with monkeypatch.context() as m:
+        m.setattr(editor_module, "_coefficients", no_coefficients)
+        with pytest.raises(solver.SolverError, match=r"^relations='one-ring' makes the curvature stage a "
+                                                     r"nonsymmetric system: The banded Cholesky factors symmetric "
+                                                     r"positive definite matrices only; use 'pardiso' or 'splu', "
+                                                     r"or relations='one\+two-ring'"):
+            CurvatureEditor(V, F, b, b, backend="banded")
+    # the advice works: the symmetric normal equations of one+two-ring take it
+    ed = CurvatureEditor(V, F, b, b, backend="banded", relations="one+two-ring")
+    assert np.abs(ed.solve() - V).max() < 1e-12

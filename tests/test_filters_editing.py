@@ -533,3 +533,20 @@ def test_a_translation_with_move_handles_false_is_refused_as_doing_nothing():
     apply(ms2, "apply_curvature_editing", handles=" ".join(map(str, handles)), transform=shift,
           move_handles=False, detail_scale=1.1)
     assert np.abs(ms2.current_mesh().vertex_matrix() - V2).max() > 1e-4 * np.linalg.norm(np.ptp(V2, axis=0))
+
+
+def test_a_region_of_every_vertex_is_refused_naming_what_made_it():
+    # a region_radius beyond the mesh took in every vertex, and the refusal named only the selection
+    ms, V, d, handles = _meshset_with_roi()
+    h = " ".join(map(str, handles))
+    with pytest.raises(ConstraintError, match=r"^every vertex is in the region of interest \(selection plus handles "
+                                              r"plus every vertex within region_radius=1000(\.0)? of a handle\), so "
+                                              r"nothing stays fixed; leave part of the mesh unselected, or a smaller "
+                                              r"region_radius\.$"):
+        apply(ms, "apply_curvature_editing", handles=h, region_radius=1000.0)
+    assert np.array_equal(ms.current_mesh().vertex_matrix(), V)
+    _select(ms, np.ones(V.shape[0]))
+    with pytest.raises(ConstraintError, match=r"^every vertex is in the region of interest \(selection plus "
+                                              r"handles\), so nothing stays fixed; leave part of the mesh "
+                                              r"unselected\.$"):
+        apply(ms, "apply_curvature_editing", handles=h, region_radius=pymeshlab.PercentageValue(0.0))

@@ -390,6 +390,20 @@ def test_a_pinned_inner_vertex_is_named_as_the_cause(load_mesh):
         minimal_surface(V, F, np.union1d(boundary_vertices(F), [300]))
 
 
+def test_a_collapse_in_the_first_step_is_not_told_to_stop_earlier():
+    # the first step itself collapsed: "or stop earlier (a larger tol, or max_iterations below 1)"
+    # named what nothing accepts (max_iterations >= 1) and no tol can do (it is checked after a step)
+    from curvdetail.curvature.testing import icosphere
+
+    V, F = icosphere(2)
+    with pytest.raises(MeshError) as error:
+        minimal_surface(V, F, [0, 1, 2, 3])
+    message = str(error.value)
+    assert message.startswith("minimal surface iteration 1: ")
+    assert message.endswith("into spikes. Fix whole curves (e.g. the boundary only)."), message
+    assert "max_iterations" not in message and "tol" not in message
+
+
 def test_remaining_estimate_bounds_the_distance_to_the_limit_near_the_critical_height():
     # two unit circles 1.32 apart, just below the largest height a catenoid spans (1.3255): the
     # steps contract by only ~0.92, and the default tol stops 1.2e-3 of the diagonal (normal to

@@ -188,6 +188,13 @@ class CurvatureEditor:
         rcond = check_rcond(rcond)
         max_ring = check_max_ring(max_ring)
         resolve_backend(backend)           # an unknown or missing backend fails before the work
+        if relations == "one-ring":        # so does one the nonsymmetric curvature stage cannot use
+            try:
+                resolve_backend(backend, symmetric=False)
+            except SolverError as exc:
+                raise SolverError(f"relations='one-ring' makes the curvature stage a nonsymmetric system: "
+                                  f"{str(exc).rstrip('.')}, or relations='one+two-ring' (symmetric normal "
+                                  "equations).") from None
         V, F, L = checked_cotan_laplacian(V, F)       # every mesh check, and L in the same pass
         self.relations = relations
         n = V.shape[0]

@@ -349,18 +349,21 @@ def _collapse_message(iteration, triangles, dbl, V, F, fixed, adjacency, last_st
     edges = np.unique(undirected_edges(piece_faces), axis=0).shape[0]
     euler = np.count_nonzero(in_piece) - edges + piece_faces.shape[0]       # 1: a disk (a boundary, genus 0)
     larger_tol = f"a larger tol, e.g. the default {DEFAULT_TOL:g}" if tol < DEFAULT_TOL else "a larger tol"
+    # the first step itself: no tol or max_iterations stops before it
+    how_earlier = f"({larger_tol}, or max_iterations below {iteration})"
+    earlier = f", or stop earlier {how_earlier}" if iteration > 1 else ""
     if inner_fixed.size:
         return (f"{text}. {counted(inner_fixed.size, 'fixed vertex', 'fixed vertices', verb='lie')} inside the "
                 f"surface (first: {first_indices(inner_fixed)}): a minimal surface cannot be held at isolated "
                 f"points, and the iteration pulls the triangles around {them(inner_fixed.size)} into spikes. "
-                f"Fix whole curves (e.g. the boundary only), or stop earlier ({larger_tol}, or max_iterations "
-                f"below {iteration}).")
+                f"Fix whole curves (e.g. the boundary only){earlier}.")
     if euler == 1 and boundary.size:
         return (f"{text}. This piece is a disk, whose boundary always spans a minimal surface: the "
                 "iteration itself degraded the triangles, sliding vertices within the surface to lower "
-                f"the discrete area. Stop it earlier ({larger_tol}, or max_iterations below {iteration}) "
-                "or remesh the input more evenly (e.g. isotropic remeshing) and try again.")
+                f"the discrete area. {f'Stop it earlier {how_earlier} or r' if earlier else 'R'}emesh the "
+                "input more evenly (e.g. isotropic remeshing) and try again.")
     return (f"{text}. The fixed vertices may span no minimal surface of this topology (e.g. two circles "
             "too far apart for a catenoid: the neck pinches off); or the iteration degraded the "
-            "triangles, sliding vertices within the surface (then a larger tol or fewer max_iterations "
-            "stop it earlier, or remesh the input more evenly).")
+            "triangles, sliding vertices within the surface (then "
+            f"{'a larger tol or fewer max_iterations stop it earlier, or ' if earlier else ''}remesh the "
+            "input more evenly).")

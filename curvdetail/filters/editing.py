@@ -178,8 +178,10 @@ def apply_curvature_editing(ms, *, handles, region_radius, transform, detail_sca
             "compute_selection_by_condition_per_vertex) or set a larger region_radius (e.g. 20%).")
     roi = np.union1d(selected, h)
     if roi.size == V.shape[0]:
-        raise ConstraintError("every vertex is in the region of interest (selection plus handles), so "
-                              "nothing stays fixed; leave part of the mesh unselected.")
+        reach = (f" plus every vertex within region_radius={region_radius} of a handle" if radius > 0 else "")
+        smaller = ", or a smaller region_radius" if radius > 0 else ""
+        raise ConstraintError(f"every vertex is in the region of interest (selection plus handles{reach}), so "
+                              f"nothing stays fixed; leave part of the mesh unselected{smaller}.")
     t = time.perf_counter()
     pc = h if move_handles else np.empty(0, dtype=np.int64)
     dc = h if handle_detail == "transform" else np.empty(0, dtype=np.int64)
