@@ -26,6 +26,30 @@ def test_ply_round_trip_keeps_positions_quality_and_attributes_exactly(tmp_path)
         assert np.array_equal(vertex_attribute(back, 0, name, kind), vertex_attribute(ms, 0, name, kind))
 
 
+def test_a_vertex_selection_is_kept_in_ply_and_serves_the_next_step(tmp_path):
+    # the selection (MeshLab keeps it in the vertex flags) was dropped: a step saved between
+    # curvdetail apply calls lost the vertices a later reconstruction keeps fixed
+    ms = load_meshset(NOSE)
+    V = ms.current_mesh().vertex_matrix()
+    ms.compute_selection_by_condition_per_vertex(condselect="(x < 0)")
+    selected = ms.current_mesh().vertex_selection_array().copy()
+    assert 0 < selected.sum() < selected.size
+    apply(ms, "compute_curvature_detail")
+    save_current_mesh(ms, tmp_path / "d.ply")
+    back = load_meshset(tmp_path / "d.ply")
+    assert np.array_equal(back.current_mesh().vertex_selection_array(), selected)
+    # the next step keeps the selected vertices where they are and rebuilds the rest exactly
+    apply(back, "apply_curvature_reconstruction", fix_boundary=False)
+    X = back.current_mesh().vertex_matrix()
+    assert np.array_equal(X[selected], V[selected])
+    assert np.abs(X - V).max() < 1e-9 * np.linalg.norm(np.ptp(V, axis=0))
+    # a mesh with nothing selected writes no flags
+    plain = load_meshset(NOSE)
+    save_current_mesh(plain, tmp_path / "p.ply")
+    with open(tmp_path / "p.ply", "rb") as fh:
+        assert b"property int flags" not in fh.read(2000).split(b"end_header")[0]
+
+
 def test_scratch_attributes_are_not_saved(tmp_path):
     ms = load_meshset(NOSE)
     apply(ms, "compute_curvature_detail")                 # sets quality through a scratch attribute

@@ -3,7 +3,8 @@
 Saving keeps what the format can hold: in PLY (binary, doubles) the vertex quality and every
 custom per-vertex attribute the filters wrote (``curvature_normal``, ``curvature_detail``,
 ``curvature_area``, ...; pymeshlab's PLY exporter options ``__ca_vp__<name>`` /
-``__ca_vs__<name>``), read back by :func:`load_meshset`; OBJ, OFF and CTM hold the geometry and
+``__ca_vs__<name>``), read back by :func:`load_meshset`, and a vertex selection (in the vertex
+flags, as MeshLab saves it); OBJ, OFF and CTM hold the geometry and
 the vertex colours (:data:`VERTEX_COLOUR_FORMATS`), STL the geometry only. Vertex normals and
 colours are written only where the layer holds its own, not those pymeshlab computes or gives
 every mesh (:func:`vertex_normals_kept`, :func:`vertex_colours_kept_in`). The file is written
@@ -102,6 +103,10 @@ def save_options(ms, path):
     options = {"binary": True}
     if mesh.has_vertex_scalar():
         options["save_vertex_quality"] = True
+    if mesh.selected_vertex_number():
+        # the selection rides in the vertex flags, as MeshLab saves it: the fixed vertices of a
+        # later apply_curvature_reconstruction (curvdetail apply ... then apply ...) were lost
+        options["save_vertex_flag"] = True
     for name, kind in _attributes_on_current_mesh(ms):
         options[("__ca_vp__" if kind == "point" else "__ca_vs__") + name.lower()] = True
     return options
