@@ -198,7 +198,7 @@ def check_loaded(path, n_vertices, F, error=ValueError, counts=None):
     if vertices is not None and vertices > n_vertices:     # more than declared: a misread count
         raise error(
             f"{path!r} has {vertices} vertices but pymeshlab loaded {n_vertices}: "
-            f"{vertices - n_vertices} were dropped, most likely for non-finite (NaN or inf) "
+            f"{counted(vertices - n_vertices, 'was', 'were')} dropped, most likely for non-finite (NaN or inf) "
             "coordinates, together with the faces using them, so the vertex order no longer "
             "matches the file. Fix or remove those vertices (and their faces) in the file and "
             "read it again.")
@@ -210,7 +210,7 @@ def check_loaded(path, n_vertices, F, error=ValueError, counts=None):
                                    "vertex indices out of range or repeated within a face")
         raise error(
             f"{path!r} has {faces} faces but pymeshlab loaded {F.shape[0]} triangles: at least "
-            f"{faces - F.shape[0]} were dropped, most likely for {cause}. Fix or remove those "
+            f"{counted(faces - F.shape[0], 'was', 'were')} dropped, most likely for {cause}. Fix or remove those "
             "faces in the file and read it again.")
 
 

@@ -222,7 +222,7 @@ def load_failure(path, exc):
 
 def input_path(path):
     """``path`` as a str naming an existing file, or raise: MeshFileError for what is not a path,
-    a folder or not a regular file (a pipe: the checks read it before pymeshlab does),
+    a folder, not a regular file (a pipe: the checks read it before pymeshlab does) or empty,
     FileNotFoundError for a missing file."""
     if not isinstance(path, (str, bytes, os.PathLike)):
         raise MeshFileError(f"a mesh path must be a str or os.PathLike; got {type(path).__name__}.")
@@ -234,6 +234,9 @@ def input_path(path):
             raise MeshFileError(f"{path!r} is not a regular file (a pipe or a device); write the mesh to a "
                                 "file and read that.")
         raise FileNotFoundError(f"mesh file not found: {path}")
+    if os.path.getsize(path) == 0:      # pymeshlab said "damaged or incomplete" in each format's words
+        raise MeshFileError(f"{path!r} is empty (0 bytes): there is no mesh in it; check that the program "
+                            "that wrote it finished, and write it again.")
     return path
 
 

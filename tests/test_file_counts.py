@@ -67,7 +67,7 @@ def test_check_loaded_accepts_a_complete_load_and_names_what_is_missing(tmp_path
     F = np.array([[0, 1, 2], [1, 3, 2]])
     check_loaded(str(path), 4, F)                                  # complete: nothing raised
     check_loaded(str(path), 4, np.vstack([F, F]))                  # polygons triangulated: more is fine
-    with pytest.raises(ValueError, match=r"has 4 vertices but pymeshlab loaded 3: 1 were dropped"):
+    with pytest.raises(ValueError, match=r"has 4 vertices but pymeshlab loaded 3: 1 was dropped"):
         check_loaded(str(path), 3, F[:1])
     with pytest.raises(ValueError, match=r"has 2 faces but pymeshlab loaded 1 triangles"):
         check_loaded(str(path), 4, F[:1])

@@ -433,7 +433,7 @@ def test_inf_and_nan_are_read_as_such_and_the_dropped_vertex_reported(tmp_path, 
     path = tmp_path / name
     path.write_text(_coordinate_files(form)[name])
     check_before_loading(path)                                 # read right: pymeshlab drops the vertex
-    with pytest.raises(MeshFileError, match="1 were dropped, most likely for non-finite"):
+    with pytest.raises(MeshFileError, match="1 was dropped, most likely for non-finite"):
         read_mesh(path)
 
 

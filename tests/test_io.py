@@ -245,7 +245,7 @@ def test_obj_with_a_non_finite_vertex_is_refused_with_both_counts(tmp_path, toke
     path.write_text("".join(f"v {x} {y} {z}\n" for x, y, z in V) +
                     "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in F))
     with pytest.raises(MeshFileError, match=r"bad.obj' has 5 vertices but pymeshlab loaded 4: 1 "
-                                            r"were dropped, most likely for non-finite .*Fix or remove"):
+                                            r"was dropped, most likely for non-finite .*Fix or remove"):
         read_mesh(path)
 
 
@@ -296,7 +296,7 @@ def test_stl_triangles_the_loader_drops_are_reported(tmp_path, bad, binary):
             " facet normal 0 0 1\n  outer loop\n" + "".join(f"   vertex {x} {y} {z}\n" for x, y, z in t) +
             "  endloop\n endfacet\n" for t in triangles) + "endsolid t\n")
     with pytest.raises(MeshFileError, match=r"has 3 faces but pymeshlab loaded 2 triangles: at least 1 "
-                                            r"were dropped, most likely for non-finite .* repeated corner"):
+                                            r"was dropped, most likely for non-finite .* repeated corner"):
         read_mesh(path)
     good = tmp_path / "good.stl"                                     # the two good ones load
     ms.save_current_mesh(str(good), binary=binary)
@@ -361,7 +361,7 @@ def test_off_with_counts_on_the_header_line_and_colours_is_read(tmp_path):
     ("out_of_range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\nf 2 9 3\n",
      r"line 7 \('f 2 9 3'\) names the vertex 9, which the file does not have"),
     ("repeated.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\nf 2 2 3\n",
-     r"has 3 faces but pymeshlab loaded 2 triangles: at least 1 were dropped, most likely for vertex indices "
+     r"has 3 faces but pymeshlab loaded 2 triangles: at least 1 was dropped, most likely for vertex indices "
      r"out of range or repeated"),
 ])
 def test_obj_faces_the_loader_drops_are_reported(tmp_path, name, text, message):
@@ -1261,3 +1261,14 @@ def test_binary_ply_of_triangles_and_quads_is_read_in_order_and_checked(tmp_path
     else:
         V, F = read_mesh(path)
         assert V.tolist() == corners.tolist() and F.tolist() == triangles
+
+
+@pytest.mark.parametrize("suffix", [".obj", ".off", ".ply", ".stl", ".ctm"])
+def test_an_empty_file_is_named_as_empty(tmp_path, suffix):
+    # pymeshlab's failure read as "damaged or incomplete, or a variant pymeshlab does not read";
+    # an empty file is more plainly one whose writer did not finish
+    path = tmp_path / f"empty{suffix}"
+    path.write_bytes(b"")
+    with pytest.raises(MeshFileError, match=r"empty\.\w+' is empty \(0 bytes\): there is no mesh in it; check "
+                                            r"that the program that wrote it finished, and write it again\.$"):
+        read_mesh(path)
