@@ -638,10 +638,14 @@ def _run_command(parser):
     add_output_arguments(parser)
 
     def run(args):
-        from .filters import run_script
+        from .filters import ScriptError, run_script
         from .filters.mlx import check_script
 
-        check_script(args.script)       # a folder, malformed XML or a bad step: before reading INPUT
+        # a folder, malformed XML or a bad step: before reading INPUT
+        if not check_script(args.script):
+            raise ScriptError(f"{args.script} has no filter steps: nothing would run, and OUTPUT would be a "
+                              "copy of INPUT. Add steps (curvdetail list names our filters; MeshLab saves "
+                              "its own with Filters > Show current filter script), or name another script.")
         bar = Progress(0, enabled=sys.stderr.isatty())
 
         def step(k, total, name):

@@ -289,6 +289,14 @@ def test_run_malformed_script(capsys, tmp_path):
                   "not a MeshLab filter script", tmp_path / "o.ply")
 
 
+def test_run_refuses_a_script_with_no_steps(capsys, tmp_path):
+    # it printed [], exited 0 and wrote a copy of INPUT
+    (tmp_path / "s.mlx").write_text("<!DOCTYPE FilterScript>\n<FilterScript>\n</FilterScript>\n")
+    assert_failed(capsys, ["run", tmp_path / "s.mlx", NOSE, tmp_path / "o.ply"],
+                  "s.mlx has no filter steps: nothing would run, and OUTPUT would be a copy of INPUT",
+                  tmp_path / "o.ply")
+
+
 def test_run_failing_step(capsys, tmp_path):
     (tmp_path / "s.mlx").write_text(SCRIPT.replace("Select Border", "Select Nothing Like This"))
     assert_failed(capsys, ["run", tmp_path / "s.mlx", NOSE, tmp_path / "o.ply"],
