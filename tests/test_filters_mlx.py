@@ -377,3 +377,41 @@ def test_a_step_with_another_tag_is_named_by_its_tag_not_as_nameless(tmp_path):
     with pytest.raises(ScriptError, match=r"step 1 is <Filter name='Select Border'>; a step is "
                                           r"<filter name=\"\.\.\.\"> \(the tag in lower case"):
         run_script(meshset(), path)
+
+
+def test_a_layer_set_to_the_current_mesh_is_saved_as_such_not_as_its_default(tmp_path):
+    # targetmesh=None (current) was left out of the saved script, so the run took its default,
+    # layer 0: "sampledmesh and targetmesh are both layer 0", or, with other layers, another
+    # layer than the one meant, without a word
+    ms = meshset()
+    ms.generate_copy_of_current_mesh()                       # layer 1, current
+    params = {"sampledmesh": 0, "targetmesh": None, "samplenum": 1000, "set_quality": False}
+    save_script(tmp_path / "e.mlx", [("get_curvature_reconstruction_error", params)])
+    assert 'name="targetmesh" value=""' in (tmp_path / "e.mlx").read_text()
+    assert 'name="sampledmesh" value="0"' in (tmp_path / "e.mlx").read_text()
+    figures = run_script(ms, tmp_path / "e.mlx")[0]["figures"]
+    assert (figures["sampledmesh"], figures["targetmesh"]) == (0, 1) == \
+        tuple(apply(ms, "get_curvature_reconstruction_error", **params)[k] for k in ("sampledmesh", "targetmesh"))
+    assert figures["hausdorff_max"] < 1e-12                 # a copy: on it to rounding
+
+
+@pytest.mark.parametrize("param, value, message", [
+    ("transform", "1 0 0 0 0 1 0 0 0 0 1 0", r"'transform' has 12 numbers; it must be 16 finite numbers"),
+    ("transform", "1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 nan", r"'transform' has NaN or infinite numbers"),
+    ("transform", "1 0 0 0 0 1 0 0 0 0 1 0 1 0 0 1", r"'transform': the last row is \[1.0, 0.0, 0.0, 1.0\]"),
+    ("handles", "5 x", r"'handles' must be vertex indices"),
+    ("handles", "5 5", r"'handles': 1 index is repeated \(first: 5\)"),
+    ("handles", "2.5", r"'handles': 1 value is not a whole number"),
+    ("handles", "3 -1", r"'handles': 1 index is negative \(first: -1\)"),
+])
+def test_a_malformed_edit_is_refused_before_the_first_step_runs(tmp_path, param, value, message):
+    # a transform of 12 numbers or repeated handles were found only when the editing step ran,
+    # after the steps before it had changed the MeshSet (here: curvature detail stored)
+    path = write(tmp_path, '<filter name="compute_curvature_detail"/>\n <filter name="apply_curvature_editing">'
+                           f'<Param name="{param}" value="{value}"/></filter>')
+    ms = meshset()
+    with pytest.raises(ScriptError, match=r"s.mlx step 2 \(apply_curvature_editing\): parameter " + message):
+        run_script(ms, path)
+    assert vertex_attribute(ms, 0, "curvature_detail", "point") is None
+    with pytest.raises(FilterParameterError, match=message):          # and save_script writes no such step
+        save_script(tmp_path / "other.mlx", [("apply_curvature_editing", {param: value})])

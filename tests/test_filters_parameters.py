@@ -241,3 +241,31 @@ def test_an_enum_given_as_an_array_or_a_list_names_the_parameter_and_the_choices
     with pytest.raises(FilterParameterError, match=r"'rows' expects a str \(one of all, free, or its index\); "
                                                    r"got .*all|free"):
         p.check(value)
+
+
+def test_an_enum_index_outside_the_choices_says_the_range_of_indices():
+    # it was "expects a str (one of all, free, or its index); got 2 (int)": the type was right,
+    # the index was not (pymeshlab: "Enum 2 not valid. Must be a value between 0 and 1")
+    p = Parameter("rows", "str", "all", "rows", choices=("all", "free"))
+    for bad in (2, np.int64(-1)):
+        with pytest.raises(FilterParameterError, match=r"'rows' is .*; it must be one of all, free, or its "
+                                                       r"index, 0 to 1\."):
+            p.check(bad)
+
+
+@pytest.mark.parametrize("kind, value, expected", [
+    ("int", np.array(5), 5), ("float", np.array(0.25), 0.25), ("bool", np.array(False), False),
+    ("mesh", np.array(2, dtype=np.int32), 2), ("PercentageValue", np.array(0.5), BBoxLength(0.5, False)),
+])
+def test_a_zero_dimensional_array_is_taken_as_its_number_as_pymeshlab_takes_it(kind, value, expected):
+    # pymeshlab's iterations=np.array(5) runs; it was "expects an int; got array(5) (ndarray)"
+    default = {"int": 1, "float": 1.0, "bool": True, "mesh": None, "PercentageValue": 1.0}[kind]
+    out = Parameter("x", kind, default, "d").check(value)
+    assert out == expected and type(out) is type(expected)
+
+
+@pytest.mark.parametrize("text", ["", "current", " Current "])
+def test_a_layer_id_written_empty_or_current_reads_back_as_the_current_mesh(text):
+    # format(None) writes "", which parse refused ("expects a layer id (integer); got ''")
+    p = Parameter("targetmesh", "mesh", 0, "layer")
+    assert p.format(None) == "" and p.parse(text) is None and p.parse("3") == 3

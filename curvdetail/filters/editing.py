@@ -42,7 +42,7 @@ class AmplifiedEditWarning(UserWarning):
 def _indices(text, n):
     """The handle indices in ``text`` (spaces or commas between them) as an int64 array: whole
     numbers, written as ints or as whole floats ("3.0", from a Python list or array of floats, as
-    pymeshlab's and libigl's index arrays often are), each once, in [0, n)."""
+    pymeshlab's and libigl's index arrays often are), each once, in [0, n) (n None: 0 or more)."""
     tokens = str(text).replace(",", " ").split()
     values = []
     for t in tokens:
@@ -60,11 +60,15 @@ def _indices(text, n):
     if error is not None:
         raise error
     values = [int(v) for v in values]
-    beyond = [k for k, v in enumerate(values) if not 0 <= v < n]      # before the int64 cast, which overflows
+    # before the int64 cast, which overflows; without a mesh (n None) the negative ones only
+    beyond = [k for k, v in enumerate(values) if not (0 <= v and (n is None or v < n))]
     if beyond:
+        where = "negative" if n is None else f"outside [0, {n})"
         raise FilterParameterError(f"parameter 'handles': {counted(len(beyond), 'index', 'indices', verb='are')} "
-                                   f"outside [0, {n}) (first: {tokens[beyond[0]]}); indices are 0-based into "
+                                   f"{where} (first: {tokens[beyond[0]]}); indices are 0-based into "
                                    "the mesh's vertices.")
+    if n is None and values and max(values) > np.iinfo(np.int64).max:
+        return None                 # outside any mesh: named with the mesh's size when the filter runs
     idx = np.asarray(values, dtype=np.int64)
     if idx.size == 0:
         raise FilterParameterError("parameter 'handles' is empty; name the handle vertices, e.g. "
@@ -77,6 +81,15 @@ def _indices(text, n):
     return idx
 
 
+def _handles_without_a_mesh(text):
+    """The checks of :func:`_indices` that need no mesh (numbers, whole, not negative, each once),
+    run on the parameter's value (``Parameter.validate``), so that a script's check and the
+    command line refuse a malformed ``handles`` before any step runs. The empty default passes
+    here; the filter names it."""
+    if str(text).replace(",", " ").split():
+        _indices(text, None)
+
+
 def _matrix(text):
     try:
         values = [real_word(t) for t in str(text).replace(",", " ").split()]
@@ -84,8 +97,9 @@ def _matrix(text):
         raise FilterParameterError(f"parameter 'transform' must be 16 numbers (a 4x4 matrix, row by "
                                    f"row); got {str(text)[:40]!r}.") from None
     if len(values) != 16 or not np.all(np.isfinite(values)):
-        raise FilterParameterError(f"parameter 'transform' has {len(values)} numbers (or NaN/inf); it "
-                                   "must be 16 finite numbers, a 4x4 matrix row by row.")
+        what = f"{len(values)} numbers" if len(values) != 16 else "NaN or infinite numbers"
+        raise FilterParameterError(f"parameter 'transform' has {what}; it must be 16 finite numbers, a "
+                                   "4x4 matrix row by row.")
     T = np.asarray(values).reshape(4, 4)
     problem = affine_transform_problem(T)
     if problem:
@@ -116,14 +130,14 @@ def _matrix(text):
     parameters=[
         Parameter("handles", "str", "", "handle vertex indices, separated by spaces or commas "
                   "(from Python also a list, array, range, set or single int; whole floats such as "
-                  "3.0 are indices)"),
+                  "3.0 are indices)", validate=_handles_without_a_mesh),
         Parameter("region_radius", "PercentageValue", BBoxLength(0.0, percent=True),
                   "also put every vertex within this distance of a handle into the region of "
                   "interest (0: the selection alone); a percentage of the bbox diagonal or absolute",
                   min=0.0),
         Parameter("transform", "str", IDENTITY,
                   "4x4 handle transform, 16 numbers row by row, applied to homogeneous positions "
-                  "(from Python also a 4x4 array)", shape=(4, 4)),
+                  "(from Python also a 4x4 array)", shape=(4, 4), validate=_matrix),
         Parameter("detail_scale", "float", 1.0,
                   "factor on the handles' curvature details D = K A after the transform (1 keeps "
                   "them); below 1 flattens what the handles sit on, above 1 sharpens it "

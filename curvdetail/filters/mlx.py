@@ -455,7 +455,8 @@ def save_script(path, steps, *, overwrite=False):
     path : str or os.PathLike   destination (.mlx); written atomically
     steps : list   each a filter name or ``(name, {parameter: value})``; every parameter is
                    written (defaults for those not given), except a layer id left to the current
-                   mesh
+                   mesh where that is its default (a layer id whose default is a layer, set to
+                   None, the current mesh, is written as ``value=""``)
     overwrite : bool            replace an existing file
 
     Raises
@@ -490,9 +491,9 @@ def save_script(path, steps, *, overwrite=False):
         values = complete_parameters(spec, params)
         element = ET.SubElement(root, "filter", {"name": name})
         for p in spec.parameters:
-            if p.type == "mesh" and values[p.name] is None:
-                continue
-            element.append(_param_element(p, values[p.name]))
+            if p.type == "mesh" and values[p.name] is None and p.default is None:
+                continue            # left out: its default is the current mesh
+            element.append(_param_element(p, values[p.name]))   # None (current) as value=""
     ET.indent(root, space=" ")
     text = "<!DOCTYPE FilterScript>\n" + ET.tostring(root, encoding="unicode") + "\n"
     with atomic_output(path, overwrite=overwrite, hint=None, error=FileNotFoundError) as tmp:

@@ -108,6 +108,10 @@ class Parameter:
     #: filter); None flattens any array (an index set, where the order does not matter: a
     #: single number and a set are taken too)
     shape: tuple = None
+    #: a function of the converted value that raises FilterParameterError where the filter would
+    #: refuse the value whatever the mesh (a transform of 15 numbers), so that apply, a script's
+    #: check and the command line refuse it before any work; its return value is ignored
+    validate: object = None
 
     def __post_init__(self):
         if self.type not in TYPES:
@@ -149,7 +153,15 @@ class Parameter:
     def check(self, value):
         """Return ``value`` converted to this parameter's type, or raise FilterParameterError
         naming the parameter and the expected type (and the choices or range)."""
+        value = self._convert(value)
+        if self.validate is not None and value is not None:
+            self.validate(value)
+        return value
+
+    def _convert(self, value):
         t = self.type
+        if isinstance(value, np.ndarray) and value.ndim == 0 and t != "str":
+            value = value[()]                     # a 0-d array as its numpy scalar, as pymeshlab takes it
         if t == "bool":
             if isinstance(value, (bool, np.bool_)):
                 return bool(value)
@@ -174,6 +186,11 @@ class Parameter:
             if self.choices is not None and isinstance(value, numbers.Integral) \
                     and not isinstance(value, (bool, np.bool_)) and 0 <= value < len(self.choices):
                 return self.choices[int(value)]           # an enum index, as pymeshlab takes it
+            if self.choices is not None and isinstance(value, numbers.Integral) \
+                    and not isinstance(value, (bool, np.bool_)):
+                raise FilterParameterError(
+                    f"parameter {self.name!r} is {value!r}; it must be one of {', '.join(self.choices)}, "
+                    f"or its index, 0 to {len(self.choices) - 1}.")
             if self.choices is None:
                 value = _numbers_as_text(self._check_numbers(self._as_sequence(value)))
             if not isinstance(value, str):
@@ -281,8 +298,9 @@ class Parameter:
         """Convert ``text`` (from the command line or an .mlx ``value``) and check it.
 
         ``bool``: true/false/1/0/yes/no; ``PercentageValue``: ``"1.5%"`` (percent of the bbox
-        diagonal) or ``"0.01"`` (absolute); ``mesh``: a layer id; ``str`` with choices: the
-        choice, case-insensitive, or its 0-based index (how MeshLab writes a RichEnum).
+        diagonal) or ``"0.01"`` (absolute); ``mesh``: a layer id, or ``""`` / ``"current"`` for
+        the current mesh (how :meth:`format` writes None); ``str`` with choices: the choice,
+        case-insensitive, or its 0-based index (how MeshLab writes a RichEnum).
         """
         s = str(text).strip()
         t = self.type
@@ -294,6 +312,8 @@ class Parameter:
                 if low in ("false", "0", "no", "off"):
                     return False
                 raise ValueError
+            if t == "mesh" and s.lower() in ("", "current"):
+                return self.check(None)
             if t in ("int", "mesh"):
                 return self.check(int(s))
             if t == "float":
