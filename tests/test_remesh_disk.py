@@ -114,3 +114,17 @@ def test_fractional_indices_are_named_not_read_as_a_non_manifold_edge():
     with pytest.raises(MeshError, match="F has non-integer entries") as error:
         check_disk(V, F)
     assert not isinstance(error.value, NotADiskError)
+
+
+def test_check_disk_returns_arrays_of_its_own_not_the_inputs():
+    # float64 / int64 C inputs came back as the very objects given (writing to the checked V
+    # changed the caller's patch; a read-only input came back unwritable)
+    V, F = grid(4, 4)
+    V.setflags(write=False)
+    V0, F0 = V.copy(), F.copy()
+    W, G, loop = check_disk(V, F)
+    assert not np.shares_memory(W, V) and not np.shares_memory(G, F)
+    assert W.flags.writeable and G.flags.writeable
+    W[0] += 1.0
+    G[0] = G[0, ::-1]
+    assert np.array_equal(V, V0) and np.array_equal(F, F0)

@@ -528,3 +528,33 @@ def test_an_index_set_of_more_than_one_dimension_is_refused_by_shape():
     assert as_index_set(np.array([[4], [1]]), 9, "fixed").tolist() == [4, 1]
     assert as_index_set(np.array([[4, 1]]), 9, "fixed").tolist() == [4, 1]
     assert as_index_set(np.int64(3), 9, "fixed").tolist() == [3]
+
+
+def _read_only(a):
+    a = np.array(a)
+    a.setflags(write=False)
+    return a
+
+
+@pytest.mark.parametrize("form", ["plain", "read-only", "memmap"])
+def test_check_mesh_returns_arrays_of_its_own_not_the_inputs(form, tmp_path):
+    # float64 / int64 C arrays were returned as the very objects given: writing to the checked
+    # V changed the caller's mesh, and a read-only or memmapped input came back unwritable
+    V, F = grid(4, 4)
+    if form == "read-only":
+        V, F = _read_only(V), _read_only(F)
+    elif form == "memmap":
+        m = np.memmap(tmp_path / "F.bin", dtype=np.int64, mode="w+", shape=F.shape)
+        m[:] = F
+        m.flush()
+        F = np.memmap(tmp_path / "F.bin", dtype=np.int64, mode="r", shape=F.shape)
+    V0, F0 = np.array(V), np.array(F)
+    W, G = check_mesh(V, F)
+    assert not np.shares_memory(W, V) and not np.shares_memory(G, F)
+    assert type(W) is np.ndarray and type(G) is np.ndarray
+    assert W.flags.writeable and G.flags.writeable and W.flags.c_contiguous and G.flags.c_contiguous
+    assert np.array_equal(W, V0) and np.array_equal(G, F0)
+    W[0] += 1.0
+    G[0] = G[0, ::-1]
+    assert np.array_equal(V, V0) and np.array_equal(F, F0)
+

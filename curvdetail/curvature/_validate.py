@@ -175,8 +175,8 @@ def check_mesh(V, F, *, check_manifold=True, check_unreferenced=True):
 
     Returns
     -------
-    V : (n, 3) float64 C-contiguous array
-    F : (m, 3) int64 C-contiguous array
+    V : (n, 3) float64 C-contiguous array, a new one (never the input itself or a view of it)
+    F : (m, 3) int64 C-contiguous array, likewise new
 
     Raises
     ------
@@ -194,7 +194,11 @@ def check_mesh(V, F, *, check_manifold=True, check_unreferenced=True):
     >>> V.dtype, F.dtype
     (dtype('float64'), dtype('int64'))
     """
-    return _check_mesh(V, F, check_manifold, check_unreferenced)[:2]
+    checked = _check_mesh(V, F, check_manifold, check_unreferenced)[:2]
+    # float64 / int64 C inputs pass the conversions as themselves: copy, so that writing to the
+    # result cannot change the caller's mesh (and a read-only or memmapped input comes back writable)
+    return tuple(out.copy() if isinstance(given, np.ndarray) and np.may_share_memory(out, given) else out
+                 for out, given in zip(checked, (V, F)))
 
 
 def _check_mesh(V, F, check_manifold, check_unreferenced, cotangents=False):

@@ -506,6 +506,13 @@ class CurvatureEditor:
         X : (n, 3) float array   ``X[position_constrained] == positions`` exactly; vertices outside
                                  the roi keep their rest positions exactly
         D : (n, 3) float array   only with ``return_details=True``
+
+        Raises
+        ------
+        ConstraintError         ``positions`` / ``details`` not of shape (p, 3) / (q, 3), not real
+                                numbers, or with NaN or infinite rows
+        UndeterminedEditError   with ``return_details=True``: as :meth:`solve_details`
+        ValueError              ``return_details`` not True or False
         """
         # "no" or 0 would otherwise count as an answer, and an array as numpy's ambiguous truth value
         return_details = check_bool(return_details, "return_details")
@@ -596,6 +603,12 @@ class CurvatureEditor:
         Returns
         -------
         self
+
+        Raises
+        ------
+        ConstraintError   ``handles`` out of range, repeated, not whole numbers, or a vertex that is
+                          neither position- nor detail-constrained; ``positions`` / ``details`` as
+                          in :meth:`solve`
         """
         h = _index_set(handles, self.n, "handles")
         is_p = np.zeros(self.n, dtype=bool)
