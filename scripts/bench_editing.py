@@ -111,9 +111,11 @@ def bench_cases(repeat):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default="out/bench_editing.json")
-    ap.add_argument("--repeat", type=at_least_one, default=7)
-    ap.add_argument("--skip-100k", action="store_true")
+    ap.add_argument("--out", default="out/bench_editing.json", help="JSON results (default: %(default)s)")
+    ap.add_argument("--repeat", type=at_least_one, default=7,
+                    help="runs per Table 1 size, the median and the best kept; half as many per "
+                         "benchmark case (default: %(default)s)")
+    ap.add_argument("--skip-100k", action="store_true", help="leave out the 100k-vertex re-solve")
     ap.add_argument("--force", action="store_true", help="replace OUT if it exists")
     args = ap.parse_args(argv)
     run = _outputs.Run(ap, [args.out], args.force, makes=[os.path.dirname(os.path.abspath(args.out))])

@@ -171,13 +171,24 @@ def in_subprocess(case, variant, size, timeout):
     return json.loads(lines[-1][len("RESULT "):])
 
 
+def _positive_seconds(text):
+    """``--timeout``: a whole number of seconds >= 1, or an argparse error."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number of seconds of at least 1")
+    return value
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sizes", default="100k", help="comma-separated: 10k, 100k, 1M")
     ap.add_argument("--cases", default=",".join(CASES), help="comma-separated: " + ", ".join(CASES))
-    ap.add_argument("--out", default="out/bench_operations.json")
+    ap.add_argument("--out", default="out/bench_operations.json", help="JSON results (default: %(default)s)")
     ap.add_argument("--force", action="store_true", help="replace OUT if it exists")
-    ap.add_argument("--timeout", type=int, default=900, help="seconds per case")
+    ap.add_argument("--timeout", type=_positive_seconds, default=900, help="seconds per case")
     ap.add_argument("--child", nargs=3, help=argparse.SUPPRESS)
     ap.add_argument("--write-files", nargs=2, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
@@ -189,9 +200,11 @@ def main(argv=None):
         return 0
     sizes = [s for s in args.sizes.split(",") if s]
     cases = [c for c in args.cases.split(",") if c]
-    unknown = [s for s in sizes if s not in SIDES] + [c for c in cases if c not in CASES]
-    if unknown:
-        ap.error(f"unknown size or case: {', '.join(unknown)}")
+    for option, given, allowed in (("--sizes", sizes, SIDES), ("--cases", cases, CASES)):
+        unknown = [name for name in given if name not in allowed]
+        if unknown or not given:
+            ap.error(f"{option}: {'unknown ' + ', '.join(map(repr, unknown)) if unknown else 'none given'}; "
+                     f"choose from {', '.join(allowed)} (a comma list).")
     run = _outputs.Run(ap, [args.out], args.force, makes=[os.path.dirname(os.path.abspath(args.out))])
     results = []
     with tempfile.TemporaryDirectory(prefix="bench_operations_") as folder:

@@ -59,6 +59,10 @@ BEGIN, END = "<!-- bench:begin -->", "<!-- bench:end -->"
 OVERWRITE = "--overwrite"
 
 #: why a method is left out at a size (recorded in the JSON instead of a result)
+#: every --methods name: Reconstructor end to end, the sparse_solver backends, naive spsolve (a
+#: backend that is not installed is recorded as skipped; a name outside this list is refused)
+METHODS = ("reconstruct", "pardiso", "cholmod", "splu", "banded", "spsolve")
+
 SKIP = {
     ("spsolve", "1M"): "naive spsolve at 1M needs ~15 GB and ~6 min per solve (SPEC section 6: "
                        "114-379 s, 8.9-15.3 GB); left out on a 24 GiB machine shared with others",
@@ -392,6 +396,39 @@ def markdown_text(path, results, meta):
     return text
 
 
+def _names(parser, option, text, allowed, what):
+    """The comma list ``text`` of ``option`` as a list of names, or ``parser.error`` (exit status
+    2, before any work) naming the first that is not in ``allowed``, or an empty list."""
+    names = [name.strip() for name in text.split(",") if name.strip()]
+    unknown = [name for name in names if name not in allowed]
+    if unknown or not names:
+        given = f"unknown {what} {unknown[0]!r}" if unknown else f"no {what} given"
+        parser.error(f"{option}: {given}; choose from {', '.join(allowed)} (a comma list).")
+    return names
+
+
+def _at_least_one(text):
+    """``--rounds`` / ``--trials``: a whole number >= 1, or an argparse error."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number of at least 1")
+    return value
+
+
+def _positive(text):
+    """``--timeout`` / ``--mem-limit-gb``: a finite number > 0, or an argparse error."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not 0.0 < value < float("inf"):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a positive number")
+    return value
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -410,17 +447,17 @@ def main(argv=None):
     parser.add_argument("--overwrite", action="store_true",
                         help="replace an existing --out file and rewrite an existing --markdown "
                              "file's table (refused before any case runs otherwise)")
-    parser.add_argument("--timeout", type=float, default=1200.0, help="seconds per case")
-    parser.add_argument("--mem-limit-gb", type=float, default=16.0,
+    parser.add_argument("--timeout", type=_positive, default=1200.0, help="seconds per case")
+    parser.add_argument("--mem-limit-gb", type=_positive, default=16.0,
                         help="stop a case whose resident memory passes this (default 16; the "
                              "machine is shared)")
     parser.add_argument("--force", action="store_true",
                         help="also run the cases left out by default (naive spsolve and CHOLMOD at 1M); "
                              "replacing files is --overwrite")
-    parser.add_argument("--rounds", type=int, default=1,
+    parser.add_argument("--rounds", type=_at_least_one, default=1,
                         help="subprocess runs per case, the methods of a group taking turns; the "
                              "fastest is kept (default 1)")
-    parser.add_argument("--trials", type=int, default=None,
+    parser.add_argument("--trials", type=_at_least_one, default=None,
                         help="factor + solve runs per case, the fastest kept (default 2, 1 at 1M)")
     parser.add_argument("--rebuild-markdown", action="store_true",
                         help="run nothing: rewrite --markdown's table from the --out file")
@@ -452,10 +489,12 @@ def main(argv=None):
 
     import scipy
 
-    sizes = [s.strip() for s in args.sizes.split(",") if s.strip()]
-    for s in sizes:
-        if s not in SIZES:
-            parser.error(f"unknown size {s!r}; choose from {', '.join(SIZES)}")
+    # every list option checked before any output or case: a name outside its list is refused
+    sizes = _names(parser, "--sizes", args.sizes, SIZES, "size")
+    surfaces = _names(parser, "--surfaces", args.surfaces, SURFACES, "surface")
+    rows_modes = _names(parser, "--rows", args.rows, ROWS, "row mode")
+    if args.methods is not None:
+        args.methods = ",".join(_names(parser, "--methods", args.methods, METHODS, "method"))
     # before any case runs: --merge updates --out, --overwrite replaces it (and the markdown's table)
     run = _outputs.Run(parser, [args.out], args.overwrite or args.merge,
                        f"{OVERWRITE} (or --merge to keep its other cases)",
@@ -471,13 +510,13 @@ def main(argv=None):
     results = []
     # several groups: --out is saved after each (a commit of its own), so that a run stopped
     # part-way keeps the groups done; from the second group on, it is this run's own file
-    several = len(sizes) * len(args.surfaces.split(",")) * len(args.rows.split(",")) > 1
+    several = len(sizes) * len(surfaces) * len(rows_modes) > 1
     if args.merge and os.path.exists(args.out):
         with open(args.out) as fh:
             results = json.load(fh)["results"]
     for size in sizes:
-        for surface in args.surfaces.split(","):
-            for rows in args.rows.split(","):
+        for surface in surfaces:
+            for rows in rows_modes:
                 # the methods of one group run in turn, round after round, so that a slow spell
                 # of a shared machine falls on all of them alike
                 runs = {method: [] for method in methods}

@@ -89,7 +89,8 @@ def run_case(name, folder):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default="out/compare")
+    ap.add_argument("--out", default="out/compare",
+                    help="folder for compare.json, compare.md and the pictures (default: %(default)s)")
     ap.add_argument("--docs", default=None, help="also write small pictures docs/editing_NAME.png here")
     ap.add_argument("--force", action="store_true", help="replace output files that exist")
     args = ap.parse_args(argv)

@@ -177,8 +177,8 @@ def devil():
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default="out/fig1")
-    ap.add_argument("--docs", default=None)
+    ap.add_argument("--out", default="out/fig1", help="folder for fig1.json and the pictures (default: %(default)s)")
+    ap.add_argument("--docs", default=None, help="also write DOCS/editing_fig1.png (a folder that exists)")
     ap.add_argument("--force", action="store_true", help="replace output files that exist")
     args = ap.parse_args(argv)
     # (elevation, azimuth); (c) shows both horns, the edited one in front

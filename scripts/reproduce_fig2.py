@@ -140,8 +140,8 @@ def terrain():
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default="out/fig2")
-    ap.add_argument("--docs", default=None)
+    ap.add_argument("--out", default="out/fig2", help="folder for fig2.json and the pictures (default: %(default)s)")
+    ap.add_argument("--docs", default=None, help="also write DOCS/editing_fig2.png (a folder that exists)")
     ap.add_argument("--force", action="store_true", help="replace output files that exist")
     args = ap.parse_args(argv)
     run = _outputs.Run(ap, [os.path.join(args.out, name) for name in ("fig2a.png", "fig2b.png", "fig2.json")]

@@ -979,6 +979,27 @@ def test_reproduce_fig3_records_every_retriangulation_failure_and_peak_memory(fi
         "mannequin_nose.obj,mannequin_ear.obj,elephant_trunk.obj")
 
 
+def test_reproduce_fig3_quick_table_has_only_the_sections_it_ran(fig3, tmp_path, monkeypatch):
+    # --quick's table_quick.md had an "Every transfer configuration" section repeating the default
+    # rows, and a "Decimation, and a 100k-vertex source" heading over decimation rows only
+    run, repo, module = fig3
+    fig3_stubs(module, monkeypatch)
+    for name in FIG3_MESHES:
+        write(tmp_path / "meshes" / name, "")
+    assert run("--quick") == 0
+    table = open(repo / "out" / "fig3" / "table_quick.md").read()
+    headings = [line for line in table.splitlines() if line.startswith("### ")]
+    assert headings == ["### Default configuration (isotropic 1 %, conservative transfer, free rows, "
+                        "closest-point location)", "### Decimation (default transfer)"]
+    rows = [line for line in table.splitlines() if line.startswith("| ") and not line.startswith("| patch")]
+    assert len(rows) == 6 + len(module.EXTRA_RUNS)                  # each run once, no 100k source
+    assert "terrainA_100k" not in table
+    run("--force")                                                  # the full run keeps every section
+    full = open(repo / "out" / "fig3" / "fig3_table.md").read()
+    assert "### Every transfer configuration on the same targets" in full
+    assert "### Decimation, and a 100k-vertex source (default transfer)" in full
+
+
 def test_reproduce_fig3_as_a_program_leaves_numpy_floating_point_errors_reported(fig3, tmp_path, monkeypatch):
     # it ran np.seterr(all="ignore") for the whole process, hiding every floating-point warning;
     # no part of the run needs it (every configuration run with numpy's errors recorded: none)
