@@ -757,10 +757,11 @@ def _obj_bad_coordinate_in(chars, at, kind, digits, failed):
         keep = ~_after_hash(kind, failed, first)
         failed, newline, rank, first, end = failed[keep], newline[keep], rank[keep], first[keep], end[keep]
         keep = ~_special_words(chars, at[first] + 1, _number_end(chars, kind, at, first, end))
-        # a lone backslash ending the line: a v line continued on the next, whose joined values
-        # _obj_continued_line has checked
+        # a backslash ending the line, alone or after a value ('v 1 0\\' then ' 5': read as
+        # (1, 0, 5)): a v line continued on the next, whose joined values _obj_continued_line has
+        # checked (and refused where the backslash glues two words)
         last = np.minimum(end + 1, kind.size - 1)
-        keep &= ~((at[end] - at[first] == 2) & (chars[at[first] + 1] == 92) &
+        keep &= ~((chars[at[end] - 1] == 92) &
                   ((kind[end] == _NL) | ((kind[last] == _NL) & (at[last] == at[end] + 1) &
                                          (chars[np.minimum(at[end], chars.size - 1)] == 13))))
         failed, newline, rank, first, end = failed[keep], newline[keep], rank[keep], first[keep], end[keep]

@@ -739,6 +739,12 @@ _V3 = [[0.0, 0.0, 0.0], [1.0, 0.0, 5.0], [0.0, 1.0, 0.0]]
     (b"v 0 0 0\nv 1 0 \\\r\n5\nv 0 1 0\nf 1 2 3\n", _V3),                      # CR LF, then LF: read right
     (b"v 0 0 0\nv 1 0 5 \\\n# x\nv 0 1 0\nf 1 2 3\n", _V3),                   # a comment after the z
     (b"v 0 0 0\nv 0 1 0\nv 1 0 \\\n  5\nf 1 2 3\n", [[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 5.0]]),
+    # the backslash right after a value, the next line starting with a blank: 'v 1 0 5', as
+    # pymeshlab reads it (it was refused as "the y coordinate '0\\' ... read as the vertex (1, 0)")
+    (b"v 0 0 0\nv 1 0\\\n 5\nv 0 1 0\nf 1 2 3\n", _V3),
+    (b"v 0 0 0\nv 1\\\n\t0 5\nv 0 1 0\nf 1 2 3\n", _V3),
+    (b"v 0 0 0\nv 1 0\\\r\n 5\nv 0 1 0\nf 1 2 3\n", _V3),                      # CR LF, then LF
+    (b"v 0 0 0\nv 1 0 5\\\n \nv 0 1 0\nf 1 2 3\n", _V3),                      # continued on a blank line
 ])
 def test_obj_vertex_lines_continued_on_values_are_read_as_pymeshlab_reads_them(tmp_path, data, vertices):
     from curvdetail.io import read_mesh

@@ -187,3 +187,34 @@ def test_a_source_retriangulated_since_its_detail_was_stored_is_refused():
     ms.generate_copy_of_current_mesh()
     with pytest.raises(FilterError, match="belongs to another triangulation"):
         apply(ms, "transfer_curvature_detail", sourcemesh=0, targetmesh=1)
+
+
+def test_a_planar_map_that_collapses_a_triangle_is_named_in_the_filters_words(monkeypatch):
+    # as remesh_experiment names it (pymeshlab's float32 LSCM of a decimated camelhead put a
+    # target triangle's corners on one line): the filter said "the planar map uv[1] (UVt) ...
+    # Use another parameterization (e.g. parameterize(..., method='harmonic'))", Python words
+    import curvdetail.remesh as remesh
+    from curvdetail.curvature.testing import disk
+
+    real = remesh.parameterize
+
+    def collapsing(Vs, Fs, Vt, Ft, **kwargs):
+        UVs, UVt, info = real(Vs, Fs, Vt, Ft, **kwargs)
+        interior = np.setdiff1d(np.arange(Vt.shape[0]), boundary_vertices(Ft))
+        t = int(np.flatnonzero(np.isin(Ft, interior).all(1))[0])
+        a, b, c = Ft[t]
+        UVt = UVt.copy()
+        UVt[c] = 0.25 * UVt[a] + 0.75 * UVt[b]           # on the line through the other two
+        return UVs, UVt, info
+
+    V, F = disk(n_rings=8)
+    V[:, 2] = 0.2 * (V[:, :2] ** 2).sum(1)
+    monkeypatch.setattr(remesh, "parameterize", collapsing)
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(V, F))
+    ms.add_mesh(pymeshlab.Mesh(V, F))
+    with pytest.raises(FilterError, match=r"^the lscm parameterization of the target \(layer 1\) maps 1 triangle "
+                                          r"\(first: \d+\) to zero area in the plane .* Use parameterization="
+                                          r"'harmonic' or location='closest' \(no planar map\)\.$"):
+        apply(ms, "transfer_curvature_detail", sourcemesh=0, targetmesh=1, location="uv", parameterization="lscm")
+    assert vertex_attribute(ms, 1, "curvature_detail", "point") is None

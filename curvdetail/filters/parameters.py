@@ -160,8 +160,11 @@ class Parameter:
 
     def _convert(self, value):
         t = self.type
-        if isinstance(value, np.ndarray) and value.ndim == 0 and t != "str":
-            value = value[()]                     # a 0-d array as its numpy scalar, as pymeshlab takes it
+        if isinstance(value, np.ndarray) and value.ndim == 0 and \
+                (t != "str" or (self.choices is not None and value.dtype.kind in "iu")):
+            # a 0-d array as its numpy scalar, as pymeshlab takes it (an enum's index too; a text
+            # parameter's array is read as its numbers below)
+            value = value[()]
         if t == "bool":
             if isinstance(value, (bool, np.bool_)):
                 return bool(value)

@@ -61,6 +61,7 @@ def planar_map(location, parameterization, default="harmonic"):
 )
 def transfer_curvature_detail(ms, *, sourcemesh, targetmesh, method, location, parameterization):
     from ..remesh import check_disk, parameterize, transfer_curvature
+    from ..remesh.transfer import squashed_in_plane
 
     parameterization = planar_map(location, parameterization)
     source = layer_id(ms, sourcemesh, "sourcemesh")
@@ -79,6 +80,12 @@ def transfer_curvature_detail(ms, *, sourcemesh, targetmesh, method, location, p
     uv = None
     if location == "uv":
         UVs, UVt, info = parameterize(Vs, Fs, Vt, Ft, method=parameterization)
+        # a collapsed triangle named in the filter's words (the transfer's own refusal names uv[1]
+        # (UVt) and parameterize(...), which a filter user never sees)
+        other = "parameterization='harmonic' or " if parameterization != "harmonic" else ""
+        for which, layer, UV, T in (("source", source, UVs, Fs), ("target", target, UVt, Ft)):
+            squashed_in_plane(UV, T, f"the {parameterization} parameterization of the {which} (layer {layer})",
+                              f"Use {other}location='closest' (no planar map).", FilterError)
         uv = (UVs, UVt)
         figures.update(parameterization=parameterization, flipped_source=info["flipped_source"],
                        flipped_target=info["flipped_target"],
