@@ -293,7 +293,7 @@ def test_a_backend_the_one_ring_stage_cannot_use_is_named_in_options(tmp_path, c
                  "--backend", "banded"]) == 1
     err = capsys.readouterr().err
     assert "--relations one-ring makes the curvature stage a nonsymmetric system: The banded Cholesky " \
-           "factors symmetric positive definite matrices only; use 'pardiso' or 'splu', or --relations " \
+           "factors symmetric positive definite matrices only; use --backend pardiso or splu, or --relations " \
            "one+two-ring (symmetric normal equations)." in err, err
     assert "do not determine" not in err and not out.exists()
     # what it names works
