@@ -12,7 +12,7 @@ import numpy as np
 
 from ._ctm_scan import ctm_layout, ctm_problem, ctm_vertex_map
 from ._file_counts import check_loaded, check_polygons, declared_counts
-from ._file_scan import check_before_loading
+from ._file_scan import check_before_loading, small_pages
 from ._output import atomic_output, check_output_path
 from .curvature._validate import as_faces, as_vertices
 from .curvature.errors import MeshError, counted, first_indices
@@ -96,9 +96,10 @@ def read_mesh(path):
     """
     path = input_path(path)
     ms = _meshset()                 # kept referenced: the mesh is a view into it
-    mesh = load_checked(ms, path, vertex_maps=False)      # V and F only: a CTM's maps are not needed
-    V = np.ascontiguousarray(mesh.vertex_matrix(), dtype=np.float64)
-    F = np.ascontiguousarray(mesh.face_matrix(), dtype=np.int64)
+    with small_pages():             # a fresh process first touched huge pages slowly
+        mesh = load_checked(ms, path, vertex_maps=False)      # V and F only: a CTM's maps are not needed
+        V = np.ascontiguousarray(mesh.vertex_matrix(), dtype=np.float64)
+        F = np.ascontiguousarray(mesh.face_matrix(), dtype=np.int64)
     if F.shape[0] == 0 and V.shape[0] == 0:       # pymeshlab "reads" some other files as nothing
         raise MeshFileError(f"pymeshlab read nothing from {path!r} (no vertices, no triangles); is it a "
                             "mesh file? Use a format MeshLab reads (.obj, .off, .ply, .stl, ...).")

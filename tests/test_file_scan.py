@@ -7,6 +7,7 @@ import re
 import numpy as np
 import pytest
 
+from curvdetail import _file_scan
 from curvdetail._file_scan import check_before_loading
 
 _OFF_VERTICES = "0 0 0\n1 0 0\n0 1 0\n1 1 0\n"
@@ -830,3 +831,46 @@ def test_off_index_out_of_range_is_found_past_the_first_pieces_of_indices(tmp_pa
     path.write_bytes(text.replace(b"\n3 0 1 %d\n" % len(V), b"\n3 0 1 %d 9 9 9\n" % len(V)))   # a colour: other path
     with pytest.raises(ValueError, match=rf"\(first: face {len(F) - 1}, \[0, 1, {len(V)}\]\)"):
         check_before_loading(str(path))
+
+
+@pytest.mark.skipif(_file_scan._set_madvise_hugepage is None, reason="this numpy has no huge-page switch")
+@pytest.mark.parametrize("setting", [True, False])
+def test_reads_leave_numpys_huge_page_setting_as_they_found_it(tmp_path, setting):
+    # read_mesh turns numpy's huge pages off while it scans (a fresh process touched them slowly),
+    # and must give the setting back: after a read, a refused read, and reads in threads whose
+    # spans cross (each restoring what it found left it off for good)
+    import threading
+
+    from curvdetail.curvature.testing import grid
+    from curvdetail.io import MeshFileError, read_mesh, write_mesh
+
+    switch = _file_scan._set_madvise_hugepage
+    V, F = grid(30, 30)
+    path = tmp_path / "g.off"
+    write_mesh(path, V, F)
+    bad = tmp_path / "bad.obj"
+    bad.write_text("v 0 0 0\nv 1 0 0\nf 1 2 3\n")
+    switch(setting)
+    try:
+        read_mesh(path)
+        assert switch(setting) is setting                 # (it returns the setting it replaces)
+        with pytest.raises(MeshFileError):
+            read_mesh(bad)
+        assert switch(setting) is setting
+        entered, main_inside, left = threading.Event(), threading.Event(), threading.Event()
+
+        def first():                                      # in first, out first
+            with _file_scan.small_pages():
+                entered.set()
+                main_inside.wait(10)
+            left.set()
+        thread = threading.Thread(target=first)
+        thread.start()
+        entered.wait(10)
+        with _file_scan.small_pages():
+            main_inside.set()
+            left.wait(10)
+        thread.join()
+        assert switch(setting) is setting
+    finally:
+        switch(True)
