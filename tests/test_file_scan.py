@@ -874,3 +874,27 @@ def test_reads_leave_numpys_huge_page_setting_as_they_found_it(tmp_path, setting
         assert switch(setting) is setting
     finally:
         switch(True)
+
+
+def test_index_words_are_read_as_int_reads_them():
+    # the face scan reads words of up to 8 digits as one 64-bit word (digits paired by three
+    # multiplications) and longer ones a digit at a time; both must be int()'s value
+    from curvdetail._file_scan import _whole_values
+
+    rng = np.random.default_rng(7)
+    words = [str(int(v)) for v in rng.integers(0, 10 ** rng.integers(1, 19, 400), dtype=np.int64)]
+    words += ["0", "7", "10", "99999999", "100000000", "12345678", "123456789", "999999999999999999", "00042"]
+    text = " ".join(words).encode()
+    chars = np.frombuffer(text, dtype=np.uint8)
+    ends = np.cumsum([len(w) + 1 for w in words]) - 1              # the byte after each word
+    digits = np.array([len(w) for w in words])
+    for plain in (np.ones(len(words), dtype=bool), np.arange(len(words)) % 3 != 0):
+        values = _whole_values(chars, ends, digits, plain)
+        expected = [int(w) if p else 0 for w, p in zip(words, plain)]
+        assert values.tolist() == expected
+    # the usual file: every word short and plain (no gathers)
+    short = [w for w in words if len(w) <= 8]
+    chars = np.frombuffer(" ".join(short).encode(), dtype=np.uint8)
+    ends = np.cumsum([len(w) + 1 for w in short]) - 1
+    values = _whole_values(chars, ends, np.array([len(w) for w in short]), np.ones(len(short), dtype=bool))
+    assert values.tolist() == [int(w) for w in short] and len(short) > 10
