@@ -201,6 +201,12 @@ def check_mesh(V, F, *, check_manifold=True, check_unreferenced=True):
                  for out, given in zip(checked, (V, F)))
 
 
+def checked_arrays(V, F, *, check_manifold=True, check_unreferenced=True):
+    """:func:`check_mesh` without its copy, for callers that only read the arrays (a float64 /
+    int64 C input comes back as itself)."""
+    return _check_mesh(V, F, check_manifold, check_unreferenced)[:2]
+
+
 def _check_mesh(V, F, check_manifold, check_unreferenced, cotangents=False):
     V = as_vertices(V)
     F = as_faces(F, V.shape[0])

@@ -3,7 +3,7 @@
 import numpy as np
 
 from ._geometry import corner_cotangents
-from ._validate import _check_mesh
+from ._validate import checked_arrays
 
 
 def mixed_voronoi_area(V, F):
@@ -34,7 +34,7 @@ def mixed_voronoi_area(V, F):
     >>> mixed_voronoi_area(V, F)   # right triangle: circumcentre at the hypotenuse midpoint
     array([0.25 , 0.125, 0.125])
     """
-    V, F = _check_mesh(V, F, True, True)[:2]     # no copy: the result is computed from them
+    V, F = checked_arrays(V, F)                  # no copy: the result is computed from them
     return _mixed_voronoi_area_unchecked(V, F)
 
 

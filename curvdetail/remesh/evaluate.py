@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ..curvature._validate import as_count, check_choice, as_faces, bbox_diagonal, check_bool, check_mesh, face_double_areas
+from ..curvature._validate import as_count, check_choice, as_faces, bbox_diagonal, check_bool, checked_arrays, face_double_areas
 from ..curvature.errors import MeshError, counted, first_indices, them
 from .locate import EXACT_BLOCK, FAR_POINTS, _locate, _unit_frame, check_points_and_mesh
 
@@ -104,8 +104,8 @@ def hausdorff(Va, Fa, Vb, Fb, *, samples=None, engine="meshlab", seed=0, a_verte
     Fa = as_faces(Fa, Va.shape[0], "Fa")              # named as the caller names it
     both = np.vstack([Va, Vb])
     _, both, scale = _unit_frame(both[:0], both)
-    Va, Fa = check_mesh(both[:Va.shape[0]], Fa)
-    Vb, Fb = check_mesh(both[Va.shape[0]:], Fb)
+    Va, Fa = checked_arrays(both[:Va.shape[0]], Fa)
+    Vb, Fb = checked_arrays(both[Va.shape[0]:], Fb)
     engine = check_choice(engine, "engine", ("meshlab", "kdtree"), "; use 'meshlab' or 'kdtree'.")
     samples = _check_samples(samples)
     seed = None if seed is None else as_count(seed, "seed", minimum=0)

@@ -3,7 +3,7 @@
 import numpy as np
 
 from ..curvature._validate import (check_choice, as_faces, as_index_set, as_values, as_vertices, check_every_component_fixed,
-                                  bbox_diagonal, check_mesh)
+                                  bbox_diagonal, checked_arrays)
 from ..curvature.cotan_laplacian import _cotan_laplacian_unchecked
 from ..curvature.errors import ConstraintError, MeshError
 from ..curvature.sparse_solver import factorize
@@ -90,7 +90,7 @@ def harmonic_map(V, F, boundary, boundary_uv, *, backend="auto"):
     >>> bool(np.allclose(UV, V[:, :2], atol=1e-12))
     True
     """
-    V, F = check_mesh(V, F)
+    V, F = checked_arrays(V, F)
     boundary = as_index_set(boundary, V.shape[0], "boundary")
     if boundary.size == 0:
         raise ConstraintError("boundary is empty: with no pinned vertex the harmonic map is undetermined "

@@ -4,7 +4,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..curvature._validate import (ZERO_AREA_RELATIVE, _edge_keys, as_count, as_values, check_choice, bbox_diagonal,
-                                   check_mesh, face_double_areas)
+                                   checked_arrays, face_double_areas)
 from ..curvature.errors import MeshError, counted, first_indices
 from ..curvature.mean_curvature_normal import mean_curvature_normal
 from ..curvature.mixed_voronoi_area import mixed_voronoi_area
@@ -51,7 +51,7 @@ def edge_curvature_measure(V, F):
     >>> bool(np.allclose(D, curvature_detail(V, F), atol=1e-12))
     True
     """
-    V, F = check_mesh(V, F, check_manifold=False, check_unreferenced=False)
+    V, F = checked_arrays(V, F, check_manifold=False, check_unreferenced=False)
     return _edge_curvature_measure(V, F)
 
 
@@ -147,8 +147,8 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
         if method != "conservative":
             raise ValueError("samples_per_edge is used by method='conservative' only; drop it for 'pointwise'.")
         samples_per_edge = as_count(samples_per_edge, "samples_per_edge")
-    Vs, Fs = check_mesh(Vs, Fs)
-    Vt, Ft = check_mesh(Vt, Ft)
+    Vs, Fs = checked_arrays(Vs, Fs)
+    Vt, Ft = checked_arrays(Vt, Ft)
     if detail is not None:
         detail = as_values(detail, Vs.shape[0], "detail (the source's detail)")
     if location == "uv":
