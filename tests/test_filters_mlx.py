@@ -415,3 +415,28 @@ def test_a_malformed_edit_is_refused_before_the_first_step_runs(tmp_path, param,
     assert vertex_attribute(ms, 0, "curvature_detail", "point") is None
     with pytest.raises(FilterParameterError, match=message):          # and save_script writes no such step
         save_script(tmp_path / "other.mlx", [("apply_curvature_editing", {param: value})])
+
+
+def test_a_step_that_leaves_out_a_required_parameter_is_refused_before_the_first_step_runs(tmp_path):
+    # an editing step without handles failed only when it ran, after the steps before it had
+    # changed the MeshSet (its default, no handles, never works)
+    path = write(tmp_path, '<filter name="compute_curvature_detail"/>\n <filter name="apply_curvature_editing">'
+                           '<Param name="region_radius" value="10%"/></filter>')
+    ms = meshset()
+    with pytest.raises(ScriptError, match=r"s.mlx step 2 \(apply_curvature_editing\): filter "
+                                          r"'apply_curvature_editing' needs parameter 'handles': handle vertex "
+                                          r"indices, .*; it has no default that works\.$"):
+        run_script(ms, path)
+    assert vertex_attribute(ms, 0, "curvature_detail", "point") is None
+    with pytest.raises(FilterParameterError, match="needs parameter 'handles'"):
+        save_script(tmp_path / "other.mlx", ["apply_curvature_editing"])
+    assert not (tmp_path / "other.mlx").exists()
+    # and apply, before the mesh is read; given, the step runs
+    V = ms.current_mesh().vertex_matrix().copy()
+    with pytest.raises(FilterParameterError, match="needs parameter 'handles'"):
+        apply(ms, "apply_curvature_editing", region_radius=pymeshlab.PercentageValue(10.0))
+    assert np.array_equal(ms.current_mesh().vertex_matrix(), V)
+    apply(ms, "apply_curvature_editing", handles="0 1 2", region_radius=pymeshlab.PercentageValue(10.0))
+    from curvdetail.filters import get_filter
+    assert [p.name for p in get_filter("apply_curvature_editing").parameters if p.to_dict().get("required")] \
+        == ["handles"]

@@ -9,8 +9,9 @@ from .registry import close_matches, get_filter
 def complete_parameters(spec, params):
     """Check ``params`` against a filter's declaration and fill in the defaults.
 
-    Raises FilterParameterError for an unknown parameter (listing the close matches) or a value
-    of the wrong type or out of range (naming the parameter and the expected type)."""
+    Raises FilterParameterError for an unknown parameter (listing the close matches), a required
+    one left out, or a value of the wrong type or out of range (naming the parameter and the
+    expected type)."""
     names = spec.parameter_names
     for key in params:
         if key not in names:
@@ -18,8 +19,14 @@ def complete_parameters(spec, params):
             hint = (f"did you mean {', '.join(matches)}?" if matches else
                     f"its parameters are: {', '.join(names) if names else 'none'}.")
             raise FilterParameterError(f"filter {spec.name!r} has no parameter {key!r}; {hint}")
-    return {p.name: (p.check(params[p.name]) if p.name in params else p.default)
-            for p in spec.parameters}
+    values = {p.name: (p.check(params[p.name]) if p.name in params else p.default)
+              for p in spec.parameters}
+    missing = [p for p in spec.parameters if p.required and p.name not in params]
+    if missing:                        # after the given values' checks: what was written wrong first
+        p = missing[0]
+        raise FilterParameterError(f"filter {spec.name!r} needs parameter {p.name!r}: "
+                                   f"{' '.join(p.description.split())}; it has no default that works.")
+    return values
 
 
 def apply(ms, name, **params):

@@ -130,7 +130,7 @@ def _matrix(text):
     parameters=[
         Parameter("handles", "str", "", "handle vertex indices, separated by spaces or commas "
                   "(from Python also a list, array, range, set or single int; whole floats such as "
-                  "3.0 are indices)", validate=_handles_without_a_mesh),
+                  "3.0 are indices)", validate=_handles_without_a_mesh, required=True),
         Parameter("region_radius", "PercentageValue", BBoxLength(0.0, percent=True),
                   "also put every vertex within this distance of a handle into the region of "
                   "interest (0: the selection alone); a percentage of the bbox diagonal or absolute",

@@ -112,6 +112,9 @@ class Parameter:
     #: refuse the value whatever the mesh (a transform of 15 numbers), so that apply, a script's
     #: check and the command line refuse it before any work; its return value is ignored
     validate: object = None
+    #: the filter cannot run without it (its default, e.g. no handles, is refused): a call, a
+    #: script or a saved script that leaves it out is refused before any step runs
+    required: bool = False
 
     def __post_init__(self):
         if self.type not in TYPES:
@@ -130,7 +133,7 @@ class Parameter:
     def to_dict(self):
         """The parameter as JSON-ready values: ``name``, ``type``, ``default`` (a percentage as
         text, e.g. ``"1.0%"``), ``description``, and ``choices`` / ``min`` / ``max`` /
-        ``positive`` where set."""
+        ``positive`` / ``required`` where set."""
         out = {"name": self.name, "type": self.type,
                "default": str(self.default) if isinstance(self.default, BBoxLength) else self.default,
                "description": " ".join(self.description.split())}
@@ -141,6 +144,8 @@ class Parameter:
                 out[key] = getattr(self, key)
         if self.positive:
             out["positive"] = True
+        if self.required:
+            out["required"] = True
         return out
 
     # -- checking Python values -----------------------------------------------------------------
