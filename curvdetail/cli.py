@@ -955,6 +955,8 @@ _COMMAND_WORDS = {
               "pymeshlab.PercentageValue(1) is 1 %": "--param target_edge=1% is 1 %",
               "or use backend='auto'": "or use --param backend=auto",
               "relations='one-ring' makes": "--param relations=one-ring makes",
+              "; it has no default that works.": "; it has no default that works: give it with --param "
+                                                 "NAME=VALUE.",
               "; use 'pardiso' or 'splu', or": "; use --param backend=pardiso or splu, or",
               "or relations='one+two-ring' (": "or --param relations=one+two-ring (",
               # apply_curvature_editing's warning: what to try

@@ -672,3 +672,10 @@ def test_a_backend_the_one_ring_stage_cannot_use_is_told_as_params(capsys, tmp_p
             "factors symmetric positive definite matrices only; use --param backend=pardiso or splu, or "
             "--param relations=one+two-ring (symmetric normal equations).") in line, line
     assert not (tmp_path / "o.ply").exists()
+
+
+def test_a_required_parameter_left_out_of_apply_is_asked_for_as_a_param(capsys, tmp_path):
+    assert_failed(capsys, ["apply", "apply_curvature_editing", NOSE, tmp_path / "o.ply"],
+                  "filter 'apply_curvature_editing' needs parameter 'handles': handle vertex indices", tmp_path / "o.ply")
+    assert_failed(capsys, ["apply", "apply_curvature_editing", NOSE, tmp_path / "o.ply"],
+                  "; it has no default that works: give it with --param NAME=VALUE.", tmp_path / "o.ply")
