@@ -41,6 +41,7 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from curvdetail.cli import _whole_number_from_one as at_least_one  # noqa: E402 (the CLI's option type)
 import _outputs  # noqa: E402
 
 SIDES = {"10k": 100, "100k": 316, "1M": 1000}
@@ -171,24 +172,13 @@ def in_subprocess(case, variant, size, timeout):
     return json.loads(lines[-1][len("RESULT "):])
 
 
-def _positive_seconds(text):
-    """``--timeout``: a whole number of seconds >= 1, or an argparse error."""
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number of seconds of at least 1")
-    return value
-
-
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sizes", default="100k", help="comma-separated: 10k, 100k, 1M")
     ap.add_argument("--cases", default=",".join(CASES), help="comma-separated: " + ", ".join(CASES))
     ap.add_argument("--out", default="out/bench_operations.json", help="JSON results (default: %(default)s)")
     ap.add_argument("--force", action="store_true", help="replace OUT if it exists")
-    ap.add_argument("--timeout", type=_positive_seconds, default=900, help="seconds per case")
+    ap.add_argument("--timeout", type=at_least_one, default=900, help="seconds per case")
     ap.add_argument("--child", nargs=3, help=argparse.SUPPRESS)
     ap.add_argument("--write-files", nargs=2, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)

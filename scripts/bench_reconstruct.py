@@ -49,6 +49,7 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from curvdetail.cli import _whole_number_from_one as at_least_one  # noqa: E402 (the CLI's option type)
 import _outputs  # noqa: E402
 
 SIZES = {"10k": 10_000, "100k": 100_000, "1M": 1_000_000}
@@ -407,17 +408,6 @@ def _names(parser, option, text, allowed, what):
     return names
 
 
-def _at_least_one(text):
-    """``--rounds`` / ``--trials``: a whole number >= 1, or an argparse error."""
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number of at least 1")
-    return value
-
-
 def _positive(text):
     """``--timeout`` / ``--mem-limit-gb``: a finite number > 0, or an argparse error."""
     try:
@@ -454,10 +444,10 @@ def main(argv=None):
     parser.add_argument("--force", action="store_true",
                         help="also run the cases left out by default (naive spsolve and CHOLMOD at 1M); "
                              "replacing files is --overwrite")
-    parser.add_argument("--rounds", type=_at_least_one, default=1,
+    parser.add_argument("--rounds", type=at_least_one, default=1,
                         help="subprocess runs per case, the methods of a group taking turns; the "
                              "fastest is kept (default 1)")
-    parser.add_argument("--trials", type=_at_least_one, default=None,
+    parser.add_argument("--trials", type=at_least_one, default=None,
                         help="factor + solve runs per case, the fastest kept (default 2, 1 at 1M)")
     parser.add_argument("--rebuild-markdown", action="store_true",
                         help="run nothing: rewrite --markdown's table from the --out file")
