@@ -49,7 +49,8 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from curvdetail.cli import _whole_number_from_one as at_least_one  # noqa: E402 (the CLI's option type)
+from curvdetail.cli import _positive_number as positive_number  # noqa: E402 (the CLI's option types)
+from curvdetail.cli import _whole_number_from_one as at_least_one  # noqa: E402
 import _outputs  # noqa: E402
 
 SIZES = {"10k": 10_000, "100k": 100_000, "1M": 1_000_000}
@@ -408,17 +409,6 @@ def _names(parser, option, text, allowed, what):
     return names
 
 
-def _positive(text):
-    """``--timeout`` / ``--mem-limit-gb``: a finite number > 0, or an argparse error."""
-    try:
-        value = float(text)
-    except ValueError:
-        value = float("nan")
-    if not 0.0 < value < float("inf"):
-        raise argparse.ArgumentTypeError(f"{text!r} is not a positive number")
-    return value
-
-
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -437,8 +427,8 @@ def main(argv=None):
     parser.add_argument("--overwrite", action="store_true",
                         help="replace an existing --out file and rewrite an existing --markdown "
                              "file's table (refused before any case runs otherwise)")
-    parser.add_argument("--timeout", type=_positive, default=1200.0, help="seconds per case")
-    parser.add_argument("--mem-limit-gb", type=_positive, default=16.0,
+    parser.add_argument("--timeout", type=positive_number, default=1200.0, help="seconds per case")
+    parser.add_argument("--mem-limit-gb", type=positive_number, default=16.0,
                         help="stop a case whose resident memory passes this (default 16; the "
                              "machine is shared)")
     parser.add_argument("--force", action="store_true",

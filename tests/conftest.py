@@ -246,3 +246,19 @@ def wavy_source_and_a_rebuild_beside_it(monkeypatch):
 
     monkeypatch.setattr(experiment, "transfer_curvature", beside)
     return V, F
+
+
+def squashing_target_triangle(parameterize):
+    """``parameterize`` wrapped so that its target map puts one interior triangle's third corner on
+    the line through the other two (what pymeshlab's float32 LSCM did to a camelhead triangle)."""
+    from curvdetail.curvature import boundary_vertices
+
+    def squashing(Vs, Fs, Vt, Ft, **kwargs):
+        UVs, UVt, info = parameterize(Vs, Fs, Vt, Ft, **kwargs)
+        interior = np.setdiff1d(np.arange(Vt.shape[0]), boundary_vertices(Ft))
+        t = int(np.flatnonzero(np.isin(Ft, interior).all(1))[0])
+        a, b, c = Ft[t]
+        UVt = UVt.copy()
+        UVt[c] = 0.25 * UVt[a] + 0.75 * UVt[b]
+        return UVs, UVt, info
+    return squashing

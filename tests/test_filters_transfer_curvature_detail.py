@@ -13,6 +13,8 @@ from curvdetail.filters.errors import FilterParameterError
 from curvdetail.filters.meshset import set_vertex_positions, vertex_attribute
 from curvdetail.remesh.transfer import transfer_curvature
 
+from conftest import squashing_target_triangle
+
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
 
 
@@ -198,14 +200,7 @@ def test_a_planar_map_that_collapses_a_triangle_is_named_in_the_filters_words(mo
 
     real = remesh.parameterize
 
-    def collapsing(Vs, Fs, Vt, Ft, **kwargs):
-        UVs, UVt, info = real(Vs, Fs, Vt, Ft, **kwargs)
-        interior = np.setdiff1d(np.arange(Vt.shape[0]), boundary_vertices(Ft))
-        t = int(np.flatnonzero(np.isin(Ft, interior).all(1))[0])
-        a, b, c = Ft[t]
-        UVt = UVt.copy()
-        UVt[c] = 0.25 * UVt[a] + 0.75 * UVt[b]           # on the line through the other two
-        return UVs, UVt, info
+    collapsing = squashing_target_triangle(real)
 
     V, F = disk(n_rings=8)
     V[:, 2] = 0.2 * (V[:, :2] ** 2).sum(1)

@@ -10,7 +10,7 @@ from curvdetail.curvature.testing import disk
 from curvdetail.remesh import (NotADiskError, RemeshError, WorseThanZeroDetailWarning, hausdorff, remesh_experiment,
                                retriangulate, vertex_distance)
 
-from conftest import triangle_brute_force, wavy_source_and_a_rebuild_beside_it
+from conftest import squashing_target_triangle, triangle_brute_force, wavy_source_and_a_rebuild_beside_it
 
 
 def _gaussians(xy):
@@ -521,14 +521,7 @@ def test_a_planar_map_that_collapses_a_target_triangle_is_refused_by_the_option(
     import curvdetail.remesh.experiment as experiment
     from curvdetail.remesh import parameterize
 
-    def collapsing(Vs, Fs, Vt, Ft, **kwargs):
-        UVs, UVt, info = parameterize(Vs, Fs, Vt, Ft, **kwargs)
-        interior = np.setdiff1d(np.arange(Vt.shape[0]), boundary_vertices(Ft))
-        t = int(np.flatnonzero(np.isin(Ft, interior).all(1))[0])
-        a, b, c = Ft[t]
-        UVt = UVt.copy()
-        UVt[c] = 0.25 * UVt[a] + 0.75 * UVt[b]           # on the line through the other two
-        return UVs, UVt, info
+    collapsing = squashing_target_triangle(parameterize)
 
     V, F = disk(n_rings=8)
     V[:, 2] = 0.2 * (V[:, :2] ** 2).sum(1)
