@@ -262,3 +262,14 @@ def squashing_target_triangle(parameterize):
         UVt[c] = 0.25 * UVt[a] + 0.75 * UVt[b]
         return UVs, UVt, info
     return squashing
+
+
+def load_script(name):
+    """The script ``scripts/NAME.py`` as a fresh module (the scripts are not a package)."""
+    import importlib.util
+
+    path = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "scripts", name + ".py")
+    spec = importlib.util.spec_from_file_location(f"script_{name}", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module

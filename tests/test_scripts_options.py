@@ -10,21 +10,17 @@ case at ``--timeout -1``; bench_operations skipped every case at ``--timeout 0``
 Only argument parsing runs here: the cases are stubbed.
 """
 
-import importlib.util
 import os
 
 import pytest
+
+from conftest import load_script
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCRIPTS = os.path.join(ROOT, "scripts")
 
 
-def load(name):
-    """The script ``scripts/NAME.py`` as a fresh module (the scripts are not a package)."""
-    spec = importlib.util.spec_from_file_location(f"script_options_{name}", os.path.join(SCRIPTS, name + ".py"))
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+load = load_script
 
 
 def refused(module, args, capsys):

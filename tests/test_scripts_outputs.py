@@ -11,7 +11,6 @@ output check stops at its mesh check, in no time.
 """
 
 import errno
-import importlib.util
 import json
 import os
 import re
@@ -22,16 +21,13 @@ import sys
 import numpy as np
 import pytest
 
+from conftest import load_script
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCRIPTS = os.path.join(ROOT, "scripts")
 
 
-def load(name):
-    """The script ``scripts/NAME.py`` as a fresh module (the scripts are not a package)."""
-    spec = importlib.util.spec_from_file_location(f"script_{name}", os.path.join(SCRIPTS, name + ".py"))
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+load = load_script
 
 
 @pytest.fixture
