@@ -10,15 +10,9 @@ case at ``--timeout -1``; bench_operations skipped every case at ``--timeout 0``
 Only argument parsing runs here: the cases are stubbed.
 """
 
-import os
-
 import pytest
 
 from conftest import load_script
-
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-SCRIPTS = os.path.join(ROOT, "scripts")
-
 
 load = load_script
 
