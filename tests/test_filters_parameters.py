@@ -282,3 +282,17 @@ def test_an_enum_index_given_as_a_zero_dimensional_array_is_taken(value, expecte
     assert out == expected and type(out) is str
     with pytest.raises(FilterParameterError, match=r"'rows' is .*; it must be one of all, free, or its index, 0 to 1\."):
         p.check(np.array(2))
+
+
+def test_curvdetail_list_says_which_parameters_are_required():
+    # `curvdetail list` is the full reference: a parameter whose default is refused (the editing
+    # filter's handles) is marked there as in the JSON listing, and only that one
+    from curvdetail.filters.registry import describe_filter, list_filters
+
+    for spec in list_filters():
+        for p in spec.parameters:
+            line = next(text for text in describe_filter(spec).splitlines()
+                        if text.startswith(f"    {p.name} : "))
+            assert ("(required" in line) == bool(p.to_dict().get("required")), line
+    text = describe_filter(next(s for s in list_filters() if s.name == "apply_curvature_editing"))
+    assert "    handles : str = ''  (required)" in text.splitlines()

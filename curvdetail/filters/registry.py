@@ -277,7 +277,7 @@ def describe_filter(spec, width=96):
     lines = [f"{spec.name}  [{spec.category}]"]
     lines += textwrap.wrap(spec.description, width, initial_indent="    ", subsequent_indent="    ")
     for p in spec.parameters:
-        extra = []
+        extra = ["required"] if p.required else []       # its default is refused
         if p.choices:
             extra.append(" | ".join(p.choices))
         if p.positive:
