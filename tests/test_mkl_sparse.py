@@ -97,3 +97,27 @@ def test_a_missing_or_old_mkl_runtime_is_a_mkl_sparse_error(monkeypatch):
     b = boundary_vertices(F)
     rec = Reconstructor(V, F, b, backend="pardiso")
     assert not rec._upper and np.abs(rec.solve(curvature_detail(V, F), V[b]) - V).max() < 1e-12
+
+
+def test_the_bindings_pass_32_bit_indices_even_with_mkl_interface_layer_ilp64():
+    # with MKL_INTERFACE_LAYER=ILP64 mkl_rt read the int32 arguments as 64-bit: PARDISO crashed
+    # the process and mkl_sparse_syrk refused (status 5); the bindings now fix the LP64 layer
+    import os
+    import subprocess
+    import sys
+
+    script = """
+import numpy as np, scipy.sparse as sp
+from curvdetail.curvature._mkl_sparse import gram_upper
+from curvdetail.curvature.sparse_solver import factorize
+A = sp.random(40, 30, density=0.2, random_state=1, format="csr") + sp.eye(40, 30, format="csr")
+print(abs(gram_upper(A) - sp.triu(A @ A.T)).max())
+M = (A @ A.T + sp.eye(40)).tocsr()
+x = np.arange(40.0)
+print(np.abs(factorize(M, backend="pardiso").solve(M @ x) - x).max())
+"""
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120,
+                          env={**os.environ, "MKL_INTERFACE_LAYER": "ILP64"})
+    assert done.returncode == 0, (done.returncode, done.stderr[-2000:])
+    syrk, solve = map(float, done.stdout.split())
+    assert syrk < 1e-12 and solve < 1e-9

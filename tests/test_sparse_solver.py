@@ -456,3 +456,122 @@ def test_threads_sharing_one_factorization_solve_as_serial_solves(backend):
 @pytest.mark.parametrize("backend", every_backend(exclude=("cholmod", "banded")))
 def test_threads_sharing_one_nonsymmetric_factorization_solve_as_serial_solves(backend):
     _solve_in_threads_sharing_one_factor(backend, symmetric=False)
+
+
+_needs_pardiso = pytest.mark.skipif("pardiso" not in available_backends(), reason="PARDISO (pypardiso) not installed")
+
+
+@pytest.mark.parametrize("backend", every_backend())
+def test_a_failed_refactor_leaves_no_factors_to_solve_with(backend):
+    # after a refactor that failed, neither the old factors (another matrix) nor PARDISO's half
+    # overwritten ones (it returned a solution of neither matrix) may answer a solve
+    A, x = _spd_system(12)
+    A = sp.triu(A, format="csr") if backend == "pardiso" else A.tocsr()
+    fac = factorize(A, backend=backend, upper=backend == "pardiso")
+    singular = A.copy()
+    singular.data = singular.data.copy()
+    singular.data[(singular.tocoo().row == 0) | (singular.indices == 0)] = 0.0   # row and column 0
+    with pytest.raises(SolverError):
+        fac.refactor(singular)
+    with pytest.raises(SolverError, match="last refactor failed"):
+        fac.solve(x[:, 0])
+    fac.refactor(A)                           # valid values make it usable again
+    whole = A + sp.triu(A, k=1).T if backend == "pardiso" else A
+    assert np.abs(fac.solve(whole @ x) - x).max() < 1e-9 * np.abs(x).max()
+
+
+@pytest.mark.parametrize("backend", every_backend())
+def test_solve_refuses_a_complex_or_misshapen_right_hand_side(backend):
+    A, x = _spd_system(8)
+    fac = factorize(A, backend=backend)
+    n = A.shape[0]
+    with pytest.raises(SolverError, match="complex"):          # was: imaginary part dropped silently
+        fac.solve(np.ones(n) * 1j)
+    with pytest.raises(SolverError, match=r"shape \(\)"):      # was: IndexError
+        fac.solve(1.0)
+    with pytest.raises(SolverError, match=r"\(n, k\)"):        # was: numpy's reshape error
+        fac.solve(np.ones((n, 2, 2)))
+    # float32, Fortran order, read-only and zero columns are all fine
+    b = np.asfortranarray((A @ x).astype(np.float32))
+    b.flags.writeable = False
+    assert np.abs(fac.solve(b) - x).max() < 1e-4 * np.abs(x).max()
+    assert fac.solve(np.ones((n, 0))).shape == (n, 0)
+
+
+@_needs_pardiso
+def test_pending_factorization_of_a_pattern_with_unsorted_rows_solves_like_factorize():
+    # PARDISO needs sorted columns; an unsorted pattern was analysed as it came and the solution
+    # was off by the size of the solution (6 x 6), or PARDISO never returned (this 10 x 10 grid:
+    # hence a child process with a time limit)
+    import subprocess
+    import sys
+
+    script = """
+import numpy as np, scipy.sparse as sp
+from curvdetail.curvature import cotan_laplacian, sparse_solver
+from curvdetail.curvature.sparse_solver import SolverError
+from curvdetail.curvature.testing import grid
+V, F = grid(10, 10)
+V[:, 2] = np.sin(3 * V[:, 0]) * V[:, 1]
+L = cotan_laplacian(V, F)
+inner = np.flatnonzero((V[:, 0] > 0) & (V[:, 0] < 1) & (V[:, 1] > 0) & (V[:, 1] < 1))
+A = L[inner][:, inner]
+x = np.random.default_rng(3).normal(size=(inner.size, 3))
+U = sp.triu(A, format="csr")
+U.sort_indices()
+order = np.concatenate([np.arange(U.indptr[r], U.indptr[r + 1])[::-1] for r in range(U.shape[0])])
+pattern = sp.csr_matrix((np.zeros(U.nnz), U.indices[order], U.indptr), shape=U.shape)
+fac = sparse_solver.PendingFactorization(pattern, backend="pardiso").finish(U.data[order])
+print(np.abs(fac.solve(A @ x) - x).max() / np.abs(x).max())
+try:
+    sparse_solver.PendingFactorization(pattern, backend="pardiso").finish(U.data[1:])
+except SolverError as e:
+    print(e)
+"""
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, (done.returncode, done.stderr[-2000:])
+    error, refusal = done.stdout.strip().splitlines()
+    assert float(error) < 1e-9
+    assert refusal.startswith("finish needs ") and "values, one per stored entry of the pattern" in refusal
+
+
+@_needs_pardiso
+def test_pardiso_refuses_a_matrix_that_needs_64_bit_indices():
+    # the int32 copy of an index array with an entry over 2**31 - 1 wrapped around: 2**32 + 1
+    # stored entries became 1, and this 1 x 1 "matrix" was factored and solved without a word
+    from types import SimpleNamespace
+
+    M = SimpleNamespace(shape=(1, 1), data=np.array([2.0]), indices=np.array([0]),
+                        indptr=np.array([0, 2**32 + 1], dtype=np.int64))
+    with pytest.raises(_pardiso.PardisoSizeError, match="64-bit indices"):
+        _pardiso.PardisoFactor(M, symmetric=True)
+
+
+@_needs_pardiso
+def test_pardiso_factor_without_numeric_factors_refuses_to_solve():
+    # a failed numeric factorization (solving then returned neither matrix's solution) and an
+    # analysis alone (solving then crashed the process, hence the child process)
+    import subprocess
+    import sys
+
+    script = """
+import numpy as np, scipy.sparse as sp
+from curvdetail.curvature._pardiso import PardisoError, PardisoFactor
+A = sp.triu(sp.diags([[-1.0] * 5, [3.0] * 6, [-1.0] * 5], [-1, 0, 1]), format="csr")
+f = PardisoFactor(A, symmetric=True)
+bad = A.data.copy()
+bad[A.indices == np.repeat(np.arange(6), np.diff(A.indptr))] = [3, 3, -3, 3, 3, 3]
+for make in (lambda: f.factor_values(bad), lambda: None):
+    try:
+        make()
+    except PardisoError:
+        pass
+    try:
+        f.solve(np.ones(6)); print("solved")
+    except PardisoError as e:
+        print("refused")
+    f = PardisoFactor(A, symmetric=True, analyze_only=True)
+"""
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, (done.returncode, done.stderr[-2000:])
+    assert done.stdout.split() == ["refused", "refused"]

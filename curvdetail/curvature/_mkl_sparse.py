@@ -13,7 +13,7 @@ import ctypes
 import numpy as np
 import scipy.sparse as sp
 
-from ._pardiso import _library_path
+from ._pardiso import _library_path, _use_32_bit_indices
 
 _SPARSE_INDEX_BASE_ZERO = 0
 _SPARSE_OPERATION_NON_TRANSPOSE = 10
@@ -35,6 +35,7 @@ def _mkl():
         try:
             lib = ctypes.CDLL(_library_path())
             lib.mkl_sparse_syrk                        # an MKL old enough to lack it (< 2018)
+            _use_32_bit_indices(lib)                   # the MKL_INT arguments below are int32
         except (OSError, AttributeError, RuntimeError) as exc:   # RuntimeError: PardisoError
             raise MklSparseError(f"MKL's sparse BLAS is not available ({exc})") from None
         lib.mkl_sparse_d_create_csr.argtypes = [ctypes.POINTER(_handle), ctypes.c_int, ctypes.c_int32,

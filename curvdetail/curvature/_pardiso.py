@@ -17,6 +17,7 @@ import numpy as np
 PARALLEL_ORDERING = 50_000
 
 _INT_P = ctypes.POINTER(ctypes.c_int32)
+_INT32_MAX = 2**31 - 1
 _pardiso_function = None
 
 
@@ -35,10 +36,23 @@ def _library_path():
     return path
 
 
+def _use_32_bit_indices(library):
+    """Fix the MKL runtime to its LP64 interface (32-bit MKL_INT), the one these bindings pass:
+    with ``MKL_INTERFACE_LAYER=ILP64`` in the environment mkl_rt reads every integer argument as
+    64 bits and PARDISO crashed the process. Must run before the first MKL call (it is
+    process-wide, so once is enough for both bindings)."""
+    set_layer = library.MKL_Set_Interface_Layer
+    set_layer.argtypes, set_layer.restype = [ctypes.c_int], ctypes.c_int
+    if set_layer(0) != 0:                              # 0: MKL_INTERFACE_LP64
+        raise PardisoError("the MKL runtime is fixed to its 64-bit integer interface (ILP64); unset "
+                           "MKL_INTERFACE_LAYER or choose another solver backend")
+
+
 def _function():
     global _pardiso_function
     if _pardiso_function is None:
         library = ctypes.CDLL(_library_path())
+        _use_32_bit_indices(library)
         fn = library.pardiso
         fn.argtypes = [ctypes.POINTER(ctypes.c_int64)] + [_INT_P] * 5 + [ctypes.c_void_p, _INT_P, _INT_P,
                                                                          _INT_P, _INT_P, _INT_P, _INT_P,
@@ -50,6 +64,10 @@ def _function():
 
 class PardisoError(RuntimeError):
     """PARDISO returned a nonzero error code."""
+
+
+class PardisoSizeError(PardisoError):
+    """The matrix needs 64-bit indices, which this binding (MKL's 32-bit interface) cannot pass."""
 
 
 class PardisoFactor:
@@ -65,6 +83,10 @@ class PardisoFactor:
 
     def __init__(self, M, *, symmetric, analyze_only=False):
         n = M.shape[0]
+        nnz = int(M.indptr[-1]) if len(M.indptr) else 0
+        if max(n, nnz) > _INT32_MAX:                   # the int32 copies below would wrap around
+            raise PardisoSizeError(f"a matrix with {n} rows and {nnz} stored entries needs 64-bit indices, "
+                                   "which this PARDISO binding does not pass; use backend='splu' or 'cholmod'")
         # kept referenced: PARDISO reads them again in every solve
         self._data = np.ascontiguousarray(M.data, dtype=np.float64)
         self._indptr = np.ascontiguousarray(M.indptr, dtype=np.int32)
@@ -99,22 +121,33 @@ class PardisoFactor:
         # factor serializes its own calls; different factors still run in parallel.
         self._lock = threading.Lock()
         self._holds_memory = True                     # from the first call on, even a failed one
+        self._factored = False                        # numeric factors ready for phase 33
         # 11: ordering and symbolic analysis (reads the pattern only); 12: both phases
         self._call(11 if analyze_only else 12, np.zeros(n), np.zeros(n))
+        self._factored = not analyze_only
 
     def factor_values(self, data):
         """Numeric factorization (phase 22) with ``data``, the values of the analysed pattern in
         its order."""
         data = np.ascontiguousarray(data, dtype=np.float64)
         with self._lock:                               # a solve in another thread reads _data
+            if data.shape != self._indices.shape:     # MKL would read past the end of the array
+                raise PardisoError(f"{data.size} values for a pattern of {self._indices.size} entries")
+            if not self._holds_memory:
+                raise PardisoError("the factor was freed; factor the matrix again")
             self._data = data
+            self._factored = False                     # a failed phase 22 leaves no usable factors
             self._call_unlocked(22, np.zeros(self._n), np.zeros(self._n))
+            self._factored = True
 
     def _call(self, phase, b, x, columns=1):
         """One PARDISO call with this factor's handle, one thread at a time (see ``_lock``)."""
         with self._lock:
             if not self._holds_memory:                 # MKL would read the released handle
                 raise PardisoError("the factor was freed; factor the matrix again")
+            if phase == 33 and not self._factored:     # MKL crashed solving with the analysis only
+                raise PardisoError("the matrix has no numeric factorization (it has not run or it "
+                                   "failed); factor the matrix again")
             self._call_unlocked(phase, b, x, columns)
 
     def _call_unlocked(self, phase, b, x, columns=1):

@@ -266,11 +266,17 @@ class Factorization:
             raise SolverError("refactor needs the stored sparsity pattern of the first matrix (explicit "
                               "zeros included); use factorize for a system with another pattern.")
         factorization_count += 1
-        getattr(self, "_factor_" + self.backend)(self._as_backend_wants(A))
+        try:
+            getattr(self, "_factor_" + self.backend)(self._as_backend_wants(A))
+        except BaseException:
+            # the old factors are not of this matrix, and PARDISO's are half overwritten (a solve
+            # after a failed refactor returned neither matrix's solution): refuse to solve
+            self._solve = _after_failed_refactor
+            raise
 
     # -- backends ---------------------------------------------------------------------------
     def _factor_pardiso(self, A):
-        from ._pardiso import PardisoError, PardisoFactor
+        from ._pardiso import PardisoError, PardisoFactor, PardisoSizeError
 
         M = A if (self.upper or not self.symmetric) else _upper_triangle(A)
         _refuse_empty_rows(M.indptr)
@@ -279,6 +285,8 @@ class Factorization:
                 self._pardiso = PardisoFactor(M, symmetric=self.symmetric)
             else:                              # analysed before (pattern checked): numeric phase only
                 self._pardiso.factor_values(M.data)
+        except PardisoSizeError as exc:
+            raise SolverError(f"{exc}.") from None
         except PardisoError as exc:
             raise SolverError(f"PARDISO could not factor the matrix ({exc}); it may be singular.") from None
         self._solve = self._pardiso.solve
@@ -375,7 +383,13 @@ class Factorization:
         -------
         x : array of the shape of ``b``
         """
+        if np.iscomplexobj(b):                 # the cast below would drop the imaginary part
+            raise SolverError("the right-hand side is complex; solve its real and imaginary parts "
+                              "separately.")
         b = np.asarray(b, dtype=np.float64)
+        if b.ndim not in (1, 2):
+            raise SolverError(f"the right-hand side has shape {b.shape}; pass one column (n,) or "
+                              "k columns (n, k).")
         if b.shape[0] != self.shape[0]:
             raise SolverError(f"right-hand side has {b.shape[0]} rows; the matrix has {self.shape[0]}.")
         x = np.asarray(self._solve(b), dtype=np.float64).reshape(b.shape)
@@ -384,6 +398,10 @@ class Factorization:
                               "numerically degenerate (check for collapsed triangles).")
         return x
 
+
+def _after_failed_refactor(b):
+    raise SolverError("the last refactor failed, so no factors of a matrix are at hand; refactor "
+                      "with valid values or factorize again.")
 
 
 _background_pool = None
@@ -408,6 +426,13 @@ class PendingFactorization:
         global _background_pool
         self._indptr, self._indices, self.shape = pattern.indptr, pattern.indices, pattern.shape
         n = self.shape[0]
+        # PARDISO takes rows with sorted columns (unsorted ones gave a wrong solution silently);
+        # finish puts the values given in the pattern's stored order into the sorted one
+        self._order = None
+        if n > 0 and not sp.csr_matrix(pattern).has_sorted_indices:
+            rows = np.repeat(np.arange(n), np.diff(self._indptr))
+            self._order = np.lexsort((self._indices, rows))
+            self._indices = self._indices[self._order]
         self.backend = resolve_backend(backend, symmetric=True, size=n, nnz=2 * pattern.nnz - n)
         self._requested = backend              # "auto" stays "auto" for Factorization's fallback
         self._future = None
@@ -425,7 +450,13 @@ class PendingFactorization:
     def finish(self, data):
         """The :class:`Factorization` of the matrix with these values (in the pattern's stored
         order)."""
-        A = sp.csr_matrix((np.asarray(data, dtype=np.float64), self._indices, self._indptr), shape=self.shape)
+        data = np.asarray(data, dtype=np.float64)
+        if data.shape != self._indices.shape:
+            raise SolverError(f"finish needs {self._indices.size} values, one per stored entry of the "
+                              f"pattern in its order, not an array of shape {data.shape}.")
+        if self._order is not None:
+            data = data[self._order]
+        A = sp.csr_matrix((data, self._indices, self._indptr), shape=self.shape)
         A.has_sorted_indices = True
         if self._future is None:
             return Factorization(A, symmetric=True, backend=self._requested, upper=True)
