@@ -236,16 +236,22 @@ def _check_mesh(V, F, check_manifold, check_unreferenced, cotangents=False):
         if bad.shape[0]:
             raise non_manifold_error(bad.shape[0], bad[:3])
     if check_unreferenced:
-        used = np.zeros(V.shape[0], dtype=bool)
-        used[F.ravel()] = True
-        unused = np.flatnonzero(~used)
-        if unused.size:
-            raise MeshError(
-                f"{counted(unused.size, 'vertex', 'vertices', verb='are')} not used by any triangle "
-                f"(first: {first_indices(unused)}); "
-                f"remove {them(unused.size)}, e.g. with pymeshlab's meshing_remove_unreferenced_vertices."
-            )
+        check_referenced(V.shape[0], F)
     return V, F, cot
+
+
+def check_referenced(n, F, name=None):
+    """MeshError for vertices ``0 .. n - 1`` that no triangle of ``F`` uses; ``name``: the
+    argument the message starts with (``"Vs: ..."``), or none."""
+    used = np.zeros(n, dtype=bool)
+    used[F.ravel()] = True
+    unused = np.flatnonzero(~used)
+    if unused.size:
+        raise MeshError(
+            f"{name + ': ' if name else ''}{counted(unused.size, 'vertex', 'vertices', verb='are')} not used by "
+            f"any triangle (first: {first_indices(unused)}); "
+            f"remove {them(unused.size)}, e.g. with pymeshlab's meshing_remove_unreferenced_vertices."
+        )
 
 
 def repeated_triangles(F, n):

@@ -2,8 +2,9 @@
 
 import numpy as np
 
-from ..curvature._validate import as_count, check_choice, as_faces, bbox_diagonal, check_bool, checked_arrays, face_double_areas
-from ..curvature.errors import MeshError, counted, first_indices, them
+from ..curvature._validate import (as_count, check_choice, as_faces, bbox_diagonal, check_bool, check_referenced,
+                                   checked_arrays, face_double_areas)
+from ..curvature.errors import MeshError, first_indices
 from .locate import EXACT_BLOCK, FAR_POINTS, _locate, _unit_frame, check_points_and_mesh
 
 #: Largest ``samples`` (per direction), well below pymeshlab's 32-bit int: 5M took 35 s with
@@ -255,7 +256,9 @@ def vertex_distance(V, Vs, Fs, *, far=False):
     """
     check_bool(far, "far")
     P, Vs, Fs = check_points_and_mesh(V, Vs, Fs, names=("V", "Vs", "Fs"))
-    _check_unreferenced(Vs, Fs, "Vs")
+    # as hausdorff (check_mesh) refuses them: they measure nothing, but stretch the bounding box
+    # that the frame, the zero-area test and the far-point limit are taken relative to
+    check_referenced(Vs.shape[0], Fs, "Vs")
     if not far:
         return _locate(P, Vs, Fs)[2]
     # hausdorff's frame, where the points (its Va) and the surface together have unit size: the
@@ -263,19 +266,6 @@ def vertex_distance(V, Vs, Fs, *, far=False):
     both = np.vstack([P, Vs])
     _, both, scale = _unit_frame(both[:0], both)
     return scale * _surface_distance(both[:P.shape[0]], both[P.shape[0]:], Fs)
-
-
-def _check_unreferenced(V, F, name):
-    """MeshError for vertices of ``V`` used by no triangle of ``F``, as :func:`hausdorff` (by
-    ``check_mesh``) refuses them: they measure nothing, but stretch the bounding box that the
-    frame, the zero-area test and the far-point limit are taken relative to."""
-    used = np.zeros(V.shape[0], dtype=bool)
-    used[F.ravel()] = True
-    unused = np.flatnonzero(~used)
-    if unused.size:
-        raise MeshError(f"{name}: {counted(unused.size, 'vertex', 'vertices', verb='are')} not used by any "
-                        f"triangle (first: {first_indices(unused)}); remove {them(unused.size)}, e.g. with "
-                        "pymeshlab's meshing_remove_unreferenced_vertices.")
 
 
 def _area_samples(V, F, n, rng):
