@@ -937,15 +937,15 @@ _default_showwarning = warnings.showwarning
 #: of a long run's note, the solver backend, minimal_surface's ``tol`` and ``max_iterations``, the
 #: editing filter's ``relations`` and ``handle_detail``, and a second layer is an --add mesh of
 #: ``apply`` (``run``'s script names them as the library does).
+_BACKEND_OPTION = {"or use backend='auto'": "or use --backend auto"}   # the commands with --backend
 _COMMAND_WORDS = {
-    "reconstruct": {"or use backend='auto'": "or use --backend auto"},
-    "minimal": {"or use backend='auto'": "or use --backend auto",
+    "reconstruct": {**_BACKEND_OPTION},
+    "minimal": {**_BACKEND_OPTION,
                 # a collapse's advice (curvdetail.curvature.minimal_surface)
                 "a larger tol": "a larger --tol", "or max_iterations below": "or --max-iterations below",
                 "fewer max_iterations": "a smaller --max-iterations"},
-    "remesh": {'use method "isotropic"': "use --method isotropic",
-               "or use backend='auto'": "or use --backend auto"},
-    "edit": {"or use backend='auto'": "or use --backend auto",
+    "remesh": {'use method "isotropic"': "use --method isotropic", **_BACKEND_OPTION},
+    "edit": {**_BACKEND_OPTION,
              "relations='one-ring' makes": "--relations one-ring makes",
              "; use 'pardiso' or 'splu', or": "; use --backend pardiso or splu, or",
              "or relations='one+two-ring' (": "or --relations one+two-ring ("},
