@@ -6,12 +6,27 @@ where (the first offending indices) and what to do about it.
 """
 
 
-class MeshError(ValueError):
+class CurvdetailError(ValueError):
+    """Base of the package's input errors: the message, and the facts as fields.
+
+    ``parameter`` (the argument at fault, by its Python name), ``value`` (what was given),
+    ``hint`` (what to do, in neutral words; appended to the message), ``count`` and ``first``
+    (how many things are wrong and the first indices). A front end (the CLI, the filters) reads
+    the fields and says it in its own terms; ``problem`` is the message without the hint.
+    """
+
+    def __init__(self, problem="", *, parameter=None, value=None, hint=None, count=None, first=None):
+        super().__init__(f"{problem}; {hint}" if hint else problem)
+        self.problem, self.parameter, self.value, self.hint = problem, parameter, value, hint
+        self.count, self.first = count, first
+
+
+class MeshError(CurvdetailError):
     """A mesh ``(V, F)`` is malformed: shapes, dtypes, non-finite values, bad indices,
     degenerate or non-manifold elements, unreferenced vertices, wrong topology."""
 
 
-class ConstraintError(ValueError):
+class ConstraintError(CurvdetailError):
     """A set of constrained (fixed) vertices or their values is malformed or insufficient."""
 
 

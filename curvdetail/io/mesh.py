@@ -10,12 +10,12 @@ import re
 
 import numpy as np
 
-from ._ctm_scan import ctm_layout, ctm_problem, ctm_vertex_map
-from ._file_counts import check_loaded, check_polygons, declared_counts
-from ._file_scan import check_before_loading, small_pages
-from ._output import atomic_output, check_output_path
-from .curvature._validate import as_faces, as_vertices
-from .curvature.errors import MeshError, counted, first_indices
+from .._ctm_scan import ctm_layout, ctm_problem, ctm_vertex_map
+from .._file_counts import check_loaded, check_polygons, declared_counts
+from .._file_scan import check_before_loading, small_pages
+from .._output import atomic_output, check_output_path
+from ..curvature._validate import as_faces, as_vertices
+from ..curvature.errors import MeshError, counted, first_indices
 
 
 class MeshFileError(MeshError):
@@ -190,7 +190,7 @@ def _set_ctm_vertex_maps(ms, path):
     none), with a warning, rather than read as the red channel."""
     import warnings
 
-    from .filters.meshset import set_vertex_quality
+    from ..filters.meshset import set_vertex_quality
 
     layout = ctm_layout(path)
     if layout is None or ms.current_mesh().vertex_number() != layout["vertices"]:
