@@ -100,7 +100,7 @@ def check_mesh_output(path, overwrite):
     """:func:`curvdetail.io.check_mesh_output`, an existing file refused in the command line's
     words ("pass --overwrite", not Python's overwrite=True)."""
     from ._output import check_output_path
-    from .io import MeshFileError, check_mesh_output as check
+    from .io.mesh import MeshFileError, check_mesh_output as check
 
     check_output_path(path, overwrite, hint=None, error=MeshFileError, flag=OVERWRITE)
     return check(path, overwrite)

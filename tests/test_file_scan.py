@@ -111,7 +111,7 @@ def test_off_rows_pymeshlab_reads_right_are_read(tmp_path, name, text):
 
 
 def _read_as_the_two_triangles(path, text):
-    from curvdetail.io import read_mesh
+    from curvdetail.io.mesh import read_mesh
     path.write_bytes(text.encode())
     V, F = read_mesh(path)
     np.testing.assert_array_equal(V, _V4)
@@ -238,7 +238,7 @@ def test_decimal_commas_and_extra_off_faces_are_refused(tmp_path, name, text, me
     ("m.obj", "# made by me, today\n" + _OBJ_V4.replace("v 0 0 0", "v 0 0 0 # x, y") + "o a,b\nf 1 2 3\nf 1 3 4\n"),
 ])
 def test_commas_in_comments_and_names_and_trailing_comments_pass(tmp_path, name, text):
-    from curvdetail.io import read_mesh
+    from curvdetail.io.mesh import read_mesh
     path = tmp_path / name
     path.write_text(text)
     V, F = read_mesh(path)
@@ -404,7 +404,7 @@ def test_off_vertex_rows_pymeshlab_misreads_are_refused(tmp_path, text, message)
 ])
 @pytest.mark.parametrize("line_end", ["\n", "\r\n"])
 def test_decimal_coordinates_are_read_right(tmp_path, name, row, expected, line_end):
-    from curvdetail.io import read_mesh
+    from curvdetail.io.mesh import read_mesh
     path = tmp_path / name
     rows = _coordinate_files("1")[name].split("\n")
     rows[1 if name == "m.obj" else 3] = row
@@ -419,7 +419,7 @@ def test_decimal_coordinates_are_read_right(tmp_path, name, row, expected, line_
     "COFF\n4 2 0\n7 8 9\n0.1 0.2 0.3 \x01 255\x02 0\n0 1 0\n1 1 0\n3 0 1 2\n3 0 2 3\n",   # control characters too
 ])
 def test_off_values_after_the_coordinates_are_not_judged(tmp_path, text):
-    from curvdetail.io import read_mesh
+    from curvdetail.io.mesh import read_mesh
     path = tmp_path / "m.off"
     path.write_text(text)
     V, _ = read_mesh(path)
@@ -429,7 +429,7 @@ def test_off_values_after_the_coordinates_are_not_judged(tmp_path, text):
 @pytest.mark.parametrize("name", ["m.obj", "m.off"])
 @pytest.mark.parametrize("form", ["inf", "-Infinity", "nan", "NaN"])
 def test_inf_and_nan_are_read_as_such_and_the_dropped_vertex_reported(tmp_path, name, form):
-    from curvdetail.io import MeshFileError, read_mesh
+    from curvdetail.io.mesh import MeshFileError, read_mesh
 
     path = tmp_path / name
     path.write_text(_coordinate_files(form)[name])
@@ -580,7 +580,7 @@ def test_obj_lines_continued_by_a_backslash_are_refused(tmp_path, text, line):
     ("v 0 0 0\nv 1 0 0 \\ \nv 0 1 0\nf 1 2 3\n", [[0, 1, 2]]),                                # not at the line's end
 ])
 def test_obj_backslashes_pymeshlab_reads_right_pass(tmp_path, text, triangles):
-    from curvdetail.io import read_mesh
+    from curvdetail.io.mesh import read_mesh
     path = tmp_path / "m.obj"
     path.write_bytes(text.encode())
     V, F = read_mesh(path)
@@ -716,7 +716,7 @@ def test_obj_continued_faces_are_refused_naming_their_line(tmp_path, text, messa
     ("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2\\\n 4 3\n", [[0, 1, 3], [0, 3, 2]]),
 ])
 def test_obj_faces_continued_over_lines_are_read_right(tmp_path, text, triangles):
-    from curvdetail.io import read_mesh
+    from curvdetail.io.mesh import read_mesh
     path = tmp_path / "m.obj"
     path.write_bytes(text.encode())
     assert read_mesh(path)[1].tolist() == triangles
@@ -748,7 +748,7 @@ _V3 = [[0.0, 0.0, 0.0], [1.0, 0.0, 5.0], [0.0, 1.0, 0.0]]
     (b"v 0 0 0\nv 1 0 5\\\n \nv 0 1 0\nf 1 2 3\n", _V3),                      # continued on a blank line
 ])
 def test_obj_vertex_lines_continued_on_values_are_read_as_pymeshlab_reads_them(tmp_path, data, vertices):
-    from curvdetail.io import read_mesh
+    from curvdetail.io.mesh import read_mesh
     path = tmp_path / "m.obj"
     path.write_bytes(data)
     V, F = read_mesh(path)
@@ -765,7 +765,7 @@ def test_obj_vertex_lines_continued_on_values_are_read_as_pymeshlab_reads_them(t
     (b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 \\\r\n-2 -1\nv 1 1 0\nf 2 4 3\n", [[0, 1, 2], [1, 3, 2]]),
 ])
 def test_obj_faces_continued_after_a_crlf_line_end_are_read_as_pymeshlab_reads_them(tmp_path, data, triangles):
-    from curvdetail.io import read_mesh
+    from curvdetail.io.mesh import read_mesh
     path = tmp_path / "m.obj"
     path.write_bytes(data)
     V, F = read_mesh(path)
@@ -842,7 +842,7 @@ def test_reads_leave_numpys_huge_page_setting_as_they_found_it(tmp_path, setting
     import threading
 
     from curvdetail.curvature.testing import grid
-    from curvdetail.io import MeshFileError, read_mesh, write_mesh
+    from curvdetail.io.mesh import MeshFileError, read_mesh, write_mesh
 
     switch = _file_scan._set_madvise_hugepage
     V, F = grid(30, 30)

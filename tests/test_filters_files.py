@@ -8,7 +8,7 @@ import pytest
 from curvdetail.filters import apply, files
 from curvdetail.filters.files import check_output_path, load_meshset, save_current_mesh
 from curvdetail.filters.meshset import vertex_attribute
-from curvdetail.io import MeshFileError
+from curvdetail.io.mesh import MeshFileError
 
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
 NOSE = os.path.join(DATA, "mannequin_nose.obj")

@@ -13,7 +13,7 @@ import pytest
 
 from curvdetail import MeshError, read_mesh, write_mesh
 from curvdetail.curvature.testing import icosphere
-from curvdetail.io import MeshFileError, save_mesh
+from curvdetail.io.mesh import MeshFileError, save_mesh
 
 from conftest import data_path
 
@@ -117,7 +117,7 @@ def test_temporary_file_keeps_the_extension_and_sits_beside_the_output(tmp_path,
         seen.append(path)
         return real(self, path, **kwargs)
 
-    from curvdetail.io import check_mesh_output
+    from curvdetail.io.mesh import check_mesh_output
 
     check_mesh_output(tmp_path / "warm.obj")      # the format check's one-off probe writes elsewhere
     monkeypatch.setattr(pymeshlab.MeshSet, "save_current_mesh", spy)
@@ -329,7 +329,7 @@ def test_files_that_crash_pymeshlab_are_refused_before_it_reads_them(tmp_path, n
     # on an indented vertex line: the file must not reach the loader at all
     path = tmp_path / name
     path.write_text(text)
-    script = ("from curvdetail.io import read_mesh, MeshFileError\n"
+    script = ("from curvdetail.io.mesh import read_mesh, MeshFileError\n"
               "from curvdetail.filters.files import load_meshset\n"
               f"for read in (read_mesh, load_meshset):\n"
               f"    try:\n        read({str(path)!r})\n"
@@ -706,7 +706,7 @@ def test_other_formats_refuse_what_they_cannot_hold(tmp_path, ext, scale, messag
 
 def test_nxz_coordinates_are_refused_by_the_check_itself():
     # write_mesh refuses .nxz before this check (UNWRITTEN_FORMATS); the check says why on its own
-    from curvdetail.io import check_coordinates
+    from curvdetail.io.mesh import check_coordinates
 
     with pytest.raises(MeshFileError, match=r"pymeshlab's NXZ writer compresses the coordinates"):
         check_coordinates("m.nxz", icosphere(subdivisions=1)[0])
@@ -806,7 +806,7 @@ def test_a_ctm_files_quality_is_read_from_its_quality_map(tmp_path, lossless):
     # pymeshlab's CTM reader read the quality from the colour map (10.0 came back as 0.64, the
     # red channel) and marked the layer as holding neither colours nor quality
     from curvdetail._ctm_scan import ctm_layout
-    from curvdetail.io import load_checked
+    from curvdetail.io.mesh import load_checked
 
     path = tmp_path / "m.ctm"
     V, F, colours, quality = _coloured_ctm(path, lossless)
@@ -833,7 +833,7 @@ def test_a_ctm_quality_that_cannot_be_decoded_is_left_out_with_a_warning(tmp_pat
     # LZMA options Python's decoder lacks (OpenCTM's writer uses none): the quality is left out
     # (not read as the red channel), the colours and the geometry are read
     import curvdetail.io
-    from curvdetail.io import load_checked
+    from curvdetail.io.mesh import load_checked
 
     def undecodable(path, name, layout=None):
         raise ValueError(f"its {name.decode()!r} map's LZMA data cannot be decoded here (lc + lp > 4)")
@@ -854,7 +854,7 @@ def test_a_ctm_quality_that_cannot_be_decoded_is_left_out_with_a_warning(tmp_pat
 _CTM_CRASH = """
 import sys
 import numpy as np, pymeshlab
-from curvdetail.io import read_mesh, MeshFileError
+from curvdetail.io.mesh import read_mesh, MeshFileError
 from curvdetail.filters.files import load_meshset
 from curvdetail.curvature.testing import icosphere
 V, F = icosphere(subdivisions=1)
@@ -885,7 +885,7 @@ def test_ctm_files_that_crash_pymeshlab_are_refused_before_it_reads_them(tmp_pat
 _3DS_WRITES = """
 import sys
 import numpy as np, pymeshlab
-from curvdetail.io import save_mesh, write_mesh
+from curvdetail.io.mesh import save_mesh, write_mesh
 from curvdetail.curvature.testing import icosphere
 V, F = icosphere(subdivisions=1)
 write_mesh(sys.argv[1] + "/w.3ds", V, F)
@@ -960,7 +960,7 @@ def test_unsafe_writers_are_refused_without_running_them(tmp_path, monkeypatch, 
 _PERTURBED_WRITES = """
 import os, sys, tempfile
 import numpy as np
-from curvdetail.io import MeshFileError, check_mesh_output, write_mesh
+from curvdetail.io.mesh import MeshFileError, check_mesh_output, write_mesh
 from curvdetail.curvature.testing import icosphere
 V, F = icosphere(subdivisions=1)
 folder = tempfile.mkdtemp()
@@ -1017,7 +1017,7 @@ def test_the_write_check_agrees_with_the_loss_measured_by_writing(tmp_path, ext)
     # the check is an estimate made before writing; here the file is written by pymeshlab itself
     # and read back: no placement losing more than the limit may pass, and none losing less than
     # a third of it may be refused (CAD parts in mm at metres, GIS data in UTM coordinates)
-    from curvdetail.io import DOUBLE_TOLERANCE, OFFSET_TOLERANCE, check_coordinates
+    from curvdetail.io.mesh import DOUBLE_TOLERANCE, OFFSET_TOLERANCE, check_coordinates
 
     limit = DOUBLE_TOLERANCE if ext == ".off" else OFFSET_TOLERANCE
     V0, F = icosphere(subdivisions=2)
@@ -1116,7 +1116,7 @@ def test_dxf_coordinates_are_checked_for_its_six_decimals(tmp_path):
 def test_every_format_write_mesh_takes_has_a_measured_precision(tmp_path):
     # a format missing from the table (.dxf was) was written unchecked
     import curvdetail.io as io
-    from curvdetail.io import check_coordinates
+    from curvdetail.io.mesh import check_coordinates
 
     V, F = icosphere(subdivisions=1)
     for ext in _SAVE_FORMATS:
@@ -1187,7 +1187,7 @@ def _polygon_file(path, corners, face):
     (".ply", [(0, 0, 0), (2, 0, 0), (2, 1, 0), (1, 1, 0), (1, 2, 0), (0, 2, 0)], 2),   # an L from a far corner
 ])
 def test_concave_polygons_cut_wrong_by_the_loader_are_refused(tmp_path, suffix, corners, start):
-    from curvdetail.io import MeshFileError, read_mesh
+    from curvdetail.io.mesh import MeshFileError, read_mesh
     path = tmp_path / ("m" + suffix)
     n = len(corners)
     _polygon_file(path, corners, [(start + i) % n for i in range(n)])
@@ -1199,7 +1199,7 @@ def test_concave_polygons_cut_wrong_by_the_loader_are_refused(tmp_path, suffix, 
 
 def test_concave_obj_polygon_refusal_names_its_line(tmp_path):
     # the face's line counts the file's lines: comments, blank and continued ones too
-    from curvdetail.io import MeshFileError, read_mesh
+    from curvdetail.io.mesh import MeshFileError, read_mesh
     path = tmp_path / "m.obj"
     path.write_text("# a dart\n" + "".join(f"v {x} {y} {z}\n" for x, y, z in _DART) + "v 1 3 0\n\n"
                     "f 5 \\\n3 4\n# the dart, fanned across its dent\nf 1 2 3 4\n")
@@ -1216,7 +1216,7 @@ def test_concave_obj_polygon_refusal_names_its_line(tmp_path):
     ([(0, 0, 0), (0, 1, 0), (0, 1, 1), (0, 0, 1)], 3),                            # convex, in the y-z plane
 ])
 def test_polygons_the_loader_triangulates_right_pass_with_their_area(tmp_path, suffix, corners, start):
-    from curvdetail.io import read_mesh
+    from curvdetail.io.mesh import read_mesh
     path = tmp_path / ("m" + suffix)
     n = len(corners)
     _polygon_file(path, corners, [(start + i) % n for i in range(n)])
@@ -1233,7 +1233,7 @@ def test_polygons_the_loader_triangulates_right_pass_with_their_area(tmp_path, s
 
 def test_ascii_stl_with_vertex_in_its_name_is_read(tmp_path):
     # "vertex " in the solid line was counted as a corner, and the file refused as a facet of 4
-    from curvdetail.io import read_mesh
+    from curvdetail.io.mesh import read_mesh
     path = tmp_path / "m.stl"
     path.write_text("solid my vertex model\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n"
                     "   vertex 0 1 0\n  endloop\n endfacet\nendsolid my vertex model\n")
@@ -1247,7 +1247,7 @@ def test_ascii_stl_with_vertex_in_its_name_is_read(tmp_path):
 ])
 def test_binary_ply_of_triangles_and_quads_is_read_in_order_and_checked(tmp_path, quad, triangles):
     # rows of 3 and 4 indices mixed; pymeshlab reads them right, and fans the quad
-    from curvdetail.io import MeshFileError, read_mesh
+    from curvdetail.io.mesh import MeshFileError, read_mesh
     corners = np.array(_DART + [(1, 3, 0)], dtype="<f4")
     faces = [[4, 2, 3], quad, [4, 3, 0]]
     rows = b"".join(np.array([len(f)], "u1").tobytes() + np.array(f, "<i4").tobytes() for f in faces)

@@ -201,7 +201,7 @@ def _edit_inputs(tmp_path):
     returns the ``curvdetail edit`` arguments before OUTPUT, and the out folder."""
     from curvdetail.curvature.testing import grid as _grid
     from curvdetail.deformation_benchmark import write_selection, write_transform
-    from curvdetail.io import write_mesh
+    from curvdetail.io.mesh import write_mesh
 
     V, F = _grid(8, 8)
     src = tmp_path / "in" / "plane.obj"

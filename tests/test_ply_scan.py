@@ -115,7 +115,7 @@ def test_ply_short_face_indices_that_wrap_are_refused(tmp_path):
      _PLY_V4 + "0 1\n3 0 1 2\n3 0 2 3\n3 1 0.5 .25\n0\n"),
 ])
 def test_ply_files_pymeshlab_reads_right_are_read(tmp_path, name, header, body):
-    from curvdetail.io import read_mesh
+    from curvdetail.io.mesh import read_mesh
 
     V, F = read_mesh(_ply(tmp_path, header + body))
     np.testing.assert_array_equal(V, [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]])
@@ -132,7 +132,7 @@ def test_ascii_ply_pymeshlab_writes_is_read(tmp_path, options):
     import pymeshlab
 
     from curvdetail.curvature.testing import icosphere
-    from curvdetail.io import read_mesh
+    from curvdetail.io.mesh import read_mesh
 
     V, F = icosphere(subdivisions=2)
     rng = np.random.default_rng(0)
@@ -174,7 +174,7 @@ def test_ascii_ply_with_a_custom_attribute_pymeshlab_writes_glued_is_refused(tmp
 ])
 def test_ply_faces_pymeshlab_drops_are_reported(tmp_path, header, faces, triangles):
     # a face count cannot tell: the polygon's triangles make up for the dropped one
-    from curvdetail.io import MeshFileError, read_mesh
+    from curvdetail.io.mesh import MeshFileError, read_mesh
 
     with pytest.raises(MeshFileError, match=rf"its faces make {triangles} triangles \(a polygon of k vertices "
                                             rf"k - 2\), but pymeshlab loaded {triangles - 1}"):
@@ -201,7 +201,7 @@ def test_ply_vertex_lines_of_whole_rows_are_read_as_pymeshlab_reads_them(tmp_pat
     # fscanf does not see lines: whole rows on one line are read right (they were refused)
     import pymeshlab
 
-    from curvdetail.io import read_mesh
+    from curvdetail.io.mesh import read_mesh
 
     path = _ply(tmp_path, _PLY_HEAD + vertices + "3 0 1 2\n3 0 2 3\n")
     V, F = read_mesh(path)
@@ -233,7 +233,7 @@ def test_binary_face_list_types_pymeshlab_cannot_read_are_named(tmp_path, count,
 
     import pymeshlab
 
-    from curvdetail.io import MeshFileError, read_mesh
+    from curvdetail.io.mesh import MeshFileError, read_mesh
 
     codes = {"char": "b", "uchar": "B", "short": "h", "ushort": "H", "int": "i", "uint": "I"}
     header = ("ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
@@ -259,7 +259,7 @@ def test_binary_face_list_types_pymeshlab_cannot_read_are_named(tmp_path, count,
 
 def test_ply_hexadecimal_reals_are_read_as_pymeshlab_reads_them(tmp_path):
     # glibc's fscanf("%f") reads 0x1p-1 as 0.5; where an index is read, 0x1 stays refused
-    from curvdetail.io import read_mesh
+    from curvdetail.io.mesh import read_mesh
 
     V, _ = read_mesh(_ply(tmp_path, _PLY_HEAD + "0 0 0\n0x1p0 0 0\n1 0x1.0p0 0\n0 0x.8p1 0\n3 0 1 2\n3 0 2 3\n"))
     assert V.tolist() == [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]

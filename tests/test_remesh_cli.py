@@ -9,7 +9,7 @@ import pytest
 from curvdetail import read_mesh
 from curvdetail.cli import main
 from curvdetail.curvature.testing import cylinder
-from curvdetail.io import write_mesh
+from curvdetail.io.mesh import write_mesh
 
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
 

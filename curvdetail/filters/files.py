@@ -23,7 +23,7 @@ import weakref
 import numpy as np
 
 from .. import _output
-from ..io import MeshFileError, _save, check_coordinates, check_mesh_output, input_path, load_checked, save_mesh
+from ..io.mesh import MeshFileError, _save, check_coordinates, check_mesh_output, input_path, load_checked, save_mesh
 from .meshset import WRITTEN_ATTRIBUTES, set_vertex_attribute, vertex_attribute
 from .ply_attributes import read_ply_vertex_attributes
 
