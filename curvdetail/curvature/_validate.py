@@ -130,10 +130,12 @@ def bbox_diagonal(V):
     Vt = np.ascontiguousarray(np.asarray(V, dtype=np.float64).T)
     extent = Vt.max(axis=1) - Vt.min(axis=1)
     largest = float(np.abs(extent).max()) if extent.size else 0.0
-    if 1e-150 < largest < 1e150 or not 0.0 < largest < np.inf:
-        return float(np.linalg.norm(extent))
-    # scaled: the squares of a 1e-200 mesh's extent underflow to a diagonal of 0
-    return largest * float(np.linalg.norm(extent / largest))
+    if not 0.0 < largest < np.inf:
+        return largest
+    # scaled by the largest extent: no square over- or underflows to a wrong diagonal (and numpy
+    # 2.4's norm raises an underflow of a negligible component under the caller's errstate)
+    with np.errstate(under="ignore"):
+        return largest * float(np.sqrt(np.sum((extent / largest) ** 2)))
 
 
 def centroid_diameter(V):
