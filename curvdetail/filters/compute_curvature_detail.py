@@ -3,8 +3,8 @@
 import numpy as np
 
 from ..curvature._validate import boundary_vertices, check_oriented
-from ..curvature.cotan_laplacian import checked_cotan_laplacian, laplacian_product
-from ..curvature.mixed_voronoi_area import _mixed_voronoi_area_unchecked
+from ..curvature.curvature_detail import curvature_detail
+from ..curvature.mean_curvature_normal import mean_curvature_normal
 from .detail_attributes import AREA, DETAIL, NORMAL, store_detail  # noqa: F401  (names re-exported)
 from .meshset import layer_id, mesh_arrays, set_vertex_quality, vertex_normals
 from .registry import PAPER, filter
@@ -42,12 +42,10 @@ def signed_mean_curvature(V, F, K):
 def compute_curvature_detail(ms):
     mid = layer_id(ms)
     V, F = mesh_arrays(ms, mid)
-    V, F, L = checked_cotan_laplacian(V, F)        # validated once
+    D = curvature_detail(V, F)
     # H's sign comes from the vertex normals: with reversed triangles it was +-H at random
     check_oriented(F, "the current mesh")
-    D = laplacian_product(L, V)                    # = curvature_detail(V, F)
-    A = _mixed_voronoi_area_unchecked(V, F)        # = mixed_voronoi_area(V, F)
-    K = D / A[:, None]                             # = mean_curvature_normal(V, F)[0], bit for bit
+    K, A = mean_curvature_normal(V, F)
     H = signed_mean_curvature(V, F, K)
     store_detail(ms, mid, F, D, K, A)
     set_vertex_quality(ms, mid, H)
