@@ -18,18 +18,8 @@ GREY = (0.75, 0.78, 0.85)
 
 
 def camera(elev, azim):
-    """Rotation taking world coordinates (z up) to the camera's (x right, y up, z to the viewer).
-
-    Parameters
-    ----------
-    elev, azim : float
-        Camera elevation above the xy plane and azimuth about z, in degrees.
-
-    Returns
-    -------
-    R : (3, 3) float array
-        ``P = V @ R.T`` are camera coordinates; ``R[2]`` points from the scene to the viewer.
-    """
+    """Rotation ``R`` taking world coordinates (z up) to the camera's (x right, y up, z to the
+    viewer) for an elevation and azimuth in degrees: ``V @ R.T`` are camera coordinates."""
     e, a = np.radians(elev), np.radians(azim)
     Rz = np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
     Rx = np.array([[1, 0, 0], [0, np.cos(e - np.pi / 2), -np.sin(e - np.pi / 2)],
@@ -43,15 +33,9 @@ def view_direction(elev, azim):
 
 
 def top_view(V, F):
-    """Rotation taking a patch's area-weighted mean normal to +z, so that ``V @ R.T`` is seen from
-    above; where the normals cancel (a closed surface), the direction in which the vertices spread
-    least (sign: its largest component positive).
-
-    Returns
-    -------
-    R : (3, 3) float array
-        A rotation (``R @ R.T = I``, ``det R = 1``).
-    """
+    """Rotation ``R`` taking a patch's area-weighted mean normal to +z (``V @ R.T`` is seen from
+    above); where the normals cancel (a closed surface), the direction in which the vertices spread
+    least, its largest component positive."""
     V, F = np.asarray(V, dtype=np.float64), np.asarray(F)
     normals = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
     n = normals.sum(0)
@@ -168,22 +152,16 @@ def save_panels(path, panels, *, elev=20.0, azim=-60.0, title=None, panel_size=4
 
 def save_remeshing_figure(path, V, F, X, Ft, Z, distance, report, *, overwrite=False, dpi=110):
     """Save the picture of one remeshing experiment: the source, the rebuilt target coloured by
-    its distance to the source, and the zero-detail baseline, with the error figures in the titles.
+    its distance to the source, and the zero-detail baseline, the errors in the titles.
 
     Parameters
     ----------
     path : str or os.PathLike
         Destination ``.png``.
-    V : (n, 3) float array
-        Source positions (triangles ``F``).
-    F : (m, 3) int array
-        Source triangles.
-    X : (p, 3) float array
-        Rebuilt target positions (triangles ``Ft``).
-    Ft : (q, 3) int array
-        Target triangles.
-    Z : (p, 3) float array
-        Zero-detail baseline positions (triangles ``Ft``).
+    V, F : (n, 3) float array, (m, 3) int array
+        The source mesh.
+    X, Ft : (p, 3) float array, (q, 3) int array
+        The rebuilt target; ``Z`` (p, 3) is the zero-detail baseline on the same triangles.
     distance : (p,) float array
         Distance of each vertex of ``X`` to the source.
     report : dict

@@ -26,20 +26,22 @@ class DeformationFileError(CurvdetailError):
     ``e.count`` and ``e.first`` the bad lines' count and first line numbers where there are such)."""
 
 
+def _file_error(path, problem, **facts):
+    return DeformationFileError(f"{path}: {problem}", parameter="path", value=path, **facts)
+
+
 def _data_lines(path, what):
     """``(line number, stripped text)`` of the lines that are neither blank nor comments."""
-    path = os.fspath(path)
     if os.path.isdir(path):
-        raise DeformationFileError(f"{path} is a folder", parameter="path", value=path,
-                                   hint=f"name a {what} file")
+        raise _file_error(path, "is a folder", hint=f"name a {what} file")
     if not os.path.isfile(path):
         raise FileNotFoundError(f"{what} file not found: {path}")
     try:
         with open(path, encoding="utf-8-sig") as fh:        # -sig: a byte-order mark is no text
             lines = fh.read().splitlines()
     except UnicodeDecodeError as exc:
-        raise DeformationFileError(f"{path}: byte {exc.start} is not UTF-8 text", parameter="path", value=path,
-                                   first=[exc.start], hint="save the file as UTF-8 or ASCII") from None
+        raise _file_error(path, f"byte {exc.start} is not UTF-8 text", first=[exc.start],
+                          hint="save the file as UTF-8 or ASCII") from None
     return [(k + 1, line.strip()) for k, line in enumerate(lines)
             if line.strip() and not line.lstrip().startswith("#")]
 
@@ -74,23 +76,20 @@ def read_selection(path, n_vertices=None):
     >>> read_selection(p, 4).tolist()
     [0, 1, 1, 2]
     """
-    rows = _data_lines(path, "selection")
     path = os.fspath(path)
+    rows = _data_lines(path, "selection")
     bad = [(no, text) for no, text in rows if text not in ("0", "1", "2")]
     if bad:
         shown = ", ".join(f"line {no}: {text[:20]!r}" for no, text in bad[:3])
-        raise DeformationFileError(
-            f"{path}: {counted(len(bad), 'line', verb='are')} not a vertex status 0, 1 or 2 ({shown})",
-            parameter="path", value=path, count=len(bad), first=[no for no, _ in bad[:3]],
-            hint="a .sel file holds one status per vertex (0 fixed, 1 free, 2 handle) after '#' comment lines")
+        raise _file_error(path, f"{counted(len(bad), 'line', verb='are')} not a vertex status 0, 1 or 2 ({shown})",
+                          count=len(bad), first=[no for no, _ in bad[:3]],
+                          hint="a .sel file holds one status per vertex (0 fixed, 1 free, 2 handle)")
     if not rows:
-        raise DeformationFileError(f"{path}: no vertex statuses found (only comments or blank lines)",
-                                   parameter="path", value=path, count=0)
+        raise _file_error(path, "no vertex statuses found (only comments or blank lines)", count=0)
     status = np.array([int(text) for _, text in rows], dtype=np.int8)
     if n_vertices is not None and status.size != int(n_vertices):
-        raise DeformationFileError(
-            f"{path}: {status.size} vertex statuses for a mesh of {int(n_vertices)} vertices", parameter="path",
-            value=path, count=status.size, hint="the .sel file must list every vertex, in the mesh's vertex order")
+        raise _file_error(path, f"{status.size} vertex statuses for a mesh of {int(n_vertices)} vertices",
+                          count=status.size, hint="list every vertex, in the mesh's vertex order")
     return status
 
 
@@ -118,24 +117,21 @@ def read_transform(path):
     >>> read_transform(p).tolist() == np.eye(4).tolist()
     True
     """
-    rows = _data_lines(path, "transform")
     path = os.fspath(path)
+    rows = _data_lines(path, "transform")
     if len(rows) != 4:
-        raise DeformationFileError(f"{path}: {len(rows)} matrix rows", parameter="path", value=path,
-                                   count=len(rows), hint="a .def file holds 4 rows of 4 numbers after '#' comments")
+        raise _file_error(path, f"{len(rows)} matrix rows", count=len(rows), hint="a .def file holds 4 rows of 4 numbers")
     T = np.empty((4, 4))
     for r, (no, text) in enumerate(rows):
         try:
-            values = [real_word(p) for p in text.replace(",", " ").split()]
-        except ValueError:
-            values = None
-        if values is None or len(values) != 4 or not np.all(np.isfinite(values)):
-            raise DeformationFileError(f"{path}: line {no} ({text[:40]!r}) is not 4 finite numbers",
-                                       parameter="path", value=path, count=1, first=[no])
-        T[r] = values
+            T[r] = [real_word(p) for p in text.replace(",", " ").split()]
+        except ValueError:               # not numbers, or not 4 of them
+            T[r] = np.nan
+        if not np.isfinite(T[r]).all():
+            raise _file_error(path, f"line {no} ({text[:40]!r}) is not 4 finite numbers", count=1, first=[no])
     problem = affine_transform_problem(T)
     if problem:
-        raise DeformationFileError(f"{path}: {problem}", parameter="path", value=path)
+        raise _file_error(path, problem)
     return T
 
 
@@ -185,17 +181,12 @@ def _as_transform(T, error):
     """``T`` as a (4, 4) float array that :func:`read_transform` would accept, else ``error``."""
     try:
         T = np.asarray(T, dtype=np.float64)
+        problem = None if T.shape == (4, 4) and np.isfinite(T).all() else f"T has shape {T.shape} or is not finite"
     except (TypeError, ValueError) as exc:
-        raise error(f"T could not be read as a 4x4 matrix of numbers ({exc})", parameter="T",
-                    hint="a handle transform is a finite 4x4 matrix") from None
-    if T.shape != (4, 4):
-        raise error(f"T has shape {T.shape}", parameter="T", hint="a handle transform is a finite 4x4 matrix")
-    if not np.all(np.isfinite(T)):
-        raise error("T holds NaN or infinite entries", parameter="T",
-                    hint="a handle transform is a finite 4x4 matrix")
-    problem = affine_transform_problem(T)
+        problem = f"T could not be read as numbers ({exc})"
+    problem = problem or affine_transform_problem(T)
     if problem:
-        raise error(f"the handle transform T: {problem}", parameter="T")
+        raise error(f"the handle transform: {problem}", parameter="T", hint="give a finite affine 4x4 matrix")
     return T
 
 
