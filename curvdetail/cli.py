@@ -412,8 +412,8 @@ def _remesh_command(parser):
                     progress.stage("image")
                     from .plot import save_remeshing_figure
 
-                    save_remeshing_figure(image_tmp, V, F, result["X"], result["Ft"], result["Z"], result["distance"],
-                                report, overwrite=True)
+                    save_remeshing_figure(image_tmp, V, F, result["X"], result["Ft"], result["Z"],
+                                          result["distance"], report, overwrite=True)
                 if report_tmp is not None:
                     with open(report_tmp, "w", encoding="utf-8") as fh:
                         json.dump(report, fh, indent=2)
@@ -745,8 +745,8 @@ def _edit_command(parser):
         with atomic_outputs(outputs, overwrite=args.overwrite) as (image_tmp, mesh_tmp):
             if image_tmp is not None:
                 save_panels(image_tmp, [(V, F, "rest (status 0/1/2)", status),
-                                          (X, F, f"edited (handle detail: {args.handle_detail})", moved)],
-                              overwrite=True)
+                                        (X, F, f"edited (handle detail: {args.handle_detail})", moved)],
+                            overwrite=True)
             write_mesh(mesh_tmp, X, F, quality=_quality_for(args.output, moved), overwrite=True)
         progress.close()
         counts = np.bincount(status, minlength=3)
