@@ -133,6 +133,13 @@ def save_panels(path, panels, *, elev=20.0, azim=-60.0, title=None, panel_size=4
     ------
     FileExistsError
         If ``path`` exists and ``overwrite`` is False.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from curvdetail.curvature.testing import grid
+    >>> V, F = grid(5, 5); V[:, 2] = V[:, 0] * V[:, 1]
+    >>> save_panels(os.path.join(tempfile.mkdtemp(), "p.png"), [(V, F, "flat"), (V, F, "height", V[:, 2])])
     """
     from matplotlib.figure import Figure
 
