@@ -69,7 +69,7 @@ class CurvatureEditor:
     max_ring : int
         Widest ring of :func:`curvature_coefficients` (1: the paper's one-ring everywhere).
     backend : str
-        Sparse solver backend: "auto", "pardiso", "cholmod", "splu" or "banded".
+        Sparse solver backend ("auto" or one of :func:`available_backends`).
 
     Attributes
     ----------
