@@ -410,10 +410,10 @@ def _remesh_command(parser):
             with atomic_outputs(outputs, overwrite=args.overwrite) as (image_tmp, report_tmp, mesh_tmp):
                 if image_tmp is not None:
                     progress.stage("image")
-                    from .remesh.figure import save_figure
+                    from .plot import save_remeshing_figure
 
-                    save_figure(image_tmp, V, F, result["X"], result["Ft"], result["Z"], result["distance"],
-                                report, overwrite=True)
+                    save_remeshing_figure(image_tmp, V, F, result["X"], result["Ft"], result["Z"],
+                                          result["distance"], report, overwrite=True)
                 if report_tmp is not None:
                     with open(report_tmp, "w", encoding="utf-8") as fh:
                         json.dump(report, fh, indent=2)
@@ -710,8 +710,8 @@ def _edit_command(parser):
         from . import read_mesh, write_mesh
         from ._output import Output, atomic_outputs, check_output_path
         from .curvature._validate import bbox_diagonal, check_mesh
-        from .deformation_benchmark import (edit_with_selection, read_selection, read_transform,
-                                            render_panels)
+        from .io.deformation import edit_with_selection, read_selection, read_transform
+        from .plot import save_panels
         from .curvature._geometry import folded_triangles
         from .curvature.errors import UndeterminedEditError, counted, first_indices
         from .io import MeshFileError
@@ -744,9 +744,9 @@ def _edit_command(parser):
         outputs = [_extra_output(args.image or None), Output(args.output, error=MeshFileError, flag=OVERWRITE)]
         with atomic_outputs(outputs, overwrite=args.overwrite) as (image_tmp, mesh_tmp):
             if image_tmp is not None:
-                render_panels(image_tmp, [(V, F, "rest (status 0/1/2)", status),
-                                          (X, F, f"edited (handle detail: {args.handle_detail})", moved)],
-                              overwrite=True)
+                save_panels(image_tmp, [(V, F, "rest (status 0/1/2)", status),
+                                        (X, F, f"edited (handle detail: {args.handle_detail})", moved)],
+                            overwrite=True)
             write_mesh(mesh_tmp, X, F, quality=_quality_for(args.output, moved), overwrite=True)
         progress.close()
         counts = np.bincount(status, minlength=3)

@@ -133,11 +133,11 @@ class Run:
             save_figure(fig, tmp, False, **savefig_options)
 
     def render_panels(self, path, panels, **options):
-        """Keep :func:`curvdetail.deformation_benchmark.render_panels`'s picture for ``path``."""
-        from curvdetail.deformation_benchmark import render_panels
+        """Keep :func:`curvdetail.plot.save_panels`'s picture for ``path``."""
+        from curvdetail.plot import save_panels
 
         with self.stage(path) as tmp:
-            render_panels(tmp, panels, **options)
+            save_panels(tmp, panels, **options)
 
     def stack_pictures(self, path, sources, dpi=100):
         """Keep for ``path`` the pictures kept for ``sources`` (PNG), one row each, top to bottom,

@@ -30,8 +30,7 @@ from _meshes import MESHES, at_least_one, require  # noqa: E402
 from reproduce_table1 import PAPER, table1_meshes, time_edit  # noqa: E402
 
 from curvdetail import CurvatureEditor, boundary_vertices, read_mesh  # noqa: E402
-from curvdetail.deformation_benchmark import (edit_with_selection, read_selection,  # noqa: E402
-                                              read_transform)
+from curvdetail.io.deformation import edit_with_selection, read_selection, read_transform  # noqa: E402
 
 CASES = ("bar", "cactus", "cylinder", "plane")
 

@@ -32,7 +32,7 @@ from _meshes import MESHES, require  # noqa: E402
 from curvdetail import read_mesh
 from curvdetail.curvature._validate import bbox_diagonal
 from curvdetail.curvature.curvature_coefficients import DEFAULT_RCOND
-from curvdetail.deformation_benchmark import edit_with_selection, read_selection, read_transform
+from curvdetail.io.deformation import edit_with_selection, read_selection, read_transform
 
 CASES = ("bar", "cactus", "cylinder", "plane")
 #: (handle details, curvature-stage relations): the paper, the steadier stacked relations, free

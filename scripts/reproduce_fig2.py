@@ -40,7 +40,8 @@ from _meshes import MESHES, require  # noqa: E402
 from curvdetail import CurvatureEditor, edit_boundary, read_mesh, sine_displacement
 from curvdetail.curvature._validate import bbox_diagonal
 from curvdetail.curvature.errors import FoldedTrianglesWarning
-from curvdetail.deformation_benchmark import edit_with_selection, view_direction
+from curvdetail.io.deformation import edit_with_selection
+from curvdetail.plot import view_direction
 
 Y_UP = np.array([[1.0, 0, 0], [0, 0, -1.0], [0, 1.0, 0]])   # display y-up models with z up
 COW_VIEW = (15, 30)

@@ -385,55 +385,36 @@ def main(argv=None):
 #: the rebuilt panels' colours, distance 0 to the row's largest: the plain panels' light
 #: blue-grey, then amber, then red (shaded like the plain panels, so the shape reads as well)
 DISTANCE_COLOURS = [(0.75, 0.78, 0.85), (0.98, 0.78, 0.30), (0.78, 0.08, 0.06)]
-LIGHT = np.array([0.3, -0.4, 0.87])     # curvdetail.remesh.figure._draw's
 
 
 def _figure(inputs, path, force=False):
     """The Fig. 3 picture: one row per patch (source, rebuilt target coloured by each vertex's
     distance to the source with a colour bar in % of the bbox diagonal, zero-detail baseline),
-    drawn as curvdetail.remesh.figure draws one experiment. ``inputs``: ``{name: (V, F,
+    drawn by curvdetail.plot as the remeshing figure is. ``inputs``: ``{name: (V, F,
     run_experiment's dict)}``."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from matplotlib.cm import ScalarMappable
-    from matplotlib.colors import LinearSegmentedColormap, Normalize
+    from matplotlib.colors import LinearSegmentedColormap
 
-    from curvdetail.remesh.figure import _draw, _view_frame
+    from curvdetail.plot import draw_mesh, top_view
 
     cmap = LinearSegmentedColormap.from_list("distance", DISTANCE_COLOURS)
-    fig = plt.figure(figsize=(10.5, 3.4 * len(inputs)))
-    for r, (name, (V, F, out)) in enumerate(inputs.items()):
+    view = dict(elev=50.0, azim=20.0)
+    fig, rows = plt.subplots(len(inputs), 3, figsize=(10.5, 3.4 * len(inputs)), squeeze=False)
+    for axes, (name, (V, F, out)) in zip(rows, inputs.items()):
         rep = out["report"]
-        R = _view_frame(V, F)
-        centre = 0.5 * (V.max(0) + V.min(0))
-        P = (V - centre) @ R.T
-        scale = float((P.max(0) - P.min(0)).max())
-        diagonal = bbox_diagonal(V)
+        R = top_view(V, F)
         e, b = rep["error"], rep["baseline_zero_detail"]
-        axes = [fig.add_subplot(len(inputs), 3, 3 * r + c + 1, projection="3d") for c in range(3)]
-        _draw(axes[0], V, F, R, centre, scale, title=f"{name.rsplit('.', 1)[0]}: {V.shape[0]:,} vertices")
-        _draw(axes[2], out["Z"], out["Ft"], R, centre, scale,
-              title=f"zero detail\nRMS {pct(b['hausdorff_rms'], 2)} %, max {pct(b['hausdorff_max'], 1)} %")
-        X, T, distance = out["X"], out["Ft"], out["distance"]
-        _draw(axes[1], X, T, R, centre, scale,
-              title=f"rebuilt, {rep['target']['vertices']:,} vertices\nRMS {pct(e['hausdorff_rms'])} %, "
-                    f"max {pct(e['hausdorff_max'], 2)} %")
-        vmax = max(float(distance.max()), np.finfo(float).tiny)
-        Q = (X - centre) @ R.T
-        normal = np.cross(Q[T[:, 1]] - Q[T[:, 0]], Q[T[:, 2]] - Q[T[:, 0]])
-        normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), np.finfo(float).tiny)
-        shade = 0.35 + 0.65 * np.clip(np.abs(normal @ LIGHT), 0, 1)
-        colour = cmap(np.clip(distance[T].mean(1) / vmax, 0, 1))
-        colour[:, :3] *= shade[:, None]
-        surface = axes[1].collections[-1]
-        surface.set_facecolor(colour)
-        surface.set_edgecolor(colour)       # fills the hairline seams between triangles
-        surface.set_linewidth(0.3)
+        draw_mesh(axes[0], V @ R.T, F, title=f"{name.rsplit('.', 1)[0]}: {V.shape[0]:,} vertices", **view)
+        draw_mesh(axes[2], out["Z"] @ R.T, out["Ft"], **view,
+                  title=f"zero detail\nRMS {pct(b['hausdorff_rms'], 2)} %, max {pct(b['hausdorff_max'], 1)} %")
+        scale = draw_mesh(axes[1], out["X"] @ R.T, out["Ft"], 100 * out["distance"] / bbox_diagonal(V), cmap=cmap,
+                          title=f"rebuilt, {rep['target']['vertices']:,} vertices\nRMS {pct(e['hausdorff_rms'])} %, "
+                                f"max {pct(e['hausdorff_max'], 2)} %", **view)
         # in the panel's own lower margin, so that the rebuilt surface is drawn as large as the others
-        bar = fig.colorbar(ScalarMappable(Normalize(0, 100 * vmax / diagonal), cmap),
-                           cax=axes[1].inset_axes([0.15, 0.1, 0.7, 0.035]), orientation="horizontal")
+        bar = fig.colorbar(scale, cax=axes[1].inset_axes([0.15, -0.08, 0.7, 0.035]), orientation="horizontal")
         bar.set_label("distance to the source, % of the bbox diagonal", fontsize=8)
         bar.ax.tick_params(labelsize=7)
     fig.subplots_adjust(hspace=0.25)

@@ -8,7 +8,7 @@ import pytest
 from curvdetail import read_mesh, write_mesh
 from curvdetail.cli import main
 from curvdetail.curvature.testing import grid
-from curvdetail.deformation_benchmark import apply_transform, write_selection, write_transform
+from curvdetail.io.deformation import apply_transform, write_selection, write_transform
 
 
 def _case(tmp_path):
@@ -55,7 +55,7 @@ def test_handle_detail_and_relations_options_change_only_the_interior(tmp_path):
     # --relations reaches the editor: the free vertices move, to where the library puts them
     assert np.abs(A - C)[status == 1].max() > 1e-2             # 0.063
     from curvdetail.curvature._validate import bbox_diagonal
-    from curvdetail.deformation_benchmark import edit_with_selection
+    from curvdetail.io.deformation import edit_with_selection
 
     expected = edit_with_selection(V, F, status, T, relations="one+two-ring")
     assert np.abs(C - expected).max() <= 1e-6 * bbox_diagonal(V)
@@ -85,7 +85,7 @@ def test_malformed_selection_fails_cleanly_and_leaves_no_output(tmp_path, capsys
 def test_an_amplified_edit_is_written_with_exit_status_4(tmp_path, capsys, monkeypatch):
     # the cactus benchmark with its default options moved vertices by 19x the bbox diagonal and
     # exited 0: a script could not tell; the same result is now written with status 4
-    import curvdetail.deformation_benchmark as benchmark
+    import curvdetail.io.deformation as benchmark
 
     V, F, status, T, p = _case(tmp_path)
     real = benchmark.edit_with_selection
@@ -225,7 +225,7 @@ def test_the_warnings_suggest_only_options_not_in_use(tmp_path, capsys, monkeypa
     # the bar with --handle-detail free --relations one+two-ring folded 96 triangles and was told
     # "try --relations one-ring or --handle-detail free"; an amplified edit was always told
     # "--relations one+two-ring or --handle-detail free", whatever it ran with
-    import curvdetail.deformation_benchmark as benchmark
+    import curvdetail.io.deformation as benchmark
 
     V, F, status, T, p = _case(tmp_path)
     real = benchmark.edit_with_selection

@@ -10,7 +10,7 @@ MODULES = [
     "curvdetail.remesh.evaluate", "curvdetail.remesh.experiment", "curvdetail.remesh.locate",
     "curvdetail.remesh.parameterize", "curvdetail.remesh.retriangulate", "curvdetail.remesh.transfer",
     "curvdetail.filters.dispatch", "curvdetail.filters.mlx", "curvdetail.filters.parameters",
-    "curvdetail.deformation_benchmark", "curvdetail.curvature.curvature_editor",
+    "curvdetail.io.deformation", "curvdetail.plot", "curvdetail.curvature.curvature_editor",
     "curvdetail.curvature.curvature_coefficients", "curvdetail.curvature.boundary_editing",
     "curvdetail.remesh._disk",
 ]

@@ -162,7 +162,7 @@ def test_the_filter_warns_where_curvdetail_edit_exits_with_status_4(tmp_path, ca
     # moved up to 4.3 times as far as the handles") and the filter returned the same ratio silently
     from curvdetail import read_mesh, write_mesh
     from curvdetail.cli import main
-    from curvdetail.deformation_benchmark import write_selection, write_transform
+    from curvdetail.io.deformation import write_selection, write_transform
 
     V, F = read_mesh(os.path.join(DATA, "mannequin_nose.obj"))
     diagonal = np.linalg.norm(np.ptp(V, axis=0))

@@ -200,7 +200,7 @@ def _edit_inputs(tmp_path):
     """An 8 x 8 plane with its .sel / .def in tmp_path / "in", and an empty tmp_path / "out";
     returns the ``curvdetail edit`` arguments before OUTPUT, and the out folder."""
     from curvdetail.curvature.testing import grid as _grid
-    from curvdetail.deformation_benchmark import write_selection, write_transform
+    from curvdetail.io.deformation import write_selection, write_transform
     from curvdetail.io.mesh import write_mesh
 
     V, F = _grid(8, 8)
@@ -233,7 +233,7 @@ def test_edit_failed_mesh_write_leaves_no_image(tmp_path, capsys, monkeypatch):
 
 
 def test_selection_file_has_normal_permissions(tmp_path, umask_022):
-    from curvdetail.deformation_benchmark import write_selection
+    from curvdetail.io.deformation import write_selection
 
     V, _ = grid(3, 3)
     write_selection(tmp_path / "a.sel", np.zeros(V.shape[0], dtype=int))

@@ -17,10 +17,8 @@ from .reconstruct import Reconstructor, reconstruct
 from .sparse_solver import SolverError, available_backends
 
 __all__ = [
-    "ConstraintError", "MeshError", "Reconstructor", "SolverError", "available_backends",
-    "boundary_edges", "boundary_vertices", "check_mesh", "cotan_laplacian", "curvature_detail",
-    "mean_curvature_normal", "minimal_surface", "mixed_voronoi_area", "reconstruct",
-    # editing issue
-    "CoefficientInfo", "CurvatureEditor", "boundary_loop", "curvature_coefficients", "edit_boundary",
-    "sine_displacement",
+    "CoefficientInfo", "ConstraintError", "CurvatureEditor", "MeshError", "Reconstructor", "SolverError",
+    "available_backends", "boundary_edges", "boundary_loop", "boundary_vertices", "check_mesh",
+    "cotan_laplacian", "curvature_coefficients", "curvature_detail", "edit_boundary", "mean_curvature_normal",
+    "minimal_surface", "mixed_voronoi_area", "reconstruct", "sine_displacement",
 ]

@@ -42,10 +42,12 @@ def corner_cotangents(V, F, *, lengths=True):
 
     Returns
     -------
-    cot : (m, 3) float   cot of the angle at corner k of each triangle (the transpose of a
-                         contiguous (3, m) array)
-    sq  : (m, 3) float   squared length of the edge opposite corner k (joining corners k+1, k+2)
-    dbl : (m,) float     twice the triangle's area
+    cot : (m, 3) float array
+        Cot of the angle at corner k of each triangle (the transpose of a contiguous (3, m) array).
+    sq : (m, 3) float array
+        Squared length of the edge opposite corner k (joining corners k+1, k+2).
+    dbl : (m,) float array
+        Twice the triangle's area.
     """
     # coordinate-major (3, m) arrays: every operation below runs on contiguous rows
     Vt = np.ascontiguousarray(V.T)

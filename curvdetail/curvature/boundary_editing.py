@@ -25,81 +25,64 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
                   rcond=DEFAULT_RCOND, backend="auto", return_info=False):
     """Move the boundary of a disk-topology patch and rebuild the surface from its detail.
 
-    Steps (the paper's shape editing: "the boundary vertices coordinate ... are modified ...
-    curvature normal of boundary is modified accordingly"):
-
-    1. The boundary loop (one loop, in the orientation of its triangles) is moved by
-       ``displacement``.
-    2. The boundary's curvature detail is updated accordingly (``boundary_detail="deformed"``,
-       the paper): the similarity that fits the boundary's move best (least squares) moves the
-       whole patch, the rest of the displacement is spread into the interior as a
-       cotangent-harmonic field (rest weights), and the boundary details are those of that
-       provisional surface, ``D_b = (L(V') V')_b``. So a boundary rotated, scaled or moved as a
-       whole moves the patch with it, as the editor's constraints do. With ``"rest"`` the boundary keeps its rest detail (the inside
-       then keeps its rest detail too and only the embedding changes).
-    3. A :class:`CurvatureEditor` with the boundary's positions and details constrained rebuilds
-       the interior: the curvature stage carries the interior detail (rotation- and scale-
-       invariant coefficients), the embedding places it.
+    The boundary loop is moved by ``displacement``; its curvature detail is updated (with
+    ``boundary_detail="deformed"``, the paper: the details of a provisional surface, the boundary's
+    best-fitting similarity applied to the patch and the rest of the move spread harmonically
+    inside; with ``"rest"`` the rest details are kept); then a :class:`CurvatureEditor` with the
+    boundary's positions and details constrained rebuilds the interior. A boundary rotated, scaled
+    or moved as a whole moves the patch with it. See docs/editing.md, "Shape editing of a boundary".
 
     Parameters
     ----------
-    V : (n, 3) float array   rest positions of a patch with exactly one boundary loop
-    F : (m, 3) int array     triangles
+    V : (n, 3) float array
+        Rest positions of a patch with exactly one boundary loop.
+    F : (m, 3) int array
+        Triangles.
     displacement : callable or (b, 3) float array
         ``displacement(s, P) -> (b, 3)`` with ``s`` the normalized arc length in [0, 1) of each
-        boundary vertex along the loop (starting at the loop's first vertex, see ``info``) and
-        ``P`` their (b, 3) positions; or the (b, 3) displacements themselves, row r for
-        ``info["boundary"][r]`` (loop order). :func:`sine_displacement` builds the paper's sine.
-    boundary_detail : {"deformed", "rest"}   how the boundary's detail is updated (step 2).
-                             With ``"deformed"`` the curvature stage amplifies the detail change,
-                             and moves of a few percent can fold triangles (see Warns)
-    relations : str          curvature-stage relations of :class:`CurvatureEditor`
-                             (``"one+two-ring"`` folded nothing on the trunk and terrains where
-                             one-ring folds; on the nose and ear as often or more)
-    rcond : float            threshold of :func:`curvature_coefficients`
-    backend : str            sparse solver backend
-    return_info : bool       also return a dict with ``boundary`` (loop order), ``arc_length``
-                             (normalized, per boundary vertex), ``boundary_detail`` (the updated
-                             (b, 3) details), ``editor`` (the factored editor, for re-solves) and
-                             the result's figures, named as the editing filter's:
-                             ``folded_triangles`` (int: triangles whose normal points against
-                             their rest normal, both as it is and turned by the rotation of the
-                             boundary's best-fitting similarity, so a patch turned as a whole
-                             counts none),
-                             ``max_displacement`` and ``boundary_displacement`` (largest move of
-                             any vertex / of a boundary vertex, as fractions of the rest bbox
-                             diagonal) and ``amplification`` (their ratio; None where the
-                             boundary moves less than 1e-12 of the diagonal)
+        boundary vertex along the loop and ``P`` their (b, 3) positions; or the displacements
+        themselves, row r for ``info["boundary"][r]``. :func:`sine_displacement` builds the
+        paper's sine.
+    boundary_detail : {"deformed", "rest"}
+        How the boundary's detail is updated.
+    relations : {"one-ring", "one+two-ring"}
+        Curvature-stage relations of :class:`CurvatureEditor`.
+    rcond : float
+        Threshold of :func:`curvature_coefficients`.
+    backend : str
+        Sparse solver backend.
+    return_info : bool
+        Also return a dict with ``boundary`` (loop order), ``arc_length``, ``boundary_detail``
+        (the updated (b, 3) details), ``editor`` (for re-solves), ``folded_triangles`` (triangles
+        whose normal turned against their rest normal, the boundary's rotation discounted),
+        ``max_displacement`` and ``boundary_displacement`` (largest move of any vertex / of a
+        boundary vertex over the rest bbox diagonal) and ``amplification`` (their ratio, or None).
 
     Returns
     -------
-    X : (n, 3) float array   edited positions; ``X[boundary] == V[boundary] + displacement`` exactly
-    info : dict              only with ``return_info=True``
+    X : (n, 3) float array
+        Edited positions; ``X[boundary] == V[boundary] + displacement`` exactly.
+    info : dict
+        Only with ``return_info=True``.
 
     Warns
     -----
-    FoldedTrianglesWarning   when ``folded_triangles > 0``, with the count, the amplification and
-                             what to try (the other ``relations``, a smaller displacement,
-                             ``boundary_detail="rest"``). Measured on elephant_trunk (723
-                             vertices) with ``sine_displacement(a * extent, periods=2, axis=2)``,
-                             ``extent`` the loop's bbox diagonal: the boundary moves 0.31 % of
-                             the diagonal at a = 0.005 and the inside 7.2 % (one-ring) / 5.9 %
-                             (one+two-ring); at a = 0.02 (boundary 1.25 %) 29 % and 299 of 1399
-                             triangles folded (one-ring) / 23 % and none (one+two-ring);
-                             ``"rest"``: 1.3 %, none. Large amplification alone does not warn:
-                             it is ~23 / ~19 on the trunk at every amplitude, folded or not
+    FoldedTrianglesWarning
+        When ``folded_triangles > 0``, with the count, the amplification and what to try (the
+        other ``relations``, a smaller displacement, ``boundary_detail="rest"``).
 
     Raises
     ------
-    MeshError         malformed mesh, or not exactly one boundary loop
-    ConstraintError   displacement array of the wrong shape or with NaN / inf; a displaced boundary
-                      beyond 1e75; with ``"deformed"``, a displacement that collapses the loop
-                      (onto a point or a line: the provisional surface has zero-area triangles)
-    ValueError        the displacement callable does not take (s, P), or returned the wrong
-                      shape or non-finite values, ``return_info`` is not a bool, or an option is
-                      not one of its values (or not a single str); SolverError for an unknown
-                      ``backend``. An exception raised inside the displacement callable reaches
-                      the caller unchanged
+    MeshError
+        If the mesh is malformed or has not exactly one boundary loop.
+    ConstraintError
+        If the displacements have the wrong shape, are not finite or too large, or collapse the
+        loop (``"deformed"``).
+    ValueError
+        If the displacement callable does not take ``(s, P)`` or returns the wrong shape or
+        non-finite values, or an option is not one of its values.
+    SolverError
+        If ``backend`` is unknown or not installed.
 
     Examples
     --------
@@ -303,19 +286,24 @@ def sine_displacement(amplitude, periods=1, axis=1, phase=0.0):
 
     Parameters
     ----------
-    amplitude : float   in the mesh's length unit
-    periods : float     number of periods along the whole loop (an integer closes it smoothly)
-    axis : int          0, 1 or 2 (x, y or z)
-    phase : float       in periods
+    amplitude : float
+        In the mesh's length unit.
+    periods : float
+        Number of periods along the whole loop (an integer closes it smoothly).
+    axis : {0, 1, 2}
+        The axis moved (x, y or z).
+    phase : float
+        In periods.
 
     Returns
     -------
-    displacement : callable ``(s, P) -> (b, 3)`` for :func:`edit_boundary`
+    displacement : callable
+        ``(s, P) -> (b, 3)``, for :func:`edit_boundary`.
 
     Raises
     ------
-    ValueError   ``axis`` not the integer 0, 1 or 2, or ``amplitude``, ``periods`` or ``phase``
-                 not a finite number
+    ValueError
+        If ``axis`` is not the integer 0, 1 or 2, or another argument is not a finite number.
 
     Examples
     --------
@@ -344,20 +332,20 @@ def boundary_loop(F):
 
     Parameters
     ----------
-    F : (m, 3) int array    triangles, consistently oriented (checked as in :func:`boundary_edges`;
-                            no vertex positions are needed)
+    F : (m, 3) int array
+        Triangles, consistently oriented (no vertex positions are needed).
 
     Returns
     -------
-    loop : (b,) int64 array   boundary vertices in order, each once; ``loop[0]`` is the smallest
-                              index and each ``(loop[i], loop[i + 1])`` runs as in its triangle (for
-                              a patch whose normals face the viewer: counter-clockwise)
+    loop : (b,) int64 array
+        Boundary vertices in order, each once; ``loop[0]`` is the smallest index and each
+        ``(loop[i], loop[i + 1])`` runs as in its triangle (counter-clockwise seen from the normals).
 
     Raises
     ------
-    MeshError   the mesh has no boundary, several loops, or a vertex where the boundary
-                touches itself; triangles wound against their neighbours and several pieces are
-                named as such; ``F`` malformed (as :func:`boundary_edges` refuses it)
+    MeshError
+        If the mesh has no boundary, several loops, a vertex where the boundary touches itself,
+        misoriented triangles, or ``F`` is malformed.
 
     Examples
     --------

@@ -26,21 +26,22 @@ class CoefficientInfo:
 
     Attributes
     ----------
-    rank : (n,) int array            numerical rank (0-3) of the detail matrix ``D_N(i)`` of the
-                                     ring the coefficients span (the one-ring but where widened)
-    rank_deficient : int             number of vertices with ``rank < 3`` (flat or cylindrical
-                                     rings); their coefficients are the truncated (regularized)
-                                     minimum-norm solution
-    rank_deficient_vertices : (r,) int array   those vertices, increasing
-    residual : (n,) float array      ``|D_i - sum_j C_ij D_j|`` (absolute; zero where ``D_i`` lies
-                                     in the span of the kept singular directions)
-    scale : (n,) float array         the reference ``s_i`` of the relative threshold
-    rcond : float                    the threshold used
-    ring : (n,) int array            the ring each vertex's coefficients span: 1 (the one-ring)
-                                     but where the one-ring could not represent the detail (a
-                                     ring that stopped growing counts once: the narrowest ring
-                                     with the row's pattern)
-    widened_vertices : (w,) int array   the vertices with ``ring > 1``, increasing
+    rank : (n,) int array
+        Numerical rank (0-3) of the detail matrix of the ring the coefficients span.
+    rank_deficient : int
+        Number of vertices with ``rank < 3`` (flat or cylindrical rings).
+    rank_deficient_vertices : (r,) int array
+        Those vertices, increasing.
+    residual : (n,) float array
+        ``|D_i - sum_j C_ij D_j|``.
+    scale : (n,) float array
+        The reference ``s_i`` of the relative threshold.
+    rcond : float
+        The threshold used.
+    ring : (n,) int array
+        The ring each vertex's coefficients span: 1 (the one-ring) but where widened.
+    widened_vertices : (w,) int array
+        The vertices with ``ring > 1``, increasing.
     """
 
     rank: np.ndarray
@@ -56,70 +57,46 @@ class CoefficientInfo:
 def curvature_coefficients(V, F, *, rcond=DEFAULT_RCOND, max_ring=DEFAULT_MAX_RING, return_info=False):
     """Rotation- and scale-invariant curvature coefficients ``C`` with ``D_i = sum_j C_ij D_j``.
 
-    For each vertex ``i`` with one-ring ``N(i)`` the coefficients ``c_i`` are the minimum-norm
-    solution of ``D_N c_i = D_i``, where ``D_N`` is the 3 x |N(i)| matrix of the neighbours'
-    curvature details ``D_j = (L V)_j`` (the paper's ``K_j A_j``):
-    ``c_i = D_N^T (D_N D_N^T)^+ D_i``. The coefficients depend only on angles and length ratios of
-    the details, so they do not change when the detail is rotated or uniformly scaled.
+    Row ``i`` is the minimum-norm solution ``c_i = D_N^T (D_N D_N^T)^+ D_i`` of ``D_N c_i = D_i``,
+    where ``D_N`` (3 x |N(i)|) holds the one-ring's curvature details ``D_j = (L V)_j`` (the
+    paper's ``K_j A_j``). It depends only on angles and length ratios of the details, so ``C``
+    does not change when the mesh is rotated, uniformly scaled or moved.
 
-    Computation, batched (no per-vertex loop): the 3x3 Gram matrices ``G_i = D_N D_N^T`` are
-    summed over the mesh edges with ``bincount``; where ``det(G_i) > 1e-6 trace(G_i)^3`` (so
-    ``cond(G_i) < 1e6`` and rank 3 is certain) they are inverted in closed form (adjugate over
-    determinant), all others are pseudo-inverted at once through a batched symmetric
-    eigendecomposition. Never ``np.linalg.solve``, which returns wrong values without an error
-    where ``G_i`` is singular (valence-2 corners). Forming ``G_i`` squares the ring's condition
-    number; the threshold below is chosen well above the resulting ~1.5e-8 noise floor.
-
-    Regularization (rank-deficient rings): a singular value ``sigma_k`` of ``D_N`` is kept only if
-    ``sigma_k > rcond * s_i`` with ``s_i = max(sigma_1(D_N), sqrt(sum_j A_j^2) / size)``; the
-    others are truncated (a truncated pseudo-inverse). ``sigma_1`` makes the threshold relative
-    to the ring itself (coplanar details on a cylinder: the third singular value is roundoff);
-    the second term is the detail a curvature of ``1 / size`` would give on the ring (``A_j`` mixed
-    Voronoi areas, ``size`` twice the largest distance from the vertices' centroid: the
-    bounding-box diagonal's size, but unchanged by rotations, as the coefficients must be), so
-    that a ring whose curvature is below ``rcond / size`` counts as flat: its details are
-    roundoff and its coefficients are zero
-    (``D_i = 0`` is kept there). Vertices with fewer than three kept singular values are
-    counted as rank-deficient; their detail is represented only where it lies in the kept span.
-    Where a singular value lies between ~1e-7 and 1e-3 of the largest (near the threshold, or
-    kept with a large weight), ``G_i``'s eigenvalues do not give it accurately (they carry
-    ~1e-16 of the largest): those rings are pseudo-inverted through a batched SVD of the ring
-    matrix ``D_N`` itself (batched by ring size).
-
-    Widening: where the detail does not lie in that span (the residual
-    ``|D_i - sum_j C_ij D_j|`` is above ``rcond * s_i``: a valence-2 corner of a grid, whose two
-    neighbours' details span a plane that its own detail leaves), the relation cannot hold and
-    nothing keeps the edited detail there consistent with a similarity of the constraints: the
-    editor's result then moved by up to 16 diagonals under a uniform scale of all constraints
-    (terrainA_10k, two such corners). Those rows take the minimum-norm coefficients over the
-    vertex's two-ring instead (without the vertex), then its three-ring, up to ``max_ring``;
-    ``max_ring=1`` keeps the one-ring everywhere (the paper's relations). A ring that stops
-    growing (it holds the vertex's whole connected piece already) is not widened further: the
-    row keeps that ring's fit, and ``info.ring`` reports that ring. The decision depends
-    only on ratios, so it too is invariant.
+    A singular value ``sigma_k`` of ``D_N`` is kept only if ``sigma_k > rcond * s_i``, with
+    ``s_i = max(sigma_1(D_N), sqrt(sum_j A_j^2) / size)`` (``A_j`` mixed Voronoi areas, ``size``
+    twice the largest distance of a vertex from the vertices' centroid): a ring flatter than
+    curvature ``rcond / size`` gets zero coefficients. Where the kept span does not hold ``D_i``
+    (a grid's valence-2 corner), the row is fitted over the two-ring instead (without the vertex),
+    then the three-ring, up to ``max_ring``. See docs/editing.md, "Curvature coefficients".
 
     Parameters
     ----------
-    V : (n, 3) float array   vertex positions
-    F : (m, 3) int array     triangles
-    rcond : float            relative singular-value threshold, in (0, 1); default 1e-6
-    max_ring : int           widest ring for a vertex whose one-ring cannot represent its detail
-                             (>= 1; default 3; 1 = one-ring only)
-    return_info : bool       also return a :class:`CoefficientInfo` (ranks, rank-deficient count,
-                             residuals, widened rings)
+    V : (n, 3) float array
+        Vertex positions.
+    F : (m, 3) int array
+        Triangles.
+    rcond : float
+        Relative singular-value threshold, in (0, 1).
+    max_ring : int
+        Widest ring for a vertex whose one-ring cannot represent its detail (1: one-ring only).
+    return_info : bool
+        Also return a :class:`CoefficientInfo`.
 
     Returns
     -------
-    C : (n, n) scipy.sparse.csr_matrix   one-ring sparsity pattern (every mesh edge in both
-                                         directions is stored, possibly as an explicit 0; a
-                                         widened row stores its whole ring), zero diagonal; rows
-                                         are not normalized and need not sum to 1
-    info : CoefficientInfo               only with ``return_info=True``
+    C : (n, n) scipy.sparse.csr_matrix
+        Every mesh edge stored in both directions (possibly as an explicit 0; a widened row stores
+        its whole ring), zero diagonal; rows are not normalized.
+    info : CoefficientInfo
+        Only with ``return_info=True``.
 
     Raises
     ------
-    MeshError    malformed mesh (shapes, NaN, bad indices, zero-area or non-manifold elements)
-    ValueError   ``rcond`` outside (0, 1), ``max_ring`` not a count >= 1, ``return_info`` not a bool
+    MeshError
+        If the mesh is malformed (as for :func:`cotan_laplacian`).
+    ValueError
+        If ``rcond`` is outside (0, 1), ``max_ring`` is not a count >= 1 or ``return_info`` is not
+        a bool.
 
     Examples
     --------
@@ -450,8 +427,7 @@ def _truncated_fit(D, A, target, counts, cols, rcond, size, *, area_scale=None):
     ``sqrt(sum_j A_j^2) / size`` where the caller has it.
 
     Rings are batched by size (up to 16, larger ones padded to the next power of two), not all
-    padded to the largest: one pole of valence 1024 among 100k such rings made that 5 GB and
-    13 s (now 0.3 GB and 0.8 s for the whole call)."""
+    padded to the largest (one high-valence pole would make every ring that large)."""
     if area_scale is None:
         at = np.repeat(np.arange(target.size), counts)
         area_scale = (np.sqrt(np.bincount(at, weights=A[cols] ** 2, minlength=target.size))

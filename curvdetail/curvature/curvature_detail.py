@@ -11,17 +11,20 @@ def curvature_detail(V, F):
 
     Parameters
     ----------
-    V : (n, 3) float array   vertex positions
-    F : (m, 3) int array     triangles
+    V : (n, 3) float array
+        Vertex positions.
+    F : (m, 3) int array
+        Triangles.
 
     Returns
     -------
-    D : (n, 3) float array   equal to ``cotan_laplacian(V, F) @ V``
+    D : (n, 3) float array
+        Equal to ``cotan_laplacian(V, F) @ V``.
 
     Raises
     ------
-    MeshError   if V or F is malformed, a triangle has zero area, an edge is non-manifold or a
-                vertex is unreferenced (names the first ones)
+    MeshError
+        If the mesh is malformed (as for :func:`cotan_laplacian`).
 
     Examples
     --------

@@ -34,129 +34,80 @@ MAX_REST_ERROR = 1e-3
 class CurvatureEditor:
     """Edit a mesh through its curvature detail: factor once, re-solve for any constraint values.
 
-    Two stages (the paper's mesh editing):
-
-    1. **Curvature stage.** The details ``D_u`` of the vertices without a detail constraint
-       minimize ``|(I - C) D|^2`` over their own rows, i.e. they solve the square system
-       ``(I - C)_uu D_u = C_uk D_k`` exactly (``C`` = :func:`curvature_coefficients` of ``V``,
-       ``k`` = detail-constrained vertices and every vertex outside ``roi``): the paper's
-       linear-system form ``C D = D``. (The paper names a second form, the least-squares
-       minimum over all rows, and used it; through normal equations it squares a condition
-       number of up to 1e14, see docs/editing.md.) The system is not symmetric; it is
-       LU-factored once.
-    2. **Embedding stage.** Positions minimize the paper's ``E_Q = sum_i |(L X)_i - D_i|^2``
-       (``L`` = cotangent Laplacian of ``V``) over the vertices without a position constraint,
-       summed over every row that involves them (as :class:`Reconstructor` with
-       ``rows="all"``); position-constrained vertices and all vertices outside ``roi`` keep
-       their positions exactly. Normal equations, Cholesky-type factorization, once; each
-       solve adds corrected semi-normal refinement (at least ``refinement_steps`` steps, see
-       :func:`refine_least_squares`), which keeps the error at solver precision as in
-       :class:`Reconstructor`.
-
-    Vertices outside ``roi`` are fixed: position and detail as in ``V`` (a smooth transition
-    across the region's border), and they are left out of both systems, whose sizes are those
-    of the region. The constructor does all factoring; :meth:`solve` only back-substitutes.
-
-    Invariance (exact up to solver precision): with ``roi=None``, moving every position
-    constraint by a similarity ``x -> s R x + t`` and every detail constraint by its linear part
-    ``D -> s R D`` (the detail ``D = L V`` scales like a length) moves the result by the same
-    similarity, because ``C`` and ``L`` are invariant and both stages are linear. Where a
-    one-ring cannot represent its vertex's detail (a grid's valence-2 corner), ``C`` takes that
-    row over a wider ring (see :func:`curvature_coefficients`, ``max_ring``); without it, the
-    rest residual ``(I - C) D`` there was a constant that no similarity moves, and ``(I - C)_uu``
-    amplified it: terrainA_10k with 40 handles came back 16 diagonals off under a uniform scale
-    of its constraints (now 2e-11). Two parts of the detail still stay as they are at rest and do
-    not follow the similarity: the detail of *detail islands* (see ``detail_islands``), and the
-    residual of any ring still unable to represent its detail at the three-ring (kept as a
-    constant term so that unchanged constraints give back the rest shape exactly; none on the
-    meshes tested). Where either is present the invariance holds only approximately (a bump in
-    a plane, 621 island vertices: 3 % of the diagonal under a rotation).
+    Two stages (the paper's Sections 3.1-3.2). The curvature stage gives the details ``D_u`` of
+    the region's vertices without a detail constraint: the square system
+    ``(I - C)_uu D_u = C_uk D_k`` (``C`` from :func:`curvature_coefficients`, LU-factored), or
+    with ``relations="one+two-ring"`` the least squares of ``|(I - C) D|^2 + |(I - C2) D|^2``.
+    The embedding stage gives the positions minimizing ``E_Q = sum_i |(L X)_i - D_i|^2`` over the
+    free positions, as :class:`Reconstructor`. Vertices outside ``roi`` keep their rest positions
+    and details. The constructor does all factoring; :meth:`solve` only back-substitutes. With
+    ``roi=None``, moving the position constraints by a similarity ``x -> s R x + t`` and the
+    detail constraints by ``D -> s R D`` moves the result by the same similarity (see
+    docs/editing.md, "Invariance of the editor").
 
     Parameters
     ----------
-    V : (n, 3) float array      rest positions (supply ``L``, ``C`` and the values outside ``roi``)
-    F : (m, 3) int array        triangles
-    position_constrained : (p,) int array or (n,) bool mask   vertices whose positions are given
-                                to :meth:`solve` (handles); inside ``roi``
-    detail_constrained : (q,) int array or (n,) bool mask     vertices whose curvature details
-                                are given to :meth:`solve`; inside ``roi``. May overlap
-                                ``position_constrained`` (a handle with both constrained)
-    roi : (r,) int array or (n,) bool mask or None   region of interest; None = the whole mesh;
-                                its order does not matter, so a set is taken too
-                                (Index arguments also take a list, a range, a single int and
-                                whole floats such as 3.0, as pymeshlab's and libigl's float index
-                                arrays; 3.5 is refused, naming the first such value.)
-    rows : {"all", "free"}      embedding rows: ``"all"`` sums ``E_Q`` over every row that
-                                involves a free position (the paper; normal equations, 2-ring
-                                fill), ``"free"`` over the free vertices' rows only (the square
-                                system ``L_ff X_f = D_f - L_fc X_c``: sparser, faster re-solves)
+    V : (n, 3) float array
+        Rest positions.
+    F : (m, 3) int array
+        Triangles.
+    position_constrained : (p,) int array or (n,) bool mask
+        Vertices whose positions are given to :meth:`solve` (the handles), inside ``roi``.
+    detail_constrained : (q,) int array or (n,) bool mask
+        Vertices whose curvature details are given to :meth:`solve`, inside ``roi``; may overlap
+        ``position_constrained``.
+    roi : (r,) int array or (n,) bool mask, optional
+        Region of interest, in any order (a set is taken too); None is the whole mesh.
+    rows : {"all", "free"}
+        Embedding rows: every row that involves a free position (the paper; normal equations), or
+        the free vertices' rows only (a square system: sparser, faster re-solves).
     relations : {"one-ring", "one+two-ring"}
-                                curvature stage: ``"one-ring"`` is the paper's relations (in
-                                the square system's form above); ``"one+two-ring"`` also
-                                computes minimum-norm coefficients over each vertex's two-ring,
-                                ``C2``, and minimizes
-                                ``|(I - C) D|^2 + |(I - C2) D|^2`` over the region's rows (normal
-                                equations). Same invariance and the same rest state, but twice the
-                                equations for the same unknowns: far less amplification of
-                                inconsistent constraints (a rotated handle), at the price of a
-                                denser factorization
-    rcond : float               singular-value threshold of :func:`curvature_coefficients`
-    max_ring : int              widest ring of :func:`curvature_coefficients` (default 3; 1 keeps
-                                the paper's one-ring relations everywhere, with the rank-deficient
-                                corners' residuals kept as constants, see Invariance)
-    backend : str               sparse solver backend ("auto", "pardiso", "cholmod", "splu", "banded");
-                                with "auto" the curvature stage uses SuperLU below
-                                :data:`CURVATURE_SPLU_MAX` unknowns (fastest back-substitution
-                                for ``(I - C)`` there) and the core's automatic choice from there,
-                                the embedding the core's automatic choice
+        Curvature stage: the paper's one-ring relations, or two-ring ones as well (twice the
+        equations: far less amplification of inconsistent constraints, a denser factorization).
+    rcond : float
+        Singular-value threshold of :func:`curvature_coefficients`.
+    max_ring : int
+        Widest ring of :func:`curvature_coefficients` (1: the paper's one-ring everywhere).
+    backend : str
+        Sparse solver backend ("auto" or one of :func:`available_backends`).
 
     Attributes
     ----------
-    position_constrained, detail_constrained : int arrays   as given (masks: increasing)
-    roi : (r,) int array        the region, increasing
-    detail : (n, 3) float array rest detail ``D = L V``
-    laplacian : (n, n) csr_matrix   ``L`` of the rest shape (:func:`cotan_laplacian`)
-    coefficients : (n, n) csr_matrix   ``C``
-    coefficients_two_ring : (n, n) csr_matrix   ``C2`` (only with ``relations="one+two-ring"``)
-    relations, rows : str       as given
-    backend : dict              the solver backend of each stage, e.g. ``{"curvature": "splu",
-                                "embedding": "banded"}`` ("none" where a stage has no unknowns)
-    timings : dict              seconds spent in the constructor: ``coefficients`` (L, D and C),
-                                ``curvature_setup`` (checks and LU of ``(I - C)_uu``),
-                                ``embedding_setup`` (normal equations and their factorization),
-                                ``rest_check`` (``rest_error``: one back-substitution of each stage)
-    widened_rings : int         vertices whose coefficients span a ring wider than the one-ring
-                                (see :func:`curvature_coefficients`); ``widened_vertices`` and
-                                ``rank_deficient_vertices`` (int arrays, increasing) list them
-    rank_deficient : int        vertices whose ring detail is rank-deficient (see
-                                :func:`curvature_coefficients`)
-    detail_islands : int        free vertices whose detail the coefficients cannot determine
-                                (groups cut off from every known detail by flat vertices, whose
-                                coefficients are zero, e.g. a bump in a plane); they keep their
-                                rest detail, like detail-constrained vertices
-    rest_error : float          largest distance of :meth:`solve` with the rest values from ``V``,
-                                over the bbox diagonal, as far as the curvature stage causes it:
-                                rounding (0 ... 1e-7 on real meshes) where the constraints
-                                determine the edit
+    detail : (n, 3) float array
+        Rest detail ``D = L V``.
+    laplacian, coefficients : (n, n) scipy.sparse.csr_matrix
+        ``L`` and ``C`` of the rest shape; ``coefficients_two_ring`` is ``C2``
+        (``relations="one+two-ring"`` only).
+    roi : (r,) int array
+        The region, increasing; ``position_constrained`` and ``detail_constrained`` as given.
+    backend : dict
+        Solver backend of each stage, ``{"curvature": ..., "embedding": ...}`` ("none": no unknowns).
+    timings : dict
+        Constructor seconds: ``coefficients``, ``curvature_setup``, ``embedding_setup``,
+        ``rest_check``.
+    widened_rings, rank_deficient : int
+        Vertices whose coefficients span a ring wider than the one-ring, and whose ring detail is
+        rank-deficient (``widened_vertices``, ``rank_deficient_vertices``: the vertices).
+    detail_islands : int
+        Free vertices whose detail no constraint reaches (cut off by flat vertices); they keep
+        their rest detail.
+    rest_error : float
+        Distance from ``V`` of the result for the rest values, over the bbox diagonal.
 
     Raises
     ------
-    MeshError         malformed mesh
-    ConstraintError   indices out of range, repeated, not whole numbers (3.0 is taken, 3.5 is
-                      not) or None; ``position_constrained`` / ``detail_constrained`` given
-                      as a set (which has no order; a set ``roi`` is taken); a
-                      constraint outside ``roi``; an empty
-                      ``roi``; no position constraint (or fewer than three detail constraints)
-                      while ``roi`` is the whole mesh; a connected free region that touches no position (or no
-                      detail) constraint; a piece of the mesh wholly inside ``roi`` with only one or
-                      two detail constraints (UndeterminedEditError: its details are fixed only up
-                      to a linear map); constraints that do not determine the edit
-                      (UndeterminedEditError: the rest values give back a shape more than
-                      :data:`MAX_REST_ERROR` of the diagonal off ``V``, or the curvature stage
-                      could not be factored)
-    ValueError        unknown ``rows`` or ``relations`` (or not a single str); ``rcond`` outside (0, 1)
-    SolverError       unknown or uninstalled ``backend`` (before any work); the embedding could
-                      not be factored
+    MeshError
+        If the mesh is malformed.
+    ConstraintError
+        If constraint indices are out of range, repeated or outside ``roi``, ``roi`` is empty,
+        there are too few constraints, or a free region touches no constraint.
+    UndeterminedEditError
+        If the constraints do not determine the edit (``rest_error`` above :data:`MAX_REST_ERROR`,
+        or the curvature stage cannot be factored).
+    ValueError
+        If ``rows``, ``relations`` or ``rcond`` is not one of its choices.
+    SolverError
+        If ``backend`` is unknown or not installed, or the embedding cannot be factored.
 
     Examples
     --------
@@ -292,17 +243,10 @@ class CurvatureEditor:
         """Distance from ``V`` (over the bbox diagonal) of the shape the rest constraints give;
         UndeterminedEditError above :data:`MAX_REST_ERROR`.
 
-        The rest state solves both stages exactly (the rest residual is kept as a constant
-        term), so anything but rounding means a system singular to working precision, whose
-        every edit would be one arbitrary solution among many (a flat grid with three detail
-        constraints: 0.3-0.9 of the diagonal at rest). Real meshes come back to 1e-7 and better,
-        ill-conditioned ones included (fandisk, cond(I - C) ~1e14). Both stages are linear, so
-        the shape's error is the embedding's response to the curvature stage's rest-detail
-        error: one back-substitution of each stage, no refinement of the embedding (~1.4 ms at
-        951 vertices, ~6 % of the set-up; it only has to tell 1e-7 from 1e-3; the stacked
-        one+two-ring curvature stage keeps its own refinement). The embedding's own rounding
-        is not counted: its system is positive definite and refined at every solve, its error
-        far below the threshold (or a SolverError from solve())."""
+        The rest state solves both stages exactly, so anything but rounding means a system
+        singular to working precision. Both stages are linear: the shape's error is the
+        embedding's response to the curvature stage's rest-detail error (one unrefined
+        back-substitution of each stage; the embedding's own rounding is not counted)."""
         error = 0.0
         if self._curv is not None and self._embed is not None:
             dc_rest = self.detail[self._dc]
@@ -464,20 +408,21 @@ class CurvatureEditor:
 
         Parameters
         ----------
-        details : (q, 3) float array or None   details of ``detail_constrained`` (row r for
-                                               vertex ``detail_constrained[r]``); None = rest values
+        details : (q, 3) float array, optional
+            Details of ``detail_constrained`` (row r for vertex ``detail_constrained[r]``); None
+            gives the rest values.
 
         Returns
         -------
-        D : (n, 3) float array   given values at ``detail_constrained``, solved values elsewhere in
-                                 the roi, rest values outside it
+        D : (n, 3) float array
+            Given values at ``detail_constrained``, solved ones elsewhere in the roi, rest values
+            outside it.
 
         Raises
         ------
-        UndeterminedEditError   every roi position is given (the positions are then determined)
-                                and the detail constraints do not determine the details (the rest
-                                values give them back more than MAX_REST_ERROR off); also from
-                                ``solve(..., return_details=True)``
+        UndeterminedEditError
+            If every roi position is given and the detail constraints do not determine the
+            details (also from ``solve(..., return_details=True)``).
         """
         self._refuse_undetermined_details()
         Dk = self._details(details)
@@ -492,27 +437,31 @@ class CurvatureEditor:
 
         Parameters
         ----------
-        positions : (p, 3) float array or None   positions of ``position_constrained`` (row r for
-                                                 vertex ``position_constrained[r]``); None = rest
-        details : (q, 3) float array or None     curvature details ``D = K A`` of
-                                                 ``detail_constrained``; None = rest values. Under a
-                                                 similarity with linear part ``s R`` a detail
-                                                 becomes ``s R D``
-        return_details : bool                    also return the curvature stage's details (True or
-                                                 False; ValueError otherwise)
+        positions : (p, 3) float array, optional
+            Positions of ``position_constrained`` (row r for vertex ``position_constrained[r]``);
+            None gives the rest positions.
+        details : (q, 3) float array, optional
+            Curvature details ``D = K A`` of ``detail_constrained``; None gives the rest values.
+            Under a similarity with linear part ``s R`` a detail becomes ``s R D``.
+        return_details : bool
+            Also return the curvature stage's details.
 
         Returns
         -------
-        X : (n, 3) float array   ``X[position_constrained] == positions`` exactly; vertices outside
-                                 the roi keep their rest positions exactly
-        D : (n, 3) float array   only with ``return_details=True``
+        X : (n, 3) float array
+            ``X[position_constrained] == positions`` exactly; vertices outside the roi keep their
+            rest positions exactly.
+        D : (n, 3) float array
+            Only with ``return_details=True``.
 
         Raises
         ------
-        ConstraintError         ``positions`` / ``details`` not of shape (p, 3) / (q, 3), not real
-                                numbers, or with NaN or infinite rows
-        UndeterminedEditError   with ``return_details=True``: as :meth:`solve_details`
-        ValueError              ``return_details`` not True or False
+        ConstraintError
+            If ``positions`` or ``details`` is not of shape (p, 3) / (q, 3) of finite numbers.
+        UndeterminedEditError
+            With ``return_details=True``, as :meth:`solve_details`.
+        ValueError
+            If ``return_details`` is not True or False.
         """
         # "no" or 0 would otherwise count as an answer, and an array as numpy's ambiguous truth value
         return_details = check_bool(return_details, "return_details")
@@ -572,8 +521,7 @@ class CurvatureEditor:
         followed by corrected semi-normal refinement, as in :class:`Reconstructor`
         (:func:`refine_least_squares`: at least ``refinement_steps`` steps, more where the error
         estimate asks, SolverError where it stalls): without it the error grows with the
-        squared condition number (mannequin_devil, every detail given: 4e-8 of the diagonal
-        against 4e-14)."""
+        squared condition number."""
         if self._A_T is None:
             return self._embed.solve(rhs)
         X = self._embed.solve(self._A_T @ rhs)
@@ -584,31 +532,27 @@ class CurvatureEditor:
         """Precompute the response to the constraints of a few vertices, for real-time edits.
 
         Both stages are linear in the constraint values, so the result is the solution at a base
-        state plus one response column per handle vertex (the three coordinates share it). This
-        method computes the base solution and the columns by back-substitution (one
-        multi-column solve per stage, no factoring). Afterwards :meth:`solve` calls whose
-        constraint values differ from the base only at ``handles`` cost one dense
-        ``(free x h) @ (h x 3)`` product instead of two sparse back-substitutions; any other call
-        falls back to the full solve. Exact up to roundoff (the response is the same linear map).
-        Threads may share the editor: a solve while another thread precomputes uses the previous
-        response or the full solve; of calls made at once, the last to finish stays.
+        state plus one response column per handle vertex, computed here by back-substitution.
+        Afterwards a :meth:`solve` whose values differ from the base only at ``handles`` is one
+        dense ``(free x h) @ (h x 3)`` product (exact up to rounding); any other falls back to the
+        full solve. Threads may share the editor; of calls made at once, the last to finish stays.
 
         Parameters
         ----------
-        handles : (h,) int array     vertices of ``position_constrained`` and/or
-                                     ``detail_constrained`` whose values will change (order
-                                     does not matter: a set is taken too)
-        positions, details           the base constraint values (as in :meth:`solve`; None = rest)
+        handles : (h,) int array
+            Position- and/or detail-constrained vertices whose values will change (any order).
+        positions, details : float arrays, optional
+            The base constraint values, as in :meth:`solve` (None: rest values).
 
         Returns
         -------
-        self
+        self : CurvatureEditor
 
         Raises
         ------
-        ConstraintError   ``handles`` out of range, repeated, not whole numbers, or a vertex that is
-                          neither position- nor detail-constrained; ``positions`` / ``details`` as
-                          in :meth:`solve`
+        ConstraintError
+            If ``handles`` are out of range, repeated, or not constrained vertices, or
+            ``positions`` / ``details`` are refused as in :meth:`solve`.
         """
         h = _index_set(handles, self.n, "handles")
         is_p = np.zeros(self.n, dtype=bool)

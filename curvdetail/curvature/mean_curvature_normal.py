@@ -9,20 +9,24 @@ def mean_curvature_normal(V, F):
 
     Parameters
     ----------
-    V : (n, 3) float array   vertex positions
-    F : (m, 3) int array     triangles
+    V : (n, 3) float array
+        Vertex positions.
+    F : (m, 3) int array
+        Triangles.
 
     Returns
     -------
-    K : (n, 3) float array   ``K_i = (L V)_i / A_i = 2 H_i n_i``; on a sphere of radius R it points
-                             away from the centre with ``|K| = 2 / R``. Intensive: it does not
-                             depend on the mesh density. On boundary vertices it carries the
-                             boundary's geodesic-curvature term as well (one-sided cotangents).
-    A : (n,) float array     mixed Voronoi areas; ``A.sum()`` is the surface area
+    K : (n, 3) float array
+        ``K_i = (L V)_i / A_i = 2 H_i n_i``; on a sphere of radius R it points away from the
+        centre with ``|K| = 2 / R``. Intensive: independent of the mesh density. On boundary
+        vertices it carries the boundary's geodesic-curvature term as well.
+    A : (n,) float array
+        Mixed Voronoi areas (:func:`mixed_voronoi_area`); ``A.sum()`` is the surface area.
 
     Raises
     ------
-    MeshError   if V or F is malformed or a triangle has zero area (names the first ones)
+    MeshError
+        If the mesh is malformed (as for :func:`cotan_laplacian`).
 
     Examples
     --------

@@ -13,21 +13,25 @@ from .sparse_solver import factorize
 
 
 class MinimalSurfaceResult(np.ndarray):
-    """(n, 3) positions with the iteration's figures attached:
+    """(n, 3) positions with the iteration's figures attached (they survive ``copy()``, slicing,
+    arithmetic and pickling). Steps are relative to the bbox diagonal of the vertex's piece.
 
-    ``iterations``          steps taken
-    ``converged``           the last step fell below ``tol``: a bound on that step, *not* on the
-                            distance to where the iteration is heading (see ``remaining_estimate``)
-    ``last_step``           the last step's largest displacement as ``step`` measures it (by
-                            default its part normal to the surface)
-    ``last_full_step``      its largest displacement, tangential sliding included
-    ``contraction``         ``last_step`` over the step before (nan after fewer than two steps)
-    ``remaining_estimate``  how much farther the steps would still add up to, were they to keep
-                            contracting by ``contraction``: ``last_step * rho / (1 - rho)`` (inf
-                            where the steps do not contract, 0 where nothing was free)
-
-    The steps are relative to the bbox diagonal of the vertex's piece. The figures survive
-    ``copy()``, slicing, arithmetic (the result keeps its operand's figures) and pickling.
+    Attributes
+    ----------
+    iterations : int
+        Steps taken.
+    converged : bool
+        The last step fell below ``tol``: a bound on that step, not on the distance to the
+        iteration's limit (see ``remaining_estimate``).
+    last_step : float
+        The last step's largest displacement as ``step`` measures it (by default its normal part).
+    last_full_step : float
+        Its largest displacement, tangential sliding included.
+    contraction : float
+        ``last_step`` over the step before (nan after fewer than two steps).
+    remaining_estimate : float
+        How much farther the steps would add up to at that contraction,
+        ``last_step * rho / (1 - rho)`` (inf where they do not contract, 0 where nothing is free).
     """
 
     _FIGURES = ("iterations", "converged", "last_step", "last_full_step", "contraction", "remaining_estimate")
@@ -54,13 +58,7 @@ class MinimalSurfaceResult(np.ndarray):
 
 #: Default stopping tolerance of :func:`minimal_surface`: the last step moved the shape by less
 #: than 1e-4 of the bbox diagonal (0.01 %). That bounds the step, not the distance to the
-#: iteration's limit, which the steps approach at their contraction rate: on the 64 x 33
-#: catenoid (steps contracting by 0.38) the shape stops 3.6e-5 of its diagonal from that limit,
-#: near the critical height (two unit circles 1.32 apart, 0.92) 1.3e-3. On irregular meshes a
-#: slow drift (contraction ~0.98) that the first steps hide goes on: the ear and the terrain stop
-#: after 3 steps 3.1e-3 and 2.2e-3 of the diagonal from their surfaces after 400 steps. That drift
-#: is the triangles degrading, not the shape settling (the nose's collapse after ~700 steps): a
-#: smaller ``tol`` follows it, a larger one stops before it.
+#: iteration's limit (see docs/benchmarks.md, "minimal_surface: what the tolerance means").
 DEFAULT_TOL = 1e-4
 
 #: Largest ``|cot|`` of a corner in a usable result: an angle within 1e-6 rad of 0 or 180 degrees.
@@ -128,73 +126,50 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, step="n
     """Minimal surface with the ``fixed`` vertices kept: the paper's validity check, ``D = 0``.
 
     Each step solves the free rows ``L_ff X_f = -L_fc X_c`` with the cotangent weights of the
-    current surface (a cotangent-harmonic step; Pinkall & Polthier 1993), then recomputes the
-    weights. It stops when a step is small: when the largest displacement of a step
-    *normal to the surface* (projected on the area-weighted vertex normals of the new surface) is
-    below ``tol`` times the bbox diagonal of the vertex's connected piece (the mesh's, for one
-    piece), or after ``max_iterations`` steps. ``step="full"`` compares the whole displacement
-    instead (the largest vertex step, as the issue words it). On a mesh of several pieces a
-    piece whose step falls below ``tol`` keeps its positions from then on while the others go
-    on: each piece's result is the one it would have alone.
-
-    Why the normal part: after the first few steps the shape is found, but on irregular meshes
-    the vertices keep sliding *within* the surface, because sliding lowers the discrete area by
-    degrading triangles; Pinkall-Polthier's iteration never stops doing that. On the mannequin
-    nose (640 vertices) the full step is still 2e-4 of the diagonal after 200 steps and 1.6e-4
-    after 400, nearly all of it tangential, while the normal part is below 1e-4 from step ~40
-    on. On a symmetric grid (the catenoid) a tangential drift of ~2.4e-7 per step goes on forever
-    while the normal step falls to 1e-11. The full step is reported as ``last_full_step``.
-
-    A small step is not a small error: the steps contract by a factor ``rho`` each, and after a
-    last step ``s`` the iteration still has up to ``s rho / (1 - rho)`` to go, reported as
-    ``remaining_estimate`` (``rho``, the last two steps' ratio, as ``contraction``). With the
-    default ``tol`` the 64 x 33 catenoid (rho 0.38) stops 3.6e-5 of its diagonal from the
-    iteration's limit; two unit circles 1.32 apart, near the largest height a catenoid spans
-    (rho 0.92), 1.3e-3 (estimated 1.2e-3). On irregular meshes a slower drift that the first
-    steps hide follows (rho ~0.98; the estimate misses it): the ear and the terrain, stopped
-    after 3 steps, lie 3.1e-3 and 2.2e-3 of the diagonal from their surfaces after 400 steps.
-    That drift degrades the triangles (the nose's collapse after ~700 steps at ``tol=1e-6``), so
-    chasing it with a smaller ``tol`` gains no accuracy against the smooth minimal surface.
-
-    The iteration refuses results it has ruined: a step that collapses triangles (zero area, or
-    an angle within 1e-6 rad of 0 or 180 degrees that the input did not have) raises MeshError
-    saying where it got to and the likely cause (a disk's boundary always spans a minimal
-    surface: there the iteration itself wore the triangles down).
+    current surface (Pinkall & Polthier 1993), then recomputes the weights. It stops when the
+    largest displacement of a step *normal to the surface* is below ``tol`` times the bbox
+    diagonal of the vertex's connected piece (tangential sliding, which degrades triangles and
+    never stops on irregular meshes, is not counted), or after ``max_iterations`` steps. A piece
+    whose step falls below ``tol`` keeps its positions while the others go on. A step that
+    collapses triangles raises MeshError. See docs/benchmarks.md, "minimal_surface: what the
+    tolerance means".
 
     Parameters
     ----------
-    V : (n, 3) float array      initial surface (also the source of the first weights)
-    F : (m, 3) int array        triangles
-    fixed : (k,) int array or (n,) bool mask   vertices that keep their positions, e.g. the boundary
-    max_iterations : int        at least 1
-    tol : float                 stop when no vertex moves more than ``tol`` x its piece's bbox
-                                diagonal across the surface in a step (default 1e-4,
-                                :data:`DEFAULT_TOL`), > 0
-    step : {"normal", "full"}   what ``tol`` is compared with: the step's part normal to the
-                                surface (triangles need not be consistently oriented) or the whole
-                                vertex displacement (tangential sliding included: on irregular
-                                meshes it may not fall below ``tol`` in ``max_iterations``)
-    backend : str               sparse solver backend
-    callback : callable or None called as ``callback(iteration, relative_step)`` after each step
-                                (``relative_step``: the step that ``tol`` is compared with)
+    V : (n, 3) float array
+        Initial surface (also the source of the first weights).
+    F : (m, 3) int array
+        Triangles.
+    fixed : (k,) int array or (n,) bool mask
+        Vertices that keep their positions, e.g. the boundary.
+    max_iterations : int
+        At least 1.
+    tol : float
+        Stopping step, relative to the piece's bbox diagonal, > 0.
+    step : {"normal", "full"}
+        What ``tol`` is compared with: the step's part normal to the surface, or the whole vertex
+        displacement (which on irregular meshes may not fall below ``tol``).
+    backend : str
+        Sparse solver backend.
+    callback : callable, optional
+        Called as ``callback(iteration, relative_step)`` after each step.
 
     Returns
     -------
-    X : (n, 3) float array (a :class:`MinimalSurfaceResult` with ``.iterations``,
-        ``.converged``, ``.last_step``, ``.last_full_step``, ``.contraction`` and
-        ``.remaining_estimate``; they survive copies and pickling)
+    X : (n, 3) MinimalSurfaceResult
+        The positions, an ndarray with the iteration's figures as attributes.
 
     Raises
     ------
-    MeshError         malformed mesh, or triangles collapsed during the iteration (the boundary
-                      spans no minimal surface of this topology, e.g. two circles too far apart
-                      for a catenoid; fixed vertices inside the surface; or, on a disk, the
-                      iteration's own sliding: the message says which)
-    ConstraintError   bad fixed set, a piece with no fixed vertex, or a boundary vertex left free
-                      (a free boundary has no minimal surface)
-    ValueError        ``max_iterations`` not a whole number >= 1, ``tol`` not a positive number,
-                      ``step`` not "normal" or "full"
-    SolverError       an unknown or uninstalled ``backend``
+    MeshError
+        If the mesh is malformed, or triangles collapsed during the iteration (the message says
+        the likely cause).
+    ConstraintError
+        If ``fixed`` is refused, a piece has no fixed vertex, or a boundary vertex is left free.
+    ValueError
+        If ``max_iterations``, ``tol`` or ``step`` is not one of its allowed values.
+    SolverError
+        If ``backend`` is unknown or not installed.
 
     Examples
     --------

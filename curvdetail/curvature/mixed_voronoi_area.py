@@ -16,16 +16,20 @@ def mixed_voronoi_area(V, F):
 
     Parameters
     ----------
-    V : (n, 3) float array   vertex positions
-    F : (m, 3) int array     triangles
+    V : (n, 3) float array
+        Vertex positions.
+    F : (m, 3) int array
+        Triangles.
 
     Returns
     -------
-    A : (n,) float array, strictly positive
+    A : (n,) float array
+        Strictly positive areas.
 
     Raises
     ------
-    MeshError   if the mesh is malformed (see :func:`cotan_laplacian`)
+    MeshError
+        If the mesh is malformed (as for :func:`cotan_laplacian`).
 
     Examples
     --------

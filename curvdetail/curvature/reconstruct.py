@@ -15,56 +15,53 @@ ROW_MODES = ("all", "free")
 class Reconstructor:
     """Factor the reconstruction system once; rebuild positions for any detail by back-substitution.
 
-    Minimizes the paper's ``E_Q = sum_i |(L X)_i - D_i|^2`` over the free positions ``X_f`` with
-    the fixed positions ``X_c`` kept exactly. ``L`` is the cotangent Laplacian of the reference
-    geometry ``V_ref`` (positive semi-definite convention, see :func:`cotan_laplacian`).
-
-    ``rows="all"`` sums over every vertex (the paper): normal equations
-    ``(L_:f^T L_:f) X_f = L_:f^T (D - L_:c X_c)``, formed as ``L_f: L_f:^T`` since ``L`` is
-    symmetric, followed by ``refinement_steps`` (default 1) steps of corrected semi-normal
-    refinement: the correction solves the same factored system with ``L_:f^T (D - L X)``, the
-    least-squares residual. Without it the normal equations lose accuracy with the square of the
-    condition number (camelhead, 11k vertices: 1.5e-9 of the bbox diagonal on its own round trip);
-    with it the error is ~1e-14, as for the square system. The step costs one extra
-    back-substitution and two sparse products. Where one step is not enough (needle or sliver
-    triangles), more follow while the estimated error left is above ``REFINEMENT_TOLERANCE``
-    (1e-12 of the solution), up to ``MAX_REFINEMENT_STEPS``; a refinement that stalls above
-    ``REFINEMENT_FLOOR`` (1e-9) raises SolverError instead of returning a wrong surface. Solves
-    run relative to the fixed positions' centre, so coordinates far from the origin (UTM, ECEF)
-    lose no digits.
-    ``rows="free"`` sums over the free vertices only: the square system
-    ``L_ff X_f = D_f - L_fc X_c``. Both are symmetric positive definite when every connected
-    component holds a fixed vertex, and both reproduce ``V_ref`` exactly from its own detail.
+    Minimizes the paper's ``E_Q = sum_i |(L X)_i - D_i|^2`` over the free positions ``X_f``, the
+    fixed positions ``X_c`` kept exactly; ``L`` is the cotangent Laplacian of ``V_ref`` (positive
+    semi-definite, see :func:`cotan_laplacian`). ``rows="all"`` sums over every vertex (the
+    paper): normal equations ``(L_:f^T L_:f) X_f = L_:f^T (D - L_:c X_c)``, each solve followed by
+    corrected semi-normal refinement (:func:`refine_least_squares`), which keeps the error at
+    ~1e-14 of the solution. ``rows="free"`` sums over the free vertices only: the square system
+    ``L_ff X_f = D_f - L_fc X_c``. Both reproduce ``V_ref`` from its own detail. Solves run
+    relative to the fixed positions' centre, so coordinates far from the origin lose no digits.
 
     Parameters
     ----------
-    V_ref : (n, 3) float array   geometry that supplies the cotangent weights
-    F : (m, 3) int array         triangles
-    fixed : (k,) int array or (n,) bool mask   constrained vertices
-    rows : {"all", "free"}       which residual rows enter the energy
-    backend : str                sparse solver: "auto", "pardiso", "cholmod", "splu" or "banded"
-                                 (see :mod:`.sparse_solver` for what "auto" picks)
-    refinement_steps : int, optional   least refinement steps of ``rows="all"`` solves (default:
-                                 the class attribute, 1; more where the error estimate asks for
-                                 them), at most ``MAX_LEAST_REFINEMENT_STEPS`` (100). 0 halves
-                                 the back-substitution time and gives the plain normal-equation
-                                 solution (~cond^2 eps).
+    V_ref : (n, 3) float array
+        Geometry that supplies the cotangent weights.
+    F : (m, 3) int array
+        Triangles.
+    fixed : (k,) int array or (n,) bool mask
+        Constrained vertices; every connected piece needs one.
+    rows : {"all", "free"}
+        Which residual rows enter the energy.
+    backend : str
+        Sparse solver backend ("auto" or one of :func:`available_backends`).
+    refinement_steps : int, optional
+        Least refinement steps of ``rows="all"`` solves (default: the class attribute, 1), at
+        most ``MAX_LEAST_REFINEMENT_STEPS``; 0 gives the plain normal-equation solution.
 
     Attributes
     ----------
-    fixed : (k,) int array       the constrained vertices, in the order given (a mask: increasing)
-    free : (n - k,) int array    the solved-for vertices, increasing
-    backend : str                the solver backend in use
-    refinement_steps : int       refinement steps of ``rows="all"`` solves (class default 1)
+    fixed : (k,) int array
+        The constrained vertices, in the order given (a mask: increasing).
+    free : (n - k,) int array
+        The solved-for vertices, increasing.
+    backend : str
+        The solver backend in use.
+    refinement_steps : int
+        Least refinement steps of ``rows="all"`` solves.
 
     Raises
     ------
-    MeshError         malformed mesh (see :func:`check_mesh`)
-    ConstraintError   no fixed vertex, fixed indices out of range or repeated, a boolean mask of
-                      the wrong length, or a connected piece without a fixed vertex
-    ValueError        an unknown ``rows`` mode
-    SolverError       an unknown or uninstalled ``backend``; in :meth:`solve`, ``rows="all"``
-                      normal equations too ill-conditioned to refine (near-degenerate triangles)
+    MeshError
+        If the mesh is malformed (see :func:`check_mesh`).
+    ConstraintError
+        If there is no fixed vertex, ``fixed`` is out of range, repeated or a mask of the wrong
+        length, or a connected piece has no fixed vertex.
+    ValueError
+        If ``rows`` is unknown.
+    SolverError
+        If ``backend`` is unknown or not installed.
 
     Examples
     --------
@@ -158,19 +155,22 @@ class Reconstructor:
 
         Parameters
         ----------
-        detail : (n, 3) float array          target curvature detail ``D`` (rows of fixed
-                                             vertices are used by ``rows="all"`` only)
-        fixed_positions : (k, 3) float array positions of ``self.fixed``, row r for ``fixed[r]``
+        detail : (n, 3) float array
+            Target curvature detail ``D`` (the fixed vertices' rows count with ``rows="all"`` only).
+        fixed_positions : (k, 3) float array
+            Positions of ``self.fixed``, row r for ``fixed[r]``.
 
         Returns
         -------
-        X : (n, 3) float array   with ``X[self.fixed] == fixed_positions`` exactly
+        X : (n, 3) float array
+            With ``X[self.fixed] == fixed_positions`` exactly.
 
         Raises
         ------
-        ConstraintError   ``detail`` or ``fixed_positions`` has the wrong shape or non-finite rows
-        SolverError       ``rows="all"``: the refinement stalled (normal equations too
-                          ill-conditioned, see the class docstring)
+        ConstraintError
+            If ``detail`` or ``fixed_positions`` has the wrong shape or non-finite rows.
+        SolverError
+            If the ``rows="all"`` refinement stalls (near-degenerate triangles).
         """
         D = as_values(detail, self.n, "detail")
         Xc = as_values(fixed_positions, self.fixed.size, "fixed_positions")
@@ -363,25 +363,36 @@ def reconstruct(V_ref, F, detail, fixed, fixed_positions, *, rows="all", backend
 
     Parameters
     ----------
-    V_ref : (n, 3) float array             geometry that supplies the cotangent weights
-    F : (m, 3) int array                   triangles
-    detail : (n, 3) float array            target curvature detail ``D = K A``
-    fixed : (k,) int array or (n,) bool    constrained vertices
-    fixed_positions : (k, 3) float array   their positions, row r for vertex ``fixed[r]`` (for a
-                                           boolean mask: in increasing index order)
-    rows : {"all", "free"}                 residual rows in the energy (see :class:`Reconstructor`)
-    backend : str                          sparse solver backend
+    V_ref : (n, 3) float array
+        Geometry that supplies the cotangent weights.
+    F : (m, 3) int array
+        Triangles.
+    detail : (n, 3) float array
+        Target curvature detail ``D = K A``.
+    fixed : (k,) int array or (n,) bool mask
+        Constrained vertices.
+    fixed_positions : (k, 3) float array
+        Their positions, row r for vertex ``fixed[r]`` (for a mask: in increasing index order).
+    rows : {"all", "free"}
+        Residual rows in the energy (see :class:`Reconstructor`).
+    backend : str
+        Sparse solver backend.
 
     Returns
     -------
     X : (n, 3) float array
+        With ``X[fixed] == fixed_positions`` exactly.
 
     Raises
     ------
-    MeshError         malformed mesh
-    ConstraintError   bad fixed indices, wrong shapes, or a piece with no fixed vertex
-    ValueError        an unknown ``rows`` mode
-    SolverError       an unknown or uninstalled ``backend``
+    MeshError
+        If the mesh is malformed.
+    ConstraintError
+        If ``fixed`` is refused, a shape is wrong, or a connected piece has no fixed vertex.
+    ValueError
+        If ``rows`` is unknown.
+    SolverError
+        If ``backend`` is unknown or not installed, or the refinement stalls.
 
     Examples
     --------

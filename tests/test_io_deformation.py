@@ -1,4 +1,5 @@
-"""The Botsch-Sorkine .sel/.def format and edit_with_selection's exact constraint placement."""
+"""The Botsch-Sorkine .sel/.def format (curvdetail.io.deformation) and edit_with_selection's exact
+constraint placement."""
 
 import numpy as np
 import pytest
@@ -6,9 +7,8 @@ import pytest
 from curvdetail import CurvatureEditor
 from curvdetail.curvature.errors import ConstraintError, MeshError
 from curvdetail.curvature.testing import grid
-from curvdetail.deformation_benchmark import (DeformationFileError, apply_transform,
-                                              edit_with_selection, read_selection, read_transform,
-                                              write_selection, write_transform)
+from curvdetail.io.deformation import (DeformationFileError, apply_transform, edit_with_selection,
+                                       read_selection, read_transform, write_selection, write_transform)
 
 
 def _strip(n=14):
@@ -32,7 +32,9 @@ def test_selection_file_round_trip_keeps_comments_out(tmp_path):
     assert read_selection(p, 5).tolist() == [0, 1, 2, 1, 0]
     q = tmp_path / "b.sel"
     write_selection(q, [2, 1, 0])
-    assert q.read_text().startswith("#") and read_selection(q).tolist() == [2, 1, 0]
+    assert q.read_text() == ("# per vertex status: 0=fixed, 1=deformable-region, 2=handle\n"
+                             "# 3 vertices\n2\n1\n0\n")
+    assert read_selection(q).tolist() == [2, 1, 0] and read_selection(q).dtype == np.int8
 
 
 def test_transform_file_is_read_as_a_homogeneous_matrix(tmp_path):
@@ -45,40 +47,53 @@ def test_transform_file_is_read_as_a_homogeneous_matrix(tmp_path):
     assert np.allclose(apply_transform(got, P), (np.c_[P, [1.0]] @ T.T)[:, :3])
 
 
-@pytest.mark.parametrize("text, message", [
-    ("# c\n0\n1\n3\n", r"1 line is not a vertex status 0, 1 or 2 \(line 4: '3'\)"),
-    ("# c\n0\nx\n1\n7\n", r"2 lines are not a vertex status 0, 1 or 2 \(line 3: 'x', line 5: '7'\)"),
-    ("# only comments\n\n", "no vertex statuses"),
+@pytest.mark.parametrize("text, count, first", [
+    ("# c\n0\n1\n3\n", 1, [4]),
+    ("# c\n0\nx\n1\n7\n", 2, [3, 5]),
+    ("# only comments\n\n", 0, None),
 ])
-def test_malformed_selection_is_refused_with_its_line(tmp_path, text, message):
+def test_malformed_selection_is_refused_with_its_lines(tmp_path, text, count, first):
     p = tmp_path / "bad.sel"
     p.write_text(text)
-    with pytest.raises(DeformationFileError, match=message):
+    with pytest.raises(DeformationFileError) as e:
         read_selection(p)
+    assert (e.value.count, e.value.first, e.value.value) == (count, first, str(p))
 
 
 def test_selection_of_the_wrong_length_is_refused(tmp_path):
     p = tmp_path / "a.sel"
     write_selection(p, [0, 1, 2])
-    with pytest.raises(DeformationFileError, match="3 vertex statuses for a mesh of 4"):
+    with pytest.raises(DeformationFileError) as e:
         read_selection(p, 4)
+    assert e.value.count == 3 and e.value.value == str(p)
 
 
-@pytest.mark.parametrize("text, message", [
-    ("# c\n1 0 0 0\n0 1 0 0\n0 0 1 0\n", "3 matrix rows"),
-    ("1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0\n", "line 4 has 3 values"),
-    ("1 0 0 0\n0 1 0 0\n0 0 1 a\n0 0 0 1\n", "not 4 numbers"),
-    ("1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0.5 1\n", "the last row is"),
-    ("0 0 0 1\n0 1 0 0\n0 0 1 0\n0 0 0 1\n", "singular"),
-    # scale-free: this collapses z although its determinant is 1
-    ("1e6 0 0 0\n0 1e6 0 0\n0 0 1e-12 0\n0 0 0 1\n", "singular"),
-    ("1 0 0 1_0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n", "not 4 numbers"),     # Python would read 10
+@pytest.mark.parametrize("text, count, first", [
+    ("# c\n1 0 0 0\n0 1 0 0\n0 0 1 0\n", 3, None),                  # 3 rows
+    ("1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0\n", 1, [4]),
+    ("1 0 0 0\n0 1 0 0\n0 0 1 a\n0 0 0 1\n", 1, [3]),
+    ("1 0 0 0\n0 1 0 0\n0 0 1 nan\n0 0 0 1\n", 1, [3]),
+    ("1 0 0 1_0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n", 1, [1]),            # Python would read 10
 ])
-def test_malformed_transform_is_refused(tmp_path, text, message):
+def test_a_transform_file_that_is_not_four_rows_of_four_numbers_is_refused(tmp_path, text, count, first):
     p = tmp_path / "bad.def"
     p.write_text(text)
-    with pytest.raises(DeformationFileError, match=message):
+    with pytest.raises(DeformationFileError) as e:
         read_transform(p)
+    assert (e.value.count, e.value.first, e.value.value) == (count, first, str(p))
+
+
+@pytest.mark.parametrize("text", [
+    "1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0.5 1\n",                       # projective
+    "0 0 0 1\n0 1 0 0\n0 0 1 0\n0 0 0 1\n",                         # singular
+    "1e6 0 0 0\n0 1e6 0 0\n0 0 1e-12 0\n0 0 0 1\n",                 # collapses z, determinant 1
+])
+def test_a_transform_that_is_not_an_invertible_affine_map_is_refused(tmp_path, text):
+    p = tmp_path / "bad.def"
+    p.write_text(text)
+    with pytest.raises(DeformationFileError) as e:
+        read_transform(p)
+    assert e.value.value == str(p)
 
 
 def test_missing_files_raise_file_not_found(tmp_path):
@@ -128,7 +143,7 @@ def test_free_vertices_are_the_editors_solution_for_the_prescribed_constraints(m
 
 def test_a_transform_beyond_double_precision_is_named():
     V, F, status = _strip()
-    with pytest.raises(ConstraintError, match="handle transform T gives the handles values of 3e\\+300"):
+    with pytest.raises(ConstraintError, match="3e\\+300"):
         edit_with_selection(V, F, status, np.diag([1e300, 1e300, 1e300, 1.0]))
 
 
@@ -149,16 +164,15 @@ def test_rigid_motion_of_a_fully_handled_piece_is_reproduced():
     assert np.array_equal(X[status == 2], apply_transform(T, V[status == 2]))
 
 
-@pytest.mark.parametrize("change, message", [
-    (lambda s: s[:-1], "entries for"),
-    (lambda s: np.where(s == 2, 1, s), "no handle"),
-    (lambda s: np.where(s == 0, 1, s), "no fixed vertex"),
-    (lambda s: np.where(s == 1, 5, s), "other than 0, 1, 2"),
-])
-def test_bad_selections_are_refused(change, message):
+def test_bad_selections_are_refused_with_their_counts():
     V, F, status = _strip()
-    with pytest.raises(ConstraintError, match=message):
-        edit_with_selection(V, F, change(status), np.eye(4))
+    n, free = V.shape[0], np.flatnonzero(status == 1)
+    for change, count, first in [(lambda s: s[:-1], n - 1, None), (lambda s: np.where(s == 2, 1, s), 0, None),
+                                 (lambda s: np.where(s == 0, 1, s), 0, None),
+                                 (lambda s: np.where(s == 1, 5, s), free.size, free[:3].tolist())]:
+        with pytest.raises(ConstraintError) as e:
+            edit_with_selection(V, F, change(status), np.eye(4))
+        assert (e.value.parameter, e.value.count, e.value.first) == ("status", count, first)
 
 
 def test_unknown_handle_detail_mode_is_refused():
@@ -166,7 +180,7 @@ def test_unknown_handle_detail_mode_is_refused():
     with pytest.raises(ValueError, match="handle_detail"):
         edit_with_selection(V, F, status, np.eye(4), handle_detail="rotate")
     # an array was compared element-wise: numpy's "truth value ... is ambiguous" for two entries
-    with pytest.raises(ValueError, match=r"handle_detail=.*\(ndarray, not a single str\); use 'transform' or 'free'"):
+    with pytest.raises(ValueError, match="handle_detail"):
         edit_with_selection(V, F, status, np.eye(4), handle_detail=np.array(["transform", "free"]))
 
 
@@ -187,50 +201,42 @@ def test_files_with_a_byte_order_mark_are_read(tmp_path):
 
 
 def test_a_folder_or_latin1_text_is_named_as_such(tmp_path):
-    with pytest.raises(DeformationFileError, match="is a folder"):
+    with pytest.raises(DeformationFileError) as e:
         read_selection(tmp_path, 3)
+    assert e.value.value == str(tmp_path)
     p = tmp_path / "b.sel"
     p.write_bytes("# caf\xe9\n0\n".encode("latin-1"))
-    with pytest.raises(DeformationFileError, match=r"byte 5 is not UTF-8 text.*save it as UTF-8"):
+    with pytest.raises(DeformationFileError) as e:
         read_selection(p, 1)
+    assert e.value.value == str(p) and e.value.first == [5]           # the byte offset
 
 
-@pytest.mark.parametrize("T, message", [
-    (np.array([[1.0, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0.5, 0, 0, 1]]), r"the last row is \[0\.5, 0\.0, 0\.0, 1\.0\]"),
-    (np.diag([1.0, 1.0, 0.0, 1.0]), "linear part is singular"),
-    (np.zeros((4, 4)), "the last row is"),
-])
-def test_a_transform_the_reader_refuses_is_refused_when_passed_directly(T, message):
+@pytest.mark.parametrize("T", [np.array([[1.0, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0.5, 0, 0, 1]]),
+                               np.diag([1.0, 1.0, 0.0, 1.0]), np.zeros((4, 4)), [[1.0, 0.0], [0.0]], "eye", None,
+                               np.full((4, 4), np.nan)])
+def test_a_transform_the_reader_refuses_is_refused_when_passed_directly(T):
     # read_transform refuses a projective or collapsing matrix; given as an array, the last row was
-    # ignored (the handles moved by the top 3 rows alone) and a singular map flattened the handles
+    # ignored (the handles moved by the top 3 rows alone) and a singular map flattened the handles;
+    # a ragged list or a string raised numpy's own errors
     V, F, status = _strip()
-    with pytest.raises(ConstraintError, match=message):
+    with pytest.raises(ConstraintError) as e:
         edit_with_selection(V, F, status, T)
+    assert e.value.parameter == "T"
 
 
-@pytest.mark.parametrize("T, message", [([[1.0, 0.0], [0.0]], "could not be read as a 4x4 matrix"),
-                                        ("eye", "could not be read as a 4x4 matrix"), (None, r"has shape \(\)")])
-def test_a_transform_that_is_no_matrix_of_numbers_is_named(T, message):
-    # numpy's "setting an array element with a sequence" / "could not convert string to float"
-    V, F, status = _strip()
-    with pytest.raises(ConstraintError, match=r"^T " + message):
-        edit_with_selection(V, F, status, T)
-
-
-@pytest.mark.parametrize("V, message", [(3.0, r"V has shape \(\)"), ([[0.0, 1.0], [1.0]], "V could not be read"),
-                                        (np.zeros(3 * 588), r"V has shape \(1764,\)")])
-def test_vertices_that_are_no_position_array_are_refused_by_name(V, message):
+@pytest.mark.parametrize("V", [3.0, [[0.0, 1.0], [1.0]], np.zeros(3 * 588)])
+def test_vertices_that_are_no_position_array_are_refused_as_a_mesh_error(V):
     # a scalar raised IndexError ("tuple index out of range"); flat coordinates were reported as a
     # status of the wrong length ("588 entries for 1764 vertices")
     _, F, status = _strip()
-    with pytest.raises(MeshError, match=message):
+    with pytest.raises(MeshError, match="V"):
         edit_with_selection(V, F, status, np.eye(4))
 
 
 def test_return_editor_must_be_a_bool():
     # "no" is truthy: the call returned (X, editor) where X was asked for
     V, F, status = _strip()
-    with pytest.raises(ValueError, match=r"return_editor='no' must be True or False"):
+    with pytest.raises(ValueError, match="return_editor"):
         edit_with_selection(V, F, status, np.eye(4), return_editor="no")
 
 
@@ -243,10 +249,17 @@ def test_written_transforms_read_back_exactly(tmp_path, T):
     assert np.array_equal(read_transform(p), T)
 
 
-@pytest.mark.parametrize("T, message", [(np.diag([1.0, 1.0, 0.0, 1.0]), "singular"),
-                                        (np.ones((4, 4)), "the last row"), ([[1, 0], [0]], "4x4")])
-def test_a_transform_the_reader_would_refuse_is_not_written(tmp_path, T, message):
+@pytest.mark.parametrize("T", [np.diag([1.0, 1.0, 0.0, 1.0]), np.ones((4, 4)), [[1, 0], [0]]])
+def test_a_transform_the_reader_would_refuse_is_not_written(tmp_path, T):
     p = tmp_path / "t.def"
-    with pytest.raises(DeformationFileError, match=message):
+    with pytest.raises(DeformationFileError) as e:
         write_transform(p, T)
-    assert not p.exists()
+    assert e.value.parameter == "T" and not p.exists()
+
+
+def test_a_selection_with_other_values_is_not_written(tmp_path):
+    p = tmp_path / "a.sel"
+    for status in ([0, 3], []):
+        with pytest.raises(DeformationFileError) as e:
+            write_selection(p, status)
+        assert e.value.parameter == "status" and not p.exists()

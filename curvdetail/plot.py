@@ -1,0 +1,205 @@
+"""Pictures of meshes (matplotlib, headless): one renderer for every figure of the package.
+
+:func:`draw_mesh` draws a mesh, grey or coloured by per-vertex values, into a 2-D matplotlib axes
+(orthographic camera, Lambert shading, faces drawn far to near); :func:`save_panels` saves a row
+of such panels as a PNG; :func:`save_remeshing_figure` is the picture of one remeshing experiment.
+"""
+
+import os
+
+import numpy as np
+
+from .io.atomic import atomic_write
+
+#: Light direction in the camera frame (x right, y up, z towards the viewer).
+LIGHT = np.array([0.3, 0.5, 0.8]) / np.linalg.norm([0.3, 0.5, 0.8])
+#: Colour of a mesh drawn without values (a light blue-grey).
+GREY = (0.75, 0.78, 0.85)
+
+
+def camera(elev, azim):
+    """Rotation ``R`` taking world coordinates (z up) to the camera's (x right, y up, z to the
+    viewer) for an elevation and azimuth in degrees: ``V @ R.T`` are camera coordinates."""
+    e, a = np.radians(elev), np.radians(azim)
+    Rz = np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
+    Rx = np.array([[1, 0, 0], [0, np.cos(e - np.pi / 2), -np.sin(e - np.pi / 2)],
+                   [0, np.sin(e - np.pi / 2), np.cos(e - np.pi / 2)]])
+    return Rx @ Rz.T
+
+
+def view_direction(elev, azim):
+    """Unit vector (world, z up) from the scene towards the viewer of this camera."""
+    return camera(elev, azim)[2].copy()
+
+
+def top_view(V, F):
+    """Rotation ``R`` taking a patch's area-weighted mean normal to +z (``V @ R.T`` is seen from
+    above); where the normals cancel (a closed surface), the direction in which the vertices spread
+    least, its largest component positive."""
+    V, F = np.asarray(V, dtype=np.float64), np.asarray(F)
+    normals = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+    n = normals.sum(0)
+    if not np.linalg.norm(n) > 1e-9 * np.linalg.norm(normals, axis=1).sum():
+        n = np.linalg.svd(V - V.mean(0), full_matrices=False)[2][-1]
+        n = -n if n[np.argmax(np.abs(n))] < 0 else n
+    z = n / max(np.linalg.norm(n), np.finfo(float).tiny)
+    x = np.cross([1.0, 0.0, 0.0] if abs(z[0]) < 0.9 else [0.0, 1.0, 0.0], z)
+    x /= np.linalg.norm(x)
+    return np.stack([x, np.cross(z, x), z])
+
+
+def draw_mesh(ax, V, F, values=None, *, elev=20.0, azim=-60.0, cmap="viridis", title=""):
+    """Draw a shaded mesh into a 2-D matplotlib axes, fitted to the axes with equal aspect.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        A plain (2-D) axes; its axis lines are turned off.
+    V : (n, 3) float array
+        Vertex positions, world coordinates with z up.
+    F : (m, 3) int array
+        Triangles.
+    values : (n,) float array, optional
+        Per-vertex values; each face is coloured by its vertices' mean, from the values' minimum to
+        their maximum. Without values the mesh is grey.
+    elev, azim : float
+        Camera, as for :func:`camera`.
+    cmap : str or matplotlib.colors.Colormap
+        Colour map of ``values``.
+    title : str
+        Panel title.
+
+    Returns
+    -------
+    mappable : matplotlib.cm.ScalarMappable or None
+        The values' colour scale (for a colour bar); None without values.
+    """
+    import matplotlib
+    from matplotlib.cm import ScalarMappable
+    from matplotlib.collections import PolyCollection
+    from matplotlib.colors import Normalize
+
+    P = np.asarray(V, dtype=np.float64) @ camera(elev, azim).T
+    F = np.asarray(F)
+    tri = P[F]
+    normal = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), np.finfo(float).tiny)
+    shade = 0.25 + 0.75 * np.abs(normal @ LIGHT)
+    mappable = None
+    if values is None:
+        rgb = np.tile(GREY, (F.shape[0], 1))
+    else:
+        values = np.asarray(values, dtype=np.float64)
+        lo, hi = float(np.nanmin(values)), float(np.nanmax(values))
+        cmap = matplotlib.colormaps[cmap] if isinstance(cmap, str) else cmap
+        mappable = ScalarMappable(Normalize(lo, hi if hi > lo else lo + 1.0), cmap)
+        rgb = mappable.to_rgba(values[F].mean(axis=1))[:, :3]
+    colours = np.clip(rgb * shade[:, None], 0.0, 1.0)
+    order = np.argsort(tri[:, :, 2].mean(axis=1))            # far faces first
+    ax.add_collection(PolyCollection(tri[order][:, :, :2], facecolors=colours[order], edgecolors="none",
+                                     antialiased=False))
+    ax.set_xlim(P[:, 0].min(), P[:, 0].max())
+    ax.set_ylim(P[:, 1].min(), P[:, 1].max())
+    ax.set_aspect("equal")
+    ax.set_axis_off()
+    ax.set_title(title, fontsize=9)
+    return mappable
+
+
+def save_panels(path, panels, *, elev=20.0, azim=-60.0, title=None, panel_size=4.0, dpi=100,
+                colorbar=None, overwrite=False):
+    """Save meshes side by side, seen by one camera, as a PNG, atomically.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Destination ``.png``; ``panel_size * dpi`` pixels high, ``len(panels)`` times that wide.
+    panels : list of (V, F, label) or (V, F, label, values)
+        The meshes, drawn by :func:`draw_mesh`.
+    elev, azim : float
+        Camera, as for :func:`camera`.
+    title : str, optional
+        Figure title.
+    panel_size : float
+        Size of one panel in inches.
+    dpi : int
+        Pixels per inch.
+    colorbar : str, optional
+        Label of a colour bar drawn under every panel with values; none without it.
+    overwrite : bool
+        Replace an existing file.
+
+    Raises
+    ------
+    FileExistsError
+        If ``path`` exists and ``overwrite`` is False.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from curvdetail.curvature.testing import grid
+    >>> V, F = grid(5, 5); V[:, 2] = V[:, 0] * V[:, 1]
+    >>> save_panels(os.path.join(tempfile.mkdtemp(), "p.png"), [(V, F, "flat"), (V, F, "height", V[:, 2])])
+    """
+    from matplotlib.figure import Figure
+
+    with atomic_write(path, overwrite=overwrite) as tmp:
+        fig = Figure(figsize=(panel_size * len(panels), panel_size))
+        for ax, (V, F, label, *values) in zip(fig.subplots(1, len(panels), squeeze=False)[0], panels):
+            mappable = draw_mesh(ax, V, F, values[0] if values else None, elev=elev, azim=azim, title=label)
+            if colorbar and mappable is not None:
+                bar = fig.colorbar(mappable, ax=ax, orientation="horizontal", fraction=0.05, pad=0.02, shrink=0.7)
+                bar.set_label(colorbar, fontsize=8)
+                bar.ax.tick_params(labelsize=7)
+        if title:
+            fig.suptitle(title, fontsize=11)
+        fig.tight_layout(pad=1.6)
+        fig.savefig(tmp, dpi=dpi, format="png")
+
+
+def save_remeshing_figure(path, V, F, X, Ft, Z, distance, report, *, overwrite=False, dpi=110):
+    """Save the picture of one remeshing experiment: the source, the rebuilt target coloured by
+    its distance to the source, and the zero-detail baseline, the errors in the titles.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Destination ``.png``.
+    V, F : (n, 3) float array, (m, 3) int array
+        The source mesh.
+    X, Ft : (p, 3) float array, (q, 3) int array
+        The rebuilt target; ``Z`` (p, 3) is the zero-detail baseline on the same triangles.
+    distance : (p,) float array
+        Distance of each vertex of ``X`` to the source.
+    report : dict
+        The report of :func:`curvdetail.remesh.remesh_experiment`, measured (``evaluate=True``).
+
+    Raises
+    ------
+    ValueError
+        If ``report`` lacks the measurements or ``distance`` is not one finite value per vertex of X.
+    FileExistsError
+        If ``path`` exists and ``overwrite`` is False.
+    """
+    missing = [key for key in ("error", "baseline_zero_detail", "floor_retriangulated") if key not in report]
+    if missing:
+        raise ValueError(f"report has no {', '.join(missing)}: pass the report of a run with evaluate=True")
+    X = np.asarray(X, dtype=np.float64)
+    distance = np.asarray(distance if distance is not None else [], dtype=np.float64)
+    if distance.shape != (X.shape[0],) or not np.isfinite(distance).all():
+        raise ValueError(f"distance has shape {distance.shape} for {X.shape[0]} rebuilt vertices: pass one finite "
+                         "distance per vertex of X (run_experiment's result['distance'])")
+    V, Z = np.asarray(V, dtype=np.float64), np.asarray(Z, dtype=np.float64)
+    R = top_view(V, F)
+    e, b, fl = report["error"], report["baseline_zero_detail"], report["floor_retriangulated"]
+    name = os.path.basename(report["source"].get("path") or "source")
+    o = report["options"]
+    panels = [(V @ R.T, F, f"{name}: {report['source']['vertices']:,} vertices"),
+              (X @ R.T, Ft, f"rebuilt ({o['transfer']}, rows={o['rows']}): {report['target']['vertices']:,} "
+                            f"vertices\nRMS {100 * e['hausdorff_rms']:.3f} %  max {100 * e['hausdorff_max']:.2f} %  "
+                            f"(floor {100 * fl['hausdorff_rms']:.3f} %)",
+               100 * distance / report["source"]["bbox_diagonal"]),
+              (Z @ R.T, Ft, f"zero detail\nRMS {100 * b['hausdorff_rms']:.2f} %  max {100 * b['hausdorff_max']:.1f} %")]
+    save_panels(path, panels, elev=50.0, azim=20.0, panel_size=4.0, dpi=dpi, overwrite=overwrite,
+                title="Remeshing from curvature detail (all figures: % of the source's bbox diagonal)",
+                colorbar="distance to source, % of bbox diagonal")
