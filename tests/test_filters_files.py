@@ -116,7 +116,8 @@ def test_an_existing_output_is_kept_unless_overwrite(tmp_path):
 
 def test_a_full_disk_names_the_file_and_leaves_nothing(tmp_path, monkeypatch):
     def full(path, *args):
-        open(path, "wb").write(b"half a mesh")
+        with open(path, "wb") as f:
+            f.write(b"half a mesh")
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), path)
 
     monkeypatch.setattr(mesh_io, "write_ply", full)

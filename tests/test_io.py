@@ -44,6 +44,19 @@ def test_ply_quality_is_a_plain_double_property(tmp_path, nose):
     assert np.array_equal(ms.current_mesh().vertex_scalar_array(), q)
 
 
+@pytest.mark.parametrize("binary", [True, False])
+def test_a_meshlab_ply_reads_as_meshlab_reads_it(tmp_path, nose, binary):
+    # MeshLab's PLY: flags, colours, quality beside the doubles; ASCII with "%.16g"
+    V, F = nose
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(V, F.astype(np.int32), v_scalar_array=V[:, 0]))
+    ms.save_current_mesh(str(tmp_path / "m.ply"), binary=binary)
+    ms.load_new_mesh(str(tmp_path / "m.ply"))
+    W, G, fields = read_mesh(tmp_path / "m.ply", fields=True)
+    assert np.array_equal(W, ms.current_mesh().vertex_matrix()) and np.array_equal(G, F)
+    assert np.array_equal(fields["quality"], ms.current_mesh().vertex_scalar_array())
+
+
 def test_meshlab_point_attributes_are_read_as_points(tmp_path, nose):
     # pymeshlab exports a custom point attribute as a list of three doubles per vertex
     V, F = nose
@@ -178,7 +191,8 @@ def test_an_existing_file_is_kept_unless_overwrite(tmp_path, nose):
                                          ("stl", "_write_with_pymeshlab")])
 def test_a_full_disk_names_the_file_and_leaves_nothing(tmp_path, monkeypatch, nose, ext, writer):
     def full(path, *args):
-        open(path, "wb").write(b"half a mesh")
+        with open(path, "wb") as f:
+            f.write(b"half a mesh")
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), path)
 
     monkeypatch.setattr(mesh_io, writer, full)

@@ -19,6 +19,7 @@ from ..curvature.errors import MeshError
 from .atomic import atomic_write, check_output_path
 from .ply import read_ply, write_ply
 
+
 class MeshFileError(MeshError):
     """A mesh file cannot be read or written: ``e.parameter`` is ``"path"``, ``e.value`` the file.
 
@@ -54,7 +55,8 @@ def read_mesh(path, *, fields=False):
     V : (n, 3) float64 array
         Vertex positions, in file order (a PLY file's doubles exactly).
     F : (m, 3) int64 array
-        Triangles; polygons are cut into triangles fanned from their first corner.
+        Triangles; polygons are cut into triangles (PLY and OBJ: fanned from their first
+        corner).
     fields : dict of str to array
         With ``fields=True``: (n,) arrays, and (n, 3) for points (see :mod:`curvdetail.io.ply`).
 
@@ -63,11 +65,12 @@ def read_mesh(path, *, fields=False):
     FileNotFoundError
         The file does not exist.
     MeshFileError
-        The file cannot be read (which file and why), a file named .obj is not a text OBJ
-        file, fewer or more vertices or faces were loaded than the file states (``e.declared``,
-        ``e.loaded``), or the arrays fail :func:`curvdetail.check_mesh`'s first checks
-        (non-finite coordinates, face indices out of range or repeated; ``e.count``, ``e.first``
-        where the check sets them).
+        The file cannot be read (which file and why); a file named .obj is not a text OBJ
+        file; an OFF file has polygons of more than four corners (pymeshlab's loader cuts
+        them into triangles of the wrong vertices); fewer or more vertices or faces were
+        loaded than the file states (``e.declared``, ``e.loaded``); or the arrays fail the
+        checks of array input (non-finite coordinates, face indices out of range or
+        repeated).
 
     Examples
     --------
@@ -131,7 +134,7 @@ def _polygons(path, mesh, declared):
     if _extension(path) == ".off":
         with open(path, "rb") as f:
             rows = [row for row in (line.split(b"#")[0].split() for line in f.read().splitlines()) if row]
-        corners = [row[0] for row in rows[-declared:]]          # the face rows end an OFF file
+        corners = [row[0] for row in rows[-declared:]] if declared else []   # the face rows end the file
         if any(not c.isdigit() or int(c) > 4 for c in corners):
             raise _error(path, f"{path!r} has faces pymeshlab's OFF loader does not cut right (polygons of more "
                                "than four corners)", "triangulate them, or save the file as OBJ or PLY")

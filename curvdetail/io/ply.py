@@ -26,9 +26,9 @@ def read_ply(path):
     -------
     V : (n, 3) float64 array
         The ``x``, ``y``, ``z`` vertex properties, in file order.
-    F : (m, 3) int64 array
-        Triangles; a polygon of k corners is cut into k - 2 triangles fanned from its first
-        corner (as pymeshlab's loader cuts it).
+    F : (m, 3) array
+        Triangles, of the file's index type; a polygon of k corners is cut into k - 2
+        triangles fanned from its first corner (as pymeshlab cuts an OBJ file's polygons).
     fields : dict of str to array
         Every other vertex property: (n,) arrays, and (n, 3) arrays for the points (see the
         module docstring).
@@ -64,14 +64,14 @@ def read_ply(path):
 
 
 def _triangles(faces):
-    """(m, 3) int64 triangles of ``faces``: an (m, 3) array, or an object array of index lists."""
+    """(m, 3) triangles of ``faces``: an (m, 3) array, or an object array of index lists."""
     if faces.dtype != object:
-        return faces.astype(np.int64).reshape(-1, 3)
+        return faces.reshape(-1, 3)
     sizes = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
     if sizes.size and sizes.min() < 3:
         bad = np.flatnonzero(sizes < 3)
         raise ValueError(f"{bad.size} faces have fewer than 3 corners (first: face {bad[0]})")
-    flat = np.concatenate(faces).astype(np.int64) if sizes.size else np.zeros(0, dtype=np.int64)
+    flat = np.concatenate(faces) if sizes.size else np.zeros(0, dtype=np.int64)
     starts = np.repeat(np.cumsum(sizes) - sizes, sizes - 2)          # one row per triangle
     step = np.arange(starts.size) - np.repeat(np.cumsum(sizes - 2) - (sizes - 2), sizes - 2)
     return np.column_stack([flat[starts], flat[starts + step + 1], flat[starts + step + 2]])
@@ -87,8 +87,6 @@ def _fields(vertex):
             sizes = {len(row) for row in column}
             if sizes == {3}:
                 fields[name] = np.stack(column).astype(np.float64)
-        elif column.ndim == 2:                          # a list memory-mapped at its length
-            fields[name] = np.array(column, dtype=np.float64)
         else:
             fields[name] = np.array(column)
     for name in [n[:-2] for n in names if n.endswith("_x")]:
@@ -113,6 +111,7 @@ def write_ply(path, V, F, fields=None):
     """
     import plyfile
 
+    V = np.asarray(V, dtype=np.float64)
     columns = [("x", V[:, 0]), ("y", V[:, 1]), ("z", V[:, 2])]
     for name, values in (fields or {}).items():
         values = np.asarray(values)
