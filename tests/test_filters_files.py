@@ -70,6 +70,15 @@ def test_a_layers_colours_are_kept_in_ply(tmp_path):
     assert "red" not in plyfile.PlyData.read(str(tmp_path / "p.ply"))["vertex"].data.dtype.names
 
 
+def test_a_layer_without_quality_comes_back_without(tmp_path):
+    # a quality read as zeros would pass for a measured distance (a layer built from arrays has one)
+    ms = load_meshset(NOSE)
+    assert not ms.current_mesh().has_vertex_scalar()
+    save_current_mesh(ms, tmp_path / "p.ply")
+    assert "quality" not in plyfile.PlyData.read(str(tmp_path / "p.ply"))["vertex"].data.dtype.names
+    assert not load_meshset(tmp_path / "p.ply").current_mesh().has_vertex_scalar()
+
+
 def test_other_formats_hold_the_geometry_exactly(tmp_path):
     ms = load_meshset(NOSE)
     apply(ms, "compute_curvature_detail")

@@ -10,8 +10,8 @@ from curvdetail.curvature.errors import MeshError
 from curvdetail.curvature.testing import icosphere
 from curvdetail.filters import FilterError
 from curvdetail.filters.meshset import (add_layer, layer_id, mesh_arrays, set_vertex_attribute,
-                                        set_vertex_positions, set_vertex_quality, set_vertex_selection,
-                                        vertex_attribute, vertex_normals)
+                                        set_vertex_positions, set_vertex_quality, vertex_attribute,
+                                        vertex_normals)
 
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
 
@@ -49,13 +49,6 @@ def test_quality_is_set_exactly(ms, rng):
     q = rng.normal(size=640)
     set_vertex_quality(ms, 0, q)
     assert np.array_equal(ms.current_mesh().vertex_scalar_array(), q)
-
-
-def test_selection_is_set_exactly(ms, rng):
-    ms.compute_selection_by_condition_per_vertex(condselect="(x < 0)")     # replaced, not added to
-    selected = rng.random(640) < 0.3
-    set_vertex_selection(ms, 0, selected)
-    assert np.array_equal(ms.current_mesh().vertex_selection_array(), selected)
 
 
 def test_write_on_another_layer_keeps_the_current_one(ms, rng):

@@ -204,6 +204,22 @@ def test_a_full_disk_names_the_file_and_leaves_nothing(tmp_path, monkeypatch, no
     assert os.listdir(tmp_path) == []
 
 
+def test_a_full_disk_is_named_where_pymeshlab_says_only_that_it_failed(tmp_path, monkeypatch, nose):
+    import shutil
+    import types
+
+    def exporter_error(path, *args):
+        raise pymeshlab.PyMeshLabException(f"Error encountered while exportering file {path}: Output Stream error")
+
+    monkeypatch.setattr(mesh_io, "_write_with_pymeshlab", exporter_error)
+    monkeypatch.setattr(shutil, "disk_usage", lambda folder: types.SimpleNamespace(total=1 << 20, used=1 << 20, free=0))
+    path = tmp_path / "m.stl"
+    with pytest.raises(MeshFileError) as e:
+        write_mesh(path, *nose)
+    assert e.value.value == str(path) and os.strerror(errno.ENOSPC) in str(e.value)
+    assert ".curvdetail-" not in str(e.value) and os.listdir(tmp_path) == []
+
+
 def test_a_format_pymeshlab_does_not_write_names_the_file(tmp_path, nose):
     with pytest.raises(MeshFileError) as e:
         write_mesh(tmp_path / "m.nosuchformat", *nose)

@@ -10,16 +10,20 @@ an existing file only with ``overwrite=True``.
 """
 
 import os
+import tempfile
 import weakref
 
 import numpy as np
 
 from ..io.mesh import check_mesh_output, load_new_mesh, read_mesh, write_mesh_fields
-from .meshset import WRITTEN_ATTRIBUTES, get_mesh, set_vertex_attribute, set_vertex_selection, vertex_attribute
+from ..io.ply import write_ply
+from .meshset import WRITTEN_ATTRIBUTES, get_mesh, set_vertex_attribute, vertex_attribute
 
 #: MeshLab's vertex flag bit of a selected vertex (vcglib's ``SELECTED``).
 SELECTED = 32
 _RGBA = ("red", "green", "blue", "alpha")
+#: The PLY vertex properties pymeshlab reads as the layer's own: the rest are custom attributes.
+_OWN = ("quality", "flags") + _RGBA
 #: The checks of an output path, before any work (the CLI's ``apply`` and ``run`` use it).
 check_output_path = check_mesh_output
 
@@ -50,26 +54,21 @@ def load_meshset(path, *more):
 
 
 def _add_ply_layer(ms, path):
-    import pymeshlab
-
+    """Add the PLY file ``path`` as a new current layer: read with plyfile, handed to pymeshlab
+    as a plain binary PLY of its geometry, quality, colours and flags (pymeshlab marks a layer
+    as having quality and colours only where its file has them; one made from arrays always
+    does), its other vertex properties added as custom attributes."""
     V, F, fields = read_mesh(path, fields=True)
-    extra = {}
-    if "quality" in fields:
-        extra["v_scalar_array"] = fields.pop("quality").astype(np.float64)
-    if all(c in fields for c in _RGBA[:3]):
-        rgba = np.column_stack([fields.pop(c) for c in _RGBA[:3]] +
-                               [fields.pop("alpha", np.full(len(V), 255, dtype=np.uint8))])
-        extra["v_color_matrix"] = np.clip(rgba / (1.0 if rgba.dtype.kind == "f" else 255.0), 0.0, 1.0)
-    flags = fields.pop("flags", None)
-    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=V, face_matrix=F.astype(np.int32), **extra),
-                os.path.basename(path))
-    mid = ms.current_mesh_id()
-    # custom attributes go onto the MeshSet's own copy (add_mesh's copies of them crashed exports)
+    own = {name: fields.pop(name) for name in _OWN if name in fields}
+    if "flags" in own:              # the selection bit alone: pymeshlab drops vertices flagged deleted
+        own["flags"] = (own["flags"].astype(np.int64) & SELECTED).astype(np.int32)
+    with tempfile.TemporaryDirectory(prefix="curvdetail-") as folder:
+        write_ply(os.path.join(folder, "layer.ply"), V, F, own)
+        ms.load_new_mesh(os.path.join(folder, "layer.ply"))
+    ms.current_mesh().set_label(os.path.basename(path))
     for name, values in fields.items():
         if values.dtype.kind in "fiu" and np.isfinite(values).all():
-            set_vertex_attribute(ms, mid, name, values)
-    if flags is not None and np.any(flags.astype(np.int64) & SELECTED):
-        set_vertex_selection(ms, mid, (flags.astype(np.int64) & SELECTED) != 0)
+            set_vertex_attribute(ms, ms.current_mesh_id(), name, values)
 
 
 def loaded_from(ms, mesh_id):

@@ -160,14 +160,6 @@ def set_vertex_quality(ms, mesh_id, quality):
                                                  onselected=False)
 
 
-def set_vertex_selection(ms, mesh_id, selected):
-    """Select exactly the vertices where the boolean (n,) array ``selected`` is True."""
-    mesh = get_mesh(ms, mesh_id)
-    flags = _as_columns(mesh, np.asarray(selected, dtype=bool), 1, "vertex selection")
-    with _current(ms, mesh_id):
-        ms.compute_selection_by_condition_per_vertex(condselect=f"({_scratch(mesh, flags)} > 0)")
-
-
 def set_vertex_positions(ms, mesh_id, X):
     """Move a layer's vertices to ``X`` (n, 3) in place (same layer, faces and attributes)."""
     mesh = get_mesh(ms, mesh_id)

@@ -11,11 +11,12 @@ PLY element counts (plyfile reads exactly those), the OFF header's, and an OBJ f
 import contextlib
 import errno
 import os
+import shutil
 
 import numpy as np
 
 from ..curvature._validate import as_faces, as_vertices
-from ..curvature.errors import MeshError
+from ..curvature.errors import MeshError, counted
 from .atomic import atomic_write, check_output_path
 from .ply import read_ply, write_ply
 
@@ -115,10 +116,11 @@ def load_new_mesh(ms, path):
     if declared is not None:
         faces = F.shape[0] if F.shape[0] == declared[1] else _polygons(path, mesh, declared[1])
         if (V.shape[0], faces) != declared:
-            what = "has {} v lines and {} f lines" if _extension(path) == ".obj" else \
-                "declares {} vertices and {} faces"
-            err = _error(path, f"{path!r} {what.format(*declared)}, but pymeshlab loaded {V.shape[0]} vertices "
-                               f"and {faces} faces",
+            nv, nf = declared
+            what = f"has {counted(nv, 'v line')} and {counted(nf, 'f line')}" if _extension(path) == ".obj" else \
+                f"declares {counted(nv, 'vertex', 'vertices')} and {counted(nf, 'face')}"
+            err = _error(path, f"{path!r} {what}, but pymeshlab loaded {counted(V.shape[0], 'vertex', 'vertices')} "
+                               f"and {counted(faces, 'face')}",
                          "its loader drops rows it cannot use (a NaN coordinate, an index out of range, a "
                          "malformed line); fix those rows or export the file again, e.g. as PLY")
             err.declared, err.loaded = declared, (V.shape[0], faces)
@@ -292,7 +294,11 @@ def _writing(path, overwrite):
             yield tmp
         except Exception as exc:                # OSError (a full disk), pymeshlab's exceptions
             shown = os.fsdecode(path)
-            raise _error(shown, f"could not write {shown!r}: {_why(exc).replace(tmp, shown)}") from exc
+            why = _why(exc).replace(tmp, shown)
+            if not isinstance(exc, OSError) and shutil.disk_usage(os.path.dirname(tmp)).free == 0:
+                # pymeshlab's words for a full disk: "Error encountered while exportering ... Output Stream error"
+                why = f"{os.strerror(errno.ENOSPC)} (pymeshlab: {why})"
+            raise _error(shown, f"could not write {shown!r}: {why}") from exc
 
 
 def _write_text(path, V, F):
