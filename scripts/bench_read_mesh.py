@@ -95,7 +95,11 @@ def main(argv=None):
                 runs[name].append(run(name if name == "pymeshlab" else "curvdetail", path, pythonpath))
         size = os.path.getsize(path)
     first = runs["new"][0]
+    commits = {name: subprocess.run(["git", "-C", folder, "rev-parse", "--short", "HEAD"], capture_output=True,
+                                    text=True).stdout.strip() or None
+               for name, folder in (("new", HERE), ("baseline", readers["baseline"]))}
     result = {
+        "commits": commits,
         "mesh": {"vertices": first["vertices"], "triangles": first["triangles"], "file_bytes": size,
                  "format": "binary_little_endian PLY, double x y z, int32 triangles"},
         "host": {"machine": platform.machine(), "python": platform.python_version(), "cpus": os.cpu_count(),
