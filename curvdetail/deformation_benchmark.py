@@ -18,7 +18,7 @@ import os
 
 import numpy as np
 
-from ._output import atomic_output, check_output_path
+from .io.atomic import atomic_write, check_output_path
 from .curvature._validate import (affine_transform_problem, as_vertices, check_bool, check_choice,
                                   check_transformed_values, real_word)
 from .curvature.curvature_coefficients import DEFAULT_RCOND
@@ -136,7 +136,7 @@ def read_transform(path):
 
 
 def _write_text(path, text, overwrite):
-    with atomic_output(path, overwrite=overwrite, hint=None, error=FileNotFoundError) as tmp:
+    with atomic_write(path, overwrite=overwrite) as tmp:
         with open(tmp, "w", encoding="utf-8") as fh:
             fh.write(text)
 
@@ -294,7 +294,7 @@ def render_panels(path, panels, *, elev=20.0, azim=-60.0, title=None, overwrite=
     import matplotlib.pyplot as plt
     from matplotlib.collections import PolyCollection
 
-    path = check_output_path(path, overwrite, hint=None, error=FileNotFoundError)
+    path = check_output_path(path, overwrite)
     R = _camera(elev, azim)          # camera frame: x right, y up, z towards the viewer
     fig, axes = plt.subplots(1, len(panels), figsize=(panel_size * len(panels), panel_size),
                              squeeze=False)
@@ -326,7 +326,7 @@ def render_panels(path, panels, *, elev=20.0, azim=-60.0, title=None, overwrite=
         fig.suptitle(title, fontsize=11)
     fig.tight_layout(pad=1.6)
     try:
-        with atomic_output(path, overwrite=overwrite, hint=None, error=FileNotFoundError) as tmp:
+        with atomic_write(path, overwrite=overwrite) as tmp:
             fig.savefig(tmp, dpi=100, format="png")
     finally:
         plt.close(fig)

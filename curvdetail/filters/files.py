@@ -22,7 +22,7 @@ import weakref
 
 import numpy as np
 
-from .. import _output
+from ..io.atomic import atomic_write
 from ..io.mesh import MeshFileError, _save, check_coordinates, check_mesh_output, input_path, load_checked, save_mesh
 from .meshset import WRITTEN_ATTRIBUTES, set_vertex_attribute, vertex_attribute
 from .ply_attributes import read_ply_vertex_attributes
@@ -191,7 +191,7 @@ def save_current_mesh(ms, path, *, overwrite=False):
         optional["save_vertex_normal"] = False
     if not vertex_colours_kept_in(ms, path):
         optional["save_vertex_color"] = False
-    with _output.atomic_output(path, overwrite=overwrite, hint=_HINT, error=MeshFileError) as tmp:
+    with atomic_write(path, overwrite=overwrite) as tmp:
         try:
             _save(ms, tmp, options, optional)
         except Exception as exc:

@@ -32,7 +32,7 @@ import sys
 import tempfile
 import xml.etree.ElementTree as ET
 
-from .._output import atomic_output, check_output_path
+from ..io.atomic import atomic_write, check_output_path
 from .dispatch import apply
 from .errors import FilterError, ScriptError
 from .registry import _REGISTRY, close_matches, get_filter
@@ -477,7 +477,7 @@ def save_script(path, steps, *, overwrite=False):
     """
     from .dispatch import complete_parameters
 
-    path = check_output_path(path, overwrite, hint=None, error=FileNotFoundError)
+    path = check_output_path(path, overwrite)
     if isinstance(steps, str) or not isinstance(steps, (list, tuple)):
         raise ScriptError(f"steps must be a list of filter names or (name, parameters) pairs; got "
                           f"{type(steps).__name__}.")
@@ -496,6 +496,6 @@ def save_script(path, steps, *, overwrite=False):
             element.append(_param_element(p, values[p.name]))   # None (current) as value=""
     ET.indent(root, space=" ")
     text = "<!DOCTYPE FilterScript>\n" + ET.tostring(root, encoding="unicode") + "\n"
-    with atomic_output(path, overwrite=overwrite, hint=None, error=FileNotFoundError) as tmp:
+    with atomic_write(path, overwrite=overwrite) as tmp:
         with open(tmp, "w", encoding="utf-8") as out:
             out.write(text)

@@ -9,7 +9,7 @@ which fails if another process made the destination meanwhile.
 
 import contextlib
 import os
-import tempfile
+import secrets
 
 from ..curvature.errors import MeshError
 
@@ -20,7 +20,8 @@ def check_output_path(path, overwrite=False, *, parameter="path"):
     Raises
     ------
     FileExistsError
-        ``path`` exists and ``overwrite`` is False.
+        ``path`` exists and ``overwrite`` is False (``e.filename`` is ``path``,
+        ``e.parameter`` is ``"overwrite"``).
     MeshError
         ``path`` is not a path, is a folder, or its folder does not exist or is not writable
         (``e.parameter`` is ``parameter``).
@@ -35,7 +36,8 @@ def check_output_path(path, overwrite=False, *, parameter="path"):
                         hint="give a file name")
     if os.path.lexists(path) and not overwrite:
         err = FileExistsError(f"{path!r} exists; pass overwrite=True to replace it")
-        err.filename, err.parameter, err.value = path, parameter, path
+        err.filename, err.parameter, err.value = path, "overwrite", overwrite
+        err.problem, err.hint = f"{path!r} exists", "set it to replace the file"
         raise err
     folder = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(folder):
@@ -52,7 +54,9 @@ def atomic_write(path, *, overwrite=False, parameter="path"):
     """Yield a temporary path beside ``path`` (same extension); on success move it into place.
 
     Write the output to the yielded path with any library (pymeshlab, plyfile, matplotlib,
-    ``open``). The file gets a normal file's permissions (the umask's), not ``mkstemp``'s 0600.
+    ``open``). The temporary file is named ``.curvdetail-<16 hex digits><extension>`` and is
+    created with a normal file's permissions (the umask's). It is removed whatever ends the
+    block: an exception, KeyboardInterrupt, or a signal handler that raises.
 
     Raises
     ------
@@ -72,12 +76,16 @@ def atomic_write(path, *, overwrite=False, parameter="path"):
     """
     path = check_output_path(path, overwrite, parameter=parameter)
     folder, name = os.path.split(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix=".curvdetail-", suffix=os.path.splitext(name)[1], dir=folder)
+    # the name is chosen before the file exists, so that an interrupt at any point after the
+    # open finds it in ``tmp`` (mkstemp made the file before returning its name)
+    tmp = os.path.join(folder, f".curvdetail-{secrets.token_hex(8)}{os.path.splitext(name)[1]}")
+    ours = True
     try:
-        os.close(fd)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
+        try:
+            os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
+        except FileExistsError:
+            ours = False
+            raise
         yield tmp
         try:
             if overwrite:
@@ -85,9 +93,10 @@ def atomic_write(path, *, overwrite=False, parameter="path"):
             else:
                 os.link(tmp, path)
         except OSError as exc:
-            if exc.filename is None:
+            if exc.filename is None or exc.filename == tmp:
                 exc.filename = path
             raise
     finally:
-        with contextlib.suppress(FileNotFoundError):
-            os.remove(tmp)
+        if ours:
+            with contextlib.suppress(FileNotFoundError):
+                os.remove(tmp)

@@ -13,7 +13,7 @@ import numpy as np
 from .._ctm_scan import ctm_layout, ctm_problem, ctm_vertex_map
 from .._file_counts import check_loaded, check_polygons, declared_counts
 from .._file_scan import check_before_loading, small_pages
-from .._output import atomic_output, check_output_path
+from .atomic import atomic_write, check_output_path
 from ..curvature._validate import as_faces, as_vertices
 from ..curvature.errors import MeshError, counted, first_indices
 
@@ -279,7 +279,7 @@ def check_mesh_output(path, overwrite=False, *, hint=_MESH_HINT):
     MeshFileError     ``path`` is a folder, its folder is missing, or the format is not a mesh
                       format pymeshlab writes
     """
-    path = check_output_path(path, overwrite, hint=hint, error=MeshFileError)
+    path = check_output_path(path, overwrite)
     _check_utf8(path)
     extension = os.path.splitext(path)[1].lower()
     if extension in POINT_FORMATS:
@@ -696,7 +696,7 @@ def save_mesh(path, mesh, *, overwrite=False, _plain=None, **save_options):
         plain = {k: v for k, v in plain.items() if k != "save_face_color"}
     check_coordinates(path, mesh.vertex_matrix(), **options)
     # the temporary file keeps path's extension: pymeshlab picks the format from it
-    with atomic_output(path, overwrite=overwrite, error=MeshFileError) as tmp:
+    with atomic_write(path, overwrite=overwrite) as tmp:
         ms = _meshset()
         ms.add_mesh(mesh)                        # a copy: the caller's mesh is not changed
         if extension == ".3ds" and not ms.current_mesh().has_face_color():

@@ -5,7 +5,7 @@ import os
 
 import numpy as np
 
-from .._output import atomic_output, check_output_path
+from ..io.atomic import atomic_write, check_output_path
 
 
 #: Below this fraction of the triangles' total area, the area-weighted mean normal is taken as
@@ -94,7 +94,7 @@ def save_figure(path, V, F, X, Ft, Z, distance, report, *, overwrite=False, dpi=
     matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
 
-    path = check_output_path(path, overwrite, hint=None, error=FileNotFoundError)
+    path = check_output_path(path, overwrite)
     R = _view_frame(V, F)
     centre = 0.5 * (V.max(0) + V.min(0))
     P = (V - centre) @ R.T
@@ -123,7 +123,7 @@ def save_figure(path, V, F, X, Ft, Z, distance, report, *, overwrite=False, dpi=
     cb.set_label("distance to source, % of bbox diagonal", fontsize=8)
     fig.suptitle("Remeshing from curvature detail (all figures: % of the source's bbox diagonal)", fontsize=10)
     try:
-        with atomic_output(path, overwrite=overwrite, hint=None, error=FileNotFoundError) as tmp:
+        with atomic_write(path, overwrite=overwrite) as tmp:
             fig.savefig(tmp, dpi=dpi, bbox_inches="tight", format="png")
     finally:
         plt.close(fig)
