@@ -85,7 +85,8 @@ def input_output(args):
 
     if args.example:
         if args.output is not None:
-            raise CurvdetailError("with --example give only OUTPUT, not INPUT and OUTPUT", parameter="example")
+            raise CurvdetailError("with --example give only OUTPUT, not INPUT and OUTPUT", parameter="example",
+                                  hint="the example is INPUT")
         from .data import example_path
 
         args.input, args.output = example_path(), args.input

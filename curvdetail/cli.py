@@ -59,7 +59,8 @@ def _reconstruct(parser):
 
         from . import Reconstructor, curvature_detail, write_mesh
 
-        check_outputs(args, [("OUTPUT", args.output, True)], **input_output(args))
+        inputs = input_output(args)
+        check_outputs(args, [("OUTPUT", args.output, True)], **inputs)
         V, F = read_checked(args.input)
         fixed = fixed_vertices(args, V, F, purpose="to rebuild a closed mesh")
         t = time.perf_counter()
@@ -99,7 +100,8 @@ def _minimal(parser):
         from . import boundary_vertices, minimal_surface, write_mesh
         from .curvature.errors import ConstraintError
 
-        check_outputs(args, [("OUTPUT", args.output, True)], **input_output(args))
+        inputs = input_output(args)
+        check_outputs(args, [("OUTPUT", args.output, True)], **inputs)
         V, F = read_checked(args.input)
         fixed = fixed_vertices(args, V, F, purpose="(a minimal surface needs a boundary to span)")
         loose = np.setdiff1d(boundary_vertices(F), fixed)
@@ -115,7 +117,7 @@ def _minimal(parser):
                    overwrite=args.overwrite)
         state = "converged" if X.converged else "stopped (not converged)"
         step = X.last_step if args.step == "normal" else X.last_full_step
-        print_figures(f"{state} after {X.iterations} steps, last step {step:.2e} of the bbox diagonal "
+        print_figures(f"{state} after {X.iterations} step{'' if X.iterations == 1 else 's'}, last step {step:.2e} of the bbox diagonal "
                       f"({'normal to the surface' if args.step == 'normal' else 'full displacement'})")
         note_dropped(args.output, quality=True)
         return 0 if X.converged else NOT_CONVERGED

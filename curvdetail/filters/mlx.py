@@ -349,7 +349,7 @@ def run_script(ms, path, *, progress=None):
                         parameter name right but for its capitals, found after its step; then, as
                         the steps run, a MeshLab filter that needs a mesh on an empty MeshSet, or
                         a step failed (the message names the step number and filter, then the
-                        reason)
+                        reason), or the last step left the MeshSet with no mesh
 
     Examples
     --------
@@ -383,6 +383,9 @@ def run_script(ms, path, *, progress=None):
         else:
             _run_native(ms, element, where)
             figures = {}
+        if ms.mesh_number() == 0 and k == len(steps):
+            raise ScriptError(f"{where} deleted the last mesh: the script ends with none", parameter="script",
+                              hint="remove that step, or create a mesh after it")
         results.append({"filter": name, "figures": figures})
     return results
 
