@@ -226,7 +226,7 @@ def check_outputs(args, outputs, *, inputs=(), other_inputs=(), mesh_check=None)
         if mesh:
             (mesh_check or check_mesh_output)(path, args.overwrite)
         else:
-            check_output_path(path, args.overwrite)
+            check_output_path(path, args.overwrite, parameter=name.lstrip("-"))
 
 
 def quality_for(path, quality):
