@@ -159,12 +159,13 @@ def print_figures(text):
     Python's final flush does not fail again."""
     try:
         print(text, flush=True)
-    except (OSError, ValueError):
+    except (OSError, ValueError) as exc:
         try:
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         except (OSError, ValueError):       # no file descriptor (a replaced sys.stdout)
             pass
-        say("curvdetail: note: the figures could not be printed (stdout is full or closed)")
+        if not isinstance(exc, BrokenPipeError):        # `| head`: the reader had enough, as for cat
+            say(f"curvdetail: note: the figures could not be printed ({exc.strerror or exc})")
 
 
 class Progress:
@@ -301,7 +302,10 @@ def figures_status(steps, output):
         if figures.get("folded_triangles") or any(isinstance(r, float) and r > AMPLIFICATION_LIMIT for r in ratios):
             status = status or AMPLIFIED
         elif figures.get("converged") is False:
-            say(f"curvdetail: note: {name} stopped (not converged) after {figures.get('iterations')} steps; "
-                f"{os.path.basename(os.fspath(output))} is written all the same (exit status {NOT_CONVERGED}).")
+            n, last = figures.get("iterations"), figures.get("last_step")
+            text = f" after {n} step{'' if n == 1 else 's'}" if isinstance(n, int) else ""
+            text += f", last step {last:.2e} of the bbox diagonal" if isinstance(last, float) else ""
+            say(f"curvdetail: note: {name} stopped (not converged){text}; {os.path.basename(os.fspath(output))} "
+                f"is written all the same (exit status {NOT_CONVERGED}).")
             status = status or NOT_CONVERGED
     return status
