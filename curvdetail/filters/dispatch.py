@@ -26,7 +26,7 @@ def complete_parameters(spec, params):
         p = missing[0]
         raise FilterParameterError(f"filter {spec.name!r} needs parameter {p.name!r}: "
                                    f"{' '.join(p.description.split())}", parameter=p.name,
-                                   hint="it has no default that works: give it")
+                                   hint="it has no default that works")
     return values
 
 

@@ -15,19 +15,19 @@ from ..curvature.errors import MeshError
 
 
 def check_output_path(path, overwrite=False, *, parameter="path"):
-    """Return ``os.fspath(path)``, or raise before any work if it cannot be written.
+    """Return ``path`` as a str, or raise before any work if it cannot be written.
 
     Raises
     ------
     FileExistsError
-        ``path`` exists and ``overwrite`` is False (``e.filename`` is ``path``,
-        ``e.parameter`` is ``"overwrite"``).
+        ``path`` exists and ``overwrite`` is False (``e.parameter`` is ``"overwrite"``,
+        ``e.hint`` what it does).
     MeshError
         ``path`` is not a path, is a folder, or its folder does not exist or is not writable
         (``e.parameter`` is ``parameter``).
     """
     try:
-        path = os.fspath(path)
+        path = os.fsdecode(path)
     except TypeError:
         raise MeshError(f"{parameter} must be a file path, not {type(path).__name__}",
                         parameter=parameter, value=path) from None
@@ -35,9 +35,8 @@ def check_output_path(path, overwrite=False, *, parameter="path"):
         raise MeshError(f"{path!r} is a folder", parameter=parameter, value=path,
                         hint="give a file name")
     if os.path.lexists(path) and not overwrite:
-        err = FileExistsError(f"{path!r} exists; pass overwrite=True to replace it")
-        err.filename, err.parameter, err.value = path, "overwrite", overwrite
-        err.problem, err.hint = f"{path!r} exists", "set it to replace the file"
+        err = FileExistsError(f"{path} exists; pass overwrite=True to replace it.")
+        err.parameter, err.value, err.problem, err.hint = "overwrite", overwrite, f"{path} exists", "replace it"
         raise err
     folder = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(folder):
