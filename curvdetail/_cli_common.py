@@ -7,6 +7,7 @@ import json
 import os
 import sys
 import time
+import warnings
 
 #: Exit status when OUTPUT is written but an iteration stopped before it converged.
 NOT_CONVERGED = 3
@@ -309,3 +310,51 @@ def figures_status(steps, output):
                 f"is written all the same (exit status {NOT_CONVERGED}).")
             status = status or NOT_CONVERGED
     return status
+
+
+#: Python parameter names of the library whose option is named otherwise.
+_ALIASES = {"fixed": "fix", "path": "output"}
+
+
+def _option(args, parameter):
+    """The command line's name for a library parameter, or None."""
+    if parameter == "overwrite":
+        return "--overwrite"
+    if args.command in ("apply", "run"):
+        from .filters import get_filter
+
+        if args.command == "run" or parameter not in get_filter(args.filter).parameter_names:
+            return None
+        if get_filter(args.filter).parameter(parameter).type == "mesh":
+            return f"--add MESH / --param {parameter}"
+        return f"--param {parameter}"
+    return args._options.get(_ALIASES.get(parameter, parameter))
+
+
+def error_line(exc, args):
+    """``curvdetail: error: <problem> (<option>: <hint>)`` from the exception's fields, or its
+    message where it names no parameter the command line has."""
+    text = " ".join(str(exc).split()) or type(exc).__name__
+    hint, parameter = getattr(exc, "hint", None), getattr(exc, "parameter", None)
+    option = _option(args, parameter) if isinstance(parameter, str) else None
+    if hint and option:
+        text = f"{' '.join(str(getattr(exc, 'problem', text)).split())} ({option}: {hint})"
+    return f"curvdetail: error: {text}"
+
+
+def show_warning(message, category, filename, lineno, file=None, line=None):
+    """A library warning as one line: a note where it announces a long run or a finding, a
+    warning where an edit folded or amplified; other warnings as Python shows them."""
+    from .curvature.errors import FoldedTrianglesWarning
+    from .filters.editing import AmplifiedEditWarning
+    from .remesh import LongRunWarning, WorseThanZeroDetailWarning
+
+    if issubclass(category, (LongRunWarning, WorseThanZeroDetailWarning)):
+        say(f"note: {message}")
+    elif issubclass(category, (FoldedTrianglesWarning, AmplifiedEditWarning)):
+        say(f"curvdetail: warning: {message}")
+    else:
+        _python_showwarning(message, category, filename, lineno, file, line)
+
+
+_python_showwarning = warnings.showwarning

@@ -20,8 +20,8 @@ import warnings
 
 from ._cli_common import (AMPLIFIED, NOT_CONVERGED, Progress, add_backend, add_fix, add_input_output,
                           add_overwrite, check_outputs, choice, diagonal, figures_status, fixed_vertices,
-                          input_output, note_dropped, percentage, positive_number, print_figures, quality_for,
-                          read_checked, run_on_file, say, whole_number_from_one)
+                          error_line, input_output, note_dropped, percentage, positive_number, print_figures,
+                          quality_for, read_checked, run_on_file, say, show_warning, whole_number_from_one)
 
 __all__ = ["AMPLIFIED", "NOT_CONVERGED", "Terminated", "build_parser", "error_line", "main",
            "positive_number", "whole_number_from_one"]
@@ -49,7 +49,7 @@ class Terminated(KeyboardInterrupt):
 def _reconstruct(parser):
     add_input_output(parser, "mesh file", "rebuilt mesh; quality = distance to INPUT (.ply keeps it)")
     choice(parser, "--rows", ("all", "free"), "all",
-            "residual rows in E_Q: all vertices (the paper) or free ones only (default: %(default)s)")
+           "residual rows in E_Q: all vertices (the paper) or free ones only (default: %(default)s)")
     add_fix(parser)
     add_backend(parser)
     add_overwrite(parser)
@@ -89,7 +89,7 @@ def _minimal(parser):
                         help="stop when no vertex moves more than TOL x the bbox diagonal in a step "
                              f"(default {DEFAULT_TOL:g})")
     choice(parser, "--step", ("normal", "full"), "normal",
-            "what TOL is compared with: the step normal to the surface (default) or the full displacement")
+           "what TOL is compared with: the step normal to the surface (default) or the full displacement")
     add_fix(parser)
     add_backend(parser)
     add_overwrite(parser)
@@ -138,9 +138,9 @@ def _remesh(parser):
     choice(parser, "--transfer", ("conservative", "pointwise"), "conservative", "detail transfer (default: conservative)")
     choice(parser, "--rows", ("all", "free"), "free", "residual rows of the reconstruction energy (default: free)")
     choice(parser, "--location", ("closest", "uv"), "closest",
-            "locate points by 3D closest point (default) or in a shared planar domain")
+           "locate points by 3D closest point (default) or in a shared planar domain")
     choice(parser, "--parameterization", ("harmonic", "meshlab_harmonic", "lscm"), None,
-            "planar domain for --location uv (default: harmonic)")
+           "planar domain for --location uv (default: harmonic)")
     parser.add_argument("--no-surface-check", action="store_true",
                         help="isotropic remeshing without its surface-distance check (faster on big targets)")
     add_backend(parser)
@@ -319,9 +319,9 @@ def _edit(parser):
     parser.add_argument("--def", dest="transform", required=True, metavar="DEF",
                         help="4x4 handle transform applied to homogeneous handle positions")
     choice(parser, "--handle-detail", ("transform", "free"), "transform",
-            "handles' curvature details: transformed by the linear part of DEF (default) or solved")
+           "handles' curvature details: transformed by the linear part of DEF (default) or solved")
     choice(parser, "--relations", ("one-ring", "one+two-ring"), "one-ring",
-            "curvature stage: the paper's one-ring coefficients or one- and two-ring together (steadier)")
+           "curvature stage: the paper's one-ring coefficients or one- and two-ring together (steadier)")
     parser.add_argument("--image", metavar="PNG", help="also save a picture: rest (by status) | edited")
     add_backend(parser)
     add_overwrite(parser, also=("--image",))
@@ -400,54 +400,6 @@ def build_parser():
     return parser
 
 
-#: Python parameter names of the library whose option is named otherwise.
-_ALIASES = {"fixed": "fix", "path": "output"}
-
-
-def _option(args, parameter):
-    """The command line's name for a library parameter, or None."""
-    if parameter == "overwrite":
-        return "--overwrite"
-    if args.command in ("apply", "run"):
-        from .filters import get_filter
-
-        if args.command == "run" or parameter not in get_filter(args.filter).parameter_names:
-            return None
-        if get_filter(args.filter).parameter(parameter).type == "mesh":
-            return f"--add MESH / --param {parameter}"
-        return f"--param {parameter}"
-    return args._options.get(_ALIASES.get(parameter, parameter))
-
-
-def error_line(exc, args):
-    """``curvdetail: error: <problem> (<option>: <hint>)`` from the exception's fields, or its
-    message where it names no parameter the command line has."""
-    text = " ".join(str(exc).split()) or type(exc).__name__
-    hint, parameter = getattr(exc, "hint", None), getattr(exc, "parameter", None)
-    option = _option(args, parameter) if isinstance(parameter, str) else None
-    if hint and option:
-        text = f"{' '.join(str(getattr(exc, 'problem', text)).split())} ({option}: {hint})"
-    return f"curvdetail: error: {text}"
-
-
-def _show_warning(message, category, filename, lineno, file=None, line=None):
-    """A library warning as one line: a note where it announces a long run or a finding, a
-    warning where an edit folded or amplified; other warnings as Python shows them."""
-    from .curvature.errors import FoldedTrianglesWarning
-    from .filters.editing import AmplifiedEditWarning
-    from .remesh import LongRunWarning, WorseThanZeroDetailWarning
-
-    if issubclass(category, (LongRunWarning, WorseThanZeroDetailWarning)):
-        say(f"note: {message}")
-    elif issubclass(category, (FoldedTrianglesWarning, AmplifiedEditWarning)):
-        say(f"curvdetail: warning: {message}")
-    else:
-        _default_showwarning(message, category, filename, lineno, file, line)
-
-
-_default_showwarning = warnings.showwarning
-
-
 def _terminate(signum, frame):
     signal.signal(signal.SIGTERM, signal.SIG_IGN)           # once: the cleanup is not cut short
     raise Terminated()
@@ -464,7 +416,7 @@ def main(argv=None):
         previous = None
     try:
         with warnings.catch_warnings():
-            warnings.showwarning = _show_warning
+            warnings.showwarning = show_warning
             return int(args._run(args) or 0)
     except Terminated:
         say("curvdetail: terminated")

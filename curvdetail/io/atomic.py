@@ -32,8 +32,7 @@ def check_output_path(path, overwrite=False, *, parameter="path"):
         raise MeshError(f"{parameter} must be a file path, not {type(path).__name__}",
                         parameter=parameter, value=path) from None
     if os.path.isdir(path):
-        raise MeshError(f"{path!r} is a folder", parameter=parameter, value=path,
-                        hint="give a file name")
+        raise MeshError(f"{path!r}: it is a folder", parameter=parameter, value=path, hint="name a file")
     if os.path.lexists(path) and not overwrite:
         err = FileExistsError(f"{path} exists; pass overwrite=True to replace it.")
         err.parameter, err.value, err.problem, err.hint = "overwrite", overwrite, f"{path} exists", "replace it"

@@ -279,7 +279,12 @@ def check_mesh_output(path, overwrite=False, *, hint=_MESH_HINT):
     MeshFileError     ``path`` is a folder, its folder is missing, or the format is not a mesh
                       format pymeshlab writes
     """
-    path = check_output_path(path, overwrite)
+    try:
+        path = check_output_path(path, overwrite)
+    except MeshError as exc:                    # a folder, a missing or read-only folder
+        raise MeshFileError(exc.problem, parameter=exc.parameter, value=exc.value, hint=exc.hint) from None
+    if not os.path.splitext(path)[1]:
+        raise MeshFileError(f"cannot write {path!r}: no file extension to choose the format from ({hint})")
     _check_utf8(path)
     extension = os.path.splitext(path)[1].lower()
     if extension in POINT_FORMATS:
