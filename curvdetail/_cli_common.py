@@ -226,7 +226,11 @@ def check_outputs(args, outputs, *, inputs=(), other_inputs=(), mesh_check=None)
                 raise CurvdetailError(f"{path} is an input of this run ({given} {p}); writing {name} there "
                                       "would destroy it, even with --overwrite", value=path)
         if mesh:
-            (mesh_check or check_mesh_output)(path, args.overwrite)
+            try:
+                (mesh_check or check_mesh_output)(path, args.overwrite)
+            except CurvdetailError as exc:          # the library calls it path
+                exc.parameter = "output"
+                raise
         else:
             check_output_path(path, args.overwrite, parameter=name.lstrip("-"))
 
@@ -313,13 +317,15 @@ def figures_status(steps, output):
 
 
 #: Python parameter names of the library whose option is named otherwise.
-_ALIASES = {"fixed": "fix", "path": "output"}
+_ALIASES = {"fixed": "fix"}
 
 
 def _option(args, parameter):
     """The command line's name for a library parameter, or None."""
     if parameter == "overwrite":
         return "--overwrite"
+    if parameter in args._options:
+        return args._options[parameter]
     if args.command in ("apply", "run"):
         from .filters import get_filter
 
@@ -328,7 +334,7 @@ def _option(args, parameter):
         if get_filter(args.filter).parameter(parameter).type == "mesh":
             return f"--add MESH / --param {parameter}"
         return f"--param {parameter}"
-    return args._options.get(_ALIASES.get(parameter, parameter))
+    return args._options.get(_ALIASES.get(parameter))
 
 
 def error_line(exc, args):

@@ -8,7 +8,9 @@ with its own option names (:func:`error_line`), never by rewriting the library's
 
 Exit status: 0 done; 1 an error, said on stderr, OUTPUT not written; 2 a command line argparse
 cannot parse; 3 OUTPUT written, but an iteration stopped before it converged; 4 OUTPUT written,
-but an edit folded triangles or amplified its constraints; 130 Ctrl-C; 143 SIGTERM.
+but an edit folded triangles or amplified its constraints; 130 Ctrl-C; 143 SIGTERM. A signal is
+an exception in the main thread, taken when the native call in progress (a factorization, a
+remeshing) returns; the temporary file of an output being written is removed.
 """
 
 import argparse
