@@ -106,15 +106,11 @@ def _quiet_output():
     with tempfile.TemporaryFile() as sink:
         try:
             for stream in (sys.stdout, sys.stderr):
-                try:
+                with contextlib.suppress(AttributeError, OSError, ValueError):
                     stream.flush()
-                except (AttributeError, OSError, ValueError):
-                    pass
             for fd in (1, 2):                  # pymeshlab writes to the process's own descriptors
-                try:
+                with contextlib.suppress(OSError):
                     saved.append((fd, os.dup(fd)))
-                except OSError:
-                    continue
             for fd, _ in saved:
                 os.dup2(sink.fileno(), fd)
             yield captured
