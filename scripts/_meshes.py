@@ -4,7 +4,7 @@
 import os
 import sys
 
-from curvdetail.cli import _whole_number_from_one as at_least_one  # noqa: F401 (--repeat)
+from curvdetail.cli import whole_number_from_one as at_least_one  # noqa: F401 (--repeat)
 
 MESHES = os.environ.get("CURVDETAIL_MESHES",
                         os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "shared", "meshes"))

@@ -25,7 +25,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
-import _outputs  # noqa: E402
+import _files  # noqa: E402
 from _meshes import MESHES, at_least_one, require  # noqa: E402
 from reproduce_table1 import PAPER, table1_meshes, time_edit  # noqa: E402
 
@@ -117,7 +117,7 @@ def main(argv=None):
     ap.add_argument("--skip-100k", action="store_true", help="leave out the 100k-vertex re-solve")
     ap.add_argument("--force", action="store_true", help="replace OUT if it exists")
     args = ap.parse_args(argv)
-    run = _outputs.Run(ap, [args.out], args.force, makes=[os.path.dirname(os.path.abspath(args.out))])
+    _files.check_outputs(ap, [args.out], args.force)
     require("mannequin_nose.obj", "mannequin.off", "mannequin_ear.obj", "cat_tosca.off", "deformation",
             *(() if args.skip_100k else ("terrainA_100k.ply",)))
     report = {"machine": {"platform": platform.platform(), "cpus": os.cpu_count(),
@@ -140,8 +140,7 @@ def main(argv=None):
                   f"{1e3 * r['handle_resolve_s']:.2f} ms = {r['handle_resolves_per_second']:.0f}/s "
                   "(target 20/s)")
     report["machine"]["load_average_after"] = os.getloadavg()
-    run.write_json(args.out, report, indent=2)
-    run.commit()
+    _files.write_json(args.out, report, args.force, indent=2)
     print(f"wrote {args.out}")
     return 0
 

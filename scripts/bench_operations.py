@@ -41,8 +41,8 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from curvdetail.cli import _whole_number_from_one as at_least_one  # noqa: E402 (the CLI's option type)
-import _outputs  # noqa: E402
+from curvdetail.cli import whole_number_from_one as at_least_one  # noqa: E402 (the CLI's option type)
+import _files  # noqa: E402
 
 SIDES = {"10k": 100, "100k": 316, "1M": 1000}
 CASES = {
@@ -195,7 +195,7 @@ def main(argv=None):
         if unknown or not given:
             ap.error(f"{option}: {'unknown ' + ', '.join(map(repr, unknown)) if unknown else 'none given'}; "
                      f"choose from {', '.join(allowed)} (a comma list).")
-    run = _outputs.Run(ap, [args.out], args.force, makes=[os.path.dirname(os.path.abspath(args.out))])
+    _files.check_outputs(ap, [args.out], args.force)
     results = []
     with tempfile.TemporaryDirectory(prefix="bench_operations_") as folder:
         os.environ[FILES] = folder                             # for the read cases' subprocesses
@@ -203,8 +203,7 @@ def main(argv=None):
             run_cases(cases, size, args.timeout, folder, results)
     report = {"machine": {"cpu": platform.processor() or platform.machine(), "cores": os.cpu_count()},
               "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "results": results}
-    run.write_json(args.out, report, indent=2, end="\n")
-    run.commit()
+    _files.write_json(args.out, report, args.force, indent=2, end="\n")
     return 0
 
 

@@ -16,12 +16,10 @@ with each case in its own subprocess, so that its peak RSS (``ru_maxrss``) is it
 is the largest vertex distance to the known surface, as a fraction of the bbox diagonal.
 
 Results go to JSON (``--out``) and a markdown table between the markers in docs/benchmarks.md
-(``--markdown``). A run of one (surface, size, rows) group writes both together at the end
-(scripts/_outputs.py: neither is written where one fails); a run of several saves ``--out`` after
-each group instead, so that a run stopped part-way keeps the groups done (``--merge`` continues
-from them), and the markdown at the end. Before any case runs, an existing file is refused
-unless ``--overwrite`` is given (``--merge`` alone allows updating ``--out``), and so is a
-``--markdown`` folder that does not exist. ``--force`` is not that flag: it runs the cases left
+(``--markdown``), each written atomically: ``--out`` after each (surface, size, rows) group, so
+that a run stopped part-way keeps the groups done (``--merge`` continues from them), and the
+markdown at the end. Before any case runs, an existing file is refused
+unless ``--overwrite`` is given (``--merge`` alone allows updating ``--out``). ``--force`` is not that flag: it runs the cases left
 out by default. docs/benchmarks.md is in the repository, so refreshing its table takes
 ``--overwrite`` (or ``--markdown ''`` for none).
 
@@ -49,9 +47,9 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from curvdetail.cli import _positive_number as positive_number  # noqa: E402 (the CLI's option types)
-from curvdetail.cli import _whole_number_from_one as at_least_one  # noqa: E402
-import _outputs  # noqa: E402
+from curvdetail.cli import positive_number  # noqa: E402 (the CLI's option types)
+from curvdetail.cli import whole_number_from_one as at_least_one  # noqa: E402
+import _files  # noqa: E402
 
 SIZES = {"10k": 10_000, "100k": 100_000, "1M": 1_000_000}
 SURFACES = ("grid", "sphere")
@@ -453,7 +451,7 @@ def main(argv=None):
     if args.rebuild_markdown:
         if not args.markdown:
             parser.error("--rebuild-markdown needs a --markdown file")
-        run = _outputs.Run(parser, [args.markdown], args.overwrite, OVERWRITE)
+        _files.check_outputs(parser, [args.markdown], args.overwrite, OVERWRITE)
         try:
             with open(args.out) as fh:
                 stored = json.load(fh)
@@ -463,8 +461,8 @@ def main(argv=None):
             parser.error(f"--rebuild-markdown reads the results of earlier runs from --out {args.out!r}, which "
                          f"cannot be used ({reason}); run the benchmark first "
                          "(it writes that file), or pass --out with the JSON an earlier run wrote.")
-        run.write_text(args.markdown, markdown_text(args.markdown, stored["results"], stored["meta"]))
-        run.commit()
+        _files.write_text(args.markdown, markdown_text(args.markdown, stored["results"], stored["meta"]),
+                          args.overwrite)
         return 0
 
     import scipy
@@ -476,10 +474,9 @@ def main(argv=None):
     if args.methods is not None:
         args.methods = ",".join(_names(parser, "--methods", args.methods, METHODS, "method"))
     # before any case runs: --merge updates --out, --overwrite replaces it (and the markdown's table)
-    run = _outputs.Run(parser, [args.out], args.overwrite or args.merge,
-                       f"{OVERWRITE} (or --merge to keep its other cases)",
-                       makes=[os.path.dirname(os.path.abspath(args.out))])
-    run.check([args.markdown or None], args.overwrite, OVERWRITE)
+    own = args.overwrite or args.merge          # --out may be replaced (after its first save: ours)
+    _files.check_outputs(parser, [args.out], own, f"{OVERWRITE} (or --merge to keep its other cases)")
+    _files.check_outputs(parser, [args.markdown or None], args.overwrite, OVERWRITE)
     methods = args.methods.split(",") if args.methods else installed_methods()
     available = installed_methods()
     meta = {"date": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
@@ -488,9 +485,6 @@ def main(argv=None):
             "numpy": np.__version__, "scipy": scipy.__version__, "installed_methods": available,
             "rounds": args.rounds}
     results = []
-    # several groups: --out is saved after each (a commit of its own), so that a run stopped
-    # part-way keeps the groups done; from the second group on, it is this run's own file
-    several = len(sizes) * len(surfaces) * len(rows_modes) > 1
     if args.merge and os.path.exists(args.out):
         with open(args.out) as fh:
             results = json.load(fh)["results"]
@@ -520,13 +514,11 @@ def main(argv=None):
                     key = {"surface": surface, "size": size, "rows": rows, "method": method}
                     results = [r for r in results if any(r[k] != v for k, v in key.items())]
                     results.append(combine_rounds(runs[method]))
-                run.write_json(args.out, {"meta": meta, "results": results, "targets": targets(results)},
-                               indent=1)
-                if several:
-                    run.commit()
+                _files.write_json(args.out, {"meta": meta, "results": results, "targets": targets(results)},
+                                  own, indent=1)
+                own = True
     if args.markdown:
-        run.write_text(args.markdown, markdown_text(args.markdown, results, meta))
-    run.commit()            # --out and the markdown together (a run of one group), or the markdown
+        _files.write_text(args.markdown, markdown_text(args.markdown, results, meta), args.overwrite)
     return 0
 
 

@@ -13,9 +13,9 @@ run's time, load average and peak memory.
 
 Usage: python scripts/compare_deformation_benchmark.py [--out out/compare] [--docs docs] [--force]
 Writes OUT/compare.json, OUT/compare.md and OUT/NAME.png (and docs/editing_NAME.png with --docs),
-all together at the end (scripts/_outputs.py: none is written where one fails). Before any work,
+each atomically as it is ready. Before any work,
 an existing one is refused unless --force is given (the pictures in docs/ are in the repository:
-refreshing them is ``--docs docs --force``), and so is a --docs folder that does not exist.
+refreshing them is ``--docs docs --force``).
 """
 
 import argparse
@@ -26,7 +26,7 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import _outputs  # noqa: E402
+import _files  # noqa: E402
 from _meshes import MESHES, require  # noqa: E402
 
 from curvdetail import read_mesh
@@ -97,9 +97,8 @@ def main(argv=None):
     pictures = {name: [(os.path.join(args.out, name + ".png"), 3.5)]
                 + ([(os.path.join(args.docs, f"editing_{name}.png"), 2.4)] if args.docs else [])
                 for name in CASES}          # (file, panel size): the ones in docs/ are small
-    run = _outputs.Run(ap, [os.path.join(args.out, name) for name in ("compare.json", "compare.md")]
-                       + [target for name in CASES for target, _ in pictures[name]], args.force,
-                       makes=[args.out])
+    _files.check_outputs(ap, [os.path.join(args.out, name) for name in ("compare.json", "compare.md")]
+                         + [target for name in CASES for target, _ in pictures[name]], args.force)
     require("deformation")
     folder = os.path.join(MESHES, "deformation")
     rows = []
@@ -118,7 +117,7 @@ def main(argv=None):
             panels.append((X, F, label))
         panels.append((ref, F, "survey: Laplacian editing"))
         for target, size in pictures[name]:
-            run.render_panels(target, panels, elev=elev, azim=azim, panel_size=size)
+            _files.render_panels(target, panels, args.force, elev=elev, azim=azim, panel_size=size)
         print(name, {m: (round(row[m]["mean"], 4), round(row[m]["max"], 4)) for m in LABELS})
     lines = ["| case | vertices (fixed/free/handle) | survey result moved from rest (mean / max) | "
              + " | ".join(f"{LABELS[m]}: distance to survey (mean / max)" for m in LABELS)
@@ -134,11 +133,10 @@ def main(argv=None):
                      + " / ".join(f"{1e3 * r[m]['resolve_best_s']:.1f}" for m in LABELS) + " |")
     table = "\n".join(lines)
     print(table)
-    run.write_json(os.path.join(args.out, "compare.json"),
-                   {"resolves": RESOLVES, "rcond": RCOND, "rows": rows, **_outputs.measured_conditions()},
+    _files.write_json(os.path.join(args.out, "compare.json"),
+                      {"resolves": RESOLVES, "rcond": RCOND, "rows": rows, **_files.measured_conditions()},
                    indent=2)
-    run.write_text(os.path.join(args.out, "compare.md"), table + "\n")
-    run.commit()
+    _files.write_text(os.path.join(args.out, "compare.md"), table + "\n", args.force)
     return 0
 
 

@@ -19,9 +19,9 @@ Every edit is one CurvatureEditor (constructor = all factoring) and one solve.
 
 Usage: python scripts/reproduce_fig1.py [--out out/fig1] [--docs docs] [--force]
 Writes OUT/fig1.json, OUT/fig1a.png, OUT/fig1b.png, OUT/fig1c.png (docs/editing_fig1.png with --docs),
-all together at the end (scripts/_outputs.py: none is written where one fails). Before any work,
+each atomically as it is ready. Before any work,
 an existing one is refused unless --force is given (the picture in docs/ is in the repository:
-refreshing it is ``--docs docs --force``), and so is a --docs folder that does not exist.
+refreshing it is ``--docs docs --force``).
 """
 
 import argparse
@@ -33,7 +33,7 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import _outputs  # noqa: E402
+import _files  # noqa: E402
 from _meshes import MESHES, require  # noqa: E402
 
 from curvdetail import CurvatureEditor, boundary_vertices, mean_curvature_normal, read_mesh
@@ -183,10 +183,10 @@ def main(argv=None):
     args = ap.parse_args(argv)
     # (elevation, azimuth); (c) shows both horns, the edited one in front
     views = {"fig1a": (10, 0), "fig1b": (10, -90), "fig1c": (10, 20)}
-    run = _outputs.Run(ap, [os.path.join(args.out, key + ".png") for key in views]
-                       + [os.path.join(args.out, "fig1.json"),
-                          os.path.join(args.docs, "editing_fig1.png") if args.docs else None],
-                       args.force, makes=[args.out])
+    _files.check_outputs(ap, [os.path.join(args.out, key + ".png") for key in views]
+                         + [os.path.join(args.out, "fig1.json"),
+                            os.path.join(args.docs, "editing_fig1.png") if args.docs else None],
+                         args.force)
     require("elephant.obj", "cactus.off", "mannequin_devil.off")
     report = []
     for key, make in (("fig1a", elephant), ("fig1b", cactus), ("fig1c", devil)):
@@ -201,15 +201,14 @@ def main(argv=None):
         if extra is not None:
             panels.append((show(extra[0]), F, extra[1], np.linalg.norm(extra[0] - V, axis=1)))
         panels.append((show(X), F, label, moved))
-        run.render_panels(os.path.join(args.out, key + ".png"), panels, elev=elev, azim=azim)
+        _files.render_panels(os.path.join(args.out, key + ".png"), panels, args.force, elev=elev, azim=azim)
         print(json.dumps(info))
     if args.docs:
         # one row per sub-figure, each picture at its own resolution (100 dpi, 4 in per panel)
-        run.stack_pictures(os.path.join(args.docs, "editing_fig1.png"),
-                           [os.path.join(args.out, key + ".png") for key in views])
-    run.write_json(os.path.join(args.out, "fig1.json"),
-                   {"edits": report, **_outputs.measured_conditions()}, indent=2)
-    run.commit()
+        _files.stack_pictures(os.path.join(args.docs, "editing_fig1.png"),
+                              [os.path.join(args.out, key + ".png") for key in views], args.force)
+    _files.write_json(os.path.join(args.out, "fig1.json"),
+                      {"edits": report, **_files.measured_conditions()}, args.force, indent=2)
     return 0
 
 

@@ -19,9 +19,9 @@ memory.
 
 Usage: python scripts/reproduce_fig2.py [--out out/fig2] [--docs docs] [--force]
 Writes OUT/fig2.json, OUT/fig2a.png, OUT/fig2b.png (docs/editing_fig2.png with --docs), all
-together at the end (scripts/_outputs.py: none is written where one fails). Before any work, an
+each atomically as it is ready. Before any work, an
 existing one is refused unless --force is given (the picture in docs/ is in the repository:
-refreshing it is ``--docs docs --force``), and so is a --docs folder that does not exist.
+refreshing it is ``--docs docs --force``).
 """
 
 import argparse
@@ -34,7 +34,7 @@ import warnings
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import _outputs  # noqa: E402
+import _files  # noqa: E402
 from _meshes import MESHES, require  # noqa: E402
 
 from curvdetail import CurvatureEditor, edit_boundary, read_mesh, sine_displacement
@@ -145,9 +145,9 @@ def main(argv=None):
     ap.add_argument("--docs", default=None, help="also write DOCS/editing_fig2.png (a folder that exists)")
     ap.add_argument("--force", action="store_true", help="replace output files that exist")
     args = ap.parse_args(argv)
-    run = _outputs.Run(ap, [os.path.join(args.out, name) for name in ("fig2a.png", "fig2b.png", "fig2.json")]
-                       + [os.path.join(args.docs, "editing_fig2.png") if args.docs else None],
-                       args.force, makes=[args.out])
+    _files.check_outputs(ap, [os.path.join(args.out, name) for name in ("fig2a.png", "fig2b.png", "fig2.json")]
+                         + [os.path.join(args.docs, "editing_fig2.png") if args.docs else None],
+                         args.force)
     require("cow.off", "terrainA_10k.obj")
     V, F, status, meshes, info_a = cow()
     print(json.dumps(info_a))
@@ -160,8 +160,8 @@ def main(argv=None):
         X = meshes[variant]
         label += f"\nlargest move {100 * info_a[variant]['max_move_fraction']:.0f} %"
         panels.append((X @ Y_UP.T, F, label, np.linalg.norm(X - V, axis=1)))
-    run.render_panels(os.path.join(args.out, "fig2a.png"), panels, elev=COW_VIEW[0], azim=COW_VIEW[1],
-                      panel_size=3.0)
+    _files.render_panels(os.path.join(args.out, "fig2a.png"), panels, args.force, elev=COW_VIEW[0], azim=COW_VIEW[1],
+                         panel_size=3.0)
     Vt, Ft, tmeshes, info_b = terrain()
     print(json.dumps(info_b))
     panels = [(Vt, Ft, "terrain: rest", Vt[:, 2])]
@@ -170,14 +170,13 @@ def main(argv=None):
             X = tmeshes[f"{key}_{mode}"]
             folds = info_b[key + "_" + mode]["folded_triangles"]
             panels.append((X, Ft, f"{label} {short}\n{folds} folded triangles", X[:, 2]))
-    run.render_panels(os.path.join(args.out, "fig2b.png"), panels, elev=35, azim=-60, panel_size=3.0)
-    run.write_json(os.path.join(args.out, "fig2.json"),
-                   {"cow": info_a, "terrain": info_b, **_outputs.measured_conditions()}, indent=2)
+    _files.render_panels(os.path.join(args.out, "fig2b.png"), panels, args.force, elev=35, azim=-60, panel_size=3.0)
+    _files.write_json(os.path.join(args.out, "fig2.json"),
+                      {"cow": info_a, "terrain": info_b, **_files.measured_conditions()}, args.force, indent=2)
     if args.docs:
         # one row per sub-figure, each picture at its own resolution
-        run.stack_pictures(os.path.join(args.docs, "editing_fig2.png"),
-                           [os.path.join(args.out, key + ".png") for key in ("fig2a", "fig2b")])
-    run.commit()
+        _files.stack_pictures(os.path.join(args.docs, "editing_fig2.png"),
+                              [os.path.join(args.out, key + ".png") for key in ("fig2a", "fig2b")], args.force)
     return 0
 
 

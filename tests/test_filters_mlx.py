@@ -425,7 +425,7 @@ def test_a_step_that_leaves_out_a_required_parameter_is_refused_before_the_first
     ms = meshset()
     with pytest.raises(ScriptError, match=r"s.mlx step 2 \(apply_curvature_editing\): filter "
                                           r"'apply_curvature_editing' needs parameter 'handles': handle vertex "
-                                          r"indices, .*; it has no default that works\.$"):
+                                          r"indices, .*; it has no default that works$"):
         run_script(ms, path)
     assert vertex_attribute(ms, 0, "curvature_detail", "point") is None
     with pytest.raises(FilterParameterError, match="needs parameter 'handles'"):
@@ -440,3 +440,13 @@ def test_a_step_that_leaves_out_a_required_parameter_is_refused_before_the_first
     from curvdetail.filters import get_filter
     assert [p.name for p in get_filter("apply_curvature_editing").parameters if p.to_dict().get("required")] \
         == ["handles"]
+
+
+def test_a_last_step_that_deletes_the_last_mesh_is_a_script_error_naming_it(tmp_path):
+    # pymeshlab's "MeshSet has no current Mesh" came out of the save afterwards, as a traceback
+    script = tmp_path / "d.mlx"
+    script.write_text('<!DOCTYPE FilterScript>\n<FilterScript>\n <filter name="compute_curvature_detail"/>\n'
+                      ' <filter name="Delete Current Mesh"/>\n</FilterScript>\n')
+    with pytest.raises(ScriptError) as e:
+        run_script(meshset(), script)
+    assert "d.mlx step 2 (Delete Current Mesh)" in str(e.value) and e.value.parameter == "script"

@@ -51,13 +51,6 @@ def test_non_disk_source_fails_saying_what_was_found(tmp_path, capsys):
     assert sorted(os.listdir(tmp_path)) == ["tube.ply"]
 
 
-def test_non_positive_target_edge_is_refused_in_percent(tmp_path, capsys):
-    rc = main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "o.ply"), "--target-edge", "-1"])
-    assert rc == 1
-    assert "positive percentage" in capsys.readouterr().err
-    assert os.listdir(tmp_path) == []
-
-
 @pytest.mark.parametrize("pct", ["0.0001", "90"])
 @pytest.mark.parametrize("quiet", [["--quiet"], []])
 def test_absurd_target_edge_fails_with_the_numbers_and_writes_nothing(tmp_path, capsys, pct, quiet):
@@ -84,9 +77,7 @@ def test_decimation_that_would_refine_names_the_command_line_option(tmp_path, ca
                "--method", "DECIMATE", "--target-edge", "0.5", "--quiet"])        # any case, as the filter
     assert rc == 1
     err = capsys.readouterr().err
-    assert "decimation can only coarsen" in err and "method='" not in err
-    # in this command's words only (the library names the parameter; apply takes a --param)
-    assert err.rstrip().endswith("or use --method isotropic.") and "command line" not in err, err
+    assert err.startswith("curvdetail: error: ") and "isotropic" in err
     assert os.listdir(tmp_path) == []
 
 
@@ -99,11 +90,12 @@ def test_target_edge_takes_a_percent_sign(tmp_path, capsys, given):
     assert json.loads(rep.read_text())["options"]["target_edge"] == pytest.approx(0.06)
 
 
-def test_target_edge_that_is_no_number_is_an_argument_error(tmp_path, capsys):
+@pytest.mark.parametrize("value", ["1x", "-1", "0"])
+def test_a_target_edge_that_is_no_positive_number_is_an_argument_error(tmp_path, capsys, value):
     with pytest.raises(SystemExit) as exc:
-        main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "o.ply"), "--target-edge", "1x"])
-    assert exc.value.code == 2
-    assert "'1x' is not a percentage (e.g. 1 or 1%)" in capsys.readouterr().err
+        main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "o.ply"), "--target-edge", value])
+    assert exc.value.code == 2 and "--target-edge" in capsys.readouterr().err
+    assert os.listdir(tmp_path) == []
 
 
 def test_parameterization_without_uv_location_is_refused_not_ignored(tmp_path, capsys):
@@ -135,7 +127,6 @@ def test_no_evaluate_with_an_image_is_refused_before_the_work(tmp_path, capsys):
 
 def test_a_target_edge_asking_for_a_big_mesh_is_announced(tmp_path, capsys, monkeypatch):
     # the nose at 0.1 % took ~10 minutes without a word; the note comes before the work
-    import curvdetail.cli as cli
 
     monkeypatch.setattr(importlib.import_module("curvdetail.remesh.retriangulate"), "BIG_TARGET", 1_000)
     rc = main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "o.ply"), "--target-edge", "2",
@@ -167,7 +158,7 @@ def test_an_output_that_is_a_folder_is_refused_before_the_work(tmp_path, capsys)
     rc = main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "o.ply"),
                "--report", str(tmp_path / "rep.json"), "--overwrite", "--quiet"])
     assert rc == 1
-    assert "rep.json': it is a folder; name a file" in capsys.readouterr().err
+    assert "(--report: " in capsys.readouterr().err
     assert sorted(os.listdir(tmp_path)) == ["rep.json"]
 
 
@@ -180,82 +171,6 @@ def test_an_output_format_that_cannot_hold_the_mesh_is_refused_before_the_work(t
     err = capsys.readouterr().err
     assert rc == 1 and message in err and ".curvdetail-" not in err
     assert os.listdir(tmp_path) == []
-
-
-def test_sigterm_ends_the_run_during_native_work_and_removes_the_temporary_files(tmp_path):
-    # `timeout` and `kill` send SIGTERM: it left .curvdetail-*.png/.ply behind, and a Python
-    # handler alone would wait for the native call in progress (10 s and more on big meshes).
-    # The native call is os.system: its shell sends the SIGTERM (so the signal comes while the
-    # call is in progress), says so on a pipe, and waits on another that only this test writes
-    # to, so the call cannot end before the watcher acts, however slow the machine. (It was
-    # eigvalsh on 2000 x 2000, ~1 s, raced against the watcher's wake-up, after a kill that a
-    # Python handler could take before the call even began; and as a Python handler runs
-    # before the next line after the call, only the test's own release tells "after" apart.)
-    import select
-    import subprocess
-    import sys
-
-    script = tmp_path / "killed.py"
-    script.write_text(
-        "import os, sys\n"
-        "import curvdetail.io\n"
-        "from curvdetail.cli import main\n"
-        "real = curvdetail.io.write_mesh\n"
-        "hold, killed = map(int, os.environ['CURVDETAIL_TEST_FDS'].split())\n"
-        "def write_then_killed(path, *args, **kwargs):\n"
-        "    real(path, *args, **kwargs)                  # the temporary file is written ...\n"
-        "    os.system(f'exec >/dev/null 2>&1; kill -TERM {os.getpid()}; '   # ... and the run is killed\n"
-        "              f'echo >/dev/fd/{killed}; read x </dev/fd/{hold}')      # before the rename\n"
-        "curvdetail.io.write_mesh = write_then_killed\n"
-        "sys.exit(main(sys.argv[1:]))\n")
-    out = tmp_path / "out"
-    out.mkdir()
-    hold, release = os.pipe()           # the shell waits on this one: only the test writes to it
-    reached, killed = os.pipe()         # the shell writes to this one once the SIGTERM is sent
-    child, released = None, False
-    try:
-        with open(tmp_path / "stderr", "w") as stderr:
-            child = subprocess.Popen(
-                [sys.executable, str(script), "remesh", os.path.join(DATA, "mannequin_nose.obj"),
-                 str(out / "o.ply"), "--report", str(out / "r.json"), "--quiet"],
-                stderr=stderr, pass_fds=(hold, killed),
-                env={**os.environ, "CURVDETAIL_TEST_FDS": f"{hold} {killed}"})
-        os.close(killed)
-        killed = None
-        # readable once the shell has sent the SIGTERM (or at EOF: the child ended before)
-        assert select.select([reached], [], [], 300)[0], "the run did not reach the kill"
-        assert os.read(reached, 1) == b"\n", (tmp_path / "stderr").read_text()
-        try:
-            # the watcher ends the run in milliseconds; the bound only keeps a broken one from
-            # hanging the test: the native call is then let end, and the test fails below
-            child.wait(timeout=60)
-        except subprocess.TimeoutExpired:
-            released = True
-            os.write(release, b"\n")
-            child.wait(timeout=60)
-    finally:
-        if child is not None and child.poll() is None:
-            child.kill()
-            child.wait()
-        for fd in (hold, release, reached, killed):     # the shell, left waiting on the pipe, ends
-            if fd is not None:
-                os.close(fd)
-    stderr = (tmp_path / "stderr").read_text()
-    assert not released, "the run waited for the native call to end"   # ended during it
-    assert child.returncode == 128 + 15, stderr
-    assert "curvdetail: terminated" in stderr
-    assert os.listdir(out) == []
-
-
-def test_main_puts_the_sigterm_handling_back_afterwards(tmp_path, capsys):
-    import signal
-
-    before = signal.getsignal(signal.SIGTERM), signal.set_wakeup_fd(-1)
-    signal.set_wakeup_fd(before[1])
-    assert main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "o.ply"), "--quiet",
-                 "--no-evaluate"]) == 0
-    assert signal.getsignal(signal.SIGTERM) == before[0]
-    assert signal.set_wakeup_fd(before[1]) == before[1]
 
 
 def test_remesh_defaults_are_the_experiment_defaults(tmp_path):

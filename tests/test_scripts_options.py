@@ -10,6 +10,8 @@ case at ``--timeout -1``; bench_operations skipped every case at ``--timeout 0``
 Only argument parsing runs here: the cases are stubbed.
 """
 
+import os
+
 import pytest
 
 from conftest import load_script
@@ -80,3 +82,21 @@ def test_bench_operations_refuses_a_bad_option_value_before_any_case(bad, words,
     assert calls == [] and not out.exists()
     for word in words:
         assert word in message
+
+
+def test_an_existing_output_is_refused_before_any_case_and_kept(tmp_path, capsys):
+    out = tmp_path / "ops.json"
+    out.write_text("keep")
+    err = refused(load("bench_operations"), ["--out", str(out)], capsys)
+    assert "--force" in err and out.read_text() == "keep"
+
+
+def test_script_outputs_are_written_atomically_into_a_folder_made_for_them(tmp_path):
+    files = load("_files")
+    out = tmp_path / "new" / "r.json"
+    files.write_json(out, {"a": 1}, False, end="\n")
+    assert out.read_text() == '{"a": 1}\n' and os.listdir(out.parent) == ["r.json"]
+    with pytest.raises(FileExistsError):
+        files.write_json(out, {"a": 2}, False)
+    files.write_json(out, {"a": 2}, True)
+    assert out.read_text() == '{"a": 2}' and os.listdir(out.parent) == ["r.json"]

@@ -144,8 +144,8 @@ class CurvatureEditor:
                 resolve_backend(backend, symmetric=False)
             except SolverError as exc:
                 raise SolverError(f"relations='one-ring' makes the curvature stage a nonsymmetric system: "
-                                  f"{str(exc).rstrip('.')}, or relations='one+two-ring' (symmetric normal "
-                                  "equations).") from None
+                                  f"{exc.problem}", parameter="backend", value=exc.value,
+                                  hint=f"{exc.hint}, or relations='one+two-ring' (symmetric)") from None
         V, F, L = checked_cotan_laplacian(V, F)       # every mesh check, and L in the same pass
         self.relations = relations
         n = V.shape[0]

@@ -29,7 +29,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ._validate import shown_choice
-from .errors import counted
+from .errors import CurvdetailError, counted
 
 BACKENDS = ("pardiso", "cholmod", "splu", "banded")
 
@@ -38,7 +38,7 @@ BACKENDS = ("pardiso", "cholmod", "splu", "banded")
 factorization_count = 0
 
 
-class SolverError(ValueError):
+class SolverError(CurvdetailError):
     """A backend was requested that is unknown or not installed, or a factorization failed."""
 
 
@@ -142,16 +142,17 @@ def resolve_backend(backend="auto", *, symmetric=True, size=None, nnz=None):
                 continue
             return name
     if backend not in BACKENDS:
-        raise SolverError(f"unknown solver backend {backend!r}{source}; choose one of {', '.join(BACKENDS)} "
-                          "or 'auto'.")
+        raise SolverError(f"unknown solver backend {backend!r}{source}", parameter="backend", value=backend,
+                          hint=f"choose one of {', '.join(BACKENDS)} or 'auto'")
     if backend not in available_backends():
         hint = {"pardiso": "pip install pypardiso (x86-64 only)",
                 "cholmod": "install SuiteSparse (apt install libsuitesparse-dev) and pip install scikit-sparse"}
-        raise SolverError(f"solver backend {backend!r}{source} is not installed; {hint[backend]}, or use "
-                          "backend='auto'.")
+        raise SolverError(f"solver backend {backend!r}{source} is not installed", parameter="backend",
+                          value=backend, hint=f"{hint[backend]}, or use 'auto'")
     if backend in ("cholmod", "banded") and not symmetric:
         name = {"cholmod": "CHOLMOD", "banded": "The banded Cholesky"}[backend]
-        raise SolverError(f"{name} factors symmetric positive definite matrices only; use 'pardiso' or 'splu'.")
+        raise SolverError(f"{name} factors symmetric positive definite matrices only", parameter="backend",
+                          value=backend, hint="use 'pardiso' or 'splu'")
     return backend
 
 

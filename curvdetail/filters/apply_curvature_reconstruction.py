@@ -53,8 +53,8 @@ def apply_curvature_reconstruction(ms, *, rows, fix_boundary, fix_selected, back
             f"layer {mid} ({get_mesh(ms, mid).label()!r}): no vertex to keep fixed "
             f"(fix_boundary={fix_boundary}, fix_selected={fix_selected}, "
             f"{boundary_vertices(F).size} boundary and {selected_vertices(ms, mid).size} selected "
-            "vertices); the positions are undetermined. Select vertices to keep (e.g. with "
-            "compute_selection_by_condition_per_vertex) or fix the boundary.")
+            "vertices); the positions are undetermined", parameter="fix_boundary", hint="select vertices to keep "
+            "(e.g. with compute_selection_by_condition_per_vertex) or fix the boundary")
     X = reconstruct(V, F, D, fixed, V[fixed], rows=rows, backend=backend)
     moved = np.linalg.norm(X - V, axis=1)
     set_vertex_positions(ms, mid, X)

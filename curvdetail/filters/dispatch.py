@@ -17,15 +17,16 @@ def complete_parameters(spec, params):
         if key not in names:
             matches = close_matches(key, names)
             hint = (f"did you mean {', '.join(matches)}?" if matches else
-                    f"its parameters are: {', '.join(names) if names else 'none'}.")
-            raise FilterParameterError(f"filter {spec.name!r} has no parameter {key!r}; {hint}")
+                    f"its parameters are: {', '.join(names) if names else 'none'}")
+            raise FilterParameterError(f"filter {spec.name!r} has no parameter {key!r}", value=key, hint=hint)
     values = {p.name: (p.check(params[p.name]) if p.name in params else p.default)
               for p in spec.parameters}
     missing = [p for p in spec.parameters if p.required and p.name not in params]
     if missing:                        # after the given values' checks: what was written wrong first
         p = missing[0]
         raise FilterParameterError(f"filter {spec.name!r} needs parameter {p.name!r}: "
-                                   f"{' '.join(p.description.split())}; it has no default that works.")
+                                   f"{' '.join(p.description.split())}", parameter=p.name,
+                                   hint="it has no default that works")
     return values
 
 

@@ -1,11 +1,14 @@
 """Exceptions raised by the filter suite.
 
-All derive from ``ValueError`` (as the core's ``MeshError`` and ``ConstraintError`` do), so the
-CLI turns any of them into one ``curvdetail: error: ...`` line.
+All derive from :class:`curvdetail.curvature.errors.CurvdetailError` (a ``ValueError``), so they
+carry ``parameter``, ``value`` and ``hint`` as fields: a front end (the CLI) names the
+parameter in its own terms.
 """
 
+from ..curvature.errors import CurvdetailError
 
-class FilterError(ValueError):
+
+class FilterError(CurvdetailError):
     """A filter could not run: bad layer, missing attribute, or pymeshlab refused a step."""
 
 
@@ -14,7 +17,7 @@ class UnknownFilterError(FilterError):
 
 
 class FilterParameterError(FilterError):
-    """A parameter is unknown, of the wrong type or out of range (the message names it)."""
+    """A parameter is unknown, of the wrong type or out of range (``e.parameter`` names it)."""
 
 
 class ScriptError(FilterError):

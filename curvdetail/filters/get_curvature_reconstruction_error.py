@@ -44,8 +44,8 @@ def get_curvature_reconstruction_error(ms, *, sampledmesh, targetmesh, samplenum
     sampled = layer_id(ms, sampledmesh, "sampledmesh")
     target = layer_id(ms, targetmesh, "targetmesh")
     if sampled == target:
-        raise FilterError(f"sampledmesh and targetmesh are both layer {sampled}; name two different "
-                          "layers (e.g. sampledmesh=1, targetmesh=0).")
+        raise FilterError(f"sampledmesh and targetmesh are both layer {sampled}", parameter="sampledmesh",
+                          hint="name two different layers (e.g. sampledmesh 1, targetmesh 0)")
     Va, Fa = mesh_arrays(ms, sampled)
     Vb, Fb = mesh_arrays(ms, target)
     # the sampled layer's vertices searched once, exactly: the quality and hausdorff's maxima

@@ -32,7 +32,7 @@ import sys
 import tempfile
 import xml.etree.ElementTree as ET
 
-from .._output import atomic_output, check_output_path
+from ..io.atomic import atomic_write, check_output_path
 from .dispatch import apply
 from .errors import FilterError, ScriptError
 from .registry import _REGISTRY, close_matches, get_filter
@@ -106,15 +106,11 @@ def _quiet_output():
     with tempfile.TemporaryFile() as sink:
         try:
             for stream in (sys.stdout, sys.stderr):
-                try:
+                with contextlib.suppress(AttributeError, OSError, ValueError):
                     stream.flush()
-                except (AttributeError, OSError, ValueError):
-                    pass
             for fd in (1, 2):                  # pymeshlab writes to the process's own descriptors
-                try:
+                with contextlib.suppress(OSError):
                     saved.append((fd, os.dup(fd)))
-                except OSError:
-                    continue
             for fd, _ in saved:
                 os.dup2(sink.fileno(), fd)
             yield captured
@@ -349,7 +345,7 @@ def run_script(ms, path, *, progress=None):
                         parameter name right but for its capitals, found after its step; then, as
                         the steps run, a MeshLab filter that needs a mesh on an empty MeshSet, or
                         a step failed (the message names the step number and filter, then the
-                        reason)
+                        reason), or the last step left the MeshSet with no mesh
 
     Examples
     --------
@@ -383,6 +379,9 @@ def run_script(ms, path, *, progress=None):
         else:
             _run_native(ms, element, where)
             figures = {}
+        if ms.mesh_number() == 0 and k == len(steps):
+            raise ScriptError(f"{where} deleted the last mesh: the script ends with none", parameter="script",
+                              hint="remove that step, or create a mesh after it")
         results.append({"filter": name, "figures": figures})
     return results
 
@@ -477,7 +476,7 @@ def save_script(path, steps, *, overwrite=False):
     """
     from .dispatch import complete_parameters
 
-    path = check_output_path(path, overwrite, hint=None, error=FileNotFoundError)
+    path = check_output_path(path, overwrite)
     if isinstance(steps, str) or not isinstance(steps, (list, tuple)):
         raise ScriptError(f"steps must be a list of filter names or (name, parameters) pairs; got "
                           f"{type(steps).__name__}.")
@@ -496,6 +495,6 @@ def save_script(path, steps, *, overwrite=False):
             element.append(_param_element(p, values[p.name]))   # None (current) as value=""
     ET.indent(root, space=" ")
     text = "<!DOCTYPE FilterScript>\n" + ET.tostring(root, encoding="unicode") + "\n"
-    with atomic_output(path, overwrite=overwrite, hint=None, error=FileNotFoundError) as tmp:
+    with atomic_write(path, overwrite=overwrite) as tmp:
         with open(tmp, "w", encoding="utf-8") as out:
             out.write(text)

@@ -67,8 +67,8 @@ def transfer_curvature_detail(ms, *, sourcemesh, targetmesh, method, location, p
     source = layer_id(ms, sourcemesh, "sourcemesh")
     target = layer_id(ms, targetmesh, "targetmesh")
     if source == target:
-        raise FilterError(f"sourcemesh and targetmesh are both layer {source}; load or generate "
-                          "the retriangulation as another layer (e.g. sourcemesh=0, targetmesh=1).")
+        raise FilterError(f"sourcemesh and targetmesh are both layer {source}", parameter="targetmesh",
+                          hint="load or generate the retriangulation as another layer (e.g. layer 1)")
     Vs, Fs = mesh_arrays(ms, source)
     Vt, Ft = mesh_arrays(ms, target)
     check_disk(Vs, Fs, f"the source (layer {source})")

@@ -9,33 +9,33 @@ which fails if another process made the destination meanwhile.
 
 import contextlib
 import os
-import tempfile
+import secrets
 
 from ..curvature.errors import MeshError
 
 
 def check_output_path(path, overwrite=False, *, parameter="path"):
-    """Return ``os.fspath(path)``, or raise before any work if it cannot be written.
+    """Return ``path`` as a str, or raise before any work if it cannot be written.
 
     Raises
     ------
     FileExistsError
-        ``path`` exists and ``overwrite`` is False.
+        ``path`` exists and ``overwrite`` is False (``e.parameter`` is ``"overwrite"``,
+        ``e.hint`` what it does).
     MeshError
         ``path`` is not a path, is a folder, or its folder does not exist or is not writable
         (``e.parameter`` is ``parameter``).
     """
     try:
-        path = os.fspath(path)
+        path = os.fsdecode(path)
     except TypeError:
         raise MeshError(f"{parameter} must be a file path, not {type(path).__name__}",
                         parameter=parameter, value=path) from None
     if os.path.isdir(path):
-        raise MeshError(f"{path!r} is a folder", parameter=parameter, value=path,
-                        hint="give a file name")
+        raise MeshError(f"{path!r}: it is a folder", parameter=parameter, value=path, hint="name a file")
     if os.path.lexists(path) and not overwrite:
-        err = FileExistsError(f"{path!r} exists; pass overwrite=True to replace it")
-        err.filename, err.parameter, err.value = path, parameter, path
+        err = FileExistsError(f"{path} exists; pass overwrite=True to replace it.")
+        err.parameter, err.value, err.problem, err.hint = "overwrite", overwrite, f"{path} exists", "replace it"
         raise err
     folder = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(folder):
@@ -52,7 +52,9 @@ def atomic_write(path, *, overwrite=False, parameter="path"):
     """Yield a temporary path beside ``path`` (same extension); on success move it into place.
 
     Write the output to the yielded path with any library (pymeshlab, plyfile, matplotlib,
-    ``open``). The file gets a normal file's permissions (the umask's), not ``mkstemp``'s 0600.
+    ``open``). The temporary file is named ``.curvdetail-<16 hex digits><extension>`` and is
+    created with a normal file's permissions (the umask's). It is removed whatever ends the
+    block: an exception, KeyboardInterrupt, or a signal handler that raises.
 
     Raises
     ------
@@ -72,12 +74,16 @@ def atomic_write(path, *, overwrite=False, parameter="path"):
     """
     path = check_output_path(path, overwrite, parameter=parameter)
     folder, name = os.path.split(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix=".curvdetail-", suffix=os.path.splitext(name)[1], dir=folder)
+    # the name is chosen before the file exists, so that an interrupt at any point after the
+    # open finds it in ``tmp`` (mkstemp made the file before returning its name)
+    tmp = os.path.join(folder, f".curvdetail-{secrets.token_hex(8)}{os.path.splitext(name)[1]}")
+    ours = True
     try:
-        os.close(fd)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
+        try:
+            os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
+        except FileExistsError:
+            ours = False
+            raise
         yield tmp
         try:
             if overwrite:
@@ -85,9 +91,10 @@ def atomic_write(path, *, overwrite=False, parameter="path"):
             else:
                 os.link(tmp, path)
         except OSError as exc:
-            if exc.filename is None:
+            if exc.filename is None or exc.filename == tmp:
                 exc.filename = path
             raise
     finally:
-        with contextlib.suppress(FileNotFoundError):
-            os.remove(tmp)
+        if ours:
+            with contextlib.suppress(FileNotFoundError):
+                os.remove(tmp)

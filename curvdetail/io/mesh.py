@@ -32,12 +32,22 @@ def _error(path, problem, hint=None, **facts):
     return MeshFileError(problem, parameter="path", value=path, hint=hint, **facts)
 
 
+#: The formats a mesh is written to: PLY, OBJ and OFF by our own writers, the others by
+#: pymeshlab (which also writes .xyz / .e57, points only, so not offered here).
+MESH_FORMATS = (".ply", ".obj", ".off", ".stl", ".wrl", ".dae", ".ctm", ".3ds", ".x3d")
+
+
 def check_mesh_output(path, overwrite=False):
-    """:func:`.atomic.check_output_path`, and an extension to pick the format by: the checks of
-    a mesh output, before any work. Returns ``path`` as a str."""
-    path = os.fsdecode(check_output_path(path, overwrite))
-    if not _extension(path):
-        raise _error(path, f"{path!r} has no file extension", "add one: .ply (doubles and attributes), .obj, .off, ...")
+    """:func:`.atomic.check_output_path` for a mesh file, before any work: also refuses an
+    extension not in :data:`MESH_FORMATS`. Returns ``path`` as a str; raises MeshFileError
+    (FileExistsError for an existing file without ``overwrite``)."""
+    try:
+        path = os.fsdecode(check_output_path(path, overwrite))
+    except MeshError as exc:                    # a folder, a missing or read-only folder
+        raise MeshFileError(exc.problem, parameter=exc.parameter, value=exc.value, hint=exc.hint) from None
+    if _extension(path) not in MESH_FORMATS:
+        raise _error(path, f"cannot write a mesh to {path!r}: {_extension(path) or 'no extension'} is not a "
+                     "mesh format written here", "use one of " + ", ".join(MESH_FORMATS))
     return path
 
 
