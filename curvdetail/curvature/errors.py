@@ -50,6 +50,18 @@ class FoldedTrianglesWarning(UserWarning):
     ``warnings.simplefilter("error", FoldedTrianglesWarning)``."""
 
 
+def warn(message, category):
+    """``warnings.warn`` naming the first caller outside curvdetail: the warning points at the
+    user's line (and is shown once per such line, not once per process)."""
+    import sys
+    import warnings
+
+    frame, level = sys._getframe(1), 2
+    while frame is not None and frame.f_globals.get("__name__", "").startswith("curvdetail"):
+        frame, level = frame.f_back, level + 1
+    warnings.warn(message, category, stacklevel=level)
+
+
 def first_indices(indices, count=3):
     """Format the first few offending indices for an error message: ``'17, 402, 9311'``."""
     indices = [int(i) for i in list(indices)[:count]]

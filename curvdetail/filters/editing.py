@@ -1,7 +1,6 @@
 """Filter ``apply_curvature_editing``: move handles, rebuild the selection from curvature detail."""
 
 import time
-import warnings
 
 import numpy as np
 
@@ -9,7 +8,7 @@ from ..curvature._geometry import folded_triangles
 from ..curvature._validate import (affine_transform_problem, bbox_diagonal, check_transformed_values,
                                    non_whole_index_error, real_word)
 from ..curvature.curvature_editor import CurvatureEditor
-from ..curvature.errors import (ConstraintError, FoldedTrianglesWarning, UndeterminedEditError, counted,
+from ..curvature.errors import (warn, ConstraintError, FoldedTrianglesWarning, UndeterminedEditError, counted,
                                 first_indices)
 from .apply_curvature_reconstruction import BACKEND_DESCRIPTION, BACKENDS
 from .errors import FilterParameterError
@@ -277,7 +276,6 @@ def _warn_if_amplified(figures, folded, m, moved, D, D0, options):
     amplified = [r for r in (ratio, detail_ratio) if r is not None and r > AMPLIFICATION_LIMIT]
     if not folded.size and not amplified:
         return
-    from ..remesh.experiment import _caller_outside_the_package
 
     parts = []
     if folded.size:
@@ -306,7 +304,7 @@ def _warn_if_amplified(figures, folded, m, moved, D, D0, options):
                  "region, or coefficients that distort it")
         tries.append("a larger region")
     category = FoldedTrianglesWarning if folded.size else AmplifiedEditWarning
-    warnings.warn(f"apply_curvature_editing with relations={relations!r}: {'; '.join(parts)}: {cause}, see "
+    warn(f"apply_curvature_editing with relations={relations!r}: {'; '.join(parts)}: {cause}, see "
                   "docs/editing.md). "
                   f"The mesh was edited all the same; try {', '.join(tries[:-1])} or {tries[-1]} on the original.",
-                  category, stacklevel=_caller_outside_the_package())
+                  category)

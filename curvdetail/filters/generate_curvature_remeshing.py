@@ -131,14 +131,12 @@ def _warn_of_a_big_target(V, F, target_edge, length, fraction, method, evaluate)
     vertices, edges of ``length``, ``fraction`` of the diagonal; not for a decimation that will
     be refused), saying what takes the time: a plain target_edge=0.01 is 0.01 model units (on a
     15 km terrain 1.3M vertices, 10 minutes without a word), not 1 %."""
-    import warnings
-
-    from ..remesh.experiment import _caller_outside_the_package
+    from ..curvature.errors import warn
     from ..remesh.retriangulate import LongRunWarning, long_run_reason, long_run_vertices
 
     count = long_run_vertices(V, F, length, method=method, evaluate=evaluate)
     if count is not None:
-        warnings.warn(f"target_edge={target_edge} ({100 * fraction:.3g} % of the bbox diagonal) gives about "
+        warn(f"target_edge={target_edge} ({100 * fraction:.3g} % of the bbox diagonal) gives about "
                       f"{count:,.0f} target vertices; this takes minutes. {long_run_reason(method, evaluate)} "
                       "A plain number is in model units; pymeshlab.PercentageValue(1) is 1 % of the diagonal.",
-                      LongRunWarning, stacklevel=_caller_outside_the_package())
+                      LongRunWarning)

@@ -1,10 +1,10 @@
 """The remeshing experiment of the paper's Fig. 3, end to end, with a JSON-ready report."""
 
-import sys
 import time
-import warnings
 
 import numpy as np
+
+from ..curvature.errors import warn
 
 from ..curvature._validate import bbox_diagonal, check_bool, check_choice
 from ..curvature.boundary_editing import boundary_loop
@@ -92,15 +92,6 @@ def worse_than_zero_detail(report, cli=False):
             f"{100 * rms:.4g} % against {100 * zero:.4g} % of the bbox diagonal): the transferred detail made it "
             f"worse than no detail at all, so this configuration failed on this patch. Try "
             f"{'; and '.join(tries)}. docs/remeshing.md has what was measured.")
-
-
-def _caller_outside_the_package():
-    """The ``stacklevel`` of the first frame outside curvdetail: a warning names the caller's line
-    (and is shown once per such line, not once per process)."""
-    frame, level = sys._getframe(1), 1
-    while frame is not None and frame.f_globals.get("__name__", "").startswith("curvdetail"):
-        frame, level = frame.f_back, level + 1
-    return level
 
 
 def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="conservative", rows="free",
@@ -381,7 +372,7 @@ def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="cons
         seconds["evaluate"] = time.perf_counter() - t
         worse = worse_than_zero_detail(report)
         if worse is not None:
-            warnings.warn(worse, WorseThanZeroDetailWarning, stacklevel=_caller_outside_the_package())
+            warn(worse, WorseThanZeroDetailWarning)
     seconds["total"] = time.perf_counter() - t_all
     report["seconds"] = {k: round(v, 4) for k, v in seconds.items()}
     out["report"] = report
