@@ -4,7 +4,7 @@ import numpy as np
 
 from ..curvature._validate import (as_count, check_choice, as_faces, bbox_diagonal, check_referenced, checked_arrays,
                                    face_double_areas)
-from ..curvature.errors import MeshError, first_indices
+from ..curvature.errors import CurvdetailError, MeshError, first_indices
 from .closest_point import check_points_and_mesh, closest_in_frame, unit_frame
 
 #: Largest ``samples`` (per direction), well below pymeshlab's 32-bit int: 10M is minutes and
@@ -109,40 +109,39 @@ def hausdorff(Va, Fa, Vb, Fb, *, samples=None, engine="exact", seed=0, a_vertex_
 
 def _check_vertex_distance(d, n):
     """``a_vertex_distance`` of :func:`hausdorff` as a (n,) float64 array (None stays None), or
-    ValueError saying what is wrong and what to pass."""
+    CurvdetailError (a ValueError) with ``parameter="a_vertex_distance"``."""
     if d is None:
         return None
-    fix = "pass vertex_distance(Va, Vb, Fb), or None to measure them here"
+    fix = "pass vertex_distance(Va, Vb, Fb), or None to measure them here."
     try:
         arr = np.asarray(d)
     except (TypeError, ValueError):             # ragged lists and the like
         arr = np.asarray(None)
-    if arr.dtype == bool or arr.dtype.kind not in "fiu":
-        raise ValueError(f"a_vertex_distance has dtype {arr.dtype}; it must hold one distance (a real "
-                         f"number) per vertex of Va: {fix}.")
-    if arr.shape != (n,):
-        raise ValueError(f"a_vertex_distance has shape {arr.shape}, but Va has {n} vertices: it must hold one "
-                         f"distance per vertex, shape ({n},); {fix}.")
+    if arr.dtype == bool or arr.dtype.kind not in "fiu" or arr.shape != (n,):
+        raise CurvdetailError(f"a_vertex_distance has dtype {arr.dtype} and shape {arr.shape}; it must hold one "
+                              f"distance per vertex of Va, shape ({n},)", parameter="a_vertex_distance",
+                              value=arr.shape, hint=fix)
     arr = arr.astype(np.float64)
     bad = np.flatnonzero(~(arr >= 0) | ~np.isfinite(arr))
     if bad.size:
-        raise ValueError(f"a_vertex_distance: {bad.size} of {n} entries are NaN, infinite or negative (first: "
-                         f"{first_indices(bad)}); distances are finite and >= 0: {fix}.")
+        raise CurvdetailError(f"a_vertex_distance: {bad.size} of {n} entries are NaN, infinite or negative "
+                              f"(first: {first_indices(bad)})", parameter="a_vertex_distance", count=bad.size,
+                              first=bad[:5].tolist(), hint=fix)
     return arr
 
 
 def _check_samples(samples):
+    """``samples`` of :func:`hausdorff` as an int from 1 to ``MAX_SAMPLE_COUNT`` (None stays None)."""
     if samples is None:
         return None
     try:
         count = as_count(samples, "samples")
     except ValueError:
-        raise ValueError(f"samples={samples!r} must be a whole number of at least 1, or None for "
-                         "10 per triangle (100,000 to 1,000,000).") from None
-    if count > MAX_SAMPLE_COUNT:
-        raise ValueError(f"samples={count:,} is more than the limit of {MAX_SAMPLE_COUNT:,} per direction "
-                         "(minutes of sampling and GBs beyond it); ~1,000,000 is plenty for 1e-3 relative "
-                         "accuracy.")
+        count = None
+    if count is None or count > MAX_SAMPLE_COUNT:
+        raise CurvdetailError(f"samples={samples!r} must be a whole number from 1 to {MAX_SAMPLE_COUNT:,}",
+                              parameter="samples", value=samples,
+                              hint="or None for 10 per triangle (100,000 to 1,000,000); ~1,000,000 is plenty.")
     return count
 
 

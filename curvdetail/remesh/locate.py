@@ -69,31 +69,28 @@ def _locate(P, V, F):
 
 
 def _located(F, face, bary, what):
-    """``(F, face, bary)`` as arrays, or MeshError if they do not fit each other (the callers
-    check ``F`` against their vertex count)."""
-    F = np.asarray(F)
-    face = np.asarray(face)
-    bary = np.asarray(bary)
+    """``(F, face, bary)`` as int64 / int64 / float64 arrays, or MeshError if they do not fit
+    each other (the callers check ``F`` against their vertex count)."""
+    F, face, bary = np.asarray(F), np.asarray(face), np.asarray(bary)
     if F.ndim != 2 or F.shape[1] != 3 or face.ndim != 1 or bary.shape != (face.shape[0], 3):
         raise MeshError(f"{what}: F {F.shape}, face {face.shape} and bary {bary.shape} must be (m, 3), "
-                        "(k,) and (k, 3), as locate() returns them.")
-    for name, X in (("F", F), ("face", face)):
-        if X.size and X.dtype.kind not in "iu":       # floats would be truncated, bools mean 0/1
-            raise MeshError(f"{what}: {name} has dtype {X.dtype}; pass integer indices, as locate() uses them.")
-    if bary.dtype.kind not in "fiu":
-        raise MeshError(f"{what}: bary has dtype {bary.dtype}; pass the (k, 3) float barycentric coordinates "
-                        "locate() returns.")
-    F = F.astype(np.int64, copy=False)
-    face = face.astype(np.int64, copy=False)
-    bary = bary.astype(np.float64, copy=False)
+                        "(k,) and (k, 3)", parameter="face", value=face.shape, hint="as locate() returns them.")
+    for name, X in (("F", F), ("face", face), ("bary", bary)):
+        kinds = "fiu" if name == "bary" else "iu"        # floats would be truncated, bools mean 0/1
+        if X.size and X.dtype.kind not in kinds:
+            raise MeshError(f"{what}: {name} has dtype {X.dtype}", parameter=name, value=X.dtype,
+                            hint="pass the arrays locate() returns.")
+    F, face, bary = F.astype(np.int64, copy=False), face.astype(np.int64, copy=False), bary.astype(float, copy=False)
     bad = np.flatnonzero((face < 0) | (face >= F.shape[0]))
     if bad.size:
         raise MeshError(f"{what}: {bad.size} face indices are outside [0, {F.shape[0]}) (first: "
-                        f"{first_indices(face[bad])}, at positions {first_indices(bad)}); pass the faces "
-                        "locate() found in this F.")
+                        f"{first_indices(face[bad])}, at positions {first_indices(bad)})", parameter="face",
+                        count=bad.size, first=bad[:5].tolist(), hint="pass the faces locate() found in this F.")
     if F.size and F.min() < 0:
-        raise MeshError(f"{what}: F has negative vertex indices; indices are 0-based.")
-    # weights far outside [0, 1] or not summing to 1 would extrapolate (and break spread's
+        bad = np.flatnonzero((F < 0).any(axis=1))
+        raise MeshError(f"{what}: F has negative vertex indices (first: {first_indices(bad)})", parameter="F",
+                        count=bad.size, first=bad[:5].tolist(), hint="indices are 0-based.")
+    # weights outside [0, 1] or not summing to 1 would extrapolate (and break spread's
     # conservation) silently; locate()'s own are exact to rounding
     tol = BARY_TOLERANCE
     with np.errstate(invalid="ignore"):
@@ -102,30 +99,28 @@ def _located(F, face, bary, what):
     if off.any():
         bad = np.flatnonzero(off)
         raise MeshError(f"{what}: {bad.size} rows of bary are not barycentric coordinates (first: "
-                        f"{first_indices(bad)}): each must be finite, in [0, 1] and sum to 1 (within {tol:g}); "
-                        "pass the coordinates locate() returns.")
+                        f"{first_indices(bad)}): each must be finite, in [0, 1] and sum to 1 (within {tol:g})",
+                        parameter="bary", count=bad.size, first=bad[:5].tolist(),
+                        hint="pass the coordinates locate() returns.")
     return F, face, bary
 
 
 def _as_point_values(values, count, what, per):
-    """``values`` as a float array of shape (count,) or (count, c), finite, or MeshError naming
-    ``values``, the expected leading length ``count`` and ``per`` (what one row stands for)."""
+    """``values`` as a finite float array of shape (count,) or (count, c), or MeshError
+    (``per``: what one row stands for, for the message)."""
+    fix = f"pass a ({count},) or ({count}, c) array of real numbers, one value (or row) per {per}."
     try:
         vals = np.asarray(values)
-    except Exception as exc:               # ragged lists and the like
-        raise MeshError(f"{what}: values could not be read as an array ({exc}); pass a ({count},) or "
-                        f"({count}, c) float array, one value (or row) per {per}.") from None
-    if vals.dtype.kind not in "fiu":       # strings, None (object), complex; bools would mean 0/1
-        raise MeshError(f"{what}: values has dtype {vals.dtype}; pass a ({count},) or ({count}, c) array of "
-                        f"real numbers, one value (or row) per {per}.")
-    if vals.ndim not in (1, 2):
-        raise MeshError(f"{what}: values has shape {vals.shape}; pass a ({count},) or ({count}, c) array, one "
-                        f"value (or row) per {per}.")
+    except (TypeError, ValueError):        # ragged lists and the like
+        vals = np.asarray(None)
+    if vals.dtype.kind not in "fiu" or vals.ndim not in (1, 2):     # strings, objects, complex, bools
+        raise MeshError(f"{what}: values has dtype {vals.dtype} and shape {vals.shape}", parameter="values",
+                        value=vals.shape, hint=fix)
     vals = vals.astype(np.float64, copy=False)
     if not np.isfinite(vals).all():
         bad = np.flatnonzero(~np.isfinite(vals.reshape(vals.shape[0], -1)).all(axis=1))
-        raise MeshError(f"{what}: values has {bad.size} NaN or infinite rows (first: {first_indices(bad)}); "
-                        "repair them first.")
+        raise MeshError(f"{what}: values has {bad.size} NaN or infinite rows (first: {first_indices(bad)})",
+                        parameter="values", count=bad.size, first=bad[:5].tolist(), hint="repair them first.")
     return vals
 
 
@@ -134,20 +129,25 @@ def interpolate(values, F, face, bary):
 
     Parameters
     ----------
-    values : (n,) or (n, c) float array   finite, one value (or row) per vertex of the mesh ``F``
-                                          indexes (at least ``F.max() + 1``)
-    F : (m, 3) int array                  triangles
-    face : (k,) int array                 triangle of each point, as :func:`locate` returns it
-    bary : (k, 3) float array             barycentric coordinates in that triangle (rows in [0, 1]
-                                          summing to 1, within ``BARY_TOLERANCE``)
+    values : (n,) or (n, c) float array
+        Finite, one value (or row) per vertex of the mesh ``F`` indexes (at least ``F.max() + 1``).
+    F : (m, 3) int array
+        Triangles.
+    face : (k,) int array
+        Triangle of each point, as :func:`locate` returns it.
+    bary : (k, 3) float array
+        Barycentric coordinates in that triangle (rows in [0, 1] summing to 1, within
+        ``BARY_TOLERANCE``).
 
     Returns
     -------
-    (k,) or (k, c) float array   the interpolated values, as ``values`` is 1-D or 2-D
+    (k,) or (k, c) float array
+        The interpolated values, as ``values`` is 1-D or 2-D.
 
     Raises
     ------
-    MeshError   any of the above not so
+    MeshError
+        Any of the above not so (``e.parameter`` names the argument).
 
     Examples
     --------
@@ -161,36 +161,38 @@ def interpolate(values, F, face, bary):
     need = int(F.max()) + 1 if F.size else 0
     vals = _as_point_values(values, need, "interpolate", "vertex of the mesh F indexes")
     if vals.shape[0] < need:          # the values, not F, are what does not fit
-        raise MeshError(f"interpolate: values has {vals.shape[0]} rows but F references vertex {need - 1}; "
-                        f"pass one value (or row) per vertex of the mesh F indexes (at least {need}).")
+        raise MeshError(f"interpolate: values has {vals.shape[0]} rows but F references vertex {need - 1}",
+                        parameter="values", value=vals.shape[0],
+                        hint=f"pass one value (or row) per vertex of the mesh F indexes (at least {need}).")
     corner = vals[F[face]]                                   # (k, 3) or (k, 3, c)
-    if corner.ndim == 2:
-        return (bary * corner).sum(1)
-    return (bary[:, :, None] * corner).sum(1)
+    weights = bary if corner.ndim == 2 else bary[:, :, None]
+    return (weights * corner).sum(1)
 
 
 def spread(values, F, face, bary, n):
     """Adjoint of :func:`interpolate`: each point's value split over the 3 corners of its
-    triangle by barycentric weights and summed per vertex. The sum is conserved exactly (up to
-    rounding), since the weights of a point sum to 1.
+    triangle by its barycentric weights and summed per vertex (the total is kept, to rounding).
 
     Parameters
     ----------
-    values : (k,) or (k, c) float array   finite, one value (or row) per located point
-    F : (m, 3) int array                  triangles
-    face : (k,) int array, bary : (k, 3) float array   as for :func:`interpolate`
-    n : int                               vertex count of the result: a whole number, at least
-                                          ``F.max() + 1`` and at most ``MAX_SPREAD_VERTICES``
+    values : (k,) or (k, c) float array
+        Finite, one value (or row) per located point.
+    F, face, bary
+        As for :func:`interpolate`.
+    n : int
+        Vertex count of the result: at least ``F.max() + 1``, at most ``MAX_SPREAD_VERTICES``.
 
     Returns
     -------
-    (n,) or (n, c) float array   per-vertex sums, as ``values`` is 1-D or 2-D (zeros where no
-                                 point lies on a vertex's triangles, and for no points at all)
+    (n,) or (n, c) float array
+        Per-vertex sums, as ``values`` is 1-D or 2-D (zeros where no point lies).
 
     Raises
     ------
-    ValueError   ``n`` not a whole number or too large
-    MeshError    the others not as above
+    ValueError
+        ``n`` not a whole number or above ``MAX_SPREAD_VERTICES``.
+    MeshError
+        The others not as above (``e.parameter`` names the argument).
 
     Examples
     --------
@@ -207,12 +209,12 @@ def spread(values, F, face, bary, n):
                          "pass the vertex count of the mesh F indexes.")
     F, face, bary = _located(F, face, bary, "spread")
     if F.size and F.max() >= n:
-        raise MeshError(f"spread: F has vertex indices outside [0, n={n}) (up to {F.max()}); pass n >= "
-                        f"{F.max() + 1}, the vertex count of the mesh F indexes.")
+        raise MeshError(f"spread: F has vertex indices outside [0, n={n}) (up to {F.max()})", parameter="n",
+                        value=n, hint=f"pass n >= {F.max() + 1}, the vertex count of the mesh F indexes.")
     vals = _as_point_values(values, face.shape[0], "spread", "located point")
     if vals.shape[0] != face.shape[0]:
-        raise MeshError(f"spread: values has {vals.shape[0]} rows for {face.shape[0]} located "
-                        "points; give one value (or row) per point.")
+        raise MeshError(f"spread: values has {vals.shape[0]} rows for {face.shape[0]} located points",
+                        parameter="values", value=vals.shape[0], hint="give one value (or row) per point.")
     rows = F[face].ravel()
     W = sp.csr_matrix((bary.ravel(), (rows, np.repeat(np.arange(face.shape[0]), 3))), shape=(n, face.shape[0]))
     return W @ vals                     # as interpolate: 1-D values give a 1-D result
