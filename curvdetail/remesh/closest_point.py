@@ -60,13 +60,13 @@ def closest_points(P, V, F):
     return sqrD * scale ** 2, face, C * scale + centre, bary
 
 
-def closest_in_frame(P, V, F):
+def closest_in_frame(P, V, F, bary=True):
     """:func:`closest_points` on arrays that passed :func:`check_points_and_mesh`, in the frame
-    given (no rescaling): ``(sqrD, face, C, bary)``."""
+    given (no rescaling): ``(sqrD, face, C, bary)``; ``bary=False``: None for the barycentrics."""
     if P.shape[0] == 0:
         return np.empty(0), np.empty(0, dtype=np.int64), np.empty((0, V.shape[1])), np.empty((0, 3))
     sqrD, face, C = igl.point_mesh_squared_distance(P, V, F)
-    return sqrD, face, C, _barycentric(C, V[F[face]])
+    return sqrD, face, C, _barycentric(C, V[F[face]]) if bary else None
 
 
 def _barycentric(X, T):

@@ -234,7 +234,7 @@ def vertex_distance(V, Vs, Fs):
 
 def _surface_distance(P, V, F):
     """Exact distance from each point of ``P`` (k, d) to the surface ``(V, F)``, in the frame given."""
-    return np.sqrt(closest_in_frame(P, V, F)[0])
+    return np.sqrt(closest_in_frame(P, V, F, bary=False)[0])
 
 
 def _area_samples(V, F, n, rng):
