@@ -214,8 +214,9 @@ def test_zero_area_triangles_are_refused_by_index():
 
 
 def test_points_beyond_the_overflow_distance_are_refused_by_index():
+    # more than 1e100 diagonals away (libigl's squared distances overflow from ~1e154)
     V, F = grid(5, 5)
-    P = np.array([[0.5, 0.5, 1.0], [0.0, 0.0, 1e60], [0.0, 0.0, -1e70]])
+    P = np.array([[0.5, 0.5, 1.0], [0.0, 0.0, 1e110], [0.0, 0.0, -1e140]])
     with pytest.raises(MeshError) as e:
         locate(P, V, F)
     assert (e.value.parameter, e.value.count, e.value.first) == ("points", 2, [1, 2])
@@ -225,7 +226,7 @@ def test_points_and_mesh_of_other_dimensions_are_refused():
     V, F = grid(5, 5)
     with pytest.raises(MeshError) as e:
         closest_points(V[:3, :2], V, F)
-    assert (e.value.parameter, e.value.value) == ("points", (3, 2))
+    assert (e.value.parameter, e.value.value) == ("P", (3, 2))
 
 
 @pytest.mark.parametrize("what, value, words", [

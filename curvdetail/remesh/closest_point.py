@@ -10,9 +10,9 @@ from ..curvature.errors import MeshError, first_indices
 #: input's own differences must not overflow.
 MAX_COORDINATE_HERE = 1e150
 
-#: Points further than this (bbox diagonals of the mesh) are refused: the point-triangle
-#: arithmetic multiplies squared lengths, which overflow beyond ~1e77 diagonals.
-MAX_RELATIVE_DISTANCE = 1e50
+#: Points further than this (bbox diagonals of the mesh) are refused: libigl's squared
+#: distances overflow beyond ~1e154 diagonals (and its face index is garbage there).
+MAX_RELATIVE_DISTANCE = 1e100
 
 
 def closest_points(P, V, F):
@@ -53,7 +53,7 @@ def closest_points(P, V, F):
     >>> sqrD.round(12).tolist(), face.tolist(), bary.round(12).tolist()
     ([4.0], [0], [[0.5, 0.25, 0.25]])
     """
-    P, V, F = check_points_and_mesh(P, V, F)
+    P, V, F = check_points_and_mesh(P, V, F, names=("P", "V", "F"))
     centre = 0.5 * (V.max(axis=0) + V.min(axis=0))
     P, U, scale = unit_frame(P, V)
     sqrD, face, C, bary = closest_in_frame(P, U, F)
@@ -86,8 +86,8 @@ def check_points_and_mesh(points, V, F, names=("points", "V", "F")):
     shapes as :func:`~curvdetail.curvature.check_mesh` takes them (``V`` and ``points`` both
     (k, 2) or both (k, 3)), NaN or infinite coordinates, triangle indices outside ``V``,
     zero-area triangles or a mesh of zero extent, coordinates beyond 1e150 and points further
-    than ``MAX_RELATIVE_DISTANCE`` bbox diagonals. ``names``: the three arguments as the caller
-    calls them, for the messages."""
+    than ``MAX_RELATIVE_DISTANCE`` (1e100) bbox diagonals. ``names``: the three arguments as
+    the caller calls them, for the messages and ``e.parameter``."""
     P = as_coordinates(points, names[0], allow_empty=True)
     V = as_coordinates(V, names[1])
     if P.shape[1] != V.shape[1]:

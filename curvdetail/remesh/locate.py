@@ -48,7 +48,7 @@ def locate(points, V, F):
         Malformed input (see :func:`~.closest_point.check_points_and_mesh`): mismatched
         dimensions, dtypes that are not real numbers / integers, NaN or infinite coordinates,
         triangle indices outside ``V``, zero-area triangles, a mesh of zero extent, coordinates
-        beyond 1e150 or points more than 1e50 bbox diagonals away.
+        beyond 1e150 or points more than 1e100 bbox diagonals away.
 
     Examples
     --------
