@@ -9,10 +9,8 @@ mesh), each case in its own subprocess so that its peak RSS is its own:
 * the editor's curvature stage ``(I - C)``: SuperLU against PARDISO (``CurvatureEditor``'s
   ``timings["curvature_setup"]`` and a three-column back-substitution), the two sides of the
   size rule ``CURVATURE_SPLU_MAX``;
-* ``hausdorff`` with pymeshlab's engine against the kd-tree engine (1M samples each way);
-* ``locate`` of the target's vertices on the source: pymeshlab's grid ("auto") against the
-  numpy engine in space, matplotlib's trapezoid map ("auto") against the numpy engine in the
-  plane;
+* ``hausdorff`` with pymeshlab's engine against the exact engine (1M samples each way; the
+  closest-point engine itself against the ones it replaced: bench_closest_point.py);
 * ``read_mesh`` (pymeshlab's load with the checks before and after it) against a bare
   ``pymeshlab.MeshSet().load_new_mesh`` and its vertex and face matrices, per format (OBJ, OFF,
   PLY, STL as ``write_mesh`` writes them: ASCII OBJ and OFF, binary PLY and STL); the grid's
@@ -48,9 +46,7 @@ SIDES = {"10k": 100, "100k": 316, "1M": 1000}
 CASES = {
     "edge_measure": ("int64 keys", "np.unique(axis=0)"),
     "curvature_stage": ("splu", "pardiso"),
-    "hausdorff": ("meshlab", "kdtree"),
-    "locate_3d": ("auto", "numpy"),
-    "locate_2d": ("auto", "numpy"),
+    "hausdorff": ("meshlab", "exact"),
     "read_obj": ("read_mesh", "pymeshlab"),
     "read_off": ("read_mesh", "pymeshlab"),
     "read_ply": ("read_mesh", "pymeshlab"),
@@ -124,7 +120,7 @@ def run_case(case, variant, size):
     if case.startswith("read_"):
         return run_read_case(case, variant, size)
     from curvdetail import CurvatureEditor, boundary_vertices
-    from curvdetail.remesh import hausdorff, locate
+    from curvdetail.remesh import hausdorff
     from curvdetail.remesh.transfer import _edge_curvature_measure
 
     V, F = grid_surface(SIDES[size])
@@ -146,15 +142,10 @@ def run_case(case, variant, size):
             editor._curv.solve(rhs)
             solves.append(time.perf_counter() - s)
         out.update(unknowns=int(editor._fd.size), solve_s=float(np.median(solves)))
-    else:
+    else:                                   # hausdorff
         Vt, Ft = grid_surface(SIDES[size] * 7 // 10)
-        if case == "hausdorff":
-            h = hausdorff(Vt, Ft, V, F, engine=variant, samples=1_000_000)
-            out.update(max=h["max"], rms=h["rms"], samples=h["samples"])
-        else:
-            dim = 3 if case == "locate_3d" else 2
-            _, _, dist = locate(Vt[:, :dim], V[:, :dim], F, engine=variant)
-            out.update(points=int(Vt.shape[0]), max_distance=float(dist.max()))
+        h = hausdorff(Vt, Ft, V, F, engine=variant, samples=1_000_000)
+        out.update(max=h["max"], rms=h["rms"], samples=h["samples"])
     out["seconds"] = time.perf_counter() - t
     out["peak_rss_gb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0 ** 2
     return out

@@ -7,7 +7,8 @@ import importlib
 import pytest
 
 MODULES = [
-    "curvdetail.remesh.evaluate", "curvdetail.remesh.experiment", "curvdetail.remesh.locate",
+    "curvdetail.remesh.closest_point", "curvdetail.remesh.evaluate", "curvdetail.remesh.experiment",
+    "curvdetail.remesh.locate",
     "curvdetail.remesh.parameterize", "curvdetail.remesh.retriangulate", "curvdetail.remesh.transfer",
     "curvdetail.filters.dispatch", "curvdetail.filters.mlx", "curvdetail.filters.parameters",
     "curvdetail.io.deformation", "curvdetail.plot", "curvdetail.curvature.curvature_editor",

@@ -55,7 +55,7 @@ def test_remesh_transfer_rebuild_pipeline():
     expected = reconstruct(Vt, Ft, Dt, b, Vt[b], rows="free")
     assert np.abs(ms.mesh(1).vertex_matrix() - expected).max() < 1e-9 * bbox_diagonal(Vt)
     # quality = each vertex's exact distance to the source (the search the Hausdorff maximum uses)
-    d = vertex_distance(ms.mesh(1).vertex_matrix(), ms.mesh(0).vertex_matrix(), ms.mesh(0).face_matrix(), far=True)
+    d = vertex_distance(ms.mesh(1).vertex_matrix(), ms.mesh(0).vertex_matrix(), ms.mesh(0).face_matrix())
     assert np.abs(ms.mesh(1).vertex_scalar_array() - d).max() < 1e-15 * bbox_diagonal(Vt)
     assert ms.mesh(1).vertex_scalar_array().max() <= error["hausdorff_max"] * bbox_diagonal(ms.mesh(0).vertex_matrix())
 

@@ -43,7 +43,7 @@ def test_nose_against_its_minimal_surface():
     # quality: each vertex's distance to the source surface, the same as curvdetail.remesh's
     quality = ms.mesh(1).vertex_scalar_array()
     assert np.array_equal(quality, vertex_distance(ms.mesh(1).vertex_matrix(), ms.mesh(0).vertex_matrix(),
-                                                   ms.mesh(0).face_matrix(), far=True))
+                                                   ms.mesh(0).face_matrix()))
     assert figures["hausdorff_max"] > 0.05            # a nose is far from its minimal surface
     assert ms.current_mesh_id() == 1
 
@@ -55,9 +55,9 @@ def test_figures_are_the_remeshing_report_measure(monkeypatch):
 
     calls = []
 
-    def spy(Va, Fa, Vb, Fb, *, samples=None, a_vertex_distance=None):
+    def spy(Va, Fa, Vb, Fb, *, samples=None, engine=None, a_vertex_distance=None):
         calls.append((Va, Fa, Vb, Fb, samples))
-        return hausdorff(Va, Fa, Vb, Fb, samples=samples, a_vertex_distance=a_vertex_distance)
+        return hausdorff(Va, Fa, Vb, Fb, samples=samples, engine=engine, a_vertex_distance=a_vertex_distance)
 
     monkeypatch.setattr(remesh, "hausdorff", spy)
     ms = pymeshlab.MeshSet()
@@ -143,9 +143,9 @@ def test_the_sample_limit_is_the_one_hausdorff_takes():
 def _flat_layer_beside_a_wavy_one():
     """A MeshSet: layer 0 a wavy 10 x 10 grid (heights +-0.5, the target), layer 1 a flat
     25 x 25 grid at z = 0.3 (the source's height) spread 1.4x about the centre, past the
-    target's edge (current, the sampled layer). There pymeshlab's closest-face grid (locate's
-    search) returns faces that are not the closest: 11 of 625 vertices up to 0.67 % of the
-    diagonal too far."""
+    target's edge (current, the sampled layer). There pymeshlab's closest-face grid (once
+    locate's search) returned faces that were not the closest: 11 of 625 vertices up to 0.67 %
+    of the diagonal too far."""
     V, F = grid(10, 10)
     V[:, 2] = 0.5 * np.sin(8 * V[:, 0]) * np.cos(6.4 * V[:, 1])
     P, G = grid(25, 25)
@@ -157,13 +157,12 @@ def _flat_layer_beside_a_wavy_one():
     return ms
 
 
-def test_quality_is_exact_where_the_grid_search_is_not():
+def test_quality_is_exact_beside_a_wavy_target():
     ms = _flat_layer_beside_a_wavy_one()
     figures = apply(ms, "get_curvature_reconstruction_error", samplenum=2000)
     V, F, P = ms.mesh(0).vertex_matrix(), ms.mesh(0).face_matrix(), ms.mesh(1).vertex_matrix()
     exact = triangle_brute_force(P, V, F)
     d = bbox_diagonal(V)
-    assert (vertex_distance(P, V, F) - exact).max() > 1e-3 * d            # the grid is off here
     np.testing.assert_allclose(ms.mesh(1).vertex_scalar_array(), exact, rtol=1e-12, atol=1e-15 * d)
     assert figures["sampled_to_target_max"] >= exact.max() / d            # the maxima take them in
 
@@ -184,21 +183,20 @@ def test_the_sampled_layers_vertices_are_searched_once(monkeypatch):
         return spy
 
     monkeypatch.setattr(evaluate, "_surface_distance", spying(evaluate._surface_distance))
-    monkeypatch.setattr(evaluate, "_locate", spying(evaluate._locate))
     apply(ms, "get_curvature_reconstruction_error", samplenum=2000)
     assert rows == [625]
 
 
 def test_figures_are_those_hausdorff_measures_itself(monkeypatch):
     # the quality handed to hausdorff changes none of its figures (to the last bit): the call is
-    # repeated without it, with the kd-tree engine forced (seeded: figures repeat exactly)
+    # repeated without it, with the exact engine forced (seeded: figures repeat exactly)
     import curvdetail.remesh as remesh
 
     calls = []
 
-    def spy(Va, Fa, Vb, Fb, *, samples=None, a_vertex_distance=None):
-        given = hausdorff(Va, Fa, Vb, Fb, samples=samples, engine="kdtree", a_vertex_distance=a_vertex_distance)
-        calls.append((a_vertex_distance, given, hausdorff(Va, Fa, Vb, Fb, samples=samples, engine="kdtree")))
+    def spy(Va, Fa, Vb, Fb, *, samples=None, engine=None, a_vertex_distance=None):
+        given = hausdorff(Va, Fa, Vb, Fb, samples=samples, engine="exact", a_vertex_distance=a_vertex_distance)
+        calls.append((a_vertex_distance, given, hausdorff(Va, Fa, Vb, Fb, samples=samples, engine="exact")))
         return given
 
     monkeypatch.setattr(remesh, "hausdorff", spy)

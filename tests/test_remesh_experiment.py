@@ -73,7 +73,7 @@ def test_report_figures_are_the_distances_over_the_source_diagonal(height_field)
         # (pymeshlab's face sampling is not repeatable to the last digit: ~0.1 %)
         assert r[key]["hausdorff_rms"] == pytest.approx(h["rms"] / d, rel=0.02)
         assert r[key]["hausdorff_max"] == pytest.approx(h["max"] / d, rel=0.05)
-    assert r["error"]["vertex_max"] == pytest.approx(vertex_distance(X, V, F, far=True).max() / d, rel=1e-12)
+    assert r["error"]["vertex_max"] == pytest.approx(vertex_distance(X, V, F).max() / d, rel=1e-12)
     rms = r["error"]["hausdorff_rms"]
     assert r["improvement_over_zero_detail"] == pytest.approx(r["baseline_zero_detail"]["hausdorff_rms"] / rms)
     assert r["improvement_over_zero_detail"] > 20
@@ -129,8 +129,8 @@ def test_run_experiment_returns_exact_per_vertex_distances(height_field):
     V, F = height_field
     r = run_experiment(V, F, target_edge=0.05)
     # the tree search's distances (exact at any distance), the ones the maxima are taken over
-    assert np.array_equal(r["distance"], vertex_distance(r["X"], V, F, far=True))
-    assert np.array_equal(r["zero_distance"], vertex_distance(r["Z"], V, F, far=True))
+    assert np.array_equal(r["distance"], vertex_distance(r["X"], V, F))
+    assert np.array_equal(r["zero_distance"], vertex_distance(r["Z"], V, F))
     assert r["distance"].max() / r["report"]["source"]["bbox_diagonal"] == r["report"]["error"]["vertex_max"]
 
 
@@ -376,10 +376,8 @@ def test_what_to_try_follows_the_options_that_failed(options, cli, says):
 
 def test_each_vertex_set_is_searched_once(height_field, monkeypatch):
     # the rebuilt, zero-detail and retriangulated vertices are searched against the source once
-    # each (vertex_distance(far=True), whose distances hausdorff then takes), besides the
-    # baseline's own face samples (the kd-tree engine; pymeshlab's engine samples inside
-    # pymeshlab). The rebuilt vertices used to be searched twice, by locate's grid for the
-    # per-vertex distances and by hausdorff for its maximum: 4 x 202 + 20,000 rows here
+    # each (vertex_distance, whose distances hausdorff then takes), besides the baseline's own
+    # face samples (the exact engine; pymeshlab's engine samples inside pymeshlab)
     import curvdetail.remesh.evaluate as evaluate
     from curvdetail.remesh.experiment import BASELINE_SAMPLES, run_experiment
 
@@ -394,7 +392,6 @@ def test_each_vertex_set_is_searched_once(height_field, monkeypatch):
         return spy
 
     monkeypatch.setattr(evaluate, "_surface_distance", spying(evaluate._surface_distance))
-    monkeypatch.setattr(evaluate, "_locate", spying(evaluate._locate))
     r = run_experiment(V, F, target_edge=0.05)
     p = r["X"].shape[0]
     assert r["Ft"].shape[0] != F.shape[0]                # the spy tells the surfaces apart
@@ -403,7 +400,7 @@ def test_each_vertex_set_is_searched_once(height_field, monkeypatch):
 
 def test_report_figures_are_those_hausdorff_measures_itself(height_field, monkeypatch):
     # the vertex distances handed to hausdorff change none of its figures (to the last bit):
-    # each call is repeated without them, with the kd-tree engine forced (seeded, so that a
+    # each call is repeated without them, with the exact engine forced (seeded, so that a
     # figure repeats exactly; pymeshlab's samples change from call to call)
     import curvdetail.remesh.experiment as experiment
 
@@ -413,8 +410,8 @@ def test_report_figures_are_those_hausdorff_measures_itself(height_field, monkey
 
     def spy(P, Ft, Vs, Fs, *, samples=None, engine="meshlab", a_vertex_distance=None):
         n = samples or 20000
-        given = hausdorff(P, Ft, Vs, Fs, samples=n, engine="kdtree", a_vertex_distance=a_vertex_distance)
-        calls.append((a_vertex_distance, given, hausdorff(P, Ft, Vs, Fs, samples=n, engine="kdtree")))
+        given = hausdorff(P, Ft, Vs, Fs, samples=n, engine="exact", a_vertex_distance=a_vertex_distance)
+        calls.append((a_vertex_distance, given, hausdorff(P, Ft, Vs, Fs, samples=n, engine="exact")))
         return given
 
     monkeypatch.setattr(experiment, "hausdorff", spy)
@@ -427,9 +424,9 @@ def test_report_figures_are_those_hausdorff_measures_itself(height_field, monkey
     assert calls[0][0] is r["distance"] and calls[1][0] is r["zero_distance"]
 
 
-def test_rebuilt_vertex_distances_are_exact_where_the_grid_search_is_not(monkeypatch):
-    # the per-vertex distances (the CLI's and the filter's quality, vertex_max) were locate's,
-    # up to 0.49 % of the diagonal too large here; now the exact ones, to rounding
+def test_rebuilt_vertex_distances_are_exact_beside_a_wavy_source(monkeypatch):
+    # the per-vertex distances (the CLI's and the filter's quality, vertex_max) are the exact
+    # ones, to rounding, where pymeshlab's closest-face grid was up to 0.49 % of the diagonal off
     import warnings
 
     from curvdetail.remesh.experiment import run_experiment
@@ -440,7 +437,6 @@ def test_rebuilt_vertex_distances_are_exact_where_the_grid_search_is_not(monkeyp
         r = run_experiment(V, F, target_edge=0.05)
     d = r["report"]["source"]["bbox_diagonal"]
     exact = triangle_brute_force(r["X"], V, F)
-    assert (vertex_distance(r["X"], V, F) - exact).max() > 1e-3 * d          # the grid is off here
     np.testing.assert_allclose(r["distance"], exact, rtol=1e-12, atol=1e-15 * d)
     assert r["report"]["error"]["vertex_max"] == pytest.approx(exact.max() / d, rel=1e-12)
     np.testing.assert_allclose(r["zero_distance"], triangle_brute_force(r["Z"], V, F), rtol=1e-12, atol=1e-15 * d)
@@ -448,7 +444,7 @@ def test_rebuilt_vertex_distances_are_exact_where_the_grid_search_is_not(monkeyp
 
 def test_ratios_of_a_flat_patch_are_none_with_the_reason():
     # a flat square: the rebuilt, zero-detail and retriangulated surfaces all lie on it, to
-    # pymeshlab's single precision (RMS ~1e-10 of the diagonal) or the kd-tree engine's double
+    # pymeshlab's single precision (RMS ~1e-10 of the diagonal) or the exact engine's double
     # (~1e-16): ratios of those are noise (they came out 0.3-1.3, or 0 where one was exactly 0)
     import json
     import warnings
@@ -479,7 +475,7 @@ def test_ratios_of_a_curved_patch_are_the_rms_quotients(height_field):
 
 def test_a_rebuild_at_rounding_is_not_said_to_be_worse_than_zero_detail():
     # a two-triangle square rebuilt from itself: pymeshlab's single precision gave it an RMS of
-    # 1.4e-9 of the diagonal against the kd-tree engine's exact 0 for zero detail, and the
+    # 1.4e-9 of the diagonal against the exact engine's exact 0 for zero detail, and the
     # warning said the transferred detail had made it worse
     import warnings
 

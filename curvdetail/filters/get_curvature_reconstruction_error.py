@@ -18,7 +18,7 @@ from .registry import PAPER, filter
         loaded), with pymeshlab's get_hausdorff_distance sampling the faces in both directions
         and every vertex measured exactly, for the maxima (curvdetail.remesh.hausdorff, the same
         figures as the remeshing report; layers more than
-        one bounding-box diagonal apart are measured with its kd-tree engine instead, and the
+        one bounding-box diagonal apart are measured with its exact engine instead, and the
         figures say which engine ran). Returns the
         maximum and RMS distances as fractions of the target's bounding-box diagonal (the
         evaluation of the paper's remeshing experiment, Fig. 3), and the one-sided figures. With
@@ -51,8 +51,8 @@ def get_curvature_reconstruction_error(ms, *, sampledmesh, targetmesh, samplenum
     # the sampled layer's vertices searched once, exactly: the quality and hausdorff's maxima
     # (which takes them as they are, in its own frame: the same figures as measuring them there)
     try:
-        distance = vertex_distance(Va, Vb, Fb, far=True)
-        h = hausdorff(Va, Fa, Vb, Fb, samples=samplenum or None, a_vertex_distance=distance)
+        distance = vertex_distance(Va, Vb, Fb)
+        h = hausdorff(Va, Fa, Vb, Fb, samples=samplenum or None, engine="meshlab", a_vertex_distance=distance)
     except MeshError as exc:
         raise _naming_the_layer(exc, ms, ("sampledmesh", sampled, Va, Fa),
                                 ("targetmesh", target, Vb, Fb)) from None

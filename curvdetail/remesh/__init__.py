@@ -2,10 +2,11 @@
 curvature detail to the new triangulation, rebuild it from that detail, and measure.
 
 Depends on :mod:`curvdetail.curvature` (operators and solvers), pymeshlab (isotropic remeshing,
-closest-face grid, Hausdorff distance) and fast-simplification (decimation).
+Hausdorff distance), libigl (closest points) and fast-simplification (decimation).
 """
 
 from ._disk import NotADiskError, RemeshError, check_disk
+from .closest_point import closest_points
 from .evaluate import hausdorff, vertex_distance
 from .experiment import WorseThanZeroDetailWarning, remesh_experiment
 from .locate import interpolate, locate, spread
@@ -14,7 +15,7 @@ from .retriangulate import LongRunWarning, retriangulate
 from .transfer import edge_curvature_measure, transfer_curvature
 
 __all__ = [
-    "LongRunWarning", "NotADiskError", "RemeshError", "WorseThanZeroDetailWarning", "check_disk",
+    "LongRunWarning", "NotADiskError", "RemeshError", "WorseThanZeroDetailWarning", "check_disk", "closest_points",
     "edge_curvature_measure", "flipped_triangles", "harmonic_map", "hausdorff", "interpolate", "locate",
     "parameterize", "remesh_experiment", "retriangulate", "spread", "transfer_curvature", "vertex_distance",
 ]

@@ -22,24 +22,24 @@ from .transfer import squashed_in_plane, transfer_curvature
 
 #: Face samples per direction for the zero-detail baseline. It lies ~10 % of the bbox diagonal
 #: from the source, where pymeshlab's grid search is slow (minutes); it is measured with
-#: ``hausdorff(engine="kdtree")`` and 20,000 samples, which agree with pymeshlab's 100,000-sample
+#: ``hausdorff(engine="exact")`` and 20,000 samples, which agree with pymeshlab's 100,000-sample
 #: figures to ~1 % (mannequin_nose, mannequin_disk_1k, camelhead).
 BASELINE_SAMPLES = 20000
 
 #: A rebuilt surface with a vertex further than this (x bbox diagonal) from the source is measured
-#: with the kd-tree engine as well (see :func:`hausdorff`).
+#: with the exact engine as well (see :func:`hausdorff`).
 FAR_SURFACE = 0.02
 
 #: RMS distances (fractions of the source's bbox diagonal) below which a figure is rounding, not
 #: a measurement, by the engine that measured it (see :func:`hausdorff`): pymeshlab's works in
 #: single precision (a flat square against its retriangulation: RMS 3e-11 to 1.6e-10, max up
-#: to 5e-8, where the distances are 0), the kd-tree engine in double (1e-17 to 1e-16). On a
+#: to 5e-8, where the distances are 0), the exact engine in double (1e-17 to 1e-16). On a
 #: flat patch the rebuilt, zero-detail and retriangulated surfaces all lie on the source, and a
 #: ratio of two such figures is noise (on those squares the improvement over zero detail came
 #: out 0 to 7e-6 and the ratio to the floor 0.3 to 1.3; with a divisor of exactly 0, clamped to
 #: 1e-300, up to ~1e284). The report's ratios with such a figure are None, with the reason in
 #: ``ratio_notes``; a rebuild that close is never said to be worse than zero detail.
-ROUNDING_RMS = {"meshlab": 1e-7, "kdtree": 1e-12}
+ROUNDING_RMS = {"meshlab": 1e-7, "exact": 1e-12}
 
 STAGES = ("retriangulate", "parameterize", "transfer", "reconstruct", "evaluate")
 
@@ -71,7 +71,7 @@ def worse_than_zero_detail(report, cli=False):
     if "error" not in report or "baseline_zero_detail" not in report:
         return None
     rms, zero = report["error"]["hausdorff_rms"], report["baseline_zero_detail"]["hausdorff_rms"]
-    if not (rms > zero and rms >= ROUNDING_RMS[report["error"].get("engine", "kdtree")]):
+    if not (rms > zero and rms >= ROUNDING_RMS[report["error"].get("engine", "exact")]):
         return None                                 # not worse, or rounding (a flat patch)
     options = report.get("options", {})
     tries = []
@@ -158,7 +158,7 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="c
         ``improvement_over_zero_detail`` (zero-detail RMS / error RMS) and ``ratio_to_floor``
         (error RMS / floor RMS), each None where one of its two RMS values is rounding, not a
         measurement (below ``ROUNDING_RMS``: 1e-7 of the diagonal as pymeshlab's single-precision
-        engine measures, 1e-12 as the kd-tree engine does; e.g. every surface of a flat patch, or
+        engine measures, 1e-12 as the exact engine does; e.g. every surface of a flat patch, or
         a target equal to the source), with the reason under ``ratio_notes``
         (``{ratio name: reason}``, present only then),
         ``parameterization`` (flip counts, for ``location="uv"``) and
@@ -349,20 +349,19 @@ def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="cons
     out = {"X": X, "Ft": Ft, "Vt": Vt, "Z": Z, "Dt": Dt, "distance": None, "zero_distance": None}
     if evaluate:
         t = stage("evaluate")
-        # each vertex set searched once, exactly (the tree search, at any distance: pymeshlab's
-        # grid may miss the closest face away from the source): these distances are the
-        # per-vertex figures (quality, vertex_max) and hausdorff takes them for its maxima, in
-        # its own frame, so its figures are those it would measure itself
-        out["distance"] = vertex_distance(X, V, F, far=True)
-        out["zero_distance"] = vertex_distance(Z, V, F, far=True)
+        # each vertex set searched once, exactly: these distances are the per-vertex figures
+        # (quality, vertex_max) and hausdorff takes them for its maxima, in its own frame, so
+        # its figures are those it would measure itself
+        out["distance"] = vertex_distance(X, V, F)
+        out["zero_distance"] = vertex_distance(Z, V, F)
         # pymeshlab's grid search slows down with the cube of the distance: surfaces that are
-        # far apart (a failed rebuild, the zero-detail baseline) use the kd-tree engine.
+        # far apart (a failed rebuild, the zero-detail baseline) use the exact engine.
         far = out["distance"].max() > FAR_SURFACE * d
         engines = {}
         for key, P, dist, n, engine in (
-                ("error", X, out["distance"], None, "kdtree" if far else "meshlab"),
-                ("baseline_zero_detail", Z, out["zero_distance"], BASELINE_SAMPLES, "kdtree"),
-                ("floor_retriangulated", Vt, vertex_distance(Vt, V, F, far=True), None, "meshlab")):
+                ("error", X, out["distance"], None, "exact" if far else "meshlab"),
+                ("baseline_zero_detail", Z, out["zero_distance"], BASELINE_SAMPLES, "exact"),
+                ("floor_retriangulated", Vt, vertex_distance(Vt, V, F), None, "meshlab")):
             h = hausdorff(P, Ft, V, F, samples=n, engine=engine, a_vertex_distance=dist)
             report[key] = {"hausdorff_max": h["max"] / d, "hausdorff_rms": h["rms"] / d}
             engines[key] = h["engine"]

@@ -9,7 +9,8 @@ from ..curvature.errors import MeshError, counted, first_indices
 from ..curvature.mean_curvature_normal import mean_curvature_normal
 from ..curvature.mixed_voronoi_area import mixed_voronoi_area
 from ..curvature.sparse_solver import factorize
-from .locate import _as_coordinates, _locate, _unit_frame, check_points_and_mesh, interpolate, spread
+from .closest_point import as_coordinates, check_points_and_mesh, unit_frame
+from .locate import _locate, interpolate, spread
 
 METHODS = ("conservative", "pointwise")
 LOCATIONS = ("closest", "uv")
@@ -226,7 +227,7 @@ def squashed_in_plane(UV, F, what, advice, error):
     mesh's triangles with advice to repair it."""
     if np.ptp(UV, axis=0).max() == 0:
         raise error(f"{what} puts all {UV.shape[0]} vertices at one point. {advice}")
-    _, U, _ = _unit_frame(UV[:0], UV)
+    _, U, _ = unit_frame(UV[:0], UV)
     zero = np.flatnonzero(face_double_areas(np.column_stack([U, np.zeros(U.shape[0])]), F)
                           <= 2.0 * ZERO_AREA_RELATIVE)
     if zero.size:
@@ -241,7 +242,7 @@ def _check_uv(uv, n_s, n_t):
         got = "None" if uv is None else type(uv).__name__
         raise ValueError(f"location='uv' needs uv=(UVs, UVt), a pair of arrays, e.g. from "
                          f"curvdetail.remesh.parameterize; got {got}.")
-    UVs, UVt = (_as_coordinates(u, name) for u, name in zip(uv, ("uv[0] (UVs)", "uv[1] (UVt)")))
+    UVs, UVt = (as_coordinates(u, name) for u, name in zip(uv, ("uv[0] (UVs)", "uv[1] (UVt)")))
     if UVs.shape != (n_s, 2) or UVt.shape != (n_t, 2):
         raise ValueError(f"uv shapes {UVs.shape}, {UVt.shape} do not match the meshes "
                          f"({n_s}, 2), ({n_t}, 2).")
