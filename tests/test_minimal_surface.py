@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from curvdetail import (ConstraintError, MeshError, available_backends, boundary_vertices, cotan_laplacian,
+from curvdetail import (ConstraintError, MeshError, boundary_vertices, cotan_laplacian,
                         minimal_surface)
 from curvdetail.curvature._validate import bbox_diagonal, face_double_areas
 from curvdetail.curvature.testing import cylinder, grid

@@ -71,7 +71,7 @@ def check_disk(V, F, what="the source"):
     nm = None
     try:
         V, F = check_mesh(V, F)
-    except MeshError as exc:
+    except MeshError:
         try:
             nm = non_manifold_edges(as_faces(F, None))    # checked: a cast would truncate 1.5 to 1
         except Exception:  # F too malformed to look at: the original message says why
