@@ -194,7 +194,7 @@ class CurvatureEditor:
             except SolverError as exc:
                 raise SolverError(f"relations='one-ring' makes the curvature stage a nonsymmetric system: "
                                   f"{str(exc).rstrip('.')}, or relations='one+two-ring' (symmetric normal "
-                                  "equations).") from None
+                                  "equations).", parameter="backend", value=backend) from None
         V, F, L = checked_cotan_laplacian(V, F)       # every mesh check, and L in the same pass
         self.relations = relations
         n = V.shape[0]

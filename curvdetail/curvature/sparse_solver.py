@@ -114,6 +114,14 @@ def _upper_triangle(A):
     return sp.csr_matrix((A.data[keep], A.indices[keep], indptr), shape=A.shape)
 
 
+def _release(solver):
+    """Free MKL's memory of a PARDISO solver (with the last reference to its Factorization)."""
+    try:
+        solver.free_memory(everything=True)
+    except Exception:                          # a handle that never reached MKL (a refused matrix)
+        pass
+
+
 class Factorization:
     """A factored square sparse matrix; :meth:`solve` back-substitutes only. See :func:`factorize`.
 
@@ -134,6 +142,7 @@ class Factorization:
         self.shape, self.symmetric, self.upper = A.shape, bool(symmetric), bool(upper)
         self.backend = resolve_backend(backend, symmetric=symmetric, nnz=2 * A.nnz - A.shape[0] if upper else A.nnz)
         self._automatic = _chosen_automatically(backend)
+        self._pivoting = False                 # SuperLU's partial pivoting, once it took over from PARDISO
         self._lock = threading.Lock()          # pypardiso's solver object is not thread-safe
         A.sort_indices()
         self._pattern = (A.indptr.copy(), A.indices.copy())
@@ -169,7 +178,7 @@ class Factorization:
         elif self.backend == "cholmod":
             self._solve = self._factor_cholmod(A)
         else:
-            self._solve = self._factor_splu(A)
+            self._solve = self._factor_splu(A, self._pivoting)
 
     def _factor_pardiso(self, M):
         import pypardiso
@@ -186,7 +195,7 @@ class Factorization:
                 solver = pypardiso.PyPardisoSolver(mtype=2 if self.symmetric else 11)
                 for i, value in {**_IPARM[self.symmetric], 2: 3 if M.shape[0] >= 50_000 else 2}.items():
                     solver.set_iparm(i, value)
-                weakref.finalize(self, solver.free_memory, True).atexit = False
+                weakref.finalize(self, _release, solver).atexit = False
                 solver.factorize(M)
                 solver.remove_stored_factorization()             # its copy of M: M is kept here
                 self._pardiso = solver
@@ -201,7 +210,7 @@ class Factorization:
                 raise SolverError(f"PARDISO perturbed {perturbed} pivots of this nonsymmetric matrix: it is "
                                   "singular or nearly so", parameter="backend", value="pardiso", count=perturbed,
                                   hint="use backend='splu' (LU with partial pivoting) or 'auto'")
-            self.backend = "splu"
+            self.backend, self._pivoting = "splu", True
             return self._factor_splu(M, partial_pivoting=True)
 
         lock = self._lock                # not self: the factors go with the last reference to it
@@ -260,6 +269,8 @@ class Factorization:
             raise SolverError("the last refactor failed, so there are no factors to solve with",
                               hint="refactor with valid values or factorize again")
         b = np.asarray(b, dtype=np.float64)
+        if b.size == 0:                        # no columns (MKL refuses nrhs = 0)
+            return np.zeros(b.shape)
         x = np.asarray(self._solve(b), dtype=np.float64).reshape(b.shape)
         if not np.all(np.isfinite(x)):
             raise SolverError("the solve produced NaN or infinite values: the matrix is singular or "
