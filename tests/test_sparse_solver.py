@@ -67,12 +67,13 @@ def test_backends_agree_with_a_dense_solve(backend):
 
 @_needs_pardiso
 @pytest.mark.parametrize("symmetric", [True, False])
-def test_pardiso_parallel_ordering_solves_the_same(symmetric):
-    # from 50k unknowns PARDISO orders with parallel METIS (iparm[1] = 3): a 300 x 300 grid
-    A, x = _spd_system(226)
+def test_pardiso_parallel_ordering_solves_the_same(monkeypatch, symmetric):
+    # large systems are ordered with parallel METIS; lower the threshold to take that path here
+    monkeypatch.setattr(sparse_solver, "PARALLEL_ORDERING", 10)
+    A, x = _spd_system()
     A = A if symmetric else _nonsymmetric(A)
     fac = factorize(A, symmetric=symmetric, backend="pardiso")
-    assert A.shape[0] >= 50_000 and fac._pardiso.iparm[1] == 3
+    assert fac._pardiso.iparm[1] == 3
     assert np.abs(fac.solve(A @ x) - x).max() < 1e-9 * np.abs(x).max()
 
 
@@ -169,9 +170,9 @@ def test_environment_variable_overrides_auto_and_a_named_backend_overrides_it(mo
     assert resolve_backend("auto", nnz=10) == "splu"
     monkeypatch.setenv("CURVDETAIL_SOLVER", "umfpack")
     assert resolve_backend("splu") == "splu"
-    with pytest.raises(SolverError) as e:
+    with pytest.raises(SolverError) as e:                 # where the name came from
         resolve_backend("auto")
-    assert e.value.parameter == "backend"
+    assert e.value.parameter == "CURVDETAIL_SOLVER" and e.value.value == "umfpack"
 
 
 @pytest.mark.parametrize("name", ["SPLU", " splu", "Splu "])
@@ -180,11 +181,19 @@ def test_backend_names_are_case_insensitive(monkeypatch, name):
     assert resolve_backend(name) == "splu"
 
 
-@pytest.mark.parametrize("backend", [np.array(["splu"]), np.array(["splu", "pardiso"]), ["splu"], 3, "umfpack"])
-def test_a_backend_that_is_not_a_known_name_is_refused(backend):
+@pytest.mark.parametrize("backend", [np.array(["splu"]), np.array(["splu", "pardiso"]), ["splu"], 3])
+def test_a_backend_that_is_not_one_str_is_refused(backend):
     with pytest.raises(SolverError) as e:
         resolve_backend(backend)
     assert e.value.parameter == "backend" and e.value.value is backend
+
+
+@pytest.mark.parametrize("name", ["umfpack", "banded", " Banded"])
+def test_an_unknown_backend_name_is_refused(monkeypatch, name):
+    monkeypatch.delenv("CURVDETAIL_SOLVER", raising=False)
+    with pytest.raises(SolverError) as e:
+        resolve_backend(name)
+    assert e.value.parameter == "backend" and e.value.value == name.strip().lower()
 
 
 def test_missing_backend_is_refused(monkeypatch):

@@ -37,6 +37,9 @@ AUTO_RULE = (f"auto = SuperLU below {SMALL_SYSTEM_NNZ:,} stored entries, else th
 _IPARM = {True: {1: 1, 8: 0, 10: 8, 11: 0, 13: 0, 24: 1, 25: 2},
           False: {1: 1, 8: 0, 10: 13, 11: 1, 13: 1, 24: 0, 25: 0}}
 
+#: From this many unknowns PARDISO orders with parallel METIS (iparm 2 = 3).
+PARALLEL_ORDERING = 50_000
+
 #: Number of numeric factorizations in this process (a solver that promises back-substitution
 #: only can be checked against it).
 factorization_count = 0
@@ -67,42 +70,45 @@ def available_backends():
 
 
 def _requested(backend):
-    """``backend`` as a lower-case name, ``"auto"`` replaced by ``CURVDETAIL_SOLVER`` where set."""
+    """``(name, where)``: ``backend`` as a lower-case name and ``"backend"``, or for ``"auto"``
+    the setting of ``CURVDETAIL_SOLVER`` and that variable's name where it is set."""
     if backend is not None and not isinstance(backend, str):
         raise SolverError(f"backend={backend!r} ({type(backend).__name__}, not a single str) is not a "
                           "solver backend", parameter="backend", value=backend,
                           hint=f"choose one of {', '.join(BACKENDS)} or 'auto'")
     backend = (backend or "auto").strip().lower()
-    if backend == "auto":
-        backend = (os.environ.get("CURVDETAIL_SOLVER") or "auto").strip().lower()
-    return backend
+    setting = os.environ.get("CURVDETAIL_SOLVER", "").strip().lower()
+    if backend == "auto" and setting:
+        return setting, "CURVDETAIL_SOLVER"
+    return backend, "backend"
 
 
 def resolve_backend(backend="auto", *, symmetric=True, nnz=None):
     """The installed backend that ``backend`` names or ``"auto"`` picks for a matrix with ``nnz``
-    stored entries (None: a large one); SolverError where there is none."""
-    name = _requested(backend)
+    stored entries (None: a large one); SolverError where there is none (``parameter`` is
+    ``"backend"`` or, for a setting of the environment variable, ``"CURVDETAIL_SOLVER"``)."""
+    name, where = _requested(backend)
     if name == "auto":
         if nnz is not None and nnz < SMALL_SYSTEM_NNZ:
             return "splu"
         return next(b for b in available_backends() if symmetric or b != "cholmod")
     if name not in BACKENDS:
-        raise SolverError(f"unknown solver backend {name!r}", parameter="backend", value=backend,
+        raise SolverError(f"unknown solver backend {name!r}", parameter=where, value=name,
                           hint=f"choose one of {', '.join(BACKENDS)} or 'auto'")
     if name not in available_backends():
         install = {"pardiso": "pip install pypardiso (x86-64 only)",
                    "cholmod": "install SuiteSparse and pip install scikit-sparse"}[name]
-        raise SolverError(f"solver backend {name!r} is not installed", parameter="backend", value=backend,
+        raise SolverError(f"solver backend {name!r} is not installed", parameter=where, value=name,
                           hint=f"{install}, or use backend='auto'")
     if name == "cholmod" and not symmetric:
-        raise SolverError("CHOLMOD factors symmetric positive definite matrices only", parameter="backend",
-                          value=backend, hint="use 'pardiso' or 'splu'")
+        raise SolverError("CHOLMOD factors symmetric positive definite matrices only", parameter=where,
+                          value=name, hint="use 'pardiso' or 'splu'")
     return name
 
 
 def _chosen_automatically(backend):
     """True if ``backend`` leaves the choice to the ``"auto"`` rule (no name, no setting)."""
-    return _requested(backend) == "auto"
+    return _requested(backend)[0] == "auto"
 
 
 def _upper_triangle(A):
@@ -193,7 +199,7 @@ class Factorization:
                 solver._call_pardiso(M, np.zeros((M.shape[0], 1), order="F"))
             else:
                 solver = pypardiso.PyPardisoSolver(mtype=2 if self.symmetric else 11)
-                for i, value in {**_IPARM[self.symmetric], 2: 3 if M.shape[0] >= 50_000 else 2}.items():
+                for i, value in {**_IPARM[self.symmetric], 2: 3 if M.shape[0] >= PARALLEL_ORDERING else 2}.items():
                     solver.set_iparm(i, value)
                 weakref.finalize(self, _release, solver).atexit = False
                 solver.factorize(M)
