@@ -75,7 +75,7 @@ def _requested(backend):
     if backend is not None and not isinstance(backend, str):
         raise SolverError(f"backend={backend!r} ({type(backend).__name__}, not a single str) is not a "
                           "solver backend", parameter="backend", value=backend,
-                          hint=f"choose one of {', '.join(BACKENDS)} or 'auto'")
+                          hint=f"choose one of {', '.join(BACKENDS)} or 'auto'.")
     backend = (backend or "auto").strip().lower()
     setting = os.environ.get("CURVDETAIL_SOLVER", "").strip().lower()
     if backend == "auto" and setting:
@@ -94,15 +94,15 @@ def resolve_backend(backend="auto", *, symmetric=True, nnz=None):
         return next(b for b in available_backends() if symmetric or b != "cholmod")
     if name not in BACKENDS:
         raise SolverError(f"unknown solver backend {name!r}", parameter=where, value=name,
-                          hint=f"choose one of {', '.join(BACKENDS)} or 'auto'")
+                          hint=f"choose one of {', '.join(BACKENDS)} or 'auto'.")
     if name not in available_backends():
         install = {"pardiso": "pip install pypardiso (x86-64 only)",
                    "cholmod": "install SuiteSparse and pip install scikit-sparse"}[name]
         raise SolverError(f"solver backend {name!r} is not installed", parameter=where, value=name,
-                          hint=f"{install}, or use backend='auto'")
+                          hint=f"{install}, or use backend='auto'.")
     if name == "cholmod" and not symmetric:
         raise SolverError("CHOLMOD factors symmetric positive definite matrices only", parameter=where,
-                          value=name, hint="use 'pardiso' or 'splu'")
+                          value=name, hint="use 'pardiso' or 'splu'.")
     return name
 
 
@@ -140,11 +140,11 @@ class Factorization:
     def __init__(self, A, *, symmetric=True, backend="auto", upper=False):
         A = sp.csr_matrix(A, dtype=np.float64)
         if A.shape[0] != A.shape[1]:
-            raise SolverError(f"cannot factor a non-square matrix of shape {A.shape}", parameter="A",
+            raise SolverError(f"cannot factor a non-square matrix of shape {A.shape}.", parameter="A",
                               value=A.shape)
         if upper and not symmetric:
             raise SolverError("upper=True stores half of a symmetric matrix", parameter="upper",
-                              hint="pass the whole matrix with symmetric=False")
+                              hint="pass the whole matrix with symmetric=False.")
         self.shape, self.symmetric, self.upper = A.shape, bool(symmetric), bool(upper)
         self.backend = resolve_backend(backend, symmetric=symmetric, nnz=2 * A.nnz - A.shape[0] if upper else A.nnz)
         self._automatic = _chosen_automatically(backend)
@@ -163,7 +163,7 @@ class Factorization:
         if A.shape != self.shape or not (np.array_equal(A.indptr, self._pattern[0])
                                          and np.array_equal(A.indices, self._pattern[1])):
             raise SolverError("refactor needs the shape and stored sparsity pattern of the first matrix",
-                              parameter="A", hint="use factorize for another system")
+                              parameter="A", hint="use factorize for another system.")
         try:
             with self._lock:
                 self._factor(A)
@@ -206,7 +206,7 @@ class Factorization:
                 solver.remove_stored_factorization()             # its copy of M: M is kept here
                 self._pardiso = solver
         except (ValueError, PyPardisoError) as exc:    # ValueError: an empty row
-            raise SolverError(f"PARDISO could not factor the matrix ({exc}); it may be singular",
+            raise SolverError(f"PARDISO could not factor the matrix ({exc}); it may be singular.",
                               parameter="A") from None
         perturbed = int(solver.iparm[13])
         if perturbed and not self.symmetric:
@@ -215,7 +215,7 @@ class Factorization:
             if not self._automatic:
                 raise SolverError(f"PARDISO perturbed {perturbed} pivots of this nonsymmetric matrix: it is "
                                   "singular or nearly so", parameter="backend", value="pardiso", count=perturbed,
-                                  hint="use backend='splu' (LU with partial pivoting) or 'auto'")
+                                  hint="use backend='splu' (LU with partial pivoting) or 'auto'.")
             self.backend, self._pivoting = "splu", True
             return self._factor_splu(M, partial_pivoting=True)
 
@@ -238,7 +238,7 @@ class Factorization:
                 return cholmod.cho_factor(M).solve
             return cholmod.cholesky(A.tocsc())                # 0.4: factor(b) solves
         except Exception as exc:
-            raise SolverError(f"CHOLMOD could not factor the matrix ({exc}); it is not positive definite",
+            raise SolverError(f"CHOLMOD could not factor the matrix ({exc}); it is not positive definite.",
                               parameter="A") from None
 
     @staticmethod
@@ -249,7 +249,7 @@ class Factorization:
             return spla.splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
                              options={"SymmetricMode": True}).solve
         except RuntimeError as exc:
-            raise SolverError(f"SuperLU could not factor the matrix ({exc}); it is singular",
+            raise SolverError(f"SuperLU could not factor the matrix ({exc}); it is singular.",
                               parameter="A") from None
 
     def solve(self, b):
@@ -270,17 +270,17 @@ class Factorization:
         """
         if np.iscomplexobj(b) or np.ndim(b) not in (1, 2) or np.shape(b)[0] != self.shape[0]:
             raise SolverError(f"the right-hand side must be real of shape ({self.shape[0]},) or "
-                              f"({self.shape[0]}, k)", parameter="b", value=np.shape(b))
+                              f"({self.shape[0]}, k).", parameter="b", value=np.shape(b))
         if self._solve is None:
             raise SolverError("the last refactor failed, so there are no factors to solve with",
-                              hint="refactor with valid values or factorize again")
+                              hint="refactor with valid values or factorize again.")
         b = np.asarray(b, dtype=np.float64)
         if b.size == 0:                        # no columns (MKL refuses nrhs = 0)
             return np.zeros(b.shape)
         x = np.asarray(self._solve(b), dtype=np.float64).reshape(b.shape)
         if not np.all(np.isfinite(x)):
             raise SolverError("the solve produced NaN or infinite values: the matrix is singular or "
-                              "numerically degenerate", hint="check for collapsed triangles")
+                              "numerically degenerate", hint="check for collapsed triangles.")
         return x
 
 
