@@ -61,7 +61,7 @@ OVERWRITE = "--overwrite"
 #: why a method is left out at a size (recorded in the JSON instead of a result)
 #: every --methods name: Reconstructor end to end, the sparse_solver backends, naive spsolve (a
 #: backend that is not installed is recorded as skipped; a name outside this list is refused)
-METHODS = ("reconstruct", "pardiso", "cholmod", "splu", "banded", "spsolve")
+METHODS = ("reconstruct", "pardiso", "cholmod", "splu", "spsolve")
 
 SKIP = {
     ("spsolve", "1M"): "naive spsolve at 1M needs ~15 GB and ~6 min per solve (SPEC section 6: "

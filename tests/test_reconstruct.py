@@ -8,8 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from curvdetail import (ConstraintError, MeshError, Reconstructor, SolverError, available_backends,
-                        boundary_vertices, cotan_laplacian, curvature_detail, reconstruct)
+from curvdetail import (ConstraintError, MeshError, Reconstructor, SolverError, boundary_vertices, cotan_laplacian, curvature_detail, reconstruct)
 from curvdetail.curvature import sparse_solver
 from curvdetail.curvature._validate import bbox_diagonal
 from curvdetail.curvature.testing import grid, icosphere
@@ -311,48 +310,6 @@ def test_free_system_is_the_sliced_matrix(keep_every):
     assert np.array_equal(upper.data, expected.data)
     assert L_fc.shape == (is_free.sum(), fixed.size)
     assert np.array_equal(L_fc.toarray(), L[is_free][:, fixed].toarray())
-
-
-@pytest.mark.skipif("pardiso" not in available_backends(), reason="PARDISO (pypardiso) not installed")
-def test_free_rows_with_the_analysis_started_early_give_the_same_answer(monkeypatch, load_mesh, rng):
-    # from OVERLAP_MIN_FREE free vertices PARDISO analyses L_ff's pattern in a background thread
-    # while the mesh is checked and L assembled; lower the threshold to take that path here
-    reconstruct_module = importlib.import_module("curvdetail.curvature.reconstruct")
-    V, F, fixed = _problem(load_mesh, "mannequin_ear.obj")
-    D = curvature_detail(V, F) + rng.normal(scale=1e-3, size=V.shape)
-    sequential = Reconstructor(V, F, fixed, rows="free", backend="pardiso")
-    monkeypatch.setattr(reconstruct_module, "OVERLAP_MIN_FREE", 10)
-    started = []
-    monkeypatch.setattr(sparse_solver.PendingFactorization, "finish",
-                        lambda self, data, real=sparse_solver.PendingFactorization.finish:
-                        (started.append(1), real(self, data))[1])
-    early = Reconstructor(V, F, fixed, rows="free", backend="pardiso")
-    assert started == [1] and early.backend == "pardiso"
-    a, b = sequential.solve(D, V[fixed]), early.solve(D, V[fixed])
-    assert np.abs(a - b).max() < 1e-12 * bbox_diagonal(V)
-
-
-@pytest.mark.skipif("pardiso" not in available_backends(), reason="PARDISO (pypardiso) not installed")
-def test_a_check_failing_after_the_early_analysis_still_reports_its_error(monkeypatch):
-    reconstruct_module = importlib.import_module("curvdetail.curvature.reconstruct")
-    monkeypatch.setattr(reconstruct_module, "OVERLAP_MIN_FREE", 10)
-    V, F = grid(8, 8)
-    two = np.vstack([V, V + [5.0, 0.0, 0.0]])
-    both = np.vstack([F, F + V.shape[0]])
-    with pytest.raises(ConstraintError, match="no fixed vertex"):          # the second piece
-        Reconstructor(two, both, boundary_vertices(F), rows="free", backend="pardiso")
-    edges = np.sort(np.vstack([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
-    unique, count = np.unique(edges, axis=0, return_counts=True)
-    a, b = unique[count == 2][0]                                            # an interior edge
-    fin = np.vstack([V, (V[a] + V[b]) / 2 + [0.0, 0.0, 1.0]])               # and a third triangle on it
-    laplacian_module = importlib.import_module("curvdetail.curvature.cotan_laplacian")
-    monkeypatch.setattr(laplacian_module, "_edge_pattern", None)           # the checks may not count again
-    with pytest.raises(MeshError, match=rf"1 edge is shared by more than two triangles \(first: \({a}, {b}\)\)"):
-        Reconstructor(fin, np.vstack([F, [a, b, V.shape[0]]]), [0], rows="free",
-                      backend="pardiso")                                    # counted by the analysis' pattern
-    V[F[3]] = V[F[3, 0]]                                                    # collapse a triangle
-    with pytest.raises(MeshError, match="zero area"):
-        Reconstructor(V, F, boundary_vertices(F), rows="free", backend="pardiso")
 
 
 @pytest.mark.parametrize("rows", ["all", "free"])

@@ -145,7 +145,7 @@ class CurvatureEditor:
             except SolverError as exc:
                 raise SolverError(f"relations='one-ring' makes the curvature stage a nonsymmetric system: "
                                   f"{exc.problem}", parameter="backend", value=exc.value,
-                                  hint=f"{exc.hint}, or relations='one+two-ring' (symmetric)") from None
+                                  hint=f"{(exc.hint or '').rstrip('.')}, or relations='one+two-ring' (symmetric)") from None
         V, F, L = checked_cotan_laplacian(V, F)       # every mesh check, and L in the same pass
         self.relations = relations
         n = V.shape[0]

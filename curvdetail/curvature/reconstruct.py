@@ -3,11 +3,11 @@
 import numpy as np
 import scipy.sparse as sp
 
-from ._validate import (check_choice, as_count, as_faces, as_index_set, as_values, as_vertices, bbox_centre,
+from ._validate import (check_choice, as_count, as_index_set, as_values, bbox_centre,
                         check_every_component_fixed)
-from .cotan_laplacian import _edge_pattern, _symmetric_from_upper, checked_cotan_triangle
+from .cotan_laplacian import _symmetric_from_upper, checked_cotan_triangle
 from .errors import ConstraintError
-from .sparse_solver import SMALL_SYSTEM_NNZ, PendingFactorization, SolverError, factorize, resolve_backend
+from .sparse_solver import SolverError, _upper_triangle, factorize, resolve_backend
 
 ROW_MODES = ("all", "free")
 
@@ -91,28 +91,15 @@ class Reconstructor:
                 raise ValueError(f"{exc} (1, the default, gives solver precision; 0 skips the "
                                  "refinement).") from None
         self.rows = rows
-        # rows="free" only: for rows="all" the pattern of L_f: L_f:^T costs a sparse product as
-        # long as the values' one, and starting early saved nothing (measured at 1M)
-        started = _start_factorization(V_ref, F, fixed, backend) if rows == "free" else None
-        try:
-            system = self._build(V_ref, F, fixed, started, backend)
-        except BaseException:
-            if started is not None:
-                started[1].cancel()
-            raise
-        if not self.free.size:
-            self._factor = None
-        elif started is not None:
-            self._factor = started[1].finish(system.data)
-        else:
-            self._factor = factorize(system, symmetric=True, backend=backend, upper=self._upper)
+        system = self._build(V_ref, F, fixed, backend)
+        self._factor = factorize(system, symmetric=True, backend=backend, upper=self._upper) \
+            if self.free.size else None
         self.backend = self._factor.backend if self._factor is not None else "none"
 
-    def _build(self, V_ref, F, fixed, started, backend):
+    def _build(self, V_ref, F, fixed, backend):
         """Every check, then the system to factor; ``self._upper`` says whether it is given as its
         upper triangle."""
-        V_ref, F, U, diagonal = checked_cotan_triangle(
-            V_ref, F, edge_counts=started[0].edge_counts if started is not None else None)
+        V_ref, F, U, diagonal = checked_cotan_triangle(V_ref, F)
         n = V_ref.shape[0]
         self.n = n
         self.fixed = as_index_set(fixed, n, "fixed")
@@ -128,8 +115,7 @@ class Reconstructor:
             # the solvers take the upper triangle of L_ff: cut it, and L_fc, straight from U
             # (1M vertices: 0.15 s, against 0.45 s for building L, slicing it and cutting L_ff's
             # triangle)
-            layout = started[0] if started is not None else _FreeSystemLayout(U, is_free, self.fixed)
-            system, self._L_fc = layout.values(U, diagonal)
+            system, self._L_fc = _FreeSystemLayout(U, is_free, self.fixed).values(U, diagonal)
             self._upper = True
             return system
         L = _symmetric_from_upper(U, diagonal)
@@ -137,18 +123,10 @@ class Reconstructor:
                                                                  # (= rows, L is symmetric)
         # L is symmetric, so L_:f = L_f:^T and the normal matrix L_:f^T L_:f is L_f: L_f:^T
         self._L_f = L[self.free]                                 # (f, n) rows of the free vertices
-        self._upper = self.free.size >= MKL_GRAM_MIN_FREE and \
-            resolve_backend(backend, symmetric=True, size=self.free.size) == "pardiso"
-        if self._upper:
-            # PARDISO takes the upper triangle, which MKL computes alone and on every core
-            # (1M vertices: 0.4-0.6 s against 1.2 s for SciPy's product, sort and cut)
-            from ._mkl_sparse import MklSparseError, gram_upper
-
-            try:
-                return gram_upper(self._L_f)
-            except MklSparseError:
-                self._upper = False
-        return self._L_f @ self._L_f.T
+        normal = self._L_f @ self._L_f.T
+        # PARDISO takes the upper triangle: cut here, the whole product is gone before it factors
+        self._upper = resolve_backend(backend, nnz=normal.nnz) == "pardiso"
+        return _upper_triangle(normal) if self._upper else normal
 
     def solve(self, detail, fixed_positions):
         """Positions whose detail best matches ``detail``, by back-substitution only.
@@ -264,45 +242,6 @@ MAX_LEAST_REFINEMENT_STEPS = 100
 #: below this fraction of the solution (the round-trip bound), else SolverError
 REFINEMENT_FLOOR = 1e-9
 
-#: From this many free vertices, ``rows="all"`` with PARDISO forms the normal matrix's upper
-#: triangle with MKL's ``mkl_sparse_syrk`` (see :mod:`._mkl_sparse`); below, SciPy's product
-#: (the systems where ``"auto"`` may pick another backend, and the product takes milliseconds).
-MKL_GRAM_MIN_FREE = 20_000
-
-#: From this many free vertices, ``rows="free"`` with PARDISO starts the solver's ordering and
-#: symbolic analysis from the mesh's edges alone, in a background thread, while the checks and
-#: the Laplacian's values are computed (see :func:`_start_factorization`).
-OVERLAP_MIN_FREE = 50_000
-
-
-def _start_factorization(V_ref, F, fixed, backend):
-    """Start PARDISO on the pattern of ``rows="free"``'s system, or return None.
-
-    The pattern of ``L_ff``'s upper triangle depends on the triangles and the fixed set only,
-    so PARDISO can order and analyse it (~2/3 of its factorization time at 1M unknowns, on both
-    cores but not fully: 6.6 s of CPU in 3.9 s) while this thread checks the mesh and computes
-    the values (~1 s at 1M). Returns ``(layout, PendingFactorization)``; None where that does
-    not pay (small systems, another backend) or the input is malformed: the checks in their
-    usual order then report it. (A check that fails after the start raises at once; the
-    analysis frees its memory when it ends.)"""
-    try:
-        V = as_vertices(V_ref)
-        n = V.shape[0]
-        F = as_faces(F, n)
-        fixed = as_index_set(fixed, n, "fixed")
-    except ValueError:
-        return None
-    free = n - fixed.size
-    if fixed.size == 0 or free < OVERLAP_MIN_FREE or \
-            resolve_backend(backend, symmetric=True, size=free, nnz=SMALL_SYSTEM_NNZ) != "pardiso":
-        return None
-    is_free = np.ones(n, dtype=bool)
-    is_free[fixed] = False
-    counts = _edge_pattern(F, n)                  # its values count the triangles on each edge
-    layout = _FreeSystemLayout(counts, is_free, fixed, edge_counts=counts)
-    return layout, PendingFactorization(layout.pattern, backend=backend)
-
-
 class _FreeSystemLayout:
     """Where the entries of a symmetric ``L``, given by its strict upper triangle ``U`` (CSR,
     sorted) and diagonal, go in the free-row system: the upper triangle, diagonal included, of
@@ -310,9 +249,8 @@ class _FreeSystemLayout:
     (CSR, columns in the order of ``fixed``). Built from ``U``'s pattern alone, so that it serves
     every ``U`` with that pattern (the steps of :func:`minimal_surface`)."""
 
-    def __init__(self, U, is_free, fixed, edge_counts=None):
+    def __init__(self, U, is_free, fixed):
         n = U.shape[0]
-        self.edge_counts = edge_counts          # for the mesh checks, where the caller has them
         index = U.indices.dtype
         self._indptr_U, self._indices_U = U.indptr, U.indices
         rows = np.repeat(np.arange(n, dtype=index), np.diff(U.indptr))
