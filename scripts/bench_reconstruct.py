@@ -144,7 +144,7 @@ def run_case(surface, size, rows, method, repeats=3, trials=None):
     """Time one case; factor + solve run ``trials`` times (2 below 1M, 1 at 1M) and the fastest
     is kept, which also leaves out once-per-process costs (PARDISO's library look-up)."""
     from curvdetail import Reconstructor, curvature_detail
-    from curvdetail.curvature._validate import bbox_diagonal
+    from curvdetail.curvature.geometry import bbox_diagonal
     from curvdetail.curvature.cotan_laplacian import _cotan_laplacian_unchecked
     from curvdetail.curvature.sparse_solver import factorize
 

@@ -30,7 +30,7 @@ import _files  # noqa: E402
 from _meshes import MESHES, require  # noqa: E402
 
 from curvdetail import read_mesh
-from curvdetail.curvature._validate import bbox_diagonal
+from curvdetail.curvature.geometry import bbox_diagonal
 from curvdetail.curvature.curvature_coefficients import DEFAULT_RCOND
 from curvdetail.io.deformation import edit_with_selection, read_selection, read_transform
 

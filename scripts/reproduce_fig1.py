@@ -37,7 +37,7 @@ import _files  # noqa: E402
 from _meshes import MESHES, require  # noqa: E402
 
 from curvdetail import CurvatureEditor, boundary_vertices, mean_curvature_normal, read_mesh
-from curvdetail.curvature._validate import bbox_diagonal
+from curvdetail.curvature.geometry import bbox_diagonal
 
 Y_UP = np.array([[1.0, 0, 0], [0, 0, -1.0], [0, 1.0, 0]])   # display y-up models with z up
 

@@ -38,7 +38,7 @@ import _files  # noqa: E402
 from _meshes import MESHES, require  # noqa: E402
 
 from curvdetail import CurvatureEditor, edit_boundary, read_mesh, sine_displacement
-from curvdetail.curvature._validate import bbox_diagonal
+from curvdetail.curvature.geometry import bbox_diagonal
 from curvdetail.curvature.errors import FoldedTrianglesWarning
 from curvdetail.io.deformation import edit_with_selection
 from curvdetail.plot import view_direction

@@ -41,7 +41,7 @@ import _files  # noqa: E402
 from _meshes import MESHES  # noqa: E402
 
 from curvdetail import read_mesh
-from curvdetail.curvature._validate import bbox_diagonal
+from curvdetail.curvature.geometry import bbox_diagonal
 from curvdetail.remesh import retriangulate
 from curvdetail.remesh.experiment import run_experiment
 

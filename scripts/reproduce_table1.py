@@ -30,7 +30,9 @@ import _files  # noqa: E402
 from _meshes import MESHES, at_least_one, require  # noqa: E402
 
 from curvdetail import CurvatureEditor, boundary_vertices, read_mesh
-from curvdetail.curvature._validate import bbox_diagonal, check_mesh, vertex_components
+from curvdetail.curvature.checks import check_mesh
+from curvdetail.curvature.geometry import bbox_diagonal
+from curvdetail.curvature.topology import vertex_components
 
 
 #: how far the seed and its one-ring are lifted along the mean normal: a fraction of the diagonal

@@ -108,7 +108,7 @@ def rng():
 def wavy_grid_with_a_sliver():
     """A builder: ``(V, F)`` of a 30 x 30 wavy grid with one valid but near-degenerate triangle
     of the given doubled area (times the squared bbox diagonal)."""
-    from curvdetail.curvature._validate import bbox_diagonal
+    from curvdetail.curvature.geometry import bbox_diagonal
     from curvdetail.curvature.testing import grid
 
     def _build(double_area):

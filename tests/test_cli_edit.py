@@ -54,7 +54,7 @@ def test_handle_detail_and_relations_options_change_only_the_interior(tmp_path):
     assert np.abs(A - B)[status == 1].max() > 1e-3
     # --relations reaches the editor: the free vertices move, to where the library puts them
     assert np.abs(A - C)[status == 1].max() > 1e-2             # 0.063
-    from curvdetail.curvature._validate import bbox_diagonal
+    from curvdetail.curvature.geometry import bbox_diagonal
     from curvdetail.io.deformation import edit_with_selection
 
     expected = edit_with_selection(V, F, status, T, relations="one+two-ring")
@@ -168,7 +168,7 @@ def test_an_edit_that_folds_triangles_is_written_with_exit_status_4(tmp_path, ca
     # handles, so the amplification rule alone let it exit 0; apply_curvature_editing warned
     from scipy.spatial import cKDTree
 
-    from curvdetail.curvature._geometry import folded_triangles
+    from curvdetail.curvature.geometry import folded_triangles
 
     V, F = read_mesh(os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "terrainA_1k.obj"))
     diagonal = np.linalg.norm(np.ptp(V, axis=0))

@@ -169,7 +169,7 @@ def test_apply_with_added_layer_transfers_between_files(capsys, tmp_path):
     # the source than the zero-detail (harmonic) surface of the same boundary (vertex distance
     # at most 0.11 % of the diagonal against 16.5 %)
     from curvdetail import boundary_vertices, read_mesh, reconstruct
-    from curvdetail.curvature._validate import bbox_diagonal
+    from curvdetail.curvature.geometry import bbox_diagonal
     from curvdetail.remesh import vertex_distance
 
     t = load_meshset(tmp_path / "t.ply")
@@ -357,7 +357,7 @@ def test_a_closed_stderr_does_not_stop_the_work(tmp_path):
 
 def test_a_script_step_with_a_big_target_is_announced_as_a_note(capsys, tmp_path, monkeypatch):
     from curvdetail import read_mesh
-    from curvdetail.curvature._validate import bbox_diagonal
+    from curvdetail.curvature.geometry import bbox_diagonal
     from curvdetail.filters import save_script
 
     monkeypatch.setattr(importlib.import_module("curvdetail.remesh.retriangulate"), "BIG_TARGET", 500)

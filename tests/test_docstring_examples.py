@@ -1,23 +1,21 @@
-"""The Examples sections of the remeshing, filter and editing modules run as written (the core
-modules' doctests run in their own test files)."""
+"""The Examples sections of every module run as written."""
 
 import doctest
 import importlib
+import pkgutil
 
 import pytest
 
-MODULES = [
-    "curvdetail.remesh.closest_point", "curvdetail.remesh.evaluate", "curvdetail.remesh.experiment",
-    "curvdetail.remesh.locate",
-    "curvdetail.remesh.parameterize", "curvdetail.remesh.retriangulate", "curvdetail.remesh.transfer",
-    "curvdetail.filters.dispatch", "curvdetail.filters.mlx", "curvdetail.filters.parameters",
-    "curvdetail.io.deformation", "curvdetail.plot", "curvdetail.curvature.curvature_editor",
-    "curvdetail.curvature.curvature_coefficients", "curvdetail.curvature.boundary_editing",
-    "curvdetail.remesh._disk",
-]
+import curvdetail
+
+MODULES = sorted(m.name for m in pkgutil.walk_packages(curvdetail.__path__, "curvdetail.")
+                 if not m.name.endswith("__main__"))
+#: the modules whose docstrings hold examples
+WITH_EXAMPLES = [name for name in MODULES
+                 if any(t.examples for t in doctest.DocTestFinder().find(importlib.import_module(name)))]
 
 
-@pytest.mark.parametrize("name", MODULES)
+@pytest.mark.parametrize("name", WITH_EXAMPLES)
 def test_examples_run_as_written(name):
     result = doctest.testmod(importlib.import_module(name), optionflags=doctest.ELLIPSIS)
     assert result.attempted > 0 and result.failed == 0

@@ -7,7 +7,7 @@ import pymeshlab
 import pytest
 
 from curvdetail import ConstraintError, boundary_vertices
-from curvdetail.curvature._validate import bbox_diagonal
+from curvdetail.curvature.geometry import bbox_diagonal
 from curvdetail.filters import FilterError, apply
 from curvdetail.filters.meshset import set_vertex_positions
 

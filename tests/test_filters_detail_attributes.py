@@ -8,7 +8,7 @@ import pymeshlab
 import pytest
 
 from curvdetail import boundary_vertices, curvature_detail, reconstruct
-from curvdetail.curvature._validate import bbox_diagonal
+from curvdetail.curvature.geometry import bbox_diagonal
 from curvdetail.filters import FilterError, apply
 
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")

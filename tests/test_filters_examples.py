@@ -9,7 +9,7 @@ import pytest
 
 from curvdetail import boundary_vertices, reconstruct
 from curvdetail.cli import main
-from curvdetail.curvature._validate import bbox_diagonal
+from curvdetail.curvature.geometry import bbox_diagonal
 from curvdetail.data import example_path
 from curvdetail.filters import run_script
 from curvdetail.filters.files import load_meshset

@@ -7,7 +7,7 @@ import pymeshlab
 import pytest
 
 from curvdetail import boundary_vertices
-from curvdetail.curvature._validate import bbox_diagonal
+from curvdetail.curvature.geometry import bbox_diagonal
 from curvdetail.filters import apply
 from curvdetail.filters.errors import FilterParameterError
 from curvdetail.filters.meshset import vertex_attribute

@@ -6,7 +6,7 @@ import numpy as np
 import pymeshlab
 import pytest
 
-from curvdetail.curvature._validate import bbox_diagonal
+from curvdetail.curvature.geometry import bbox_diagonal
 from curvdetail.curvature.errors import MeshError
 from curvdetail.curvature.testing import grid
 from curvdetail.filters import FilterError, apply

@@ -7,7 +7,7 @@ import pymeshlab
 import pytest
 
 from curvdetail import MeshError, boundary_vertices, curvature_detail, mixed_voronoi_area, reconstruct
-from curvdetail.curvature._validate import bbox_diagonal
+from curvdetail.curvature.geometry import bbox_diagonal
 from curvdetail.filters import FilterError, apply
 from curvdetail.filters.errors import FilterParameterError
 from curvdetail.filters.meshset import set_vertex_positions, vertex_attribute

@@ -10,7 +10,7 @@ from scipy.optimize import brentq
 
 from curvdetail import (ConstraintError, MeshError, boundary_vertices, cotan_laplacian,
                         minimal_surface)
-from curvdetail.curvature._validate import bbox_diagonal, face_double_areas
+from curvdetail.curvature.geometry import bbox_diagonal, face_double_areas
 from curvdetail.curvature.testing import cylinder, grid
 
 from conftest import every_backend
@@ -249,7 +249,7 @@ def _moebius_strip(n_around=60, n_across=6):
 
 
 def test_a_moebius_strip_which_no_orientation_fits_converges():
-    from curvdetail.curvature._validate import misoriented_edges
+    from curvdetail.curvature.topology import misoriented_edges
 
     V, F = _moebius_strip()
     assert misoriented_edges(F).shape[0] > 0              # not orientable
@@ -291,7 +291,7 @@ def test_aligned_normals_take_the_largest_triangle_as_reference():
     # a flat fan around vertex 0 with two triangles reversed, and a small triangle standing
     # perpendicular to it: taken as the reference, the small one flipped the fan's normals
     # into its own plane ([0, 1, 0] instead of the fan's -z)
-    from curvdetail.curvature.minimal_surface import _vertex_normals
+    from curvdetail.curvature.geometry import vertex_normals as _vertex_normals
 
     V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0], [0.05, 0, 0.05]], dtype=float)
     fan = [[0, 1, 2], [0, 3, 2], [0, 3, 4], [0, 1, 4]]          # the second and fourth reversed
@@ -324,7 +324,7 @@ def test_a_neck_pinching_into_needles_is_refused_not_converged():
 def test_healthy_results_keep_their_angles_clear_of_the_needle_threshold(load_mesh):
     # the needle check (|cot| above 1e6 and 100 times the input's) must not touch real results:
     # they stay below ~100 (the nose's after its 44 steps: under 20)
-    from curvdetail.curvature._geometry import corner_cotangents
+    from curvdetail.curvature.geometry import corner_cotangents
     from curvdetail.curvature.minimal_surface import DEGENERATE_COTANGENT
 
     V, F = load_mesh("mannequin_nose.obj")
@@ -337,7 +337,7 @@ def test_an_input_sliver_is_not_taken_for_a_collapse():
     # a bump with a flat rim, and a flap 1e-8 high on a rim edge: its |cot| is 1.25e7 in the
     # input already (its vertices are fixed, it stays so). Only a growth past the input's counts
     from curvdetail.curvature import boundary_edges
-    from curvdetail.curvature._geometry import corner_cotangents
+    from curvdetail.curvature.geometry import corner_cotangents
 
     V, F = grid(5, 5)
     V[:, 2] = V[:, 0] * (1 - V[:, 0]) * V[:, 1] * (1 - V[:, 1])
@@ -408,7 +408,7 @@ def test_remaining_estimate_bounds_the_distance_to_the_limit_near_the_critical_h
     # two unit circles 1.32 apart, just below the largest height a catenoid spans (1.3255): the
     # steps contract by only ~0.92, and the default tol stops 1.2e-3 of the diagonal (normal to
     # the surface) from where the iteration converges, twelve times tol; the estimate says so
-    from curvdetail.curvature.minimal_surface import _vertex_normals
+    from curvdetail.curvature.geometry import vertex_normals as _vertex_normals
 
     V, F = cylinder(radius=1.0, height=1.32, n_around=64, n_along=33)
     b = boundary_vertices(F)

@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 
 from curvdetail import (ConstraintError, MeshError, Reconstructor, SolverError, boundary_vertices, cotan_laplacian, curvature_detail, reconstruct)
 from curvdetail.curvature import sparse_solver
-from curvdetail.curvature._validate import bbox_diagonal
+from curvdetail.curvature.geometry import bbox_diagonal
 from curvdetail.curvature.testing import grid, icosphere
 
 from conftest import InexactSolves, every_backend, jittered_grid

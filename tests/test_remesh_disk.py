@@ -92,7 +92,7 @@ def test_patch_with_a_handle_is_refused_with_the_handle_count():
 
 def test_a_reversed_boundary_triangle_is_named_as_an_orientation_problem(flat_disk):
     # it looked like a pinched boundary ("cut one out"); the fix is to orient the triangles
-    from curvdetail.curvature._validate import boundary_edges
+    from curvdetail.curvature.topology import boundary_edges
 
     V, F = flat_disk
     F = F.copy()

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from curvdetail.curvature._validate import bbox_diagonal
+from curvdetail.curvature.geometry import bbox_diagonal
 from curvdetail.curvature.testing import grid
 from curvdetail.remesh import RemeshError, retriangulate
 from curvdetail.remesh._disk import Polyline, check_disk
@@ -36,7 +36,7 @@ def test_isotropic_edges_are_near_the_target_length(load_mesh):
 @pytest.mark.parametrize("target_edge, aggressiveness", [(0.03, 7), (0.06, 7), (0.06, 3), (0.06, 1), (0.06, 0)])
 def test_decimation_reaches_the_triangle_count_of_the_target_edge(load_mesh, target_edge, aggressiveness):
     # at any aggressiveness: with the patch as it came, agg=1 removed 14 of 2,048 triangles
-    from curvdetail.curvature._validate import face_double_areas
+    from curvdetail.curvature.geometry import face_double_areas
 
     V, F = load_mesh("terrainA_1k.obj")
     Vt, Ft = retriangulate(V, F, method="decimate", target_edge=target_edge, aggressiveness=aggressiveness)
@@ -407,7 +407,7 @@ def test_a_decimation_the_boundary_keeps_from_its_target_is_refused_not_returned
 def test_every_decimation_target_in_the_range_is_reached(load_mesh, where):
     # the range ended at 50 estimated vertices (10.7 % on terrainA_1k), where decimation, which
     # keeps the 128 boundary vertices, came back with 148 triangles for 102 asked
-    from curvdetail.curvature._validate import face_double_areas
+    from curvdetail.curvature.geometry import face_double_areas
     from curvdetail.remesh.retriangulate import target_edge_range
 
     V, F = load_mesh("terrainA_1k.obj")

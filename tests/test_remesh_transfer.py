@@ -305,7 +305,7 @@ def test_a_moved_source_rebuilt_from_its_given_detail_comes_back(load_mesh, meth
     # carrying Z's own detail gives Z back (RMS 5.7 %, max 16 %); L is the flat target's, so
     # not to solver precision (on the same mesh: RMS 2.6 %)
     from curvdetail.curvature import boundary_vertices, reconstruct
-    from curvdetail.curvature._validate import bbox_diagonal
+    from curvdetail.curvature.geometry import bbox_diagonal
     from curvdetail.remesh import vertex_distance
 
     V, F, D, Z = _moved_nose(load_mesh)

@@ -1,4 +1,4 @@
-"""Input checks (_validate): every bad-input class gets its error class and a message that names
+"""Input checks (checks, topology): every bad-input class gets its error class and a message that names
 the count and the first offending indices; good input comes back as float64 / int64."""
 
 import numpy as np
@@ -8,7 +8,8 @@ from curvdetail import (ConstraintError, CurvatureEditor, MeshError, check_mesh,
                         curvature_coefficients, curvature_detail, edit_boundary, mean_curvature_normal,
                         minimal_surface, mixed_voronoi_area, reconstruct, sine_displacement)
 from curvdetail.curvature import boundary_edges, boundary_vertices
-from curvdetail.curvature._validate import as_index_set, as_values, vertex_components
+from curvdetail.curvature.checks import as_index_set, as_values
+from curvdetail.curvature.topology import vertex_components
 from curvdetail.curvature.testing import grid, icosphere
 
 OPERATORS = [cotan_laplacian, mixed_voronoi_area, mean_curvature_normal, curvature_detail]
@@ -169,7 +170,7 @@ def test_duplicates_inside_a_mesh_are_named_as_such_not_as_non_manifold_edges(en
 
 
 def test_repeated_triangles_finds_every_repeat_also_for_vertex_counts_beyond_its_key():
-    from curvdetail.curvature._validate import repeated_triangles
+    from curvdetail.curvature.topology import repeated_triangles
 
     V, F = grid(6, 6)
     assert repeated_triangles(F, V.shape[0]) is None
@@ -430,7 +431,7 @@ def test_counts_and_positive_numbers_take_what_numpy_hands_out():
     # float32 scalars (no overflow warning in the range check), 0-d arrays, whole floats
     import warnings
 
-    from curvdetail.curvature._validate import as_count, as_positive_number
+    from curvdetail.curvature.checks import as_count, as_positive_number
 
     with warnings.catch_warnings():
         warnings.simplefilter("error")
@@ -449,7 +450,7 @@ def test_docstring_examples_run():
     import doctest
     import importlib
 
-    result = doctest.testmod(importlib.import_module("curvdetail.curvature._validate"), optionflags=doctest.ELLIPSIS)
+    result = doctest.testmod(importlib.import_module("curvdetail.curvature.checks"), optionflags=doctest.ELLIPSIS)
     assert result.attempted > 0 and result.failed == 0, result
 
 
@@ -466,7 +467,7 @@ def test_boundary_functions_take_sparse_huge_indices_without_allocating_or_overf
 
 
 def test_misoriented_edges_finds_the_three_edges_of_a_reversed_interior_triangle():
-    from curvdetail.curvature._validate import misoriented_edges
+    from curvdetail.curvature.topology import misoriented_edges
 
     V, F = grid(6, 6)
     assert misoriented_edges(F).shape == (0, 2)
@@ -490,7 +491,7 @@ def test_an_integer_0_1_mask_is_named_as_such_with_both_fixes():
 
 
 def test_check_choice_takes_one_str_of_the_choices_and_names_anything_else():
-    from curvdetail.curvature._validate import check_choice
+    from curvdetail.curvature.checks import check_choice
 
     assert check_choice("free", "rows", ("all", "free"), "; use 'all' or 'free'.") == "free"
     assert type(check_choice(np.str_("all"), "rows", ("all", "free"), ".")) is str
@@ -505,7 +506,7 @@ def test_check_choice_takes_one_str_of_the_choices_and_names_anything_else():
 
 
 def test_index_values_that_are_not_whole_numbers_are_named_with_the_first_and_its_position():
-    from curvdetail.curvature._validate import non_whole_index_error      # here: new in this module
+    from curvdetail.curvature.checks import non_whole_index_error      # here: new in this module
 
     assert non_whole_index_error([3.0, 7.0, -0.0], "handles") is None         # whole floats are indices
     assert non_whole_index_error(np.arange(5), "handles") is None

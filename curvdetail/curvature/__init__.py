@@ -3,7 +3,8 @@
 numpy/scipy only. Every function takes ``(V, F)`` arrays and validates them at its boundary.
 """
 
-from ._validate import boundary_edges, boundary_vertices, check_mesh
+from .checks import check_mesh
+from .topology import boundary_edges, boundary_vertices
 from .boundary_editing import boundary_loop, edit_boundary, sine_displacement
 from .cotan_laplacian import cotan_laplacian
 from .curvature_coefficients import CoefficientInfo, curvature_coefficients

@@ -9,10 +9,10 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import depth_first_order
 
-from ._geometry import folded_triangles, ignoring_underflow
-from ._validate import (MIN_DIAGONAL, ZERO_AREA_RELATIVE, _check_magnitude, _compact_ids, as_faces, as_values,
-                        as_vertices, bbox_diagonal, boundary_edges, check_bool, check_choice, check_mesh,
-                        check_oriented, face_double_areas, vertex_components)
+from .geometry import folded_triangles, ignoring_underflow
+from .checks import MIN_DIAGONAL, ZERO_AREA_RELATIVE, _check_magnitude, as_faces, as_values, as_vertices, check_bool, check_choice, check_mesh
+from .geometry import bbox_diagonal, face_double_areas
+from .topology import _compact_ids, boundary_edges, check_oriented, vertex_components
 from .cotan_laplacian import _cotan_laplacian_unchecked, laplacian_product
 from .curvature_coefficients import DEFAULT_RCOND, check_rcond
 from .curvature_editor import CurvatureEditor, _check_relations

@@ -3,8 +3,9 @@
 import numpy as np
 import scipy.sparse as sp
 
-from ._geometry import corner_cotangents, thread_pool
-from ._validate import _check_mesh, bbox_centre, non_manifold_error
+from .geometry import corner_cotangents, thread_pool
+from .checks import _check_mesh, non_manifold_error
+from .geometry import bbox_centre
 
 
 def cotan_laplacian(V, F):

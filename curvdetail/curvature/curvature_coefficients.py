@@ -5,8 +5,9 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ._geometry import ignoring_underflow
-from ._validate import as_count, as_float, centroid_diameter, check_bool
+from .geometry import ignoring_underflow
+from .checks import as_count, as_float, check_bool
+from .geometry import centroid_diameter
 from .cotan_laplacian import checked_cotan_laplacian, laplacian_product
 from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
 

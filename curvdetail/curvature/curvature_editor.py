@@ -6,8 +6,9 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from ._validate import (as_index_set, as_values, bbox_centre, bbox_diagonal, centroid_diameter, check_bool,
-                        check_choice, vertex_components)
+from .checks import as_index_set, as_values, check_bool, check_choice
+from .geometry import bbox_centre, bbox_diagonal, centroid_diameter
+from .topology import vertex_components
 from .cotan_laplacian import checked_cotan_laplacian, laplacian_product
 from .curvature_coefficients import (DEFAULT_MAX_RING, DEFAULT_RCOND, _coefficients, _one_ring_pairs, check_max_ring,
                                      check_rcond)

@@ -2,10 +2,9 @@
 
 import numpy as np
 
-from ._geometry import corner_cotangents, ignoring_underflow
-from ._validate import (check_choice, ZERO_AREA_RELATIVE, as_count, as_index_set, as_positive_number, bbox_centre,
-                        bbox_diagonal, boundary_vertices, check_every_component_fixed, misoriented_edges,
-                        undirected_edges, vertex_components)
+from .checks import ZERO_AREA_RELATIVE, as_count, as_index_set, as_positive_number, check_choice
+from .geometry import bbox_centre, bbox_diagonal, corner_cotangents, ignoring_underflow, vertex_normals
+from .topology import boundary_vertices, check_every_component_fixed, misoriented_edges, undirected_edges, vertex_components
 from .cotan_laplacian import _assemble_upper, checked_cotan_triangle
 from .errors import ConstraintError, MeshError, counted, first_indices, them
 from .reconstruct import _FreeSystemLayout
@@ -70,37 +69,6 @@ DEGENERATE_COTANGENT = 1e6
 #: A triangle counts as degenerated only where its ``|cot|`` also grew this many times over the
 #: input's: an input sliver that the checks accept (down to ZERO_AREA_RELATIVE) is not refused.
 DEGENERATE_GROWTH = 100.0
-
-
-def _vertex_normals(X, F, face_cross=None, aligned=False):
-    """Area-weighted unit vertex normals, shape (n, 3); ``face_cross`` (m, 3), the triangles'
-    ``(x1 - x0) x (x2 - x0)``, where the caller has it. ``aligned=True`` is for triangles that
-    are not consistently oriented (a Moebius strip cannot be): each triangle's normal enters a
-    vertex's sum turned to agree with one of the vertex's triangles, so reversed triangles do not
-    cancel it (the result's sign is then arbitrary; the step measure takes its absolute value).
-    That triangle is the vertex's largest."""
-    fn = np.cross(X[F[:, 1]] - X[F[:, 0]], X[F[:, 2]] - X[F[:, 0]]) if face_cross is None else face_cross
-    n = X.shape[0]
-    if not aligned:
-        N = np.column_stack([np.bincount(F.ravel(), weights=np.repeat(fn[:, k], 3), minlength=n)
-                             for k in range(3)])
-    else:
-        # each vertex's reference is its largest triangle: one nearly perpendicular to the rest
-        # (a sharp crease) would otherwise flip them and the sum could lie in their plane
-        corner_vertex = F.ravel()
-        corner_face = np.repeat(np.arange(F.shape[0]), 3)
-        size = np.repeat(np.einsum("ij,ij->i", fn, fn), 3)
-        order = np.lexsort((size, corner_vertex))
-        last = np.flatnonzero(np.r_[corner_vertex[order][1:] != corner_vertex[order][:-1], True])
-        reference = np.zeros((n, 3))
-        reference[corner_vertex[order][last]] = fn[corner_face[order][last]]
-        N = np.zeros((n, 3))
-        for corner in range(3):
-            sign = np.where(np.einsum("ij,ij->i", fn, reference[F[:, corner]]) < 0, -1.0, 1.0)
-            N += np.column_stack([np.bincount(F[:, corner], weights=sign * fn[:, k], minlength=n)
-                                  for k in range(3)])
-    length = np.linalg.norm(N, axis=1, keepdims=True)
-    return N / np.where(length > 0, length, 1.0)
 
 
 def _piece_diagonals(V, F, adjacency):
@@ -249,7 +217,7 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, step="n
         each = np.linalg.norm(move, axis=1) / scale
         full_step = float(each.max())
         if step == "normal":
-            normals = _vertex_normals(X_new, F, cross, aligned=aligned)
+            normals = vertex_normals(X_new, F, cross, aligned=aligned)
             each = np.abs(np.einsum("ij,ij->i", move, normals)) / scale
         measured, previous = float(each.max()), measured
         if pieces is not None:

@@ -2,8 +2,8 @@
 
 import numpy as np
 
-from ._geometry import corner_cotangents
-from ._validate import checked_arrays
+from .geometry import corner_cotangents
+from .checks import checked_arrays
 
 
 def mixed_voronoi_area(V, F):

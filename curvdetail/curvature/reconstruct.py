@@ -3,8 +3,9 @@
 import numpy as np
 import scipy.sparse as sp
 
-from ._validate import (check_choice, as_count, as_index_set, as_values, bbox_centre,
-                        check_every_component_fixed)
+from .checks import as_count, as_index_set, as_values, check_choice
+from .geometry import bbox_centre
+from .topology import check_every_component_fixed
 from .cotan_laplacian import _symmetric_from_upper, checked_cotan_triangle
 from .errors import ConstraintError
 from .sparse_solver import SolverError, _upper_triangle, factorize, resolve_backend

@@ -3,7 +3,8 @@
 import numpy as np
 
 from ..curvature import reconstruct
-from ..curvature._validate import bbox_diagonal, boundary_vertices
+from ..curvature.geometry import bbox_diagonal
+from ..curvature.topology import boundary_vertices
 from ..curvature.errors import ConstraintError
 from ..curvature.sparse_solver import AUTO_RULE, BACKENDS as _SOLVERS
 from .detail_attributes import load_detail

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from ..curvature._validate import boundary_vertices, check_oriented
+from ..curvature.topology import boundary_vertices, check_oriented
 from ..curvature.curvature_detail import curvature_detail
 from ..curvature.mean_curvature_normal import mean_curvature_normal
 from .detail_attributes import AREA, DETAIL, NORMAL, store_detail  # noqa: F401  (names re-exported)

@@ -4,9 +4,9 @@ import time
 
 import numpy as np
 
-from ..curvature._geometry import folded_triangles
-from ..curvature._validate import (affine_transform_problem, bbox_diagonal, check_transformed_values,
-                                   non_whole_index_error, real_word)
+from ..curvature.geometry import folded_triangles
+from ..curvature.checks import affine_transform_problem, check_transformed_values, non_whole_index_error, real_word
+from ..curvature.geometry import bbox_diagonal
 from ..curvature.curvature_editor import CurvatureEditor
 from ..curvature.errors import (warn, ConstraintError, FoldedTrianglesWarning, UndeterminedEditError, counted,
                                 first_indices)

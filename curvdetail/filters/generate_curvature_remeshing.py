@@ -2,7 +2,7 @@
 
 import os
 
-from ..curvature._validate import bbox_diagonal
+from ..curvature.geometry import bbox_diagonal
 from .apply_curvature_reconstruction import BACKEND_DESCRIPTION, BACKENDS
 from .detail_attributes import DETAIL, stamp
 from .files import loaded_from

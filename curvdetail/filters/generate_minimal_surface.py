@@ -4,7 +4,8 @@ import numpy as np
 
 from ..curvature import minimal_surface
 from ..curvature.minimal_surface import DEFAULT_TOL
-from ..curvature._validate import bbox_diagonal, boundary_vertices, face_double_areas
+from ..curvature.geometry import bbox_diagonal, face_double_areas
+from ..curvature.topology import boundary_vertices
 from ..curvature.errors import ConstraintError
 from .apply_curvature_reconstruction import BACKEND_DESCRIPTION, BACKENDS
 from .meshset import add_layer, get_mesh, layer_id, mesh_arrays

@@ -1,6 +1,7 @@
 """Filter ``get_curvature_reconstruction_error``: two-sided Hausdorff distance between two layers."""
 
-from ..curvature._validate import bbox_diagonal, check_mesh
+from ..curvature.checks import check_mesh
+from ..curvature.geometry import bbox_diagonal
 from ..curvature.errors import MeshError
 from .errors import FilterError
 from .meshset import layer_id, mesh_arrays, set_vertex_quality

@@ -17,7 +17,7 @@ import itertools
 import numpy as np
 
 from ..curvature.errors import MeshError
-from ..curvature.minimal_surface import _vertex_normals as vertex_normals  # noqa: F401  (area-weighted, unit)
+from ..curvature.geometry import vertex_normals  # noqa: F401  (area-weighted, unit)
 from .errors import FilterError
 
 _scratch_ids = itertools.count()

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..curvature._validate import as_float
+from ..curvature.checks import as_float
 from .errors import FilterParameterError
 
 #: Largest magnitude of an int parameter or layer id (pymeshlab passes them as C++ ints).

@@ -10,8 +10,7 @@ import os
 
 import numpy as np
 
-from ..curvature._validate import (affine_transform_problem, as_vertices, check_bool, check_choice,
-                                   check_transformed_values, real_word)
+from ..curvature.checks import affine_transform_problem, as_vertices, check_bool, check_choice, check_transformed_values, real_word
 from ..curvature.curvature_coefficients import DEFAULT_RCOND
 from ..curvature.curvature_editor import CurvatureEditor
 from ..curvature.errors import ConstraintError, CurvdetailError, counted, first_indices

@@ -15,7 +15,7 @@ import shutil
 
 import numpy as np
 
-from ..curvature._validate import as_faces, as_vertices
+from ..curvature.checks import as_faces, as_vertices
 from ..curvature.errors import MeshError, counted
 from .atomic import atomic_write, check_output_path
 from .ply import read_ply, write_ply

@@ -11,8 +11,8 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-from ..curvature._validate import (as_faces, boundary_edges, check_mesh, check_oriented, non_manifold_edges,
-                                   vertex_components)
+from ..curvature.checks import as_faces, check_mesh
+from ..curvature.topology import boundary_edges, check_oriented, non_manifold_edges, vertex_components
 from ..curvature.boundary_editing import loop_of_boundary_edges
 from ..curvature.errors import MeshError, counted, first_indices
 

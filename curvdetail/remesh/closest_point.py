@@ -3,7 +3,8 @@
 import igl
 import numpy as np
 
-from ..curvature._validate import ZERO_AREA_ADVICE, ZERO_AREA_RELATIVE, as_faces, as_vertices, face_double_areas
+from ..curvature.checks import ZERO_AREA_ADVICE, ZERO_AREA_RELATIVE, as_faces, as_vertices
+from ..curvature.geometry import face_double_areas
 from ..curvature.errors import MeshError, first_indices
 
 #: Largest coordinate taken: everything runs in a unit frame, so only the squares of the

@@ -2,8 +2,8 @@
 
 import numpy as np
 
-from ..curvature._validate import (as_count, check_choice, as_faces, bbox_diagonal, check_referenced, checked_arrays,
-                                   face_double_areas)
+from ..curvature.checks import as_count, as_faces, check_choice, check_referenced, checked_arrays
+from ..curvature.geometry import bbox_diagonal, face_double_areas
 from ..curvature.errors import CurvdetailError, MeshError, first_indices
 from .closest_point import check_points_and_mesh, closest_in_frame, unit_frame
 

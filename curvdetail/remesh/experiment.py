@@ -6,7 +6,8 @@ import numpy as np
 
 from ..curvature.errors import warn
 
-from ..curvature._validate import bbox_diagonal, check_bool, check_choice
+from ..curvature.checks import check_bool, check_choice
+from ..curvature.geometry import bbox_diagonal
 from ..curvature.boundary_editing import boundary_loop
 from ..curvature.reconstruct import ROW_MODES, Reconstructor
 from ..curvature.sparse_solver import resolve_backend

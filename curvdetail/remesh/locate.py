@@ -3,7 +3,7 @@
 import numpy as np
 import scipy.sparse as sp
 
-from ..curvature._validate import as_count
+from ..curvature.checks import as_count
 from ..curvature.errors import MeshError, first_indices
 from .closest_point import check_points_and_mesh, closest_in_frame, unit_frame
 

@@ -2,9 +2,10 @@
 
 import numpy as np
 
-from ..curvature._validate import (check_choice, as_faces, as_index_set, as_values, as_vertices, check_every_component_fixed,
-                                  bbox_diagonal, checked_arrays)
-from ..curvature.cotan_laplacian import _cotan_laplacian_unchecked
+from ..curvature.checks import as_faces, as_index_set, as_values, as_vertices, check_choice, checked_arrays
+from ..curvature.geometry import bbox_diagonal
+from ..curvature.topology import check_every_component_fixed
+from ..curvature.cotan_laplacian import cotan_laplacian
 from ..curvature.errors import ConstraintError, MeshError
 from ..curvature.sparse_solver import factorize
 from ._disk import Polyline, check_disk, check_target_boundary
@@ -103,7 +104,7 @@ def harmonic_map(V, F, boundary, boundary_uv, *, backend="auto"):
 def _harmonic_map(V, F, boundary, boundary_uv, backend="auto"):
     """:func:`harmonic_map` on checked input."""
     n = V.shape[0]
-    L = _cotan_laplacian_unchecked(V, F).tocsr()
+    L = cotan_laplacian(V, F).tocsr()
     is_b = np.zeros(n, dtype=bool)
     is_b[boundary] = True
     inner = np.flatnonzero(~is_b)

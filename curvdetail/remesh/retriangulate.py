@@ -4,8 +4,9 @@ import math
 
 import numpy as np
 
-from ..curvature._validate import (check_choice, as_count, as_float, as_positive_number, bbox_diagonal, boundary_edges,
-                                   check_bool, face_double_areas)
+from ..curvature.checks import as_count, as_float, as_positive_number, check_bool, check_choice
+from ..curvature.geometry import bbox_diagonal, face_double_areas
+from ..curvature.topology import boundary_edges
 from ..curvature.errors import counted
 from ._disk import NotADiskError, Polyline, RemeshError, check_disk
 

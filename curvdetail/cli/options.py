@@ -55,7 +55,7 @@ def choice(parser, name, choices, default, help):
 
 
 def add_backend(parser):
-    from .curvature.sparse_solver import BACKENDS
+    from ..curvature.sparse_solver import BACKENDS
 
     parser.add_argument("--backend", default="auto", help=f"sparse solver: {', '.join(('auto',) + BACKENDS)}")
 
@@ -82,13 +82,13 @@ def add_fix(parser):
 
 def input_output(args):
     """Fill ``args.input`` / ``args.output`` from ``--example``; refuse a missing one."""
-    from .curvature.errors import CurvdetailError
+    from ..curvature.errors import CurvdetailError
 
     if args.example:
         if args.output is not None:
             raise CurvdetailError("with --example give only OUTPUT, not INPUT and OUTPUT", parameter="example",
                                   hint="the example is INPUT")
-        from .data import example_path
+        from ..data import example_path
 
         args.input, args.output = example_path(), args.input
     if args.input is None or args.output is None:
@@ -98,7 +98,7 @@ def input_output(args):
 
 
 def read_checked(path):
-    from . import check_mesh, read_mesh
+    from .. import check_mesh, read_mesh
 
     return check_mesh(*read_mesh(path))
 
@@ -107,8 +107,8 @@ def fixed_vertices(args, V, F, *, purpose):
     """The vertices ``--fix`` / ``--fix-boundary`` name (the boundary when neither is given)."""
     import numpy as np
 
-    from . import boundary_vertices
-    from .curvature.errors import ConstraintError
+    from .. import boundary_vertices
+    from ..curvature.errors import ConstraintError
 
     if args.fix is None:
         fixed = boundary_vertices(F)
@@ -205,9 +205,9 @@ def check_outputs(args, outputs, *, inputs=(), other_inputs=(), mesh_check=None)
     meshes, --sel / --def, the bundled example): never replaced. Both ``(option, path)``.
     ``mesh_check``: how a mesh OUTPUT is checked (default :func:`curvdetail.io.mesh.check_mesh_output`).
     """
-    from .curvature.errors import CurvdetailError
-    from .io.atomic import check_output_path
-    from .io.mesh import check_mesh_output
+    from ..curvature.errors import CurvdetailError
+    from ..io.atomic import check_output_path
+    from ..io.mesh import check_mesh_output
 
     outputs = [(name, path, mesh) for name, path, mesh in outputs if path is not None]
     for name, path, _ in outputs:
@@ -277,7 +277,7 @@ def run_on_file(args, work, *, other_inputs=()):
     """``apply`` / ``run``: check OUTPUT, load INPUT and the --add meshes into a MeshSet, run
     ``work(ms)``, save the current mesh, print the figures as JSON; returns them. OUTPUT may
     replace INPUT (with --overwrite), never an --add mesh or one of ``other_inputs``."""
-    from .filters.files import (attributes_lost_in, check_output_path, load_meshset, save_current_mesh,
+    from ..filters.files import (attributes_lost_in, check_output_path, load_meshset, save_current_mesh,
                                 vertex_colours_kept_in)
 
     check_outputs(args, [("OUTPUT", args.output, True)], inputs=[("INPUT", args.input)],
@@ -297,7 +297,7 @@ def figures_status(steps, output):
     :data:`AMPLIFIED` where an edit folded triangles or amplified its constraints, :data:`NOT_CONVERGED`
     (with a note) where they say ``converged: false``, else 0; the first step's status where
     several apply."""
-    from .filters.editing import AMPLIFICATION_LIMIT
+    from ..filters.editing import AMPLIFICATION_LIMIT
 
     status = 0
     for name, figures in steps:
@@ -327,7 +327,7 @@ def _option(args, parameter):
     if parameter in args._options:
         return args._options[parameter]
     if args.command in ("apply", "run"):
-        from .filters import get_filter
+        from ..filters import get_filter
 
         if args.command == "run" or parameter not in get_filter(args.filter).parameter_names:
             return None
@@ -351,9 +351,9 @@ def error_line(exc, args):
 def show_warning(message, category, filename, lineno, file=None, line=None):
     """A library warning as one line: a note where it announces a long run or a finding, a
     warning where an edit folded or amplified; other warnings as Python shows them."""
-    from .curvature.errors import FoldedTrianglesWarning
-    from .filters.editing import AmplifiedEditWarning
-    from .remesh import LongRunWarning, WorseThanZeroDetailWarning
+    from ..curvature.errors import FoldedTrianglesWarning
+    from ..filters.editing import AmplifiedEditWarning
+    from ..remesh import LongRunWarning, WorseThanZeroDetailWarning
 
     if issubclass(category, (LongRunWarning, WorseThanZeroDetailWarning)):
         say(f"note: {message}")

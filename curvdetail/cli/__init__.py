@@ -20,7 +20,7 @@ import sys
 import time
 import warnings
 
-from ._cli_common import (AMPLIFIED, NOT_CONVERGED, Progress, add_backend, add_fix, add_input_output,
+from .options import (AMPLIFIED, NOT_CONVERGED, Progress, add_backend, add_fix, add_input_output,
                           add_overwrite, check_outputs, choice, diagonal, figures_status, fixed_vertices,
                           error_line, input_output, note_dropped, percentage, positive_number, print_figures,
                           quality_for, read_checked, run_on_file, say, show_warning, whole_number_from_one)
@@ -59,7 +59,7 @@ def _reconstruct(parser):
     def run(args):
         import numpy as np
 
-        from . import Reconstructor, curvature_detail, write_mesh
+        from .. import Reconstructor, curvature_detail, write_mesh
 
         inputs = input_output(args)
         check_outputs(args, [("OUTPUT", args.output, True)], **inputs)
@@ -81,7 +81,7 @@ def _reconstruct(parser):
 
 @command("minimal", help="minimal surface spanned by a mesh's boundary (zero curvature detail)")
 def _minimal(parser):
-    from .curvature.minimal_surface import DEFAULT_TOL
+    from ..curvature.minimal_surface import DEFAULT_TOL
 
     add_input_output(parser, "mesh file with a boundary", "minimal surface; quality = distance moved")
     parser.add_argument("--max-iterations", type=whole_number_from_one, default=200,
@@ -99,8 +99,8 @@ def _minimal(parser):
     def run(args):
         import numpy as np
 
-        from . import boundary_vertices, minimal_surface, write_mesh
-        from .curvature.errors import ConstraintError
+        from .. import boundary_vertices, minimal_surface, write_mesh
+        from ..curvature.errors import ConstraintError
 
         inputs = input_output(args)
         check_outputs(args, [("OUTPUT", args.output, True)], **inputs)
@@ -156,10 +156,10 @@ def _remesh(parser):
     def run(args):
         import json
 
-        from .curvature.errors import CurvdetailError
-        from .io import atomic_write, read_mesh, write_mesh
-        from .remesh.experiment import WorseThanZeroDetailWarning, run_experiment, worse_than_zero_detail
-        from .remesh.retriangulate import long_run_reason, long_run_vertices
+        from ..curvature.errors import CurvdetailError
+        from ..io import atomic_write, read_mesh, write_mesh
+        from ..remesh.experiment import WorseThanZeroDetailWarning, run_experiment, worse_than_zero_detail
+        from ..remesh.retriangulate import long_run_reason, long_run_vertices
 
         inputs = input_output(args)
         if args.parameterization is not None and args.location != "uv":
@@ -187,7 +187,7 @@ def _remesh(parser):
                                     surface_check=not args.no_surface_check)
         report = result["report"]
         if args.image is not None:
-            from .plot import save_remeshing_figure
+            from ..plot import save_remeshing_figure
 
             progress.stage("image")
             save_remeshing_figure(args.image, V, F, result["X"], result["Ft"], result["Z"], result["distance"], report,
@@ -226,8 +226,8 @@ def _list(parser):
     def run(args):
         import json
 
-        from .filters import get_filter, list_filters
-        from .filters.registry import describe_filter
+        from ..filters import get_filter, list_filters
+        from ..filters.registry import describe_filter
 
         specs = [get_filter(args.filter)] if args.filter else list_filters()
         if args.json:
@@ -259,7 +259,7 @@ def _apply(parser):
                              "the bbox diagonal (1%%)")
 
     def run(args):
-        from .filters import FilterParameterError, apply, get_filter
+        from ..filters import FilterParameterError, apply, get_filter
 
         spec = get_filter(args.filter)
         params = {}
@@ -284,8 +284,8 @@ def _run(parser):
     _add_file_arguments(parser)
 
     def run(args):
-        from .filters import ScriptError, run_script
-        from .filters.mlx import check_script
+        from ..filters import ScriptError, run_script
+        from ..filters.mlx import check_script
 
         if not check_script(args.script):       # a folder, malformed XML or a bad step: before INPUT
             raise ScriptError(f"{args.script} has no filter steps", parameter="script",
@@ -331,11 +331,11 @@ def _edit(parser):
     def run(args):
         import numpy as np
 
-        from . import write_mesh
-        from .curvature._geometry import folded_triangles
-        from .curvature.errors import UndeterminedEditError
-        from .io.deformation import edit_with_selection, read_selection, read_transform
-        from .plot import save_panels
+        from .. import write_mesh
+        from ..curvature.geometry import folded_triangles
+        from ..curvature.errors import UndeterminedEditError
+        from ..io.deformation import edit_with_selection, read_selection, read_transform
+        from ..plot import save_panels
 
         check_outputs(args, [("OUTPUT", args.output, True), ("--image", args.image, False)],
                       inputs=[("MESH", args.mesh)], other_inputs=[("--sel", args.sel), ("--def", args.transform)])
@@ -382,7 +382,7 @@ def _edit(parser):
 # --- entry point ----------------------------------------------------------------------------
 
 def build_parser():
-    from . import __version__
+    from .. import __version__
 
     parser = argparse.ArgumentParser(
         prog="curvdetail",
@@ -434,6 +434,3 @@ def main(argv=None):
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
 
-
-if __name__ == "__main__":
-    sys.exit(main())
