@@ -379,6 +379,16 @@ def _edit(parser):
     return run
 
 
+# --- evaluate -------------------------------------------------------------------------------
+
+@command("evaluate", help="run a study: mesh files x remeshing configurations, on Dask, into a results "
+                          "table (exit status 0 when it ran, failed cells included)")
+def _evaluate(parser):
+    from .evaluate import add_arguments
+
+    return add_arguments(parser)
+
+
 # --- entry point ----------------------------------------------------------------------------
 
 def build_parser():
