@@ -88,10 +88,6 @@ def run_study(study, inputs, results, *, workers=None, scheduler=None, cell_time
     ------
     StudyError
         An input that names nothing, a results folder that holds other files.
-
-    Examples
-    --------
-    >>> run_study(Study([{"target_edge": ["1%", "2%"]}]), "meshes/", "out/study", workers=2)  # doctest: +SKIP
     """
     if workers is not None and scheduler is not None:
         raise StudyError("workers and scheduler both given", parameter="workers",

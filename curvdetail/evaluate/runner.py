@@ -62,15 +62,16 @@ class Runner:
         self.connection.send(task)
         if not self.connection.poll(timeout):
             self.stop()
-            return failed_row(task, status="timeout", error_class="CellTimeout",
-                              message=f"the cell ran past its time limit of {timeout:g} s and was stopped")
+            return dict(failed_row(task, status="timeout", error_class="CellTimeout",
+                                   message=f"the cell ran past its time limit of {timeout:g} s and was stopped"),
+                        pid=self.process.pid)
         row = self._receive()
         if row is None:
             self.stop()
             code = self.process.returncode
             why = f"signal {signal.Signals(-code).name}" if code < 0 else f"exit status {code}"
-            return failed_row(task, error_class="CellProcessDied", message=f"the cell's process ended ({why}), e.g. "
-                              "killed for memory or crashed in native code")
+            return dict(failed_row(task, error_class="CellProcessDied", message=f"the cell's process ended ({why}), "
+                                   "e.g. killed for memory or crashed in native code"), pid=self.process.pid)
         return row
 
     def stop(self):
