@@ -176,8 +176,8 @@ def test_a_cell_past_its_time_limit_is_stopped_and_the_study_goes_on(tmp_path, m
 
 @pytest.mark.slow
 def test_the_command_runs_a_study_on_a_local_cluster_and_writes_a_summary(tmp_path, meshes, capsys):
-    args = ["evaluate", str(meshes / "bump4.obj"), str(meshes / "bad.obj"), "--results", str(tmp_path / "r"), "--method",
-            "isotropic,decimate", "--target-edge", "8%", "--workers", "2", "--summary", str(tmp_path / "s")]
+    args = ["evaluate", str(meshes / "bump4.obj"), str(meshes / "bad.obj"), "--results", str(tmp_path / "r"),
+            "--method", "isotropic,decimate", "--target-edge", "8%", "--workers", "2", "--summary", str(tmp_path / "s")]
     assert main(args) == 0         # failed cells included (decimation cannot refine bump4; bad.obj)
     table = read_results(tmp_path / "r")
     assert sorted(table.column("status").to_pylist()) == ["failed", "failed", "failed", "ok"]

@@ -6,7 +6,7 @@ import sys
 import time
 
 from .cell import failed_row
-from .study import Study, StudyError
+from .study import StudyError
 from .table import read_parts, write_part, write_results
 
 #: Seconds between rebuilds of results.parquet / results.csv while a study runs.

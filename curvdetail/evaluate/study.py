@@ -187,7 +187,7 @@ class Study:
         if grids is None:
             grids = [data]
         elif data:
-            raise StudyError(f"study: {sorted(data)[0]!r} beside a list of grids", parameter=sorted(data)[0],
+            raise StudyError(f"study: {min(data)!r} beside a list of grids", parameter=min(data),
                              hint="put the option inside each [[grid]]")
         return cls([grids] if isinstance(grids, dict) else grids, _as_list(baselines))
 

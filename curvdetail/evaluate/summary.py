@@ -24,10 +24,11 @@ def _table(groups, first):
              "|---|---:|---:|---:|---:|---:|---:|"]
     for name, rows in sorted(groups.items()):
         ok = [r for r in rows if r["status"] == "ok"]
-        col = lambda c: [r[c] for r in ok]      # noqa: E731
-        lines.append(f"| {name} | {len(ok)} / {len(rows)} | {_stats(col('error_rms_of_diagonal'), 100)} | "
-                     f"{_stats(col('rms_to_floor_ratio'))} | {_stats(col('zero_detail_rms_of_diagonal'), 100)} | "
-                     f"{_stats(col('floor_rms_of_diagonal'), 100)} | {_stats(col('cell_s'), spec='.2f')} |")
+        col = {c: [r[c] for r in ok] for c in ("error_rms_of_diagonal", "rms_to_floor_ratio", "cell_s",
+                                               "zero_detail_rms_of_diagonal", "floor_rms_of_diagonal")}
+        lines.append(f"| {name} | {len(ok)} / {len(rows)} | {_stats(col['error_rms_of_diagonal'], 100)} | "
+                     f"{_stats(col['rms_to_floor_ratio'])} | {_stats(col['zero_detail_rms_of_diagonal'], 100)} | "
+                     f"{_stats(col['floor_rms_of_diagonal'], 100)} | {_stats(col['cell_s'], spec='.2f')} |")
     return "\n".join(lines)
 
 

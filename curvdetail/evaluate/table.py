@@ -24,7 +24,7 @@ COLUMNS = [
     ("cell_key", _S, "hash of the mesh's content and the configuration: a rerun skips a key in the table"),
     ("status", _S, '"ok", "failed" (the error columns say why) or "timeout" (stopped at the cell time limit)'),
     ("mesh_name", _S, "file name"),
-    ("mesh_path", _S, "absolute path as the study was given it"),
+    ("mesh_path", _S, "absolute path the workers read"),
     ("mesh_blake2b", _S, "blake2b (128 bits, hex) of the file's bytes"),
     ("mesh_vertices", _I, "vertices of the source"),
     ("mesh_faces", _I, "triangles of the source"),
