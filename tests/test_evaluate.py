@@ -157,6 +157,8 @@ def test_a_study_writes_a_row_per_cell_with_units_and_resumes(tmp_path, meshes, 
 
     more = run_study(Study([{"target_edge": ["5%", "8%", "9%"]}]), meshes, results, scheduler=client, progress=None)
     assert (more["skipped"], more["ran"]) == (6, 3) and read_results(results).num_rows == 9
+    retry = run_study(study, meshes, results, scheduler=client, retry_failed=True, progress=None)
+    assert (retry["ran"], retry["failed"]) == (2, 2) and read_results(results).num_rows == 9    # bad.obj again
 
 
 @pytest.mark.slow

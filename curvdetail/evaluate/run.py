@@ -99,20 +99,18 @@ def run_study(study, inputs, results, *, workers=None, scheduler=None, cell_time
     cells = study.cells(inputs)
     _check_folder(results)
     table = read_parts(results)
-    keep = table if not retry_failed else table.filter(table.column("status").to_numpy(zero_copy_only=False) == "ok")
-    done = set(keep.column("cell_key").to_pylist())
+    done = {key for key, status in zip(table.column("cell_key").to_pylist(), table.column("status").to_pylist())
+            if status == "ok" or not retry_failed}
     todo = [c for c in cells if c.key not in done]
     summary = {"cells": len(cells), "skipped": len(cells) - len(todo), "ran": 0, "failed": 0}
-    if todo:
-        _say(progress, f"curvdetail evaluate: {len(todo)} of {len(cells)} cells to run"
-                       + (f" ({summary['skipped']} already in {results})" if summary["skipped"] else ""))
-        try:
+    try:
+        if todo:
+            _say(progress, f"curvdetail evaluate: {len(todo)} of {len(cells)} cells to run"
+                           + (f" ({summary['skipped']} already in {results})" if summary["skipped"] else ""))
             _run(todo, results, workers, scheduler, cell_timeout, progress, summary)
-        finally:
-            write_results(results, read_parts(results))
-    elif not os.path.isfile(os.path.join(results, "results.parquet")):
-        write_results(results, table)
-    summary["table"] = read_parts(results)
+    finally:
+        summary["table"] = read_parts(results)
+        write_results(results, summary["table"])
     return summary
 
 

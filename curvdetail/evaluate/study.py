@@ -37,7 +37,8 @@ DEFAULTS = {"method": ["isotropic"], "target_edge": ["1%"], "transfer": ["conser
             "location": ["closest"], "parameterization": ["harmonic"]}
 #: The baselines a study may name; ``pointwise`` is a configuration, the others are figures of every cell.
 BASELINES = {"zero_detail": None, "floor": None,
-             "pointwise": {"transfer": ["pointwise"], "rows": ["all"], "location": ["uv"]}}
+             "pointwise": {"transfer": ["pointwise"], "rows": ["all"], "location": ["uv"],
+                           "parameterization": ["harmonic"]}}
 #: The keys of a configuration, in the order of the table's columns.
 CONFIG_KEYS = ("method", "target_edge", "transfer", "rows", "location", "parameterization")
 
