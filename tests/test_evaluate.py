@@ -41,7 +41,7 @@ def meshes(tmp_path_factory):
 def client():
     from distributed import Client, LocalCluster
 
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster, \
             Client(cluster) as c:
         yield c
 
@@ -174,6 +174,17 @@ def test_a_cell_past_its_time_limit_is_stopped_and_the_study_goes_on(tmp_path, m
     with pytest.raises(ProcessLookupError):         # its process was killed, not left running
         os.kill(slow["pid"], 0)
     assert rows["bump4.obj"]["status"] == "ok"
+
+
+@pytest.mark.slow
+def test_a_cell_past_its_memory_limit_is_stopped(tmp_path, client):
+    # the cell process holds ~200 MiB once the package is imported; this cell grows to GBs
+    out = run_study(Study([{"target_edge": "0.2%"}]), data_path("terrainA_1k.obj"), tmp_path / "s",
+                    scheduler=client, cell_memory=100, progress=None)
+    (row,) = out["table"].to_pylist()
+    assert (row["status"], row["error_class"]) == ("memory", "CellMemoryLimit")
+    with pytest.raises(ProcessLookupError):
+        os.kill(row["pid"], 0)
 
 
 @pytest.mark.slow

@@ -29,7 +29,9 @@ def add_arguments(parser):
     where.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask cluster, e.g. tcp://HOST:8786")
     parser.add_argument("--cell-timeout", type=positive_number, metavar="S",
                         help="stop a cell after S seconds and record it as timed out")
-    parser.add_argument("--retry-failed", action="store_true", help="run the failed and timed-out cells again")
+    parser.add_argument("--cell-memory", type=positive_number, metavar="MIB",
+                        help="stop a cell whose process uses more than MIB MiB of memory, and record it")
+    parser.add_argument("--retry-failed", action="store_true", help="run the cells that did not end ok again")
     parser.add_argument("--summary", metavar="DIR", help="write DIR/summary.md and plots of the whole table")
     parser.add_argument("--overwrite", action="store_true", help="replace the files of an earlier --summary")
     return run
@@ -54,12 +56,12 @@ def run(args):
         for name in FILES:
             check_output_path(os.path.join(args.summary, name), args.overwrite)
     out = run_study(study, args.inputs, args.results, workers=args.workers, scheduler=args.scheduler,
-                    cell_timeout=args.cell_timeout, retry_failed=args.retry_failed)
+                    cell_timeout=args.cell_timeout, cell_memory=args.cell_memory, retry_failed=args.retry_failed)
     table = out["table"]
     status = table.column("status").to_pylist()
     say(f"curvdetail evaluate: {out['ran']} cells run, {out['skipped']} already in {args.results}; the table holds "
         f"{len(status)} cells: {status.count('ok')} ok, {status.count('failed')} failed, "
-        f"{status.count('timeout')} timed out")
+        f"{status.count('timeout')} timed out, {status.count('memory')} over the memory limit")
     if args.summary is not None:
         write_summary(table, args.summary, overwrite=args.overwrite)
     return 0

@@ -37,7 +37,7 @@ def _client(workers, scheduler):
             yield client
     else:
         with LocalCluster(n_workers=workers or os.cpu_count(), threads_per_worker=1, processes=True,
-                          dashboard_address=None) as cluster, Client(cluster) as client:
+                          dashboard_address=":0") as cluster, Client(cluster) as client:
             yield client
 
 
@@ -49,14 +49,15 @@ def _check_folder(results):
     os.makedirs(os.path.join(results, "parts"), exist_ok=True)
 
 
-def run_study(study, inputs, results, *, workers=None, scheduler=None, cell_timeout=None, retry_failed=False,
-              progress=sys.stderr):
+def run_study(study, inputs, results, *, workers=None, scheduler=None, cell_timeout=None, cell_memory=None,
+              retry_failed=False, progress=sys.stderr):
     """Run every cell of ``study`` on the meshes ``inputs`` names that ``results`` does not hold yet.
 
     Each finished cell's row is written at once (``results/parts/<cell key>.parquet``);
     ``results/results.parquet`` and ``results/results.csv`` are rebuilt from the parts every
     :data:`REBUILD_EVERY` seconds and at the end (also after Ctrl-C). A failed cell is a row
-    with ``status`` "failed" and its error, one past ``cell_timeout`` a row with "timeout".
+    with ``status`` "failed" and its error, one stopped at ``cell_timeout`` or ``cell_memory`` a
+    row with "timeout" or "memory".
 
     Parameters
     ----------
@@ -73,8 +74,11 @@ def run_study(study, inputs, results, *, workers=None, scheduler=None, cell_time
         Use this cluster instead (``"tcp://HOST:PORT"`` of ``dask scheduler``).
     cell_timeout : float or None
         Seconds a cell may run before it is stopped.
+    cell_memory : float or None
+        MiB of resident memory the process of a cell may use before it is stopped (checked
+        every 0.1 s).
     retry_failed : bool
-        Run failed and timed-out cells of the table again.
+        Run the table's cells that did not end "ok" again.
     progress : file or None
         Where progress lines go (cells done / failed / running, rate, time left).
 
@@ -82,7 +86,7 @@ def run_study(study, inputs, results, *, workers=None, scheduler=None, cell_time
     -------
     dict
         ``cells`` (of the study), ``skipped`` (already in the table), ``ran``, ``failed``
-        (failed or timed out, of those that ran) and ``table`` (the whole table, pyarrow).
+        (of those that ran, the ones not "ok") and ``table`` (the whole table, pyarrow).
 
     Raises
     ------
@@ -92,9 +96,9 @@ def run_study(study, inputs, results, *, workers=None, scheduler=None, cell_time
     if workers is not None and scheduler is not None:
         raise StudyError("workers and scheduler both given", parameter="workers",
                          hint="the scheduler's cluster has its own workers; give one of them")
-    if cell_timeout is not None and not cell_timeout > 0:
-        raise StudyError(f"cell_timeout {cell_timeout!r} is not a positive number of seconds",
-                         parameter="cell_timeout", value=cell_timeout)
+    for name, limit in (("cell_timeout", cell_timeout), ("cell_memory", cell_memory)):
+        if limit is not None and not limit > 0:
+            raise StudyError(f"{name} {limit!r} is not a positive number", parameter=name, value=limit)
     results = os.fspath(results)
     cells = study.cells(inputs)
     _check_folder(results)
@@ -107,21 +111,21 @@ def run_study(study, inputs, results, *, workers=None, scheduler=None, cell_time
         if todo:
             _say(progress, f"curvdetail evaluate: {len(todo)} of {len(cells)} cells to run"
                            + (f" ({summary['skipped']} already in {results})" if summary["skipped"] else ""))
-            _run(todo, results, workers, scheduler, cell_timeout, progress, summary)
+            _run(todo, results, workers, scheduler, (cell_timeout, cell_memory), progress, summary)
     finally:
         summary["table"] = read_parts(results)
         write_results(results, summary["table"])
     return summary
 
 
-def _run(cells, results, workers, scheduler, cell_timeout, progress, summary):
+def _run(cells, results, workers, scheduler, limits, progress, summary):
     from distributed import as_completed
 
     from .runner import evaluate_cell
 
     t0 = last_said = last_rebuild = time.monotonic()
     with _client(workers, scheduler) as client:
-        futures = {client.submit(evaluate_cell, cell.task(), cell_timeout, key=f"curvdetail-cell-{cell.key}",
+        futures = {client.submit(evaluate_cell, cell.task(), *limits, key=f"curvdetail-cell-{cell.key}",
                                  pure=False): cell for cell in cells}
         for future in as_completed(futures):
             cell = futures[future]

@@ -16,10 +16,14 @@ import threading
 import time
 from multiprocessing.connection import Connection
 
+import psutil
+
 from .cell import failed_row, run_cell
 
 #: Seconds a fresh process may take to import the package before the cell is failed.
 STARTUP_TIMEOUT = 300.0
+#: Seconds between checks of a running cell's time and memory.
+CHECK_EVERY = 0.1
 #: Environment of the process: one thread for every numeric library.
 ONE_THREAD = {name: "1" for name in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS",
                                      "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS")}
@@ -56,14 +60,21 @@ class Runner:
     def alive(self):
         return self.process.poll() is None
 
-    def run(self, task, timeout=None):
-        """The row of ``task``; a failed row where it ran past ``timeout`` seconds (the process is
-        killed: ``status="timeout"``) or its process died (``error_class="CellProcessDied"``)."""
+    def run(self, task, timeout=None, memory=None):
+        """The row of ``task``; a failed row where it ran past ``timeout`` seconds
+        (``status="timeout"``) or its resident memory past ``memory`` MiB (``status="memory"``),
+        the process then killed, or where its process died (``error_class="CellProcessDied"``)."""
         self.connection.send(task)
-        if not self.connection.poll(timeout):
+        start, limit = time.monotonic(), None
+        while limit is None and not self.connection.poll(CHECK_EVERY):
+            if timeout is not None and time.monotonic() - start > timeout:
+                limit = ("timeout", "CellTimeout", f"the cell ran past its time limit of {timeout:g} s")
+            elif memory is not None and psutil.Process(self.process.pid).memory_info().rss > memory * 2.0 ** 20:
+                limit = ("memory", "CellMemoryLimit", f"the cell's process grew past its limit of {memory:g} MiB")
+        if limit is not None:
             self.stop()
-            return dict(failed_row(task, status="timeout", error_class="CellTimeout",
-                                   message=f"the cell ran past its time limit of {timeout:g} s and was stopped"),
+            status, error_class, message = limit
+            return dict(failed_row(task, status=status, error_class=error_class, message=message + " and was stopped"),
                         pid=self.process.pid)
         row = self._receive()
         if row is None:
@@ -84,15 +95,16 @@ class Runner:
 _local = threading.local()
 
 
-def evaluate_cell(task, timeout=None):
+def evaluate_cell(task, timeout=None, memory=None):
     """Dask task: the row of one cell, run in this worker thread's :class:`Runner` (started on
-    first use, again after a timeout or a crash); never raises for the cell's failure."""
+    first use, again after a limit or a crash; ``timeout`` seconds, ``memory`` MiB); never
+    raises for the cell's failure."""
     runner = getattr(_local, "runner", None)
     try:
         if runner is None or not runner.alive():
             runner = _local.runner = Runner()
-        row = runner.run(task, timeout)
-    except (RuntimeError, OSError) as exc:
+        row = runner.run(task, timeout, memory)
+    except (RuntimeError, OSError, psutil.Error) as exc:
         row = failed_row(task, exc)
     try:
         from distributed import get_worker

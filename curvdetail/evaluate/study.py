@@ -171,6 +171,8 @@ class Study:
         extra = [dict(g, **BASELINES["pointwise"]) for g in grids] if "pointwise" in self.baselines else []
         for k, grid in enumerate(list(grids) + extra, start=1):
             where = f"grid {k}"
+            if not isinstance(grid, dict):
+                raise StudyError(f"{where} is not a table of options", parameter="grid", value=grid)
             unknown = sorted(set(grid) - set(DEFAULTS) - {"meshes"})
             if unknown:
                 raise StudyError(f"{where}: unknown option {unknown[0]!r}", parameter=unknown[0],

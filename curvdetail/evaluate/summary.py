@@ -35,13 +35,13 @@ def _table(groups, first):
 def summary_markdown(rows):
     """The Markdown summary of a study's rows (dicts): counts, the figures per configuration
     (over the meshes) and per mesh (over the configurations), and the cells that failed."""
-    status = {s: sum(r["status"] == s for r in rows) for s in ("ok", "failed", "timeout")}
+    status = {s: sum(r["status"] == s for r in rows) for s in ("ok", "failed", "timeout", "memory")}
     by_config, by_mesh = {}, {}
     for r in rows:
         by_config.setdefault(label(r, target=True), []).append(r)
         by_mesh.setdefault(r["mesh_name"], []).append(r)
     text = [f"# Study summary\n\n{len(rows)} cells: {status['ok']} ok, {status['failed']} failed, "
-            f"{status['timeout']} timed out. Distances in % of the source's bbox diagonal; RMS/floor is "
+            f"{status['timeout']} timed out, {status['memory']} over the memory limit. Distances in % of the source's bbox diagonal; RMS/floor is "
             "the rebuilt RMS over the retriangulated surface's own.\n",
             "## Per configuration (method transfer rows location target edge), over the meshes\n",
             _table(by_config, "configuration"), "\n## Per mesh, over the configurations\n", _table(by_mesh, "mesh")]

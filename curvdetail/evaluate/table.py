@@ -22,7 +22,7 @@ _S, _F, _I, _B = pa.string(), pa.float64(), pa.int64(), pa.bool_()
 #: (column, type, meaning) of every column, in order.
 COLUMNS = [
     ("cell_key", _S, "hash of the mesh's content and the configuration: a rerun skips a key in the table"),
-    ("status", _S, '"ok", "failed" (the error columns say why) or "timeout" (stopped at the cell time limit)'),
+    ("status", _S, '"ok", "failed" (the error columns say why), "timeout" or "memory" (stopped at a limit)'),
     ("mesh_name", _S, "file name"),
     ("mesh_path", _S, "absolute path the workers read"),
     ("mesh_blake2b", _S, "blake2b (128 bits, hex) of the file's bytes"),
