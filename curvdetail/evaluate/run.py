@@ -1,6 +1,7 @@
 """Run a study on Dask: every cell not yet in the results folder, each as one task."""
 
 import contextlib
+import logging
 import os
 import sys
 import time
@@ -37,7 +38,7 @@ def _client(workers, scheduler):
             yield client
     else:
         with LocalCluster(n_workers=workers or os.cpu_count(), threads_per_worker=1, processes=True,
-                          dashboard_address=":0") as cluster, Client(cluster) as client:
+                          dashboard_address=":0", silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
             yield client
 
 
@@ -123,8 +124,8 @@ def _run(cells, results, workers, scheduler, limits, progress, summary):
 
     from .runner import evaluate_cell
 
-    t0 = last_said = last_rebuild = time.monotonic()
     with _client(workers, scheduler) as client:
+        t0 = last_said = last_rebuild = time.monotonic()        # the rate from here: not the cluster's start
         futures = {client.submit(evaluate_cell, cell.task(), *limits, key=f"curvdetail-cell-{cell.key}",
                                  pure=False): cell for cell in cells}
         for future in as_completed(futures):
