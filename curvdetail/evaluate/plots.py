@@ -17,6 +17,16 @@ def label(row, target=False):
     return " ".join(parts + ([row["target_edge"]] if target else []))
 
 
+def _plain_log_axes(ax):
+    """Log axes with tick labels as plain numbers (0.5, 2, 10)."""
+    from matplotlib.ticker import LogFormatter
+
+    ax.set(xscale="log", yscale="log")
+    for axis in (ax.xaxis, ax.yaxis):       # minor ticks labelled where the axis spans under 2 decades
+        axis.set_major_formatter(LogFormatter())
+        axis.set_minor_formatter(LogFormatter(labelOnlyBase=False, minor_thresholds=(2, 0.5)))
+
+
 def _save(fig, path, overwrite, dpi=100):
     with atomic_write(path, overwrite=overwrite) as tmp:
         fig.savefig(tmp, dpi=dpi, format="png")
@@ -43,7 +53,8 @@ def plot_rms_against_target(rows, path, *, overwrite=False):
     for (name, style), points in sorted(series.items()):
         x = sorted(points)
         ax.plot(100 * np.array(x), [100 * np.median(points[v]) for v in x], style, label=name, markersize=4)
-    ax.set(xscale="log", yscale="log", xlabel="target edge, % of the bbox diagonal",
+    _plain_log_axes(ax)
+    ax.set(xlabel="target edge, % of the bbox diagonal",
            ylabel="RMS to the source, % of bbox diagonal\n(median over the meshes)")
     if series:
         ax.legend(fontsize=7)
@@ -61,7 +72,8 @@ def plot_ratio_to_floor(rows, path, *, overwrite=False):
     M = np.full((len(meshes), len(configs)), np.nan)
     for r in rows:
         M[meshes.index(r["mesh_name"]), configs.index(label(r, target=True))] = r["rms_to_floor_ratio"]
-    fig = Figure(figsize=(3.0 + 0.45 * len(configs), 3.5 + 0.3 * len(meshes)), layout="constrained")
+    fig = Figure(figsize=(min(3.0 + 0.45 * len(configs), 30.0), min(3.5 + 0.3 * len(meshes), 30.0)),
+                 layout="constrained")
     ax = fig.subplots()
     if rows:
         image = ax.imshow(M, aspect="auto", cmap="viridis", norm=LogNorm(vmin=max(np.nanmin(M), 1e-3)))
@@ -69,8 +81,10 @@ def plot_ratio_to_floor(rows, path, *, overwrite=False):
         if M.size <= 400:
             for (i, j), value in np.ndenumerate(M):
                 ax.text(j, i, f"{value:.3g}", ha="center", va="center", fontsize=7, color="w")
-    ax.set_xticks(range(len(configs)), configs, rotation=60, ha="right", fontsize=7)
-    ax.set_yticks(range(len(meshes)), meshes, fontsize=7)
+    if len(configs) <= 60:          # more names than fit are left out
+        ax.set_xticks(range(len(configs)), configs, rotation=60, ha="right", fontsize=7)
+    if len(meshes) <= 90:
+        ax.set_yticks(range(len(meshes)), meshes, fontsize=7)
     ax.set_title("rebuilt RMS over the retriangulated floor", fontsize=9)
     _save(fig, path, overwrite)
 
@@ -85,7 +99,8 @@ def plot_time_against_vertices(rows, path, *, overwrite=False):
     for method in sorted({r["method"] for r in rows}):
         chosen = [r for r in rows if r["method"] == method]
         ax.plot([r["mesh_vertices"] for r in chosen], [r["cell_s"] for r in chosen], "o", label=method, alpha=0.7)
-    ax.set(xscale="log", yscale="log", xlabel="source vertices", ylabel="seconds per cell")
+    _plain_log_axes(ax)
+    ax.set(xlabel="source vertices", ylabel="seconds per cell")
     if rows:
         ax.legend(fontsize=8)
     _save(fig, path, overwrite)
