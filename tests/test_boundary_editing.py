@@ -155,9 +155,9 @@ def test_the_mesh_is_checked_and_its_laplacian_assembled_once(monkeypatch):
     calls = []
     real = module._assemble_upper
 
-    def counting(V, F, cot, check_manifold, edge_counts=None):
+    def counting(V, F, cot, check_manifold):
         calls.append(check_manifold)
-        return real(V, F, cot, check_manifold, edge_counts)
+        return real(V, F, cot, check_manifold)
 
     monkeypatch.setattr(module, "_assemble_upper", counting)
     V, F = grid(10, 10)
