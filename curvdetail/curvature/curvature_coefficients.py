@@ -5,20 +5,25 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from .geometry import ignoring_underflow
 from .checks import as_count, as_float, check_bool
-from .geometry import centroid_diameter
+from .errors import CurvdetailError
+from .geometry import centroid_diameter, ignoring_underflow
 from .cotan_laplacian import checked_cotan_laplacian, laplacian_product
 from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
 
-#: Default relative threshold on the singular values of a one-ring's detail matrix (see
-#: :func:`curvature_coefficients`). The 3x3 Gram matrices carry ~1e-16 relative error in their
-#: eigenvalues, i.e. ~1.5e-8 in the singular values, so thresholds below ~1e-7 select noise.
+#: Default relative singular-value threshold (below ~1e-7 it selects the Gram matrices' roundoff).
 DEFAULT_RCOND = 1e-6
 
-#: Default widest ring (see :func:`curvature_coefficients`): a ring that cannot represent its
-#: vertex's detail is widened to the two-ring, then the three-ring.
+#: Default widest ring: a ring that cannot represent its vertex's detail is widened up to this.
 DEFAULT_MAX_RING = 3
+
+#: Gram matrices with ``det(G) > WELL_CONDITIONED * trace(G)^3`` (hence ``cond(G) < 1e6``) are
+#: inverted in closed form; the others go through the eigendecomposition.
+WELL_CONDITIONED = 1e-6
+
+#: A ring goes through the SVD of its ring matrix where one of its singular value ratios
+#: ``sigma_k / sigma_1`` (from ``G_i``'s eigenvalues) lies in this band (see :func:`_coefficients`).
+SVD_BAND = (1e-7, 1e-3)
 
 
 @dataclass(frozen=True)
@@ -123,7 +128,10 @@ def curvature_coefficients(V, F, *, rcond=DEFAULT_RCOND, max_ring=DEFAULT_MAX_RI
     n = V.shape[0]
     D = laplacian_product(L, V)
     A = _mixed_voronoi_area_unchecked(V, F)
-    rows, cols, indptr = _one_ring_of_laplacian(L, F)
+    # the one-ring pairs from L's pattern (every edge both ways, every diagonal entry, sorted)
+    diag_rows = np.repeat(np.arange(n), np.diff(L.indptr))
+    off = L.indices != diag_rows
+    rows, cols, indptr = diag_rows[off], L.indices[off].astype(np.int64), L.indptr - np.arange(n + 1)
     C, rank, scale, ring = _coefficients(D, A, rows, cols, n, rcond, centroid_diameter(V),
                                          want_scale=return_info, max_ring=max_ring, indptr=indptr)
     if not return_info:
@@ -137,7 +145,7 @@ def curvature_coefficients(V, F, *, rcond=DEFAULT_RCOND, max_ring=DEFAULT_MAX_RI
 
 
 def check_max_ring(max_ring):
-    """``max_ring`` as an int >= 1, or ValueError naming the value and the fix."""
+    """``max_ring`` as an int >= 1, or a ValueError (``parameter="max_ring"``)."""
     return as_count(max_ring, "max_ring", minimum=1)
 
 
@@ -152,40 +160,16 @@ def _one_ring_pairs(F, n):
     return rows, P.indices.astype(np.int64)
 
 
-def _one_ring_of_laplacian(L, F):
-    """The one-ring pairs as :func:`_one_ring_pairs` gives them, plus their row pointers (n + 1,),
-    read off the cotangent Laplacian's pattern: it stores every mesh edge in both directions
-    (explicit zeros kept) and every diagonal entry, sorted. That saves building the pattern
-    again from the triangles (0.3-0.5 s at 1M vertices); a Laplacian not stored so (unsorted or
-    duplicate indices, a diagonal entry missing) takes the triangles' route."""
-    n = L.shape[0]
-    if L.has_canonical_format:                      # sorted, no duplicates
-        rows = np.repeat(np.arange(n), np.diff(L.indptr))
-        off = L.indices != rows
-        if np.array_equal(rows[~off], np.arange(n)):                # every diagonal entry
-            return rows[off], L.indices[off].astype(np.int64), L.indptr - np.arange(n + 1)
-    rows, cols = _one_ring_pairs(F, n)
-    return rows, cols, _row_pointers(rows, n)
-
-
-#: Gram matrices with ``det(G) > WELL_CONDITIONED * trace(G)^3`` (hence ``cond(G) < 1e6``) are
-#: inverted in closed form; the others go through the eigendecomposition.
-WELL_CONDITIONED = 1e-6
-
-
 def check_rcond(rcond):
-    """``rcond`` as a float in (0, 1), or ValueError naming the value and the fix."""
-    number = as_float(rcond)           # a real number only: float("1e-6") and float(True) would pass
+    """``rcond`` as a float in (0, 1), or a ValueError (``parameter="rcond"``)."""
+    number = as_float(rcond)
     if number is None:
-        raise ValueError(f"rcond={rcond!r} is not a number; pass a threshold in (0, 1), e.g. 1e-6.")
+        raise CurvdetailError(f"rcond={rcond!r} is not a number; pass a threshold in (0, 1), e.g. 1e-6.",
+                              parameter="rcond", value=rcond)
     if not 0.0 < number < 1.0:
-        raise ValueError(f"rcond={rcond!r} is outside (0, 1); pass a relative threshold such as 1e-6.")
+        raise CurvdetailError(f"rcond={rcond!r} is outside (0, 1); pass a relative threshold such as 1e-6.",
+                              parameter="rcond", value=rcond)
     return number
-
-
-#: A ring goes through the SVD of its ring matrix where one of its singular value ratios
-#: ``sigma_k / sigma_1`` (from ``G_i``'s eigenvalues) lies in this band (see :func:`_coefficients`).
-SVD_BAND = (1e-7, 1e-3)
 
 
 @ignoring_underflow
@@ -224,8 +208,7 @@ def _coefficients(D, A, rows, cols, n, rcond, size, *, want_scale=False, max_rin
         # clears the threshold; cond(G) <= tr^3 / det keeps the adjugate accurate
         good = (det > WELL_CONDITIONED * tr ** 3) & \
                (np.sqrt(np.maximum(det, 0.0)) / tr > rcond * np.maximum(np.sqrt(tr), area_scale))
-        # on every row (the same operations as on the good rows alone); the others are
-        # overwritten below
+        # on every row; the others are overwritten below
         d0, d1, d2 = D[:, 0], D[:, 1], D[:, 2]
         w = np.stack([(c00 * d0 + c01 * d1 + c02 * d2) / det,
                       (c01 * d0 + c11 * d1 + c12 * d2) / det,
@@ -233,8 +216,7 @@ def _coefficients(D, A, rows, cols, n, rcond, size, *, want_scale=False, max_rin
     rank = np.full(n, 3, dtype=np.int64)
     scale = None
     if want_scale:
-        # sigma_1 of the well-conditioned rows: the largest eigenvalue of G is accurate (the
-        # other rows take theirs from their fit below)
+        # sigma_1 of the well-conditioned rows from G's largest eigenvalue (the others: their fit)
         scale = area_scale.copy()
         scale[good] = np.maximum(np.sqrt(np.maximum(np.linalg.eigvalsh(_gram(g, good))[:, 2], 0.0)),
                                  area_scale[good])
@@ -242,15 +224,12 @@ def _coefficients(D, A, rows, cols, n, rcond, size, *, want_scale=False, max_rin
     hard = np.flatnonzero(~good)
     if hard.size:
         s_hard, residual = np.empty(hard.size), np.empty(hard.size)
-        # G's eigenvalues carry ~1e-16 of the largest, so a singular value between ~1e-7 and
-        # 1e-3 of the largest (near the threshold, or kept with a large weight 1 / sigma^2) is
-        # known only to 1e-10 ... 1e-2 of itself: those rows (fandisk: 46 of them changed by up to
-        # 5e-5 under a rotation) go through the SVD of the ring matrix itself. Rows certain to
-        # go there skip the eigendecomposition (a smooth surface's rings: nearly all of them)
+        # G's eigenvalues carry ~1e-16 of the largest, so a singular value in SVD_BAND is known
+        # only to 1e-10 ... 1e-2 of itself: those rows go through the SVD of the ring matrix
+        # itself; rows certain to go there skip the eigendecomposition
         sure = _surely_in_svd_band(c00[hard], c11[hard], c22[hard], tr[hard])
         redo = sure.copy()
-        # G = 0 (every neighbour's detail is 0: a flat grid's inside) has no singular direction
-        # to keep: w = 0 and rank 0, as its eigendecomposition would give them, without it
+        # G = 0 (a flat grid's inside): w = 0 and rank 0, as the eigendecomposition would give
         zero = tr[hard] == 0.0
         w[hard[zero]], rank[hard[zero]], s_hard[zero] = 0.0, 0, area_scale[hard[zero]]
         residual[zero] = np.linalg.norm(D[hard[zero]], axis=1)
@@ -266,20 +245,13 @@ def _coefficients(D, A, rows, cols, n, rcond, size, *, want_scale=False, max_rin
         redo = np.flatnonzero(redo)
         if redo.size:
             rows_redo = hard[redo]
-            if rows_redo.size > n // 8:           # most rows (a smooth surface): one pass of masks
-                which = np.zeros(n, dtype=bool)
-                which[rows_redo] = True
-                cols_redo = cols[which[rows]]
-            else:
-                cols_redo = cols[_rows_of(indptr, rows_redo)]
+            cols_redo = cols[_rows_of(indptr, rows_redo)]
             w[rows_redo], rank[rows_redo], s_hard[redo], residual[redo] = _truncated_fit(
                 D, A, rows_redo, indptr[rows_redo + 1] - indptr[rows_redo], cols_redo, rcond, size,
                 area_scale=area_scale[rows_redo])
         if want_scale:
             scale[hard] = s_hard
-        # widen the rings that cannot represent their own detail (a valence-2 corner's two
-        # neighbours span a plane its detail leaves): the residual would otherwise be a constant
-        # that no similarity of the constraints moves (see CurvatureEditor)
+        # widen the rings that cannot represent their own detail (a valence-2 corner)
         grow = residual > rcond * s_hard
         if max_ring > 1 and grow.any():
             wide = _widen(D, A, w, rank, scale, ring, hard[grow], rows, cols, indptr, n, rcond, size,
@@ -287,8 +259,6 @@ def _coefficients(D, A, rows, cols, n, rcond, size, *, want_scale=False, max_rin
             if wide is not None:
                 wide_rows, wide_cols = wide
                 wide_vals = np.einsum("ea,ea->e", D[wide_cols], w[wide_rows])
-                # the given pattern's entries of widened rows are left out below (their w is the
-                # wide ring's)
                 vals = np.einsum("ea,ea->e", Dj, w[rows])
                 return _splice(indptr, rows, cols, vals, ring > 1, wide_rows, wide_cols, wide_vals,
                                n), rank, scale, ring
@@ -318,16 +288,13 @@ def _splice(indptr, rows, cols, vals, replaced, wide_rows, wide_cols, wide_vals,
 
 
 def _surely_in_svd_band(c00, c11, c22, tr):
-    """Rows whose Gram matrix ``G`` certainly has ``sigma_2 / sigma_1`` inside :data:`SVD_BAND`
-    as ``G``'s eigenvalues give it, told from its invariants alone (no eigendecomposition: 1.4 s
-    at 1M vertices); (k,) bool. ``c00, c11, c22`` (k,): the diagonal cofactors, ``tr`` the trace.
+    """Rows whose Gram matrix ``G`` certainly has ``sigma_2 / sigma_1`` inside :data:`SVD_BAND`,
+    told from its invariants alone (no eigendecomposition); (k,) bool. ``c00, c11, c22`` (k,):
+    the diagonal cofactors, ``tr`` the trace.
 
-    With ``S = lambda_2 + lambda_3`` and ``q = (c00 + c11 + c22) / tr^2 = (lambda_1 S +
-    lambda_2 lambda_3) / tr^2``, ``lambda_2 / lambda_1`` lies in ``[q / 2, q]`` up to ``O(q^2)``
-    and roundoff (~1e-13 even at valence 1000, where the summed ``G`` may be indefinite by that
-    much; an eigensolver's eigenvalues are off by ~1e-15 of ``lambda_1``). The band kept here
-    leaves a margin of 1e-4 of the limit at the top and a factor 100 at the bottom; rows outside
-    it (non-finite ``q`` included) are decided by their eigenvalues."""
+    ``q = (c00 + c11 + c22) / tr^2 = (lambda_1 (lambda_2 + lambda_3) + lambda_2 lambda_3) / tr^2``
+    puts ``lambda_2 / lambda_1`` in ``[q / 2, q]`` up to ``O(q^2)`` and roundoff; the band kept
+    leaves a margin of 1e-4 at the top and a factor 100 at the bottom."""
     low, high = SVD_BAND
     with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
         q = (c00 + c11 + c22) / tr ** 2
@@ -423,35 +390,23 @@ def _rows_of(indptr, which):
 def _truncated_fit(D, A, target, counts, cols, rcond, size, *, area_scale=None):
     """Truncated minimum-norm fit of ``D_i`` by its ring's details for the rows ``target``
     (``counts`` (t,) ring sizes; ``cols`` the rings' vertices, row after row), through batched
-    SVDs of the zero-padded ring matrices. Returns (w (t, 3), rank (t,), s_i (t,),
-    residual (t,)), where ``C_ij = D_j . w_i``. ``area_scale`` (t,): the rings'
-    ``sqrt(sum_j A_j^2) / size`` where the caller has it.
-
-    Rings are batched by size (up to 16, larger ones padded to the next power of two), not all
-    padded to the largest (one high-valence pole would make every ring that large)."""
+    SVDs of the ring matrices, zero-padded in batches by size (up to 16, larger ones to the next
+    power of two). Returns (w (t, 3), rank (t,), s_i (t,), residual (t,)), where
+    ``C_ij = D_j . w_i``. ``area_scale`` (t,): the rings' ``sqrt(sum_j A_j^2) / size`` if at hand."""
     if area_scale is None:
         at = np.repeat(np.arange(target.size), counts)
         area_scale = (np.sqrt(np.bincount(at, weights=A[cols] ** 2, minlength=target.size))
                       / max(size, np.finfo(float).tiny))
     width = np.where(counts <= 16, np.maximum(counts, 3), 1 << np.ceil(np.log2(np.maximum(counts, 1))).astype(np.int64))
-    widths = np.unique(width)
-    entry_width = np.repeat(width, counts) if widths.size > 1 else None
+    entry_width = np.repeat(width, counts)
     sigma, U = np.zeros((target.size, 3)), np.zeros((target.size, 3, 3))
-    for w in widths:
-        w = int(w)
-        if entry_width is None:                      # one batch: every row, every entry
-            group, cols_group, counts_group = slice(None), cols, counts
-        else:
-            group = np.flatnonzero(width == w)
-            cols_group, counts_group = cols[entry_width == w], counts[group]
-        size_group = counts_group.size
-        if np.all(counts_group == w):                # no padding: the ring matrices as they lie
-            M = D[cols_group].reshape(size_group, w, 3)
-        else:
-            # entry e of the group's row r goes to slot e - first(r) of that row's padded block
-            shift = np.arange(size_group) * w - _cumulative(counts_group)[:-1]
-            M = np.zeros((size_group, w, 3))
-            M.reshape(-1, 3)[np.arange(cols_group.size) + np.repeat(shift, counts_group)] = D[cols_group]
+    for w in np.unique(width):
+        group = np.flatnonzero(width == w)
+        cols_group, counts_group = cols[entry_width == w], counts[group]
+        # entry e of the group's row r goes to slot e - first(r) of that row's padded block
+        shift = np.arange(group.size) * w - _cumulative(counts_group)[:-1]
+        M = np.zeros((group.size, w, 3))
+        M.reshape(-1, 3)[np.arange(cols_group.size) + np.repeat(shift, counts_group)] = D[cols_group]
         # M = D_N^T; D_N's left singular vectors are M's right ones
         with np.errstate(over="ignore", invalid="ignore"):
             _, sigma_g, Vt = np.linalg.svd(M, full_matrices=False)      # descending
