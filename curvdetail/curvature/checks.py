@@ -315,20 +315,23 @@ def as_positive_number(value, name, hint=""):
 
 def as_values(values, count, name, dim=3):
     """Return ``values`` as a (count, dim) float64 array of finite numbers within
-    ``MAX_COORDINATE`` or raise ConstraintError."""
+    ``MAX_COORDINATE`` or raise ConstraintError (``parameter=name``)."""
     try:
         arr = np.asarray(values)
     except Exception as exc:
-        raise ConstraintError(f"{name} could not be read as a float array ({exc}).") from None
+        raise ConstraintError(f"{name} could not be read as a float array ({exc}).", parameter=name) from None
     if arr.dtype.kind not in "fiu":            # complex would lose its imaginary part, bool mean 0/1
-        raise ConstraintError(f"{name} has dtype {arr.dtype}; pass a ({count}, {dim}) array of real numbers.")
+        raise ConstraintError(f"{name} has dtype {arr.dtype}; pass a ({count}, {dim}) array of real numbers.",
+                              parameter=name)
     arr = arr.astype(np.float64, copy=False)
     if arr.shape != (count, dim):
-        raise ConstraintError(f"{name} has shape {arr.shape}; expected ({count}, {dim}), one row per vertex.")
-    if not np.isfinite(arr).all():      # one flat pass; the per-row search below only on failure
+        raise ConstraintError(f"{name} has shape {arr.shape}; expected ({count}, {dim}), one row per vertex.",
+                              parameter=name)
+    if not np.isfinite(arr).all():
         bad = np.flatnonzero(~np.isfinite(arr).all(axis=1))
         raise ConstraintError(f"{name}: {counted(bad.size, 'row', verb='are')} NaN or infinite "
-                              f"(first: {first_indices(bad)}).")
+                              f"(first: {first_indices(bad)}).", parameter=name, count=int(bad.size),
+                              first=bad[:3].tolist())
     _check_magnitude(arr, name, ConstraintError, "scale the problem down")
     return np.ascontiguousarray(arr)
 
