@@ -256,35 +256,15 @@ def _coefficients(D, A, rows, cols, n, rcond, size, *, want_scale=False, max_rin
         if max_ring > 1 and grow.any():
             wide = _widen(D, A, w, rank, scale, ring, hard[grow], rows, cols, indptr, n, rcond, size,
                           max_ring, adjacency)
-            if wide is not None:
+            if wide is not None:           # widened rows take their wide ring's pattern
                 wide_rows, wide_cols = wide
-                wide_vals = np.einsum("ea,ea->e", D[wide_cols], w[wide_rows])
-                vals = np.einsum("ea,ea->e", Dj, w[rows])
-                return _splice(indptr, rows, cols, vals, ring > 1, wide_rows, wide_cols, wide_vals,
-                               n), rank, scale, ring
+                kept = ring[rows] == 1
+                rows, cols = np.concatenate([rows[kept], wide_rows]), np.concatenate([cols[kept], wide_cols])
+                vals = np.einsum("ea,ea->e", D[cols], w[rows])
+                return sp.csr_matrix((vals, (rows, cols)), shape=(n, n)), rank, scale, ring
     # C_ij = D_j . w_i  (w_i = G_i^+ D_i)
     vals = np.einsum("ea,ea->e", Dj, w[rows])
     return sp.csr_matrix((vals, cols, indptr), shape=(n, n)), rank, scale, ring
-
-
-def _splice(indptr, rows, cols, vals, replaced, wide_rows, wide_cols, wide_vals, n):
-    """CSR (n, n) of the row-sorted pattern (``indptr``, ``rows``, ``cols``) and its ``vals``, with
-    the rows ``replaced`` (n,) bool taking the entries (``wide_rows``, ``wide_cols``,
-    ``wide_vals``) instead: each such row's entries are contiguous there, columns increasing.
-    Placed by position (no sort of the whole pattern, which a COO build would do)."""
-    order = np.argsort(wide_rows, kind="stable")
-    wide_cols, wide_vals = wide_cols[order], wide_vals[order]
-    new_counts = np.where(replaced, np.bincount(wide_rows, minlength=n), np.diff(indptr))
-    new_indptr = _cumulative(new_counts)
-    out_cols = np.empty(int(new_indptr[-1]), dtype=cols.dtype)
-    out_vals = np.empty(int(new_indptr[-1]))
-    kept = np.flatnonzero(~replaced[rows])
-    # a kept row's entries keep their order; the row moves by the change of its start
-    dest = kept + (new_indptr[:-1] - indptr[:-1])[rows[kept]]
-    out_cols[dest], out_vals[dest] = cols[kept], vals[kept]
-    dest = np.flatnonzero(np.repeat(replaced, new_counts))
-    out_cols[dest], out_vals[dest] = wide_cols, wide_vals
-    return sp.csr_matrix((out_vals, out_cols, new_indptr), shape=(n, n))
 
 
 def _surely_in_svd_band(c00, c11, c22, tr):

@@ -4,7 +4,7 @@ import numpy as np
 
 from .checks import ZERO_AREA_RELATIVE, as_count, as_index_set, as_positive_number, check_choice
 from .geometry import bbox_centre, bbox_diagonal, corner_cotangents, ignoring_underflow, vertex_normals
-from .topology import boundary_vertices, check_every_component_fixed, misoriented_edges, undirected_edges, vertex_components
+from .topology import boundary_vertices, check_every_component_fixed, edge_keys, misoriented_edges, vertex_components
 from .cotan_laplacian import _assemble_upper, checked_cotan_triangle
 from .errors import ConstraintError, CurvdetailError, MeshError, counted, first_indices, them
 from .reconstruct import _FreeSystemLayout
@@ -263,7 +263,7 @@ def _collapse_message(iteration, triangles, dbl, V, F, fixed, adjacency, last_st
     piece_faces = F[in_piece[F[:, 0]]]
     boundary = boundary_vertices(piece_faces)
     inner_fixed = np.setdiff1d(fixed[in_piece[fixed]], boundary)
-    edges = np.unique(undirected_edges(piece_faces), axis=0).shape[0]
+    edges = np.unique(edge_keys(piece_faces)[0]).size
     euler = np.count_nonzero(in_piece) - edges + piece_faces.shape[0]       # 1: a disk (a boundary, genus 0)
     larger_tol = f"a larger tol, e.g. the default {DEFAULT_TOL:g}" if tol < DEFAULT_TOL else "a larger tol"
     how_earlier = f"({larger_tol}, or max_iterations below {iteration})"

@@ -73,16 +73,9 @@ def repeated_triangles(F, n):
     return np.column_stack([first[inverse.reshape(-1)][repeat], repeat])
 
 
-def undirected_edges(F):
-    """All half-edges as sorted pairs, shape (3m, 2), in face order (edge k of face f at 3f+k,
-    edge k joins corners k+1 and k+2, i.e. it is opposite corner k)."""
-    E = np.stack([F[:, [1, 2]], F[:, [2, 0]], F[:, [0, 1]]], axis=1).reshape(-1, 2)
-    return np.sort(E, axis=1)
-
-
 def edge_keys(F):
-    """Key ``min * n + max`` of every half-edge's undirected edge, shape (3m,), in the order of
-    :func:`undirected_edges`, and that ``n``."""
+    """Key ``min * n + max`` of every half-edge's undirected edge, shape (3m,) (half-edge 3f + k
+    is opposite corner k of face f), and that ``n``."""
     n = int(F.max()) + 1
     b = F[:, [1, 2, 0]].ravel()          # half-edge 3f + k joins corners k+1 and k+2 of face f
     c = F[:, [2, 0, 1]].ravel()
