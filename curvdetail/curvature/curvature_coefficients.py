@@ -282,19 +282,17 @@ def _surely_in_svd_band(c00, c11, c22, tr):
 
 
 def _widen(D, A, w, rank, scale, ring, target, rows, cols, indptr, n, rcond, size, max_ring, adjacency):
-    """Refit the rows ``target`` (increasing) over wider rings until their detail is represented,
-    the ring stops growing or ``max_ring`` is reached. Updates ``w``, ``rank``, ``scale`` (where
-    not None) and ``ring`` in place; returns the widened rows' pattern ``(rows, cols)`` (each row's
-    columns increasing), or None where no row took a wider ring."""
+    """Refit the rows ``target`` over wider rings until their detail is represented, the ring
+    stops growing or ``max_ring`` is reached. Updates ``w``, ``rank``, ``scale`` (where not None)
+    and ``ring`` in place; returns the widened rows' pattern ``(rows, cols)``, or None."""
     if adjacency is None:
         P = sp.csr_matrix((np.ones(cols.size, dtype=bool), cols, indptr), shape=(n, n))
     else:
         ar, ac = adjacency
         P = sp.csr_matrix((np.ones(ac.size, dtype=bool), ac, _row_pointers(ar, n)), shape=(n, n))
-    # the rows' current rings (without the vertex itself) as CSR pieces over ``target``
-    counts = indptr[target + 1] - indptr[target]
+    counts = indptr[target + 1] - indptr[target]          # the rows' rings, without the vertex
     ring_cols = cols[_rows_of(indptr, target)]
-    wide_rows, wide_cols = [], []
+    pieces = []                                           # (rows, cols, ring) of every refit
     for extra in range(1, max_ring):
         R = sp.csr_matrix((np.ones(ring_cols.size, dtype=bool), ring_cols, _cumulative(counts)),
                           shape=(target.size, n))
@@ -303,39 +301,28 @@ def _widen(D, A, w, rank, scale, ring, target, rows, cols, indptr, n, rcond, siz
         at = np.repeat(np.arange(target.size), np.diff(R.indptr))
         keep = R.indices != target[at]
         new_counts = np.bincount(at[keep], minlength=target.size)
-        new_cols = R.indices[keep].astype(np.int64)
         # a ring that adds no vertex (the row's whole component already) keeps its narrower fit
-        grew = new_counts > counts
-        if extra > 1 and not grew.all():
-            stuck = np.flatnonzero(~grew)
-            wide_rows.append(np.repeat(target[stuck], counts[stuck]))
-            wide_cols.append(ring_cols[_rows_of(_cumulative(counts), stuck)])
-        if not grew.any():
+        moved = np.flatnonzero(new_counts > counts)
+        if not moved.size:
             break
-        if not grew.all():
-            moved = np.flatnonzero(grew)
-            new_cols = new_cols[_rows_of(_cumulative(new_counts), moved)]
-            target, new_counts = target[moved], new_counts[moved]
-        counts, ring_cols = new_counts, new_cols
+        ring_cols = R.indices[keep].astype(np.int64)[_rows_of(_cumulative(new_counts), moved)]
+        target, counts = target[moved], new_counts[moved]
         w_t, rank_t, s_t, residual_t = _truncated_fit(D, A, target, counts, ring_cols, rcond, size)
-        # a wider ring never fits worse: take it (its pattern replaces the narrower one)
+        # a wider ring never fits worse: take it
         w[target], rank[target], ring[target] = w_t, rank_t, extra + 1
         if scale is not None:
             scale[target] = s_t
-        still = residual_t > rcond * s_t
-        if extra == max_ring - 1 or not still.any():     # every row's widest fit is final
-            wide_rows.append(np.repeat(target, counts))
-            wide_cols.append(ring_cols)
+        pieces.append((np.repeat(target, counts), ring_cols, extra + 1))
+        still = np.flatnonzero(residual_t > rcond * s_t)
+        ring_cols = ring_cols[_rows_of(_cumulative(counts), still)]
+        target, counts = target[still], counts[still]
+        if not target.size:
             break
-        done = np.flatnonzero(~still)
-        wide_rows.append(np.repeat(target[done], counts[done]))
-        wide_cols.append(ring_cols[_rows_of(_cumulative(counts), done)])
-        carry = np.flatnonzero(still)
-        ring_cols = ring_cols[_rows_of(_cumulative(counts), carry)]
-        target, counts = target[carry], counts[carry]
-    if not wide_rows:
+    if not pieces:
         return None
-    return np.concatenate(wide_rows), np.concatenate(wide_cols)
+    wide_rows, wide_cols = (np.concatenate([p[k] for p in pieces]) for k in (0, 1))
+    last = ring[wide_rows] == np.concatenate([np.full(p[0].size, p[2]) for p in pieces])
+    return wide_rows[last], wide_cols[last]
 
 
 def _gram(g, which):
