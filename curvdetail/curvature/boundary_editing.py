@@ -24,12 +24,11 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
                   rcond=DEFAULT_RCOND, backend="auto", return_info=False):
     """Move the boundary of a disk-topology patch and rebuild the surface from its detail.
 
-    The boundary loop is moved by ``displacement``; its curvature detail is updated (with
-    ``boundary_detail="deformed"``, the paper: the details of a provisional surface, the boundary's
-    best-fitting similarity applied to the patch and the rest of the move spread harmonically
-    inside; with ``"rest"`` the rest details are kept); then a :class:`CurvatureEditor` with the
-    boundary's positions and details constrained rebuilds the interior. A boundary rotated, scaled
-    or moved as a whole moves the patch with it. See docs/editing.md, "Shape editing of a boundary".
+    The boundary loop is moved by ``displacement`` and its curvature detail updated (``"deformed"``,
+    the paper: the details of a provisional surface, the boundary's best-fitting similarity applied
+    to the patch and the rest of the move spread harmonically inside; ``"rest"``: kept); then a
+    :class:`CurvatureEditor` with the boundary's positions and details constrained rebuilds the
+    interior. See docs/editing.md, "Shape editing of a boundary".
 
     Parameters
     ----------
@@ -51,11 +50,11 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
     backend : str
         Sparse solver backend.
     return_info : bool
-        Also return a dict with ``boundary`` (loop order), ``arc_length``, ``boundary_detail``
-        (the updated (b, 3) details), ``editor`` (for re-solves), ``folded_triangles`` (triangles
-        whose normal turned against their rest normal, the boundary's rotation discounted),
-        ``max_displacement`` and ``boundary_displacement`` (largest move of any vertex / of a
-        boundary vertex over the rest bbox diagonal) and ``amplification`` (their ratio, or None).
+        Also return a dict: ``boundary`` (loop order), ``arc_length``, ``boundary_detail`` (b, 3),
+        ``editor`` (for re-solves), ``folded_triangles`` (normal against the rest one, the
+        boundary's rotation discounted), ``max_displacement`` / ``boundary_displacement`` (largest
+        move of any / a boundary vertex over the rest bbox diagonal), ``amplification`` (their
+        ratio, None for an unmoved boundary).
 
     Returns
     -------
@@ -67,8 +66,7 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
     Warns
     -----
     FoldedTrianglesWarning
-        When ``folded_triangles > 0``, with the count, the amplification and what to try (the
-        other ``relations``, a smaller displacement, ``boundary_detail="rest"``).
+        When ``folded_triangles > 0``, with the figures and what to try.
 
     Raises
     ------
@@ -126,7 +124,12 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
     else:                                       # editor.laplacian: of the rest shape
         Db = _deformed_boundary_detail(V, F, editor.laplacian, loop, P, Q, s_, R, t, backend)
     X = editor.solve(positions=Q, details=Db)
-    figures, folded = _figures(V, F, X, loop, R)
+    folded = folded_triangles(V, F, X, R)          # a patch turned as a whole counts none
+    diag, moved = bbox_diagonal(V), np.linalg.norm(X - V, axis=1)
+    on_loop = moved[loop].max()
+    figures = {"folded_triangles": int(folded.size), "max_displacement": float(moved.max() / diag),
+               "boundary_displacement": float(on_loop / diag),
+               "amplification": float(moved.max() / on_loop) if on_loop > 1e-12 * diag else None}
     if folded.size:
         _warn_folded(figures, folded, F.shape[0], boundary_detail, relations)
     if not return_info:
@@ -135,15 +138,12 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
 
 
 def _deformed_boundary_detail(V, F, L, loop, P, Q, s_, R, t, backend):
-    """The boundary's details on the provisional surface (``boundary_detail="deformed"``): the
-    patch moved by the boundary's best-fitting similarity ``(s_, R, t)``, plus the rest of the
-    boundary's move spread harmonically (rest cotangent weights ``L``) into the inside."""
+    """The boundary's details on the provisional surface: the patch moved by the boundary's
+    best-fitting similarity ``(s_, R, t)``, the rest of the move spread harmonically (``L``)."""
     n = V.shape[0]
     free = np.ones(n, dtype=bool)
     free[loop] = False
     inner = np.flatnonzero(free)
-    # a rotated or scaled boundary then gives the details s R D_b exactly (the cotangent weights
-    # are similarity-invariant)
     Vp = s_ * V @ R.T + t
     U = np.zeros((n, 3))
     U[loop] = Q - Vp[loop]
@@ -153,20 +153,6 @@ def _deformed_boundary_detail(V, F, L, loop, P, Q, s_, R, t, backend):
     Vp += U
     _check_provisional_surface(Vp, F, P, Q)
     return laplacian_product(_cotan_laplacian_unchecked(Vp, F), Vp)[loop]
-
-
-def _figures(V, F, X, loop, R):
-    """``(figures, folded)``: the figures for ``info`` (see :func:`edit_boundary`) and the folded
-    triangles, increasing (counted against the rest normals and those turned by ``R``, the
-    boundary's best-fitting rotation, so a patch turned as a whole counts none)."""
-    folded = folded_triangles(V, F, X, R)
-    diag = bbox_diagonal(V)
-    moved = np.linalg.norm(X - V, axis=1)
-    on_loop = moved[loop].max()
-    return {"folded_triangles": int(folded.size),
-            "max_displacement": float(moved.max() / diag),
-            "boundary_displacement": float(on_loop / diag),
-            "amplification": float(moved.max() / on_loop) if on_loop > 1e-12 * diag else None}, folded
 
 
 def _warn_folded(figures, folded, m, boundary_detail, relations):
@@ -231,12 +217,10 @@ def _check_provisional_surface(Vp, F, P, Q):
 
 def _similarity(P, Q):
     """``(s, R, t)`` with ``Q ~ s P R^T + t`` in least squares (Umeyama 1991): s > 0, R a
-    rotation (no reflection); the identity where ``P`` has no extent."""
+    rotation (no reflection)."""
     mp, mq = P.mean(axis=0), Q.mean(axis=0)
     A, B = P - mp, Q - mq
-    spread = float((A ** 2).sum())
-    if not spread > 0:
-        return 1.0, np.eye(3), mq - mp
+    spread = float((A ** 2).sum())               # > 0: a loop of one point was refused
     U, S, Wt = np.linalg.svd(B.T @ A)
     D = np.ones(3)
     D[2] = np.sign(np.linalg.det(U @ Wt)) or 1.0
@@ -303,14 +287,13 @@ def boundary_loop(F):
     Returns
     -------
     loop : (b,) int64 array
-        Boundary vertices in order, each once; ``loop[0]`` is the smallest index and each
-        ``(loop[i], loop[i + 1])`` runs as in its triangle (counter-clockwise seen from the normals).
+        Boundary vertices in order from the smallest index, each ``(loop[i], loop[i + 1])`` as in
+        its triangle (counter-clockwise seen from the normals).
 
     Raises
     ------
     MeshError
-        If the mesh has no boundary, several loops, a vertex where the boundary touches itself,
-        misoriented triangles, or ``F`` is malformed.
+        If ``F`` is malformed or has not one simple boundary loop (the cause named).
 
     Examples
     --------
