@@ -150,7 +150,16 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, step="n
     check_every_component_fixed(F, n, fixed, adjacency=U)
     is_free = np.ones(n, dtype=bool)
     is_free[fixed] = False
-    _check_boundary_fixed(F, is_free)
+    # a free rim has no minimal surface: it shrinks onto the fixed vertices
+    boundary = boundary_vertices(F)
+    loose = boundary[is_free[boundary]]
+    if loose.size:
+        raise ConstraintError(
+            f"{counted(loose.size, 'boundary vertex', 'boundary vertices', verb='are')} not fixed (of "
+            f"{boundary.size}; first: {first_indices(loose)}): a surface with a free boundary has no "
+            "minimal surface (it shrinks onto the fixed vertices until its triangles collapse). Fix the "
+            "whole boundary too, e.g. np.union1d(fixed, boundary_vertices(F)).",
+            parameter="fixed", count=int(loose.size), first=loose[:3].tolist())
     # the step is measured along vertex normals, which reversed triangles would cancel
     aligned = step == "normal" and misoriented_edges(F).shape[0] > 0
     free = np.flatnonzero(is_free)
@@ -186,8 +195,11 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, step="n
         if collapsed.size == 0:
             # the next step's weights; needles pass an area check, not this one
             cot, _, _ = corner_cotangents(X_new, F, lengths=False)
-            if np.abs(cot).max() > DEGENERATE_COTANGENT:
-                collapsed = _degenerated_triangles(V, F, cot)
+            largest = np.abs(cot).max(axis=1)
+            if largest.max() > DEGENERATE_COTANGENT:
+                candidates = np.flatnonzero(largest > DEGENERATE_COTANGENT)
+                rest, _, _ = corner_cotangents(V, F[candidates], lengths=False)
+                collapsed = candidates[largest[candidates] > DEGENERATE_GROWTH * np.abs(rest).max(axis=1)]
         if collapsed.size:
             raise MeshError(_collapse_message(it + 1, collapsed, dbl, V, F, fixed, U, measured, step, tol),
                             count=int(collapsed.size), first=collapsed[:3].tolist())
@@ -221,29 +233,6 @@ def _remaining_estimate(last, previous):
         return np.nan, np.inf
     rho = last / previous
     return rho, (last * rho / (1.0 - rho) if rho < 1.0 else np.inf)
-
-
-def _check_boundary_fixed(F, is_free):
-    """ConstraintError if a boundary vertex is free: a free rim has no minimal surface (it shrinks
-    onto the fixed vertices)."""
-    boundary = boundary_vertices(F)
-    loose = boundary[is_free[boundary]]
-    if loose.size:
-        raise ConstraintError(
-            f"{counted(loose.size, 'boundary vertex', 'boundary vertices', verb='are')} not fixed (of "
-            f"{boundary.size}; first: {first_indices(loose)}): a surface with a free boundary has no "
-            "minimal surface (it shrinks onto the fixed vertices until its triangles collapse). Fix the "
-            "whole boundary too, e.g. np.union1d(fixed, boundary_vertices(F)).",
-            parameter="fixed", count=int(loose.size), first=loose[:3].tolist())
-
-
-def _degenerated_triangles(V, F, cot):
-    """Triangles whose largest ``|cot|`` passes DEGENERATE_COTANGENT and grew DEGENERATE_GROWTH
-    times over the input's, increasing."""
-    largest = np.abs(cot).max(axis=1)
-    candidates = np.flatnonzero(largest > DEGENERATE_COTANGENT)
-    rest, _, _ = corner_cotangents(V, F[candidates], lengths=False)
-    return candidates[largest[candidates] > DEGENERATE_GROWTH * np.abs(rest).max(axis=1)]
 
 
 def _collapse_message(iteration, triangles, dbl, V, F, fixed, adjacency, last_step, step, tol):
