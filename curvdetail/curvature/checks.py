@@ -123,8 +123,15 @@ def _check_mesh(V, F, check_manifold, check_unreferenced, cotangents=False):
     V = as_vertices(V)
     F = as_faces(F, V.shape[0])
     diag = bbox_diagonal(V)
+    if diag == 0.0:
+        raise MeshError(f"the mesh is 0 across (bbox diagonal): all {V.shape[0]} vertices lie at one point, so "
+                        "every triangle has zero area; pass the mesh's real vertex positions.", parameter="V",
+                        value=diag)
     if diag < MIN_DIAGONAL:
-        raise tiny_mesh_error(diag, V.shape[0])
+        raise MeshError(f"the mesh is {diag:.3g} across (bbox diagonal), below {MIN_DIAGONAL:.0e}: its triangle "
+                        "areas (fourth powers of its lengths) underflow double precision and lose their digits; "
+                        f"scale it up, e.g. to unit size (V / {diag:.3g}), and scale the results back.",
+                        parameter="V", value=diag)
     cot = None
     with np.errstate(divide="ignore", invalid="ignore", under="ignore"):
         if cotangents:
@@ -167,17 +174,6 @@ def check_referenced(n, F, name=None):
             f"any triangle (first: {first_indices(unused)}); "
             f"remove {them(unused.size)}, e.g. with pymeshlab's meshing_remove_unreferenced_vertices.",
             parameter=name or "V", count=int(unused.size), first=unused[:3].tolist())
-
-
-def tiny_mesh_error(diag, n):
-    """The MeshError for a mesh of ``n`` vertices, ``diag`` across (below ``MIN_DIAGONAL``)."""
-    if diag == 0.0:
-        return MeshError(f"the mesh is 0 across (bbox diagonal): all {n} vertices lie at one point, so every "
-                         "triangle has zero area; pass the mesh's real vertex positions.", parameter="V", value=diag)
-    return MeshError(f"the mesh is {diag:.3g} across (bbox diagonal), below {MIN_DIAGONAL:.0e}: its triangle "
-                     "areas (fourth powers of its lengths) underflow double precision and lose their digits; "
-                     f"scale it up, e.g. to unit size (V / {diag:.3g}), and scale the results back.", parameter="V",
-                     value=diag)
 
 
 def non_manifold_error(count, first):
