@@ -227,8 +227,8 @@ def as_index_set(indices, n, name):
 
 
 def non_whole_index_error(values, name, error=ConstraintError):
-    """The ``error`` for index values that are not whole numbers (3.5, NaN, inf), or None where
-    every value is whole (3.0 is an index). ``values``: real numbers, flattened.
+    """The ``error`` (a CurvdetailError class) for index values that are not whole numbers (3.5,
+    NaN, inf), or None where every value is whole (3.0 is an index). ``values``: real numbers.
 
     Examples
     --------
@@ -246,9 +246,7 @@ def non_whole_index_error(values, name, error=ConstraintError):
     message = (f"{name}: {counted(bad.size, 'value')} {what} (first: {float(arr[bad[0]])!r}, at position "
                f"{bad[0]}); vertex indices are whole numbers: pass integers (or whole floats such as 3.0), "
                "not positions or weights.")
-    if isinstance(error, type) and issubclass(error, CurvdetailError):
-        return error(message, parameter=name, count=int(bad.size), first=bad[:3].tolist())
-    return error(message)
+    return error(message, parameter=name, count=int(bad.size), first=bad[:3].tolist())
 
 
 def check_bool(value, name):
