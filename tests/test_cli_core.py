@@ -188,7 +188,7 @@ def test_a_full_stderr_does_not_stop_the_run(tmp_path, monkeypatch, capsys):
 def test_a_full_stderr_does_not_stop_the_progress_of_remesh(tmp_path, monkeypatch):
     monkeypatch.setattr(sys, "stderr", FullStream())
     out = tmp_path / "out.ply"
-    assert main(["remesh", "--example", str(out), "--method", "decimate", "--target-edge", "5",
+    assert main(["remesh", "--example", str(out), "--method", "decimate", "--target-edge", "5%",
                  "--no-evaluate"]) == 0
     assert out.exists()
 

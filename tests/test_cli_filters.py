@@ -346,7 +346,7 @@ def test_a_closed_stderr_does_not_stop_the_work(tmp_path):
     os.close(read_end)
     out = tmp_path / "o.ply"
     try:
-        done = subprocess.run([sys.executable, "-m", "curvdetail", "remesh", NOSE, str(out), "--target-edge", "6",
+        done = subprocess.run([sys.executable, "-m", "curvdetail", "remesh", NOSE, str(out), "--target-edge", "6%",
                                "--method", "decimate", "--no-evaluate"],
                               stdout=subprocess.PIPE, stderr=write_end, timeout=300)
     finally:

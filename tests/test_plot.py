@@ -23,7 +23,7 @@ def _vivid(img):
 def result():
     V, F = disk(n_rings=10)
     V[:, 2] = 0.2 * np.exp(-3.0 * (V[:, :2] ** 2).sum(1))
-    return V, F, run_experiment(V, F, target_edge=0.06)
+    return V, F, run_experiment(V, F, target_edge="6%")
 
 
 def test_panels_are_a_png_of_the_size_asked_showing_every_mesh(tmp_path):
@@ -107,9 +107,9 @@ def test_remeshing_figure_refuses_an_unmeasured_report_or_mismatched_distances(t
 
 def test_the_remeshing_figure_of_a_closed_surface_shows_all_three_panels(tmp_path):
     V, F = _octahedron(0.3)
-    report = {"error": {"hausdorff_rms": 0.001, "hausdorff_max": 0.01},
-              "baseline_zero_detail": {"hausdorff_rms": 0.1, "hausdorff_max": 0.2},
-              "floor_retriangulated": {"hausdorff_rms": 0.0}, "options": {"transfer": "mean", "rows": "free"},
+    report = {"error": {"hausdorff_rms_percent_of_diagonal": 0.001, "hausdorff_max_percent_of_diagonal": 0.01},
+              "baseline_zero_detail": {"hausdorff_rms_percent_of_diagonal": 0.1, "hausdorff_max_percent_of_diagonal": 0.2},
+              "floor_retriangulated": {"hausdorff_rms_percent_of_diagonal": 0.0}, "options": {"transfer": "mean", "rows": "free"},
               "source": {"path": None, "vertices": 6, "bbox_diagonal": 2.0}, "target": {"vertices": 6}}
     path = tmp_path / "octahedron.png"
     save_remeshing_figure(path, V, F, V, F, 0.8 * V, np.linspace(0.0, 0.01, 6), report, dpi=50)
