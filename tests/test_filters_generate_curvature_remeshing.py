@@ -93,7 +93,7 @@ def test_absolute_target_edge_is_converted_to_a_fraction():
     diag = bbox_diagonal(ms.current_mesh().vertex_matrix())
     report = apply(ms, "generate_curvature_remeshing", target_edge=pymeshlab.PureValue(0.025 * diag),
                    evaluate=False, add_baseline=True)
-    assert report["options"]["target_edge"] == pytest.approx(0.025, rel=1e-6)   # PureValue is float32
+    assert report["options"]["target_edge_percent_of_diagonal"] == pytest.approx(2.5, rel=1e-6)   # PureValue is float32
     assert "error" not in report and report["layers"]["zero_detail"] == 2
     # the zero-detail baseline keeps the retriangulation's boundary
     b = boundary_vertices(ms.mesh(1).face_matrix())
@@ -142,7 +142,7 @@ def test_surface_check_is_passed_through_to_the_remesher(isotropic_calls, kwargs
     assert report["options"]["surface_check"] is expected
     # the retriangulated layer is retriangulate's result with that option (the ear at 3 %
     # differs without the check: 644 vertices against 648)
-    Vt, Ft = retriangulate(V, F, target_edge=report["options"]["target_edge"], **kwargs)
+    Vt, Ft = retriangulate(V, F, target_edge=f"{report['options']['target_edge_percent_of_diagonal']!r}%", **kwargs)
     assert np.array_equal(ms.mesh(report["layers"]["retriangulated"]).face_matrix(), Ft)
 
 

@@ -392,7 +392,7 @@ def test_a_layer_set_to_the_current_mesh_is_saved_as_such_not_as_its_default(tmp
     figures = run_script(ms, tmp_path / "e.mlx")[0]["figures"]
     assert (figures["sampledmesh"], figures["targetmesh"]) == (0, 1) == \
         tuple(apply(ms, "get_curvature_reconstruction_error", **params)[k] for k in ("sampledmesh", "targetmesh"))
-    assert figures["hausdorff_max_percent_of_diagonal"] < 1e-12                 # a copy: on it to rounding
+    assert figures["hausdorff_max_percent_of_diagonal"] < 1e-10                 # a copy: on it to rounding
 
 
 @pytest.mark.parametrize("param, value, message", [
