@@ -129,13 +129,15 @@ def readme_row(name, rep, t_retri=None):
 
 
 def retriangulation_record(method, target_edge, diagonal, seconds, shared, **settings):
-    """What made a report's target, for the JSON: ``method``, ``target_edge`` (fraction of the
-    source's bbox diagonal) and ``target_edge_length`` (absolute), the other settings of
+    """What made a report's target, for the JSON: ``method``, ``target_edge_percent_of_diagonal``
+    and ``target_edge_model_units`` (``target_edge`` as the functions take it), the other settings of
     :func:`retriangulate` (``settings`` as passed, the rest its defaults), ``seconds``, and
     ``shared``: True where the script made it once for all the patch's configurations (the
     report's ``options.method`` then says "given"), False where ``run_experiment`` made it."""
     relevant = ("iterations", "max_surface_distance", "surface_check") if method == "isotropic" else ("aggressiveness",)
-    record = {"method": method, "target_edge": target_edge, "target_edge_length": target_edge * diagonal}
+    from curvdetail.remesh.units import as_bbox_length, length_figures
+
+    record = {"method": method, **length_figures(as_bbox_length(target_edge), diagonal, "target_edge")}
     record.update({name: settings.get(name, RETRIANGULATE_DEFAULTS[name]) for name in relevant})
     record.update(seconds=None if seconds is None else round(seconds, 4), shared=shared)
     return record
@@ -318,11 +320,11 @@ def main(argv=None):
             out = run_experiment(V, F, method=method, target_edge=f"{100 * target_edge!r}%", source_path=name)
         except Exception as exc:
             failed(name, dict(method=method, target_edge=target_edge), exc,
-                   retriangulation_record(method, target_edge, bbox_diagonal(V), None, False))
+                   retriangulation_record(method, f"{100 * target_edge!r}%", bbox_diagonal(V), None, False))
             extra.append(f"| {name} | {V.shape[0]:,} | - | {method} | FAILED: {exc} |")
             continue
         rep = out["report"]
-        record(rep, retriangulation_record(method, target_edge, rep["source"]["bbox_diagonal"],
+        record(rep, retriangulation_record(method, f"{100 * target_edge!r}%", rep["source"]["bbox_diagonal"],
                                                  rep["seconds"]["retriangulate"], False))
         short = name.rsplit(".", 1)[0]
         line = row(short + (f" ({100 * target_edge:g} %)" if target_edge != 0.01 else ""), rep)
