@@ -24,9 +24,10 @@ from .registry import PAPER, filter
         maximum and RMS distances in % of the target's bounding-box diagonal and in model units
         (the unit in each key) (the
         evaluation of the paper's remeshing experiment, Fig. 3), and the one-sided figures. With
-        set_quality the sampled layer's vertex quality becomes its distance to the target, so
-        MeshLab colours the error: the exact distance of each vertex, the one the maxima are
-        taken over. {PAPER}, section "Remeshing", Fig. 3.
+        set_quality the sampled layer's vertex quality becomes its distance to the target in
+        model units (the exact distance of each vertex, the one the maxima are taken over), and
+        its vertex colours viridis over [0, its max], which MeshLab shows on open; that range is
+        the figure colour_range_percent_of_diagonal. {PAPER}, section "Remeshing", Fig. 3.
     """,
     parameters=[
         Parameter("sampledmesh", "mesh", None, "layer whose error is measured (default: current)"),
@@ -58,9 +59,11 @@ def get_curvature_reconstruction_error(ms, *, sampledmesh, targetmesh, samplenum
     except MeshError as exc:
         raise _naming_the_layer(exc, ms, ("sampledmesh", sampled, Va, Fa),
                                 ("targetmesh", target, Vb, Fb)) from None
-    if set_quality:
-        set_vertex_quality(ms, sampled, distance)
     diag = bbox_diagonal(Vb)
+    colours = {}
+    if set_quality:
+        lo, hi = set_vertex_quality(ms, sampled, distance)
+        colours = {"colour_range_percent_of_diagonal": [100 * lo / diag, 100 * hi / diag]}
     return {
         "hausdorff_max_percent_of_diagonal": 100 * h["max"] / diag,
         "hausdorff_rms_percent_of_diagonal": 100 * h["rms"] / diag,
@@ -75,6 +78,7 @@ def get_curvature_reconstruction_error(ms, *, sampledmesh, targetmesh, samplenum
         "engine": h["engine"],
         "sampledmesh": sampled,
         "targetmesh": target,
+        **colours,
     }
 
 
