@@ -403,10 +403,11 @@ def show_warning(message, category, filename, lineno, file=None, line=None):
     """A library warning as one line: a note where it announces a long run or a finding, a
     warning where an edit folded or amplified; other warnings as Python shows them."""
     from ..curvature.errors import FoldedTrianglesWarning
+    from ..filters import ScaleWarning
     from ..filters.editing import AmplifiedEditWarning
     from ..remesh import LongRunWarning, WorseThanZeroDetailWarning
 
-    if issubclass(category, (LongRunWarning, WorseThanZeroDetailWarning)):
+    if issubclass(category, (LongRunWarning, WorseThanZeroDetailWarning, ScaleWarning)):
         say(f"note: {message}")
     elif issubclass(category, (FoldedTrianglesWarning, AmplifiedEditWarning)):
         say(f"curvdetail: warning: {message}")

@@ -31,12 +31,11 @@ import xml.etree.ElementTree as ET
 from ..io.atomic import atomic_write, check_output_path
 from .dispatch import apply
 from .errors import FilterError, ScriptError
-from .native import check_native_parameters, run_native
+from .parameters import BBoxLength
+from .errors import ScaleWarning
+from .native import check_native_parameters, far_lengths, run_native
+from .recording import recorded_steps, step_element
 from .registry import _REGISTRY, close_matches, get_filter
-
-_RICH_TYPES = {"bool": "RichBool", "int": "RichInt", "float": "RichFloat", "str": "RichString",
-               "PercentageValue": "RichAbsPerc", "mesh": "RichMesh"}
-
 
 def _script_path(path):
     """``path`` as a str, or ScriptError if it is not a path (os.fspath raised a TypeError)."""
@@ -157,6 +156,7 @@ def run_script(ms, path, *, progress=None):
         name = element.get("name")
         if progress is not None:
             progress(k, len(steps), name)
+        _note_far_lengths(ms, where, element, params)
         if params is not None:
             try:
                 figures = apply(ms, name, **params)
@@ -220,24 +220,20 @@ def check_script(path):
     return checked
 
 
-def _param_element(p, value):
-    attrs = {"name": p.name, "value": p.format(value), "type": _RICH_TYPES[p.type],
-             "description": p.name, "tooltip": p.description}
-    if p.type == "str" and p.choices is not None:
-        attrs["type"] = "RichEnum"
-        attrs["value"] = str(p.choices.index(value))
-        attrs["enum_cardinality"] = str(len(p.choices))
-        for i, c in enumerate(p.choices):
-            attrs[f"enum_val{i}"] = c
-    return ET.Element("Param", attrs)
-
-
 def save_script(path, steps, *, overwrite=False):
-    """Write our filters as a MeshLab filter script that :func:`run_script` runs.
+    """Write a MeshLab filter script that :func:`run_script` runs: the pipeline run on a MeshSet
+    (``save_script(ms, path)``), or our filters named in a list (``save_script(path, steps)``).
+
+    ``save_script(ms, path)`` writes every step run on ``ms`` from Python, in order: ours (run by
+    :func:`~curvdetail.filters.apply`) and pymeshlab's (run by
+    :func:`~curvdetail.filters.apply_native`, whose lengths and floats replay to the last digit,
+    or on the MeshSet directly, as pymeshlab recorded them). ``curvdetail run`` replays it on the
+    same input to the same result.
 
     Parameters
     ----------
-    path : str or os.PathLike   destination (.mlx); written atomically
+    path : str or os.PathLike   destination (.mlx); written atomically (or the MeshSet, then
+                                ``steps`` is the destination)
     steps : list   each a filter name or ``(name, {parameter: value})``; every parameter is
                    written (defaults for those not given), except a layer id left to the current
                    mesh where that is its default (a layer id whose default is a layer, set to
@@ -248,7 +244,8 @@ def save_script(path, steps, *, overwrite=False):
     ------
     FileExistsError        ``path`` exists and ``overwrite`` is False
     FileNotFoundError      the destination folder does not exist
-    ScriptError            ``steps`` is not a list of names or (name, parameters) pairs
+    ScriptError            ``steps`` is not a list of names or (name, parameters) pairs; a
+                           MeshSet on which no filter has run
     UnknownFilterError, FilterParameterError   as :func:`~curvdetail.filters.apply`
 
     Examples
@@ -260,27 +257,60 @@ def save_script(path, steps, *, overwrite=False):
     >>> "apply_curvature_reconstruction" in open(path).read()
     True
     """
+    import pymeshlab
+
     from .dispatch import complete_parameters
 
+    if isinstance(path, pymeshlab.MeshSet):
+        ms, path = path, steps
+        path = check_output_path(path, overwrite)
+        elements = recorded_steps(ms)
+        if not elements:
+            raise ScriptError("no filter has run on this MeshSet", parameter="ms",
+                              hint="run filters with curvdetail.filters.apply / apply_native first")
+        return _write(path, elements, overwrite)
     path = check_output_path(path, overwrite)
     if isinstance(steps, str) or not isinstance(steps, (list, tuple)):
         raise ScriptError(f"steps must be a list of filter names or (name, parameters) pairs; got "
                           f"{type(steps).__name__}.")
-    root = ET.Element("FilterScript")
+    elements = []
     for k, step in enumerate(steps, start=1):
         if not isinstance(step, str) and not (isinstance(step, (list, tuple)) and len(step) == 2
                                               and isinstance(step[1], (dict, type(None)))):
             raise ScriptError(f"step {k} is {step!r}; give a filter name or a (name, {{parameter: value}}) pair.")
         name, params = (step, {}) if isinstance(step, str) else (step[0], dict(step[1] or {}))
         spec = get_filter(name)
-        values = complete_parameters(spec, params)
-        element = ET.SubElement(root, "filter", {"name": name})
-        for p in spec.parameters:
-            if p.type == "mesh" and values[p.name] is None and p.default is None:
-                continue            # left out: its default is the current mesh
-            element.append(_param_element(p, values[p.name]))   # None (current) as value=""
+        elements.append(step_element(spec, complete_parameters(spec, params)))
+    _write(path, elements, overwrite)
+
+
+def _write(path, elements, overwrite):
+    root = ET.Element("FilterScript")
+    root.extend(elements)
     ET.indent(root, space=" ")
     text = "<!DOCTYPE FilterScript>\n" + ET.tostring(root, encoding="unicode") + "\n"
     with atomic_write(path, overwrite=overwrite) as tmp:
         with open(tmp, "w", encoding="utf-8") as out:
             out.write(text)
+
+
+def _note_far_lengths(ms, where, element, params):
+    """A :class:`ScaleWarning` for each length of a step given in model units far from the
+    current mesh's size (see :data:`~.native.FAR_LENGTH`): likely sized for another mesh."""
+    from ..curvature.errors import warn
+    from ..curvature.geometry import bbox_diagonal
+    from .native import FAR_LENGTH
+
+    if ms.mesh_number() == 0:
+        return
+    diagonal = bbox_diagonal(ms.current_mesh().vertex_matrix())
+    if params is None:
+        far = far_lengths(ms, element)
+    else:
+        far = [(name, repr(v.value), v.value / diagonal) for name, v in params.items()
+               if isinstance(v, BBoxLength) and not v.percent
+               and not FAR_LENGTH[0] <= v.value / diagonal <= FAR_LENGTH[1]]
+    for name, value, ratio in far:
+        warn(f"{where}: {name} {value} (model units) is {100 * ratio:.3g} % of the current mesh's bbox diagonal "
+             f"({diagonal:.4g}); was it sized for another mesh? A percentage of the diagonal (value=\"2%\") "
+             "suits any mesh.", ScaleWarning)

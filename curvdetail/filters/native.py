@@ -64,7 +64,8 @@ _NATIVE_CHECKS = {
     "RichMesh": (lambda v: bool(_INTEGER.fullmatch(v)), "a layer index, a whole number"),
     "RichFloat": (lambda v: _finite(v), "a finite number with a decimal point (MeshLab reads other text as 0)"),
     "RichDynamicFloat": (lambda v: _finite(v), "a finite number with a decimal point"),
-    "RichAbsPerc": (lambda v: _finite(v), "a finite number with a decimal point, in model units"),
+    "RichAbsPerc": (lambda v: _finite(v.removesuffix("%")),
+                    "a finite number in model units, or a percentage of the bbox diagonal such as 2%"),
 }
 
 
@@ -77,7 +78,7 @@ def _finite(text):
         return False
 
 
-def _name_key(name):
+def name_key(name):
     """A parameter name as MeshLab and pymeshlab both spell it: pymeshlab's Python names are
     MeshLab's in lower case, a Python keyword with "_" appended ('lambda' -> 'lambda_')."""
     return re.sub(r"[^a-z0-9]+", "", name.lower())
@@ -108,7 +109,7 @@ def check_native_parameters(element, where):
     names the filter does not have (checked in lower case against pymeshlab's names; MeshLab's
     own check, case-sensitive, runs with the step)."""
     names = _native_parameter_names(element.get("name"))
-    keys = None if names is None else {_name_key(n) for n in names}
+    keys = None if names is None else {name_key(n) for n in names}
     seen = set()
     for child in element:
         if child.tag != "Param":
@@ -119,7 +120,7 @@ def check_native_parameters(element, where):
         if name in seen:
             raise ScriptError(f"{where}: parameter {name!r} is given twice; keep one <Param name={name!r}>.")
         seen.add(name)
-        if keys is not None and _name_key(name) not in keys:
+        if keys is not None and name_key(name) not in keys:
             raise ScriptError(f"{where}: this MeshLab filter has no parameter {name!r} (pymeshlab ignores it "
                               f"without a word); its parameters, in pymeshlab's lower case: "
                               f"{', '.join(sorted(names))}.")
@@ -192,9 +193,53 @@ def _unknown_native_step(name):
             f"MeshLab does not know. {_HOW_NAMES_ARE_WRITTEN}")
 
 
+def percentages_resolved(ms, element):
+    """A copy of a native step whose ``RichAbsPerc`` values given as ``"2%"`` (MeshLab takes
+    lengths in model units only) are resolved against the current mesh's bbox diagonal, with
+    every digit (as :func:`~.recording.apply_native` resolves a ``PercentageValue``)."""
+    import copy
+
+    from ..curvature.geometry import bbox_diagonal
+    element = copy.deepcopy(element)
+    for p in element:
+        value = (p.get("value") or "").strip()
+        if p.get("type") == "RichAbsPerc" and value.endswith("%"):
+            diagonal = bbox_diagonal(ms.current_mesh().vertex_matrix())
+            p.set("value", repr(percent_length(value[:-1], diagonal)))
+    return element
+
+
+def far_lengths(ms, element):
+    """``[(name, value, ratio)]`` of a native step's ``RichAbsPerc`` lengths in model units that
+    are far from the current mesh's size: above ``FAR_LENGTH[1]`` or below ``FAR_LENGTH[0]`` of
+    its bbox diagonal (``ratio``), likely sized for another mesh."""
+    from ..curvature.geometry import bbox_diagonal
+
+    far = []
+    for p in element:
+        value = (p.get("value") or "").strip()
+        if p.get("type") == "RichAbsPerc" and not value.endswith("%") and ms.mesh_number():
+            ratio = float(value) / bbox_diagonal(ms.current_mesh().vertex_matrix())
+            if not FAR_LENGTH[0] <= ratio <= FAR_LENGTH[1]:
+                far.append((p.get("name"), value, ratio))
+    return far
+
+
+def percent_length(percent, diagonal):
+    """A percentage of ``diagonal`` in model units: one formula for recording
+    (:func:`~.recording.apply_native`) and replay."""
+    return float(percent) / 100.0 * float(diagonal)
+
+
+#: Lengths in model units outside these fractions of the bbox diagonal get a note (a script's
+#: TargetLen of 0.3, 2 % of the terrain it was written for, is 33 % of the nose's diagonal).
+FAR_LENGTH = (1e-4, 0.1)
+
+
 def run_native(ms, element, where):
     import pymeshlab
 
+    element = percentages_resolved(ms, element)
     # pymeshlab's script runner crashes the process (segmentation fault) when a filter that needs
     # a mesh meets an empty MeshSet
     if ms.mesh_number() == 0 and not _creates_a_mesh(element.get("name")):
