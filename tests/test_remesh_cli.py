@@ -262,3 +262,16 @@ def test_the_written_ply_carries_viridis_colours_over_the_reported_range(tmp_pat
     rgba = np.stack([vertex[c] for c in ("red", "green", "blue", "alpha")], axis=1)
     assert np.array_equal(rgba, vertex_colours(q, q.max()))
     assert tuple(rgba[np.argmax(q), :3]) == (253, 231, 37)          # viridis' top colour at the max
+
+
+@pytest.mark.parametrize("quiet", [False, True])
+def test_the_evaluation_says_how_far_it_is_with_a_rate_unless_quiet(tmp_path, capsys, monkeypatch, quiet):
+    from curvdetail.cli.options import Progress
+
+    monkeypatch.setattr(Progress, "quiet_for", 0.0)            # every step, not only from 2 s on
+    rc = main(["remesh", os.path.join(DATA, "mannequin_nose.obj"), str(tmp_path / "o.ply"), "--target-edge", "4%",
+               *(["--quiet"] if quiet else [])])
+    err = capsys.readouterr().err
+    steps = [line for line in err.splitlines() if line.startswith("[4/4] evaluate ") and "per s" in line]
+    assert rc == 0 and len(steps) == (0 if quiet else 5)
+    assert quiet or steps[-1].startswith("[4/4] evaluate 5/5")

@@ -528,3 +528,12 @@ def test_a_planar_map_that_collapses_a_target_triangle_is_refused_by_the_option(
                                           r"\(first: \d+\) to zero area in the plane.*Use parameterization "
                                           r"\"harmonic\" .* or location \"closest\""):
         remesh_experiment(V, F, target=(V, F), location="uv", parameterization="lscm", evaluate=False)
+
+
+def test_the_evaluation_reports_each_measurement_through_progress(height_field):
+    from curvdetail.remesh.experiment import EVALUATION_STEPS
+
+    calls = []
+    remesh_experiment(*height_field, target_edge="8%", progress=lambda *a: calls.append(a))
+    assert [c[0] for c in calls if len(c) == 1] == ["retriangulate", "transfer", "reconstruct", "evaluate"]
+    assert [c for c in calls if len(c) == 3] == [("evaluate", k, EVALUATION_STEPS) for k in range(1, 6)]
