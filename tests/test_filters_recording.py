@@ -81,3 +81,17 @@ def test_the_bundled_script_in_percent_gives_no_note_on_any_patch(tmp_path):
         steps = run_script(ms, ROOT + "/scripts/examples/remesh_transfer_rebuild.mlx")
     assert steps[-1]["figures"]["hausdorff_rms_percent_of_diagonal"] < 1.0
     assert json.dumps(steps[-1]["figures"])
+
+
+def test_curvdetail_run_says_the_ratio_as_a_note(tmp_path, capsys):
+    from curvdetail.cli import main
+    from curvdetail.io import write_mesh
+
+    with open(ROOT + "/scripts/examples/remesh_transfer_rebuild.mlx", encoding="utf-8") as f:
+        (tmp_path / "absolute.mlx").write_text(f.read().replace('value="2%"', 'value="0.3"'))
+    V, F = grid(21, 21)
+    V[:, 2] = 0.1 * np.sin(3 * V[:, 0])
+    write_mesh(tmp_path / "square.obj", V, F)
+    assert main(["run", str(tmp_path / "absolute.mlx"), str(tmp_path / "square.obj"), str(tmp_path / "o.ply")]) == 0
+    notes = [line for line in capsys.readouterr().err.splitlines() if line.startswith("note: ")]
+    assert len(notes) == 1 and "TargetLen 0.3" in notes[0] and f"{100 * 0.3 / np.linalg.norm(np.ptp(V, axis=0)):.3g} %" in notes[0]
