@@ -100,7 +100,9 @@ def test_rebuild_of_a_moved_plane_from_its_stored_detail_has_no_error():
     assert np.abs(X[:, 2]).max() < 1e-12
     assert X[:, :2].min() >= -1e-12 and X[:, :2].max() <= 1 + 1e-12
     figures = apply(ms, "get_curvature_reconstruction_error", samplenum=5000)
-    assert figures["hausdorff_max_percent_of_diagonal"] < 1e-7 and figures["hausdorff_rms_percent_of_diagonal"] < 1e-7
+    # 0 to the rounding of pymeshlab's single-precision sampling (ROUNDING_RMS: 1e-5 % of the
+    # diagonal; 1.04e-6 % measured after other tests in the process, which draw other samples)
+    assert figures["hausdorff_max_percent_of_diagonal"] < 1e-5 and figures["hausdorff_rms_percent_of_diagonal"] < 1e-5
     assert np.abs(ms.mesh(1).vertex_scalar_array()).max() < 1e-9    # quality: distance to the source
 
 
