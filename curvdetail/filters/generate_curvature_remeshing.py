@@ -40,7 +40,7 @@ from .transfer_curvature_detail import planar_map
                   "'decimate'", choices=("isotropic", "decimate")),
         Parameter("target_edge", "PercentageValue", BBoxLength(1.0, percent=True),
                   "target edge length: a percentage of the bbox diagonal (pymeshlab.PercentageValue, "
-                  "'1%') or an absolute length", positive=True),
+                  "'1%') or a plain number in model units", positive=True),
         Parameter("transfer", "str", "conservative",
                   "how detail is carried over: 'conservative' (measure, totals kept) or 'pointwise' "
                   "(the paper: K interpolated, times the target's area)",
