@@ -35,7 +35,7 @@ def as_vertices(V, name="V", dim=3, max_coordinate=MAX_COORDINATE):
     except Exception as exc:  # ragged lists and the like
         raise MeshError(f"{name} could not be read as an array ({exc}); pass an (n, {dim}) float array.",
                         parameter=name) from None
-    if arr.dtype == object or not (np.issubdtype(arr.dtype, np.floating) or np.issubdtype(arr.dtype, np.integer)):
+    if arr.dtype.kind not in "fiu":
         raise MeshError(f"{name} has dtype {arr.dtype}; pass an (n, {dim}) array of real numbers.", parameter=name)
     if arr.ndim != 2 or arr.shape[1] != dim:
         raise MeshError(f"{name} has shape {arr.shape}; vertex positions must be an (n, {dim}) array.",
