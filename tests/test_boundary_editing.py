@@ -11,8 +11,8 @@ from curvdetail.curvature.errors import ConstraintError, FoldedTrianglesWarning,
 from curvdetail.curvature.testing import cylinder, grid
 
 
-# 5 % of the extent in three periods folds one triangle with the one-ring stage (it turns by 120
-# degrees, measured 2026-12-01) and warns; where the boundary lands is what is tested here
+# 5 % of the extent in three periods folds a triangle with the one-ring stage and warns; where
+# the boundary lands is what is tested here
 @pytest.mark.filterwarnings("ignore::curvdetail.curvature.errors.FoldedTrianglesWarning")
 def test_boundary_lands_exactly_on_the_sine_displacement(load_mesh):
     V, F = load_mesh("terrainA_1k.obj")
@@ -370,9 +370,8 @@ def _loop_extent(V, F):
 
 
 def test_a_small_boundary_move_that_folds_the_inside_warns_with_the_count_and_the_amplification(load_mesh):
-    # the review's trunk case on the nose: the boundary moves 1.9 % of the diagonal, the paper's
-    # one-ring stage amplifies its detail change ~7 times and folds ~78 of 1206 triangles
-    # (measured 2026-12-01); silently, before
+    # the boundary moves 1.9 % of the diagonal; the one-ring stage amplifies its detail change
+    # and folds triangles
     V, F = load_mesh("mannequin_nose.obj")
     f = sine_displacement(0.02 * _loop_extent(V, F), periods=2, axis=1)
     with pytest.warns(FoldedTrianglesWarning) as caught:

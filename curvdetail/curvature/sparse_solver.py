@@ -185,7 +185,7 @@ class Factorization:
         import pypardiso
         from pypardiso.pardiso_wrapper import PyPardisoError
 
-        # pypardiso searches for MKL in every new solver object (0.1 s) unless this is set
+        # pypardiso searches for MKL in every new solver object unless this is set
         os.environ.setdefault("PYPARDISO_MKL_RT", pypardiso.ps.libmkl._name)
         solver = getattr(self, "_pardiso", None)
         try:
