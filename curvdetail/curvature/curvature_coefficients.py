@@ -131,9 +131,8 @@ def curvature_coefficients(V, F, *, rcond=DEFAULT_RCOND, max_ring=DEFAULT_MAX_RI
     # the one-ring pairs from L's pattern (every edge both ways, every diagonal entry, sorted)
     diag_rows = np.repeat(np.arange(n), np.diff(L.indptr))
     off = L.indices != diag_rows
-    rows, cols, indptr = diag_rows[off], L.indices[off].astype(np.int64), L.indptr - np.arange(n + 1)
-    C, rank, scale, ring = _coefficients(D, A, rows, cols, n, rcond, centroid_diameter(V),
-                                         want_scale=return_info, max_ring=max_ring, indptr=indptr)
+    C, rank, scale, ring = _coefficients(D, A, diag_rows[off], L.indices[off].astype(np.int64), n, rcond,
+                                         centroid_diameter(V), want_scale=return_info, max_ring=max_ring)
     if not return_info:
         return C
     residual = np.linalg.norm(D - C @ D, axis=1)
@@ -173,18 +172,14 @@ def check_rcond(rcond):
 
 
 @ignoring_underflow
-def _coefficients(D, A, rows, cols, n, rcond, size, *, want_scale=False, max_ring=1, adjacency=None,
-                  indptr=None):
+def _coefficients(D, A, rows, cols, n, rcond, size, *, want_scale=False, max_ring=1, adjacency=None):
     """Batched truncated pseudo-inverse solve over the pattern (rows, cols), sorted by row.
 
     Rows whose fit leaves a residual above the threshold are widened by one ring of ``adjacency``
     (the one-ring pairs, sorted by row; default (rows, cols)) at a time, ``max_ring - 1`` times
-    at most, and no further once a widening adds no vertex (a whole small component, a vertex
-    without neighbours). ``indptr``: the pattern's row pointers where the caller has them.
-    Returns (C, rank, scale or None, ring): ``C`` on the (widened) pattern, explicit zeros kept;
+    at most, and no further once a widening adds no vertex. Returns (C, rank, scale or None, ring): ``C`` on the (widened) pattern, explicit zeros kept;
     ``ring`` (n,) the number of rings each row's coefficients span (1 = the given pattern)."""
-    if indptr is None:
-        indptr = _row_pointers(rows, n)
+    indptr = _row_pointers(rows, n)
     Dj = D[cols]
     # the 6 distinct entries of G_i = sum_j D_j D_j^T
     g = {}
