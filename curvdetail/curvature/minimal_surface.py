@@ -166,7 +166,7 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, step="n
     diag = bbox_diagonal(V)
     # steps relative to each vertex's own piece; a piece whose step fell below tol stays put
     scale, pieces = _piece_diagonals(V, F, U)
-    settled = factor = None
+    settled = factor = cot = None
     centre = bbox_centre(V[fixed])
     layout = _FreeSystemLayout(U, is_free, fixed)    # the same for every step: F does not change
     X = V.copy()
