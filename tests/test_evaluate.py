@@ -66,7 +66,7 @@ def test_the_pointwise_baseline_adds_the_papers_configuration_to_each_grid():
 
 def test_target_sizes_are_normalized_and_a_percentage_is_of_the_diagonal():
     assert [target_size(v) for v in ("0.50 %", "1%", 0.01, "2")] == ["0.5%", "1%", "0.01", "2"]
-    assert experiment_target_edge("1%") == 0.01
+    assert (experiment_target_edge("1%"), experiment_target_edge("0.01")) == ("1%", 0.01)    # model units
     for bad in ("x", "-1%", 0, True):
         with pytest.raises(StudyError) as e:
             target_size(bad)
@@ -135,13 +135,13 @@ def test_a_study_writes_a_row_per_cell_with_units_and_resumes(tmp_path, meshes, 
             r = rows[name, size]
             assert r["status"] == "ok" and r["mesh_blake2b"] == hashlib.blake2b(data, digest_size=16).hexdigest()
             assert (r["mesh_vertices"], r["mesh_closed"]) == (n, False)
-            # units: the fraction of the diagonal is the study's percentage, the length its multiple
-            assert r["target_edge_of_diagonal"] == float(size[:-1]) / 100
-            assert np.isclose(r["target_edge_model_units"], r["target_edge_of_diagonal"]
+            # units: the percentage of the diagonal is the study's, the length that share of the diagonal
+            assert r["target_edge_percent_of_diagonal"] == pytest.approx(float(size[:-1]), rel=1e-12)
+            assert np.isclose(r["target_edge_model_units"], r["target_edge_percent_of_diagonal"] / 100
                               * r["mesh_bbox_diagonal_model_units"], rtol=1e-12)
             # the rebuild beats zero detail by far; the ratio columns are the RMS columns' quotients
-            assert r["error_rms_of_diagonal"] < 0.2 * r["zero_detail_rms_of_diagonal"]
-            assert np.isclose(r["rms_to_floor_ratio"], r["error_rms_of_diagonal"] / r["floor_rms_of_diagonal"])
+            assert r["error_rms_percent_of_diagonal"] < 0.2 * r["zero_detail_rms_percent_of_diagonal"]
+            assert np.isclose(r["rms_to_floor_ratio"], r["error_rms_percent_of_diagonal"] / r["floor_rms_percent_of_diagonal"])
             stages = sum(r[f"{s}_s"] for s in ("retriangulate", "parameterize", "transfer", "reconstruct",
                                                  "evaluate"))
             assert stages <= r["experiment_s"] + 1e-3 and r["experiment_s"] <= r["cell_s"]
@@ -199,6 +199,12 @@ def test_the_command_runs_a_study_on_a_local_cluster_and_writes_a_summary(tmp_pa
     for name in ("rms_against_target.png", "ratio_to_floor.png", "time_against_vertices.png"):
         assert (tmp_path / "s" / name).read_bytes()[:4] == b"\x89PNG"
     assert main(args) == 1 and "--overwrite" in capsys.readouterr().err     # the summary exists
+
+
+def test_the_command_says_its_options(capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["evaluate", "--help"])
+    assert e.value.code == 0 and "--target-edge LIST" in capsys.readouterr().out
 
 
 @pytest.mark.slow

@@ -19,10 +19,12 @@ def add_arguments(parser):
     parser.add_argument("--study", metavar="STUDY", help="study file (.toml or .json): grids of configurations, "
                                                          "baselines (instead of the options below)")
     grid = parser.add_argument_group("one grid of configurations (comma-separated lists; every combination)")
-    for name, example in (("method", "isotropic,decimate"), ("target-edge", "0.5%,1%,2%"),
+    for name, example in (("method", "isotropic,decimate"), ("target-edge", "0.5%,1%,2% (of the bbox diagonal)"),
                           ("transfer", "conservative,pointwise"), ("rows", "free,all"), ("location", "closest,uv"),
-                          ("parameterization", "harmonic,lscm"), ("baselines", "pointwise")):
-        grid.add_argument(f"--{name}", type=_names, metavar="LIST", help=f"e.g. {example}")
+                          ("parameterization", "harmonic,lscm (location uv)"),
+                          ("baselines", "pointwise (adds the paper's configuration; zero_detail and floor are "
+                                        "in every row)")):
+        grid.add_argument(f"--{name}", type=_names, metavar="LIST", help=f"e.g. {example}".replace("%", "%%"))
     where = parser.add_mutually_exclusive_group()
     where.add_argument("--workers", type=whole_number_from_one, metavar="N",
                        help="worker processes of a local Dask cluster (default: one per core)")

@@ -11,7 +11,7 @@ from datetime import datetime, timezone
 from ..curvature.geometry import bbox_diagonal
 from ..curvature.topology import boundary_edges
 from ..io.mesh import read_mesh
-from ..remesh.experiment import remesh_experiment
+from ..remesh.experiment import MAX, RMS, remesh_experiment
 from .study import CONFIG_KEYS, experiment_target_edge
 
 _STAGES = ("retriangulate", "parameterize", "transfer", "reconstruct", "evaluate")
@@ -59,16 +59,18 @@ def report_columns(report):
     """The table's columns from a ``remesh_experiment`` report."""
     o, s = report["options"], report["seconds"]
     row = {"mesh_bbox_diagonal_model_units": report["source"]["bbox_diagonal"],
-           "target_edge_of_diagonal": o.get("target_edge"), "target_edge_model_units": o.get("target_edge_length"),
+           "target_edge_percent_of_diagonal": o.get("target_edge_percent_of_diagonal"),
+           "target_edge_model_units": o.get("target_edge_model_units"),
            "target_vertices": report["target"]["vertices"], "target_faces": report["target"]["faces"],
            "backend": o.get("backend"), "experiment_s": s["total"],
            **{f"{stage}_s": s[stage] for stage in _STAGES}}
     if "error" in report:
         for key, name in (("error", "error"), ("baseline_zero_detail", "zero_detail"),
                           ("floor_retriangulated", "floor")):
-            row[f"{name}_rms_of_diagonal"] = report[key]["hausdorff_rms"]
-            row[f"{name}_max_of_diagonal"] = report[key]["hausdorff_max"]
-        row.update(error_vertex_max_of_diagonal=report["error"]["vertex_max"], error_engine=report["error"]["engine"],
+            row[f"{name}_rms_percent_of_diagonal"] = report[key][RMS]
+            row[f"{name}_max_percent_of_diagonal"] = report[key][MAX]
+        row.update(error_vertex_max_percent_of_diagonal=report["error"]["vertex_max_percent_of_diagonal"],
+                   error_engine=report["error"]["engine"],
                    improvement_over_zero_detail_ratio=report["improvement_over_zero_detail"],
                    rms_to_floor_ratio=report["ratio_to_floor"])
     row.update({k: report.get("parameterization", {}).get(k) for k in ("flipped_source", "flipped_target")})

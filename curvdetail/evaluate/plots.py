@@ -41,18 +41,18 @@ def plot_rms_against_target(rows, path, *, overwrite=False):
     the floor (dashed) and zero-detail (dotted) medians of each method; log axes."""
     from matplotlib.figure import Figure
 
-    rows = _ok(rows, "target_edge_of_diagonal", "error_rms_of_diagonal")
+    rows = _ok(rows, "target_edge_percent_of_diagonal", "error_rms_percent_of_diagonal")
     fig = Figure(figsize=(7.5, 5.0), layout="constrained")
     ax = fig.subplots()
     series = {}
     for r in rows:
-        for name, column, style in ((label(r), "error_rms_of_diagonal", "o-"),
-                                    (f"{r['method']}: floor", "floor_rms_of_diagonal", "s--"),
-                                    (f"{r['method']}: zero detail", "zero_detail_rms_of_diagonal", "^:")):
-            series.setdefault((name, style), {}).setdefault(r["target_edge_of_diagonal"], []).append(r[column])
+        for name, column, style in ((label(r), "error_rms_percent_of_diagonal", "o-"),
+                                    (f"{r['method']}: floor", "floor_rms_percent_of_diagonal", "s--"),
+                                    (f"{r['method']}: zero detail", "zero_detail_rms_percent_of_diagonal", "^:")):
+            series.setdefault((name, style), {}).setdefault(r["target_edge_percent_of_diagonal"], []).append(r[column])
     for (name, style), points in sorted(series.items()):
         x = sorted(points)
-        ax.plot(100 * np.array(x), [100 * np.median(points[v]) for v in x], style, label=name, markersize=4)
+        ax.plot(x, [np.median(points[v]) for v in x], style, label=name, markersize=4)
     _plain_log_axes(ax)
     ax.set(xlabel="target edge, % of the bbox diagonal",
            ylabel="RMS to the source, % of bbox diagonal\n(median over the meshes)")

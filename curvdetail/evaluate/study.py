@@ -50,7 +50,7 @@ class StudyError(CurvdetailError):
 
 def target_size(value):
     """A target edge size as the study writes it: ``"1%"`` (of the source's bbox diagonal) or a
-    plain number, normalized (``"0.50 %"`` -> ``"0.5%"``, ``0.01`` -> ``"0.01"``); StudyError if
+    plain number (model units), normalized (``"0.50 %"`` -> ``"0.5%"``, ``0.01`` -> ``"0.01"``); StudyError if
     it is not a positive number."""
     text = str(value).strip()
     percent = text.endswith("%")
@@ -66,10 +66,8 @@ def target_size(value):
 
 def experiment_target_edge(size):
     """The ``target_edge`` argument of :func:`~curvdetail.remesh.remesh_experiment` for a
-    normalized size of :func:`target_size` (the one place that knows its convention)."""
-    if size.endswith("%"):
-        return float(size[:-1]) / 100.0
-    return float(size)
+    normalized size of :func:`target_size`: ``"1%"`` as it is, a plain number in model units."""
+    return size if size.endswith("%") else float(size)
 
 
 @dataclass(frozen=True)

@@ -11,11 +11,11 @@ from .plots import label, plot_ratio_to_floor, plot_rms_against_target, plot_tim
 FILES = ("summary.md", "rms_against_target.png", "ratio_to_floor.png", "time_against_vertices.png")
 
 
-def _stats(values, scale=1.0, spec=".3g"):
+def _stats(values, spec=".3g"):
     values = [v for v in values if v is not None]
     if not values:
         return "-"
-    return f"{scale * np.median(values):{spec}} / {scale * max(values):{spec}}"
+    return f"{np.median(values):{spec}} / {max(values):{spec}}"
 
 
 def _table(groups, first):
@@ -24,11 +24,11 @@ def _table(groups, first):
              "|---|---:|---:|---:|---:|---:|---:|"]
     for name, rows in sorted(groups.items()):
         ok = [r for r in rows if r["status"] == "ok"]
-        col = {c: [r[c] for r in ok] for c in ("error_rms_of_diagonal", "rms_to_floor_ratio", "cell_s",
-                                               "zero_detail_rms_of_diagonal", "floor_rms_of_diagonal")}
-        lines.append(f"| {name} | {len(ok)} / {len(rows)} | {_stats(col['error_rms_of_diagonal'], 100)} | "
-                     f"{_stats(col['rms_to_floor_ratio'])} | {_stats(col['zero_detail_rms_of_diagonal'], 100)} | "
-                     f"{_stats(col['floor_rms_of_diagonal'], 100)} | {_stats(col['cell_s'], spec='.2f')} |")
+        col = {c: [r[c] for r in ok] for c in ("error_rms_percent_of_diagonal", "rms_to_floor_ratio", "cell_s",
+                                               "zero_detail_rms_percent_of_diagonal", "floor_rms_percent_of_diagonal")}
+        lines.append(f"| {name} | {len(ok)} / {len(rows)} | {_stats(col['error_rms_percent_of_diagonal'])} | "
+                     f"{_stats(col['rms_to_floor_ratio'])} | {_stats(col['zero_detail_rms_percent_of_diagonal'])} | "
+                     f"{_stats(col['floor_rms_percent_of_diagonal'])} | {_stats(col['cell_s'], spec='.2f')} |")
     return "\n".join(lines)
 
 

@@ -2,8 +2,8 @@
 
 A results folder ``DIR`` holds ``DIR/parts/<cell key>.parquet`` (one file per finished cell,
 written atomically as the cell finishes) and ``DIR/results.parquet`` + ``DIR/results.csv``, the
-table rebuilt from the parts. Units are in the column names: ``_of_diagonal`` a fraction of
-the source's bounding-box diagonal, ``_model_units`` the mesh's own length unit, ``_s``
+table rebuilt from the parts. Units are in the column names: ``_percent_of_diagonal`` a percentage
+of the source's bounding-box diagonal, ``_model_units`` the mesh's own length unit, ``_s``
 seconds, ``_mib`` MiB (2^20 bytes).
 """
 
@@ -36,18 +36,18 @@ COLUMNS = [
     ("rows", _S, "residual rows of the reconstruction"),
     ("location", _S, "point location"),
     ("parameterization", _S, 'planar domain of location "uv" (empty otherwise)'),
-    ("target_edge_of_diagonal", _F, "target edge length"),
+    ("target_edge_percent_of_diagonal", _F, "target edge length"),
     ("target_edge_model_units", _F, "target edge length"),
     ("target_vertices", _I, "vertices of the retriangulated target"),
     ("target_faces", _I, "triangles of the target"),
-    ("error_rms_of_diagonal", _F, "two-sided Hausdorff RMS, rebuilt surface to source"),
-    ("error_max_of_diagonal", _F, "two-sided Hausdorff max, rebuilt surface to source"),
-    ("error_vertex_max_of_diagonal", _F, "largest distance of a rebuilt vertex to the source (exact)"),
+    ("error_rms_percent_of_diagonal", _F, "two-sided Hausdorff RMS, rebuilt surface to source"),
+    ("error_max_percent_of_diagonal", _F, "two-sided Hausdorff max, rebuilt surface to source"),
+    ("error_vertex_max_percent_of_diagonal", _F, "largest distance of a rebuilt vertex to the source (exact)"),
     ("error_engine", _S, 'distance engine of the error figures ("meshlab" or "exact")'),
-    ("zero_detail_rms_of_diagonal", _F, "baseline: the zero-detail (harmonic) surface, RMS"),
-    ("zero_detail_max_of_diagonal", _F, "baseline: the zero-detail surface, max"),
-    ("floor_rms_of_diagonal", _F, "baseline: the retriangulated surface itself, RMS"),
-    ("floor_max_of_diagonal", _F, "baseline: the retriangulated surface itself, max"),
+    ("zero_detail_rms_percent_of_diagonal", _F, "baseline: the zero-detail (harmonic) surface, RMS"),
+    ("zero_detail_max_percent_of_diagonal", _F, "baseline: the zero-detail surface, max"),
+    ("floor_rms_percent_of_diagonal", _F, "baseline: the retriangulated surface itself, RMS"),
+    ("floor_max_percent_of_diagonal", _F, "baseline: the retriangulated surface itself, max"),
     ("improvement_over_zero_detail_ratio", _F, "zero-detail RMS / error RMS (empty where an RMS is rounding)"),
     ("rms_to_floor_ratio", _F, "error RMS / floor RMS (empty where an RMS is rounding)"),
     ("flipped_source", _I, 'location "uv": source triangles flipped in the planar map'),
