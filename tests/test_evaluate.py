@@ -141,7 +141,8 @@ def test_a_study_writes_a_row_per_cell_with_units_and_resumes(tmp_path, meshes, 
                               * r["mesh_bbox_diagonal_model_units"], rtol=1e-12)
             # the rebuild beats zero detail by far; the ratio columns are the RMS columns' quotients
             assert r["error_rms_percent_of_diagonal"] < 0.2 * r["zero_detail_rms_percent_of_diagonal"]
-            assert np.isclose(r["rms_to_floor_ratio"], r["error_rms_percent_of_diagonal"] / r["floor_rms_percent_of_diagonal"])
+            assert np.isclose(r["rms_to_floor_ratio"],
+                              r["error_rms_percent_of_diagonal"] / r["floor_rms_percent_of_diagonal"])
             stages = sum(r[f"{s}_s"] for s in ("retriangulate", "parameterize", "transfer", "reconstruct",
                                                  "evaluate"))
             assert stages <= r["experiment_s"] + 1e-3 and r["experiment_s"] <= r["cell_s"]

@@ -40,9 +40,10 @@ def summary_markdown(rows):
     for r in rows:
         by_config.setdefault(label(r, target=True), []).append(r)
         by_mesh.setdefault(r["mesh_name"], []).append(r)
-    text = [f"# Study summary\n\n{len(rows)} cells: {status['ok']} ok, {status['failed']} failed, "
-            f"{status['timeout']} timed out, {status['memory']} over the memory limit. Distances in % of the source's bbox diagonal; RMS/floor is "
-            "the rebuilt RMS over the retriangulated surface's own.\n",
+    counts = (f"{len(rows)} cells: {status['ok']} ok, {status['failed']} failed, {status['timeout']} timed out, "
+              f"{status['memory']} over the memory limit")
+    text = [f"# Study summary\n\n{counts}. Distances in % of the source's bbox diagonal; RMS/floor is the rebuilt "
+            "RMS over the retriangulated surface's own.\n",
             "## Per configuration (method transfer rows location target edge), over the meshes\n",
             _table(by_config, "configuration"), "\n## Per mesh, over the configurations\n", _table(by_mesh, "mesh")]
     failed = [r for r in rows if r["status"] != "ok"]
