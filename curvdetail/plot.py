@@ -189,7 +189,7 @@ def save_remeshing_figure(path, V, F, X, Ft, Z, distance, report, *, overwrite=F
     if distance.shape != (X.shape[0],) or not np.isfinite(distance).all():
         raise ValueError(f"distance has shape {distance.shape} for {X.shape[0]} rebuilt vertices: pass one finite "
                          "distance per vertex of X (run_experiment's result['distance'])")
-    V, Z = np.asarray(V, dtype=np.float64), np.asarray(Z, dtype=np.float64)
+    V = np.asarray(V, dtype=np.float64)
     R = top_view(V, F)
     e, b, fl = report["error"], report["baseline_zero_detail"], report["floor_retriangulated"]
     name = os.path.basename(report["source"].get("path") or "source")
@@ -198,8 +198,10 @@ def save_remeshing_figure(path, V, F, X, Ft, Z, distance, report, *, overwrite=F
               (X @ R.T, Ft, f"rebuilt ({o['transfer']}, rows={o['rows']}): {report['target']['vertices']:,} "
                             f"vertices\nRMS {100 * e['hausdorff_rms']:.3f} %  max {100 * e['hausdorff_max']:.2f} %  "
                             f"(floor {100 * fl['hausdorff_rms']:.3f} %)",
-               100 * distance / report["source"]["bbox_diagonal"]),
-              (Z @ R.T, Ft, f"zero detail\nRMS {100 * b['hausdorff_rms']:.2f} %  max {100 * b['hausdorff_max']:.1f} %")]
+               100 * distance / report["source"]["bbox_diagonal"])]
+    if Z is not None and b is not None:     # none for a closed piece (it collapses onto its anchor)
+        panels.append((np.asarray(Z, dtype=np.float64) @ R.T, Ft,
+                       f"zero detail\nRMS {100 * b['hausdorff_rms']:.2f} %  max {100 * b['hausdorff_max']:.1f} %"))
     save_panels(path, panels, elev=50.0, azim=20.0, panel_size=4.0, dpi=dpi, overwrite=overwrite,
                 title="Remeshing from curvature detail (all figures: % of the source's bbox diagonal)",
                 colorbar="distance to source, % of bbox diagonal")

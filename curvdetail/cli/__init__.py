@@ -47,7 +47,8 @@ class Terminated(KeyboardInterrupt):
 
 # --- reconstruct / minimal ------------------------------------------------------------------
 
-@command("reconstruct", help="rebuild a mesh from its own curvature detail with the boundary fixed")
+@command("reconstruct", help="rebuild a mesh from its own curvature detail with the boundary fixed (and one "
+                             "anchor vertex on each closed piece)")
 def _reconstruct(parser):
     add_input_output(parser, "mesh file", "rebuilt mesh; quality = distance to INPUT (.ply keeps it)")
     choice(parser, "--rows", ("all", "free"), "all",
@@ -59,12 +60,13 @@ def _reconstruct(parser):
     def run(args):
         import numpy as np
 
-        from .. import Reconstructor, curvature_detail, write_mesh
+        from .. import Reconstructor, anchor_vertices, curvature_detail, write_mesh
 
         inputs = input_output(args)
         check_outputs(args, [("OUTPUT", args.output, True)], **inputs)
         V, F = read_checked(args.input)
-        fixed = fixed_vertices(args, V, F, purpose="to rebuild a closed mesh")
+        # the boundary (or --fix), and an anchor on each piece with no fixed vertex (a closed one)
+        fixed = anchor_vertices(V, F, fixed=None if args.fix is None else fixed_vertices(args, V, F, purpose=""))
         t = time.perf_counter()
         rec = Reconstructor(V, F, fixed, rows=args.rows, backend=args.backend)
         X = rec.solve(curvature_detail(V, F), V[rec.fixed])
@@ -129,10 +131,10 @@ def _minimal(parser):
 
 # --- remesh ---------------------------------------------------------------------------------
 
-@command("remesh", help="retriangulate a disk patch, rebuild it from its curvature detail, and measure "
-                        "the error (the paper's Fig. 3)")
+@command("remesh", help="retriangulate a mesh (closed, holes, pieces), rebuild it from its curvature detail, "
+                        "and measure the error (the paper's Fig. 3)")
 def _remesh(parser):
-    add_input_output(parser, "source mesh: a disk-topology patch (one boundary loop)",
+    add_input_output(parser, "source mesh: a manifold surface (a disk-topology patch for --location uv)",
                       "rebuilt target mesh; quality = distance to the source (.ply keeps it)")
     choice(parser, "--method", ("isotropic", "decimate"), "isotropic", "retriangulation (default: isotropic)")
     parser.add_argument("--target-edge", type=percentage, default=1.0, metavar="PCT",
@@ -203,8 +205,10 @@ def _remesh(parser):
             print_figures(f"{counts}; not measured (--no-evaluate); {report['seconds']['total']:.2f} s")
             return 0
         e, b, fl = report["error"], report["baseline_zero_detail"], report["floor_retriangulated"]
-        print_figures(f"{counts}; RMS {100 * e['hausdorff_rms']:.4f} %, max {100 * e['hausdorff_max']:.3f} % of the "
-                      f"bbox diagonal (zero detail {100 * b['hausdorff_rms']:.3f} % / {100 * b['hausdorff_max']:.2f} %, "
+        zero = "none" if b is None else f"{100 * b['hausdorff_rms']:.3f} % / {100 * b['hausdorff_max']:.2f} %"
+        anchors = f"; {report['anchors']} anchor{'s' * (report['anchors'] != 1)}" if report["anchors"] else ""
+        print_figures(f"{counts}{anchors}; RMS {100 * e['hausdorff_rms']:.4f} %, max {100 * e['hausdorff_max']:.3f} % of "
+                      f"the bbox diagonal (zero detail {zero}, "
                       f"floor {100 * fl['hausdorff_rms']:.4f} % / {100 * fl['hausdorff_max']:.3f} %); "
                       f"{report['seconds']['total']:.2f} s")
         note_dropped(args.output, quality=True)

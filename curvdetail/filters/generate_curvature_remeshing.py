@@ -64,7 +64,8 @@ from .transfer_curvature_detail import planar_map
                   "measure the distances to the source (half or more of the time on big meshes with "
                   "decimation, up to half with isotropic remeshing); false leaves the rebuilt and "
                   "zero-detail layers without a vertex quality, so a PLY of them holds none"),
-        Parameter("add_baseline", "bool", False, "also add the zero-detail baseline as a layer"),
+        Parameter("add_baseline", "bool", False, "also add the zero-detail baseline as a layer (none where "
+                  "the mesh has a closed piece: with zero detail it collapses onto its anchor)"),
     ],
 )
 def generate_curvature_remeshing(ms, *, method, target_edge, transfer, rows, location,
@@ -92,7 +93,7 @@ def generate_curvature_remeshing(ms, *, method, target_edge, transfer, rows, loc
               "retriangulated": add_layer(ms, result["Vt"], Ft, f"{label} retriangulated")}
     # without evaluation the measured layers get no quality at all, not pymeshlab's zeros
     measured_layer = add_layer if evaluate else _add_layer_without_quality
-    if add_baseline:
+    if add_baseline and result["Z"] is not None:        # a closed piece has no zero-detail surface
         # the distances the experiment measured for the baseline's Hausdorff maximum (None
         # without evaluation)
         layers["zero_detail"] = measured_layer(ms, result["Z"], Ft, f"{label} zero detail",

@@ -60,7 +60,7 @@ def planar_map(location, parameterization, default="harmonic"):
     ],
 )
 def transfer_curvature_detail(ms, *, sourcemesh, targetmesh, method, location, parameterization):
-    from ..remesh import check_disk, parameterize, transfer_curvature
+    from ..remesh import check_surface, parameterize, transfer_curvature
     from ..remesh.transfer import squashed_in_plane
 
     parameterization = planar_map(location, parameterization)
@@ -71,8 +71,8 @@ def transfer_curvature_detail(ms, *, sourcemesh, targetmesh, method, location, p
                           hint="load or generate the retriangulation as another layer (e.g. layer 1)")
     Vs, Fs = mesh_arrays(ms, source)
     Vt, Ft = mesh_arrays(ms, target)
-    check_disk(Vs, Fs, f"the source (layer {source})")
-    check_disk(Vt, Ft, f"the target (layer {target})")
+    check_surface(Vs, Fs, f"the source (layer {source})")       # location='uv': parameterize asks for disks
+    check_surface(Vt, Ft, f"the target (layer {target})")
     # stored detail outlives moved vertices (the editing use); a broken stamp is refused in load_detail
     stored = vertex_attribute(ms, source, DETAIL, "point") is not None
     Ds = load_detail(ms, source, Fs) if stored else curvature_detail(Vs, Fs)
