@@ -1,0 +1,99 @@
+"""The remeshing experiment on whole models: closed surfaces, handles, holes and several pieces."""
+
+import numpy as np
+import pytest
+
+from curvdetail.curvature.geometry import bbox_diagonal
+from curvdetail.curvature.testing import cylinder
+from curvdetail.curvature.topology import boundary_vertices, vertex_components
+from curvdetail.remesh import check_surface, remesh_experiment, retriangulate
+from curvdetail.remesh._disk import Polyline
+from curvdetail.remesh.experiment import run_experiment
+
+from test_anchors import torus, two_spheres
+
+
+def wavy_tube():
+    """An open tube with two boundary loops (two holes in a closed surface), radius waving along z."""
+    V, F = cylinder(n_around=48, n_along=25)
+    V[:, :2] *= 1 + 0.2 * np.sin(3 * np.pi * V[:, 2:3])
+    return V, F
+
+
+def test_closed_genus_0_model_is_rebuilt_near_its_floor(load_mesh):
+    # spot (closed, genus 0) at 3 %: measured 0.96x the retriangulated floor (RMS); allowed 1.5x,
+    # the issue's target
+    (X, Ft), report = remesh_experiment(*load_mesh("spot.obj"), target_edge=0.03)
+    assert report["anchors"] == 1 and report["target"]["boundary_loops"] == 0
+    assert report["ratio_to_floor"] < 1.5
+    assert report["baseline_zero_detail"] is None and report["improvement_over_zero_detail"] is None
+    assert "improvement_over_zero_detail" in report["ratio_notes"]
+
+
+def test_closed_genus_1_torus_is_rebuilt_near_its_floor():
+    # a torus of 3,840 vertices at 3 %, one anchor: measured 1.70x the floor (RMS) and 1.75x its
+    # maximum; allowed 2x both. The detail's error drifts further around a handle than over a
+    # sphere (4 anchors: 1.38x)
+    V, F = torus(n_major=96, n_minor=40)
+    (X, Ft), report = remesh_experiment(V, F, target_edge=0.03)
+    _, _, loops = check_surface(X, Ft)
+    assert report["anchors"] == 1 and loops == []
+    assert report["ratio_to_floor"] < 2.0
+    assert report["error"]["hausdorff_max"] < 2.0 * report["floor_retriangulated"]["hausdorff_max"]
+
+
+def test_two_holes_both_loops_are_kept_fixed_bit_for_bit():
+    V, F = wavy_tube()
+    d = bbox_diagonal(V)
+    out = run_experiment(V, F, target_edge=0.03)
+    Vt, Ft, X = out["Vt"], out["Ft"], out["X"]
+    b = boundary_vertices(Ft)
+    assert out["report"]["anchors"] == 0 and out["report"]["target"]["boundary_loops"] == 2
+    assert np.array_equal(X[b], Vt[b])                                   # fixed, bit for bit
+    # on the source's two boundary polylines (z = -0.5 and 0.5), within rounding
+    source_loops = check_surface(V, F)[2]
+    dist = np.min([Polyline(V[loop]).project(Vt[b])[2] for loop in source_loops], axis=0)
+    assert dist.max() < 1e-12 * d
+    assert out["report"]["ratio_to_floor"] < 1.5                          # measured 0.9
+
+
+def test_two_pieces_are_each_rebuilt():
+    V, F = two_spheres()
+    out = run_experiment(V, F, target_edge=0.03)
+    X, Ft = out["X"], out["Ft"]
+    labels, count = vertex_components(Ft, X.shape[0])
+    assert count == 2 and out["report"]["anchors"] == 2
+    d = bbox_diagonal(V)
+    for piece in range(2):                  # each piece stays on its sphere (radius 1, centres known)
+        P = X[labels == piece]
+        centre = np.array([3.0, 0.5, 0.0]) if P[:, 0].mean() > 1.5 else np.zeros(3)
+        assert np.abs(np.linalg.norm(P - centre, axis=1) - 1.0).max() < 2e-3 * d
+    assert out["report"]["ratio_to_floor"] < 1.5                          # measured 0.45
+
+
+def test_retriangulation_keeps_every_boundary_loop_on_its_source_loop():
+    V, F = wavy_tube()
+    Vt, Ft = retriangulate(V, F, target_edge=0.03)
+    loops = check_surface(Vt, Ft)[2]
+    assert len(loops) == 2
+    ends = sorted(np.round(Vt[loop, 2].mean(), 12) for loop in loops)
+    assert ends == [-0.5, 0.5]
+
+
+@pytest.mark.parametrize("method", ["isotropic", "decimate"])
+def test_retriangulation_of_a_torus_keeps_its_genus(method):
+    V, F = torus(n_major=96, n_minor=40)
+    Vt, Ft = retriangulate(V, F, method=method, target_edge=0.03)
+    n, m = Vt.shape[0], Ft.shape[0]
+    assert n - 3 * m // 2 + m == 0 and vertex_components(Ft, n)[1] == 1     # Euler characteristic 0
+
+
+def test_non_manifold_input_names_its_edges():
+    from curvdetail import MeshError
+
+    V, F = torus()
+    V2 = np.vstack([V, [[0.0, 0.0, 2.0]]])
+    F2 = np.vstack([F, [[F[0, 0], F[0, 1], V.shape[0]]]])               # a fin on edge F[0, :2]
+    with pytest.raises(MeshError) as refused:
+        remesh_experiment(V2, F2, target_edge=0.03)
+    assert refused.value.count == 1 and refused.value.first == [sorted(F[0, :2].tolist())]
