@@ -97,3 +97,28 @@ def test_non_manifold_input_names_its_edges():
     with pytest.raises(MeshError) as refused:
         remesh_experiment(V2, F2, target_edge=0.03)
     assert refused.value.count == 1 and refused.value.first == [sorted(F[0, :2].tolist())]
+
+
+@pytest.mark.parametrize("apart", [True, False])
+def test_two_spheres_touching_at_a_vertex_stay_two_pieces(apart, monkeypatch):
+    # two vertices at one position (cow.off has a pair): pymeshlab's remeshing merges them, which
+    # glued the pieces there; they are moved apart first (by APART of their one-ring)
+    from curvdetail.curvature.testing import icosphere
+    from curvdetail.remesh import RemeshError
+
+    V, F = icosphere(subdivisions=3)
+    v = V[0]
+    B = V + 2 * v                        # B's vertex -v lands on A's vertex v
+    assert np.flatnonzero(np.all(np.isclose(B, v, atol=1e-15), axis=1)).size == 1
+    W = np.vstack([V, B])
+    W[V.shape[0] + np.flatnonzero(np.all(np.isclose(B, v, atol=1e-15), axis=1))] = v    # exactly
+    T = np.vstack([F, F + V.shape[0]])
+    if not apart:
+        import importlib
+
+        monkeypatch.setattr(importlib.import_module("curvdetail.remesh.retriangulate"), "APART", 0.0)
+        with pytest.raises(RemeshError):
+            retriangulate(W, T, target_edge=0.03)
+        return
+    Vt, Ft = retriangulate(W, T, target_edge=0.03)
+    assert vertex_components(Ft, Vt.shape[0])[1] == 2

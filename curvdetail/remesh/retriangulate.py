@@ -338,7 +338,7 @@ def _isotropic(V, F, h, iterations, max_dist, surface_check=True):
     import pymeshlab
 
     ms = pymeshlab.MeshSet()
-    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=V, face_matrix=F.astype(np.int32)))
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=_apart(V, F), face_matrix=F.astype(np.int32)))
     # Every parameter explicitly: pymeshlab keeps values from earlier calls in one process.
     ms.meshing_isotropic_explicit_remeshing(
         iterations=iterations, adaptive=False, selectedonly=False, targetlen=pymeshlab.PureValue(h),
@@ -347,6 +347,32 @@ def _isotropic(V, F, h, iterations, max_dist, surface_check=True):
     ms.meshing_remove_unreferenced_vertices()
     m = ms.current_mesh()
     return np.array(m.vertex_matrix(), dtype=np.float64), np.array(m.face_matrix(), dtype=np.int64)
+
+
+#: How far (a fraction of the way to the centroid of its neighbours) a vertex that shares its
+#: position with another is moved before the isotropic remeshing, which merges such vertices
+#: (cow.off has two where its surface touches itself: the remesher glued the two sheets into a
+#: non-manifold edge at any target edge).
+APART = 1e-6
+
+
+def _apart(V, F):
+    """``V`` with every vertex at the position of an earlier one moved ``APART`` of the way to
+    the centroid of its neighbours (into its own sheet of the surface)."""
+    order = np.lexsort(V.T[::-1])
+    moved = order[1:][np.all(V[order[1:]] == V[order[:-1]], axis=1)]
+    if moved.size == 0:
+        return V
+    is_moved = np.zeros(V.shape[0], dtype=bool)
+    is_moved[moved] = True
+    total, count = np.zeros_like(V), np.zeros(V.shape[0])
+    for k in range(3):
+        rows = F[is_moved[F[:, k]]]
+        np.add.at(total, rows[:, k], V[rows[:, (k + 1) % 3]] + V[rows[:, (k + 2) % 3]])
+        np.add.at(count, rows[:, k], 2.0)
+    V = V.copy()
+    V[moved] += APART * (total[moved] / count[moved, None] - V[moved])
+    return V
 
 
 # shown by retriangulate, the generate_curvature_remeshing filter and `curvdetail remesh` alike,
