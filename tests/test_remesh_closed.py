@@ -122,3 +122,26 @@ def test_two_spheres_touching_at_a_vertex_stay_two_pieces(apart, monkeypatch):
         return
     Vt, Ft = retriangulate(W, T, target_edge=0.03)
     assert vertex_components(Ft, Vt.shape[0])[1] == 2
+
+
+@pytest.mark.parametrize("relocate", [True, False])
+def test_detail_stays_on_its_own_sheet_where_two_lie_close(relocate, monkeypatch):
+    # two spheres 0.001 apart; the target's first one is 2 % smaller, so near the gap the source's
+    # first sphere is closer to the target's second. Known answer: a closed piece's detail sums
+    # to zero, and the conservative transfer keeps each piece's total where its samples land
+    import importlib
+
+    from curvdetail.curvature.testing import icosphere
+    from curvdetail.remesh import transfer_curvature
+
+    V, F = icosphere(subdivisions=3)
+    n = V.shape[0]
+    Vs = np.vstack([V, V + [2.001, 0.0, 0.0]])
+    Vt = np.vstack([0.98 * V, V + [2.001, 0.0, 0.0]])
+    Fs = np.vstack([F, F + n])
+    if not relocate:
+        monkeypatch.setattr(importlib.import_module("curvdetail.remesh.transfer"), "_facing_side",
+                            lambda *args: None)
+    Dt = transfer_curvature(Vs, Fs, Vt, Fs)
+    first = np.abs(Dt[:n].sum(axis=0)).max() / np.abs(Dt).sum()
+    assert (first < 1e-12) == relocate           # moved to the other sphere without the check
