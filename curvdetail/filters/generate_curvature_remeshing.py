@@ -16,10 +16,12 @@ from .transfer_curvature_detail import planar_map
     name="generate_curvature_remeshing",
     category="Curvature detail",
     description=f"""
-        Run the whole remeshing experiment on the current mesh (a disk-topology patch):
-        retriangulate it (pymeshlab isotropic remeshing or fast-simplification decimation, the
-        boundary kept on the source boundary), carry its curvature detail over to the new
-        triangulation, rebuild the new triangulation from that detail with its boundary fixed, and
+        Run the whole remeshing experiment on the current mesh (any manifold surface: closed,
+        with holes, several pieces; a disk-topology patch for location 'uv'): retriangulate it
+        (pymeshlab isotropic remeshing or fast-simplification decimation, every boundary loop kept
+        on the source's), carry its curvature detail over to the new triangulation, rebuild the
+        new triangulation from that detail with its boundary fixed and one anchor vertex on each
+        closed piece (the report's 'anchors'), and
         measure the two-sided Hausdorff distance to the source next to two baselines (the
         zero-detail surface with the same boundary and the retriangulated surface itself, the
         floor). Adds the retriangulated layer and the rebuilt layer (current; quality = distance
