@@ -102,7 +102,8 @@ def main(argv=None):
                "from its flattest vertex). Figures are "
                "two-sided Hausdorff distances in % of the bbox diagonal; the floor is the retriangulated surface "
                f"itself. Target: both ratios within {TARGET_RATIO}x. Written by scripts/reproduce_closed.py.\n\n")
-    _files.write_json(json_path, {"target_ratio": TARGET_RATIO, "anchors": args.anchors, "runs": rows}, args.force, end="\n", indent=1)
+    _files.write_json(json_path, {"target_ratio": TARGET_RATIO, "anchors": args.anchors, "runs": rows}, args.force,
+                      end="\n", indent=1)
     _files.write_text(md_path, heading + table(rows), args.force)
     return 0 if all("error" not in r for r in rows) else 1
 

@@ -207,8 +207,8 @@ def _remesh(parser):
         e, b, fl = report["error"], report["baseline_zero_detail"], report["floor_retriangulated"]
         zero = "none" if b is None else f"{100 * b['hausdorff_rms']:.3f} % / {100 * b['hausdorff_max']:.2f} %"
         anchors = f"; {report['anchors']} anchor{'s' * (report['anchors'] != 1)}" if report["anchors"] else ""
-        print_figures(f"{counts}{anchors}; RMS {100 * e['hausdorff_rms']:.4f} %, max {100 * e['hausdorff_max']:.3f} % of "
-                      f"the bbox diagonal (zero detail {zero}, "
+        print_figures(f"{counts}{anchors}; RMS {100 * e['hausdorff_rms']:.4f} %, max "
+                      f"{100 * e['hausdorff_max']:.3f} % of the bbox diagonal (zero detail {zero}, "
                       f"floor {100 * fl['hausdorff_rms']:.4f} % / {100 * fl['hausdorff_max']:.3f} %); "
                       f"{report['seconds']['total']:.2f} s")
         note_dropped(args.output, quality=True)

@@ -19,7 +19,8 @@ from .reconstruct import Reconstructor, reconstruct
 from .sparse_solver import SolverError, available_backends
 
 __all__ = [
-    "CoefficientInfo", "anchor_vertices", "ConstraintError", "CurvatureEditor", "MeshError", "Reconstructor", "SolverError",
+    "CoefficientInfo", "ConstraintError", "CurvatureEditor", "MeshError", "Reconstructor", "SolverError",
+    "anchor_vertices",
     "available_backends", "boundary_edges", "boundary_loop", "boundary_vertices", "check_mesh",
     "cotan_laplacian", "curvature_coefficients", "curvature_detail", "edit_boundary", "mean_curvature_normal",
     "minimal_surface", "mixed_voronoi_area", "reconstruct", "sine_displacement",

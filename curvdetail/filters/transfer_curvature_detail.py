@@ -27,9 +27,9 @@ def planar_map(location, parameterization, default="harmonic"):
     name="transfer_curvature_detail",
     category="Curvature detail",
     description=f"""
-        Carry the curvature detail of the source layer (a manifold surface; a disk-topology patch
-        for location 'uv') over to the target layer (a retriangulation of it), the transfer step of the paper's remeshing
-        experiment. The detail carried is the source's stored 'curvature_detail' where it holds
+        Carry the curvature detail of the source layer (a manifold surface; a disk-topology
+        patch for location 'uv') over to the target layer (a retriangulation of it), the transfer
+        step of the paper's remeshing experiment. The detail carried is the source's stored 'curvature_detail' where it holds
         one (from compute_curvature_detail, kept while its vertices were moved; refused if the
         source was retriangulated since, as apply_curvature_reconstruction refuses it), else the
         detail of its current geometry; the returned 'detail_source' says which ('stored' or

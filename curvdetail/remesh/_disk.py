@@ -167,7 +167,8 @@ def boundary_loops(F, n, what="the mesh"):
     if pinched.size:
         check_oriented(F, what)
         raise MeshError(f"{what} is not vertex-manifold: the boundary passes "
-                        f"{counted(pinched.size, 'vertex', 'vertices')} more than once (first: {first_indices(pinched)})",
+                        f"{counted(pinched.size, 'vertex', 'vertices')} more than once "
+                        f"(first: {first_indices(pinched)})",
                         hint="split those vertices, e.g. with pymeshlab's meshing_repair_non_manifold_vertices",
                         count=int(pinched.size), first=pinched[:3].tolist())
     successor = np.full(n, -1, dtype=np.int64)
@@ -301,7 +302,8 @@ TARGET_BOUNDARY_TOLERANCE = 1e-6
 
 def check_target_boundary(P, X, d, advice):
     """RemeshError unless every target boundary vertex ``X`` lies on a source boundary
-    polyline (``P``: one loop's points, or a list of loops) within ``TARGET_BOUNDARY_TOLERANCE`` times the larger of the diagonal ``d``
+    polyline (``P``: one loop's points, or a list of loops) within
+    ``TARGET_BOUNDARY_TOLERANCE`` times the larger of the diagonal ``d``
     and the largest coordinate (float32 files far from the origin round by more than 1e-6 of a
     small diagonal); ``advice``: the sentence that ends the message (what to pass instead)."""
     loops = P if isinstance(P, list) else [P]

@@ -12,7 +12,8 @@ from ..curvature.anchors import anchor_vertices
 from ..curvature.topology import boundary_vertices
 from ..curvature.reconstruct import ROW_MODES, Reconstructor
 from ..curvature.sparse_solver import resolve_backend
-from ._disk import TARGET_BOUNDARY_TOLERANCE, RemeshError, check_disk, check_surface, check_target_boundary  # noqa: F401
+from ._disk import TARGET_BOUNDARY_TOLERANCE, RemeshError  # noqa: F401 (their home before)
+from ._disk import check_disk, check_surface, check_target_boundary
 from .evaluate import hausdorff, vertex_distance
 from .parameterize import METHODS as PARAMETERIZATIONS
 from .parameterize import parameterize
@@ -105,7 +106,8 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="c
     ``location="uv"``: :func:`parameterize`), transfer (:func:`transfer_curvature`, location
     included), reconstruct (target positions from the transferred detail with the target's
     boundary loops fixed and ``anchors`` vertices on each closed piece, see
-    :func:`~curvdetail.anchor_vertices`: one :class:`~curvdetail.Reconstructor` factorization, solved for the detail
+    :func:`~curvdetail.anchor_vertices`: one :class:`~curvdetail.Reconstructor` factorization,
+    solved for the detail
     and for the zero-detail baseline, the harmonic surface ``(L Z)_free = 0``: with
     ``rows="all"`` a second, free-row factorization gives it), evaluate (:func:`hausdorff` for
     the rebuilt mesh, the zero-detail baseline and the retriangulated surface itself, the
@@ -166,7 +168,8 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="c
         ``improvement_over_zero_detail`` (zero-detail RMS / error RMS) and ``ratio_to_floor``
         (error RMS / floor RMS). Where the target has a closed piece there is no zero-detail
         surface (it collapses onto the anchors): ``baseline_zero_detail`` and the improvement are
-        None, with the reason in ``ratio_notes``. Each ratio is None where one of its two RMS values is rounding, not a
+        None, with the reason in ``ratio_notes``. Each ratio is None where one of its two RMS
+        values is rounding, not a
         measurement (below ``ROUNDING_RMS``: 1e-7 of the diagonal as pymeshlab's single-precision
         engine measures, 1e-12 as the exact engine does; e.g. every surface of a flat patch, or
         a target equal to the source), with the reason under ``ratio_notes``
@@ -271,7 +274,8 @@ def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="cons
                    location="closest", parameterization=None, backend="auto", evaluate=True,
                    source_path=None, progress=None, target=None, surface_check=True, anchors=1):
     """:func:`remesh_experiment` returning everything as a dict: ``X``, ``Ft``, ``Vt`` (the
-    retriangulated surface), ``Z`` (zero-detail baseline; None where the target has a closed piece), ``Dt``, ``distance`` and
+    retriangulated surface), ``Z`` (zero-detail baseline; None where the target has a closed
+    piece), ``Dt``, ``distance`` and
     ``zero_distance`` (the exact distance of each vertex of ``X``, of ``Z``, to the source: the
     ones the Hausdorff maxima are taken over; None when ``evaluate=False``) and ``report``."""
     method = _check_choice("method", method, RETRIANGULATIONS)
@@ -394,8 +398,9 @@ def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="cons
                 if Z is not None and key != "baseline_zero_detail":
                     raise
                 # a harmonic surface spanning several small loops degenerates (zero-area triangles)
-                report[key], engines[key] = None, (exc.problem if P is None else "the zero-detail surface is degenerate "
-                                                   "(zero-area triangles): there is no baseline to compare with")
+                report[key] = None
+                engines[key] = exc.problem if P is None else ("the zero-detail surface is degenerate (zero-area "
+                                                              "triangles): there is no baseline to compare with")
                 continue
             report[key] = {"hausdorff_max": h["max"] / d, "hausdorff_rms": h["rms"] / d}
             engines[key] = h["engine"]
