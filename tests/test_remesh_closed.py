@@ -145,3 +145,13 @@ def test_detail_stays_on_its_own_sheet_where_two_lie_close(relocate, monkeypatch
     Dt = transfer_curvature(Vs, Fs, Vt, Fs)
     first = np.abs(Dt[:n].sum(axis=0)).max() / np.abs(Dt).sum()
     assert (first < 1e-12) == relocate           # moved to the other sphere without the check
+
+
+def test_a_closed_surface_with_a_reversed_triangle_is_refused():
+    from curvdetail import MeshError
+    from curvdetail.curvature.testing import icosphere
+
+    V, F = icosphere(subdivisions=2)
+    F[7] = F[7, ::-1]
+    with pytest.raises(MeshError):         # a closed surface has no boundary to show it otherwise
+        remesh_experiment(V, F, target_edge=0.05)

@@ -155,6 +155,7 @@ def check_surface(V, F, what="the source"):
     (0, 2)
     """
     V, F = _checked(V, F, what)
+    check_oriented(F, what)                 # a closed surface shows no boundary where it is not
     return V, F, boundary_loops(F, V.shape[0], what)
 
 
