@@ -25,6 +25,7 @@ from _meshes import MESHES  # noqa: E402
 
 from curvdetail import read_mesh  # noqa: E402
 from curvdetail.remesh import remesh_experiment  # noqa: E402
+from curvdetail.remesh.experiment import MAX, RMS  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 MODELS = ["spot.obj", "bunny.off", "cow.off", "mannequin.off", "elephant.obj"]
@@ -32,23 +33,23 @@ MODELS = ["spot.obj", "bunny.off", "cow.off", "mannequin.off", "elephant.obj"]
 TARGET_RATIO = 1.5
 
 
-def run(path, target_edge, anchors=1):
-    """One experiment's figures (fractions of the bbox diagonal) and its report; ``error`` where it failed."""
+def run(path, percent, anchors=1):
+    """One experiment's figures (% of the bbox diagonal) and its report; ``error`` where it failed."""
     V, F = read_mesh(path)
     t = time.perf_counter()
     try:
-        _, report = remesh_experiment(V, F, target_edge=target_edge, source_path=os.path.basename(path),
+        _, report = remesh_experiment(V, F, target_edge=f"{percent:g}%", source_path=os.path.basename(path),
                                       anchors=anchors)
     except ValueError as exc:
-        return {"model": os.path.basename(path), "target_edge_percent": 100 * target_edge,
+        return {"model": os.path.basename(path), "target_edge_percent": percent,
                 "error": f"{type(exc).__name__}: {exc}"}
     seconds = time.perf_counter() - t
     e, fl = report["error"], report["floor_retriangulated"]
-    return {"model": os.path.basename(path), "target_edge_percent": 100 * target_edge,
+    return {"model": os.path.basename(path), "target_edge_percent": percent,
             "source_vertices": report["source"]["vertices"], "target_vertices": report["target"]["vertices"],
-            "anchors": report["anchors"], "rms": e["hausdorff_rms"], "max": e["hausdorff_max"],
-            "floor_rms": fl["hausdorff_rms"], "floor_max": fl["hausdorff_max"],
-            "ratio_rms": report["ratio_to_floor"], "ratio_max": e["hausdorff_max"] / fl["hausdorff_max"],
+            "anchors": report["anchors"], "rms_percent": e[RMS], "max_percent": e[MAX],
+            "floor_rms_percent": fl[RMS], "floor_max_percent": fl[MAX],
+            "ratio_rms": report["ratio_to_floor"], "ratio_max": e[MAX] / fl[MAX],
             "seconds": round(seconds, 2), "report": report}
 
 
@@ -61,8 +62,8 @@ def table(rows):
             continue
         ok = lambda x: f"{x:.2f}" + ("" if x <= TARGET_RATIO else " (over)")  # noqa: E731
         lines.append(f"| {r['model']} | {r['target_edge_percent']:g} | {r['source_vertices']:,} | "
-                     f"{r['target_vertices']:,} | {r['anchors']} | {100 * r['rms']:.4f} | {100 * r['floor_rms']:.4f} | "
-                     f"{ok(r['ratio_rms'])} | {100 * r['max']:.3f} | {100 * r['floor_max']:.3f} | "
+                     f"{r['target_vertices']:,} | {r['anchors']} | {r['rms_percent']:.4f} | {r['floor_rms_percent']:.4f} | "
+                     f"{ok(r['ratio_rms'])} | {r['max_percent']:.3f} | {r['floor_max_percent']:.3f} | "
                      f"{ok(r['ratio_max'])} | {r['seconds']:.1f} |")
     return "\n".join(lines) + "\n"
 
@@ -89,13 +90,13 @@ def main(argv=None):
     rows = []
     for pct in args.target_edge:
         for model in models:
-            row = run(os.path.join(args.meshes, model), pct / 100.0, args.anchors)
+            row = run(os.path.join(args.meshes, model), pct, args.anchors)
             rows.append(row)
             if "error" in row:
                 print(f"{model} {pct:g} %: FAILED {row['error']}", file=sys.stderr)
                 continue
-            print(f"{model} {pct:g} %: RMS {100 * row['rms']:.4f} % (floor {100 * row['floor_rms']:.4f} %, "
-                  f"{row['ratio_rms']:.2f}x), max {100 * row['max']:.3f} % ({row['ratio_max']:.2f}x), "
+            print(f"{model} {pct:g} %: RMS {row['rms_percent']:.4f} % (floor {row['floor_rms_percent']:.4f} %, "
+                  f"{row['ratio_rms']:.2f}x), max {row['max_percent']:.3f} % ({row['ratio_max']:.2f}x), "
                   f"{row['anchors']} anchor(s), {row['seconds']:.1f} s", file=sys.stderr)
     heading = ("# The remeshing experiment on closed models\n\nIsotropic retriangulation, conservative transfer, "
                f"free rows, closest-point location, {args.anchors} anchor(s) per closed piece (farthest-point sampled "

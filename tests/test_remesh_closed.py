@@ -23,7 +23,7 @@ def wavy_tube():
 def test_closed_genus_0_model_is_rebuilt_near_its_floor(load_mesh):
     # spot (closed, genus 0) at 3 %: measured 0.96x the retriangulated floor (RMS); allowed 1.5x,
     # the target
-    (X, Ft), report = remesh_experiment(*load_mesh("spot.obj"), target_edge=0.03)
+    (X, Ft), report = remesh_experiment(*load_mesh("spot.obj"), target_edge="3%")
     assert report["anchors"] == 1 and report["target"]["boundary_loops"] == 0
     assert report["ratio_to_floor"] < 1.5
     assert report["baseline_zero_detail"] is None and report["improvement_over_zero_detail"] is None
@@ -35,17 +35,18 @@ def test_closed_genus_1_torus_is_rebuilt_near_its_floor():
     # maximum; allowed 2x both. The detail's error drifts further around a handle than over a
     # sphere (4 anchors: 1.38x)
     V, F = torus(n_major=96, n_minor=40)
-    (X, Ft), report = remesh_experiment(V, F, target_edge=0.03)
+    (X, Ft), report = remesh_experiment(V, F, target_edge="3%")
     _, _, loops = check_surface(X, Ft)
     assert report["anchors"] == 1 and loops == []
     assert report["ratio_to_floor"] < 2.0
-    assert report["error"]["hausdorff_max"] < 2.0 * report["floor_retriangulated"]["hausdorff_max"]
+    top = "hausdorff_max_percent_of_diagonal"
+    assert report["error"][top] < 2.0 * report["floor_retriangulated"][top]
 
 
 def test_two_holes_both_loops_are_kept_fixed_bit_for_bit():
     V, F = wavy_tube()
     d = bbox_diagonal(V)
-    out = run_experiment(V, F, target_edge=0.03)
+    out = run_experiment(V, F, target_edge="3%")
     Vt, Ft, X = out["Vt"], out["Ft"], out["X"]
     b = boundary_vertices(Ft)
     assert out["report"]["anchors"] == 0 and out["report"]["target"]["boundary_loops"] == 2
@@ -59,7 +60,7 @@ def test_two_holes_both_loops_are_kept_fixed_bit_for_bit():
 
 def test_two_pieces_are_each_rebuilt():
     V, F = two_spheres()
-    out = run_experiment(V, F, target_edge=0.03)
+    out = run_experiment(V, F, target_edge="3%")
     X, Ft = out["X"], out["Ft"]
     labels, count = vertex_components(Ft, X.shape[0])
     assert count == 2 and out["report"]["anchors"] == 2
@@ -73,7 +74,7 @@ def test_two_pieces_are_each_rebuilt():
 
 def test_retriangulation_keeps_every_boundary_loop_on_its_source_loop():
     V, F = wavy_tube()
-    Vt, Ft = retriangulate(V, F, target_edge=0.03)
+    Vt, Ft = retriangulate(V, F, target_edge="3%")
     loops = check_surface(Vt, Ft)[2]
     assert len(loops) == 2
     ends = sorted(np.round(Vt[loop, 2].mean(), 12) for loop in loops)
@@ -83,7 +84,7 @@ def test_retriangulation_keeps_every_boundary_loop_on_its_source_loop():
 @pytest.mark.parametrize("method", ["isotropic", "decimate"])
 def test_retriangulation_of_a_torus_keeps_its_genus(method):
     V, F = torus(n_major=96, n_minor=40)
-    Vt, Ft = retriangulate(V, F, method=method, target_edge=0.03)
+    Vt, Ft = retriangulate(V, F, method=method, target_edge="3%")
     n, m = Vt.shape[0], Ft.shape[0]
     assert n - 3 * m // 2 + m == 0 and vertex_components(Ft, n)[1] == 1     # Euler characteristic 0
 
@@ -95,7 +96,7 @@ def test_non_manifold_input_names_its_edges():
     V2 = np.vstack([V, [[0.0, 0.0, 2.0]]])
     F2 = np.vstack([F, [[F[0, 0], F[0, 1], V.shape[0]]]])               # a fin on edge F[0, :2]
     with pytest.raises(MeshError) as refused:
-        remesh_experiment(V2, F2, target_edge=0.03)
+        remesh_experiment(V2, F2, target_edge="3%")
     assert refused.value.count == 1 and refused.value.first == [sorted(F[0, :2].tolist())]
 
 
@@ -118,9 +119,9 @@ def test_two_spheres_touching_at_a_vertex_stay_two_pieces(apart, monkeypatch):
 
         monkeypatch.setattr(importlib.import_module("curvdetail.remesh.retriangulate"), "APART", 0.0)
         with pytest.raises(RemeshError):
-            retriangulate(W, T, target_edge=0.03)
+            retriangulate(W, T, target_edge="3%")
         return
-    Vt, Ft = retriangulate(W, T, target_edge=0.03)
+    Vt, Ft = retriangulate(W, T, target_edge="3%")
     assert vertex_components(Ft, Vt.shape[0])[1] == 2
 
 
@@ -154,4 +155,4 @@ def test_a_closed_surface_with_a_reversed_triangle_is_refused():
     V, F = icosphere(subdivisions=2)
     F[7] = F[7, ::-1]
     with pytest.raises(MeshError):         # a closed surface has no boundary to show it otherwise
-        remesh_experiment(V, F, target_edge=0.05)
+        remesh_experiment(V, F, target_edge="5%")
