@@ -62,13 +62,15 @@ def report_columns(report):
            "target_edge_percent_of_diagonal": o.get("target_edge_percent_of_diagonal"),
            "target_edge_model_units": o.get("target_edge_model_units"),
            "target_vertices": report["target"]["vertices"], "target_faces": report["target"]["faces"],
+           "target_boundary_loops": report["target"].get("boundary_loops"), "anchors": report.get("anchors"),
            "backend": o.get("backend"), "experiment_s": s["total"],
            **{f"{stage}_s": s[stage] for stage in _STAGES}}
     if "error" in report:
         for key, name in (("error", "error"), ("baseline_zero_detail", "zero_detail"),
                           ("floor_retriangulated", "floor")):
-            row[f"{name}_rms_percent_of_diagonal"] = report[key][RMS]
-            row[f"{name}_max_percent_of_diagonal"] = report[key][MAX]
+            figures = report[key] or {}         # no zero-detail surface where the target has a closed piece
+            row[f"{name}_rms_percent_of_diagonal"] = figures.get(RMS)
+            row[f"{name}_max_percent_of_diagonal"] = figures.get(MAX)
         row.update(error_vertex_max_percent_of_diagonal=report["error"]["vertex_max_percent_of_diagonal"],
                    error_engine=report["error"]["engine"],
                    improvement_over_zero_detail_ratio=report["improvement_over_zero_detail"],
