@@ -164,17 +164,22 @@ def test_a_study_writes_a_row_per_cell_with_units_and_resumes(tmp_path, meshes, 
 
 @pytest.mark.slow
 def test_a_cell_past_its_time_limit_is_stopped_and_the_study_goes_on(tmp_path, meshes, client):
-    # terrainA_1k at 0.2 % of the diagonal: ~150k target vertices, tens of seconds; bump4 at 5 %: ~0.3 s
-    study = Study([{"meshes": ["terrainA_1k.obj"], "target_edge": "0.2%"}, {"meshes": ["bump4.obj"],
-                                                                           "target_edge": "5%"}])
-    out = run_study(study, [data_path("terrainA_1k.obj"), str(meshes / "bump4.obj")], tmp_path / "s",
-                    scheduler=client, cell_timeout=3.0, progress=None)
+    # terrainA_1k at 0.2 % of the diagonal: ~150k target vertices, tens of seconds; bump4 at 5 %
+    # ~0.3 s, spot (closed) ~1 s
+    study = Study([{"meshes": ["terrainA_1k.obj"], "target_edge": "0.2%"},
+                   {"meshes": ["bump4.obj", "spot.obj"], "target_edge": "5%"}])
+    out = run_study(study, [data_path("terrainA_1k.obj"), data_path("spot.obj"), str(meshes / "bump4.obj")],
+                    tmp_path / "s", scheduler=client, cell_timeout=5.0, progress=None)
     rows = {r["mesh_name"]: r for r in out["table"].to_pylist()}
     slow = rows["terrainA_1k.obj"]
     assert (slow["status"], slow["error_class"]) == ("timeout", "CellTimeout")
     with pytest.raises(ProcessLookupError):         # its process was killed, not left running
         os.kill(slow["pid"], 0)
     assert rows["bump4.obj"]["status"] == "ok"
+    # a closed surface: rebuilt with an anchor, and no zero-detail surface to compare with
+    spot = rows["spot.obj"]
+    assert (spot["status"], spot["mesh_closed"], spot["anchors"]) == ("ok", True, 1)
+    assert spot["zero_detail_rms_percent_of_diagonal"] is None and spot["improvement_over_zero_detail_ratio"] is None
 
 
 @pytest.mark.slow
