@@ -13,7 +13,7 @@ from .sparse_solver import factorize, resolve_backend
 #: Default stopping tolerance: the largest vertex move of an iteration over the bbox diagonal.
 DEFAULT_TOL = 1e-4
 #: Default cap on the number of iterations of :meth:`RotationAwareEditor.solve`.
-DEFAULT_MAX_ITERATIONS = 200
+DEFAULT_MAX_ITERATIONS = 500
 
 
 class RotationAwareEditor:
@@ -96,6 +96,9 @@ class RotationAwareEditor:
     >>> bool(np.allclose(X[h, 2], 0.3)), ed.converged
     (True, True)
     """
+
+    #: Anderson acceleration of the iterations: how many earlier steps it combines (0: off)
+    anderson_memory = 5
 
     def __init__(self, V, F, handles, *, roi=None, scaling=False, tol=DEFAULT_TOL,
                  max_iterations=DEFAULT_MAX_ITERATIONS, backend="auto"):
@@ -201,12 +204,23 @@ class RotationAwareEditor:
         centre = bbox_centre(Xk) if Xk.size else bbox_centre(self.V)
         # the constant part of the right-hand side, about the centre (large coordinates)
         const = -(self._L_pc @ (Xk - centre)) - (self._L_out_V - self._L_out_sum[:, None] * centre)
+        fp, history = self._fp, []
         while self._embed is not None and self.iterations < self.max_iterations:
-            Xf = self._embed.solve(self._turned_details(R) + const) + centre
-            change = np.abs(Xf - X[self._fp]).max() / self.diagonal
-            X[self._fp] = Xf
+            x = X[fp]
+            g = self._embed.solve(self._turned_details(R) + const) + centre
             self.iterations += 1
-            R, energy = self._local(X)
+            change = np.abs(g - x).max() / self.diagonal      # the plain step's move: the residual
+            step = g
+            if energy is not None and self.anderson_memory:
+                history = (history + [(g.ravel(), (g - x).ravel())])[-(self.anderson_memory + 1):]
+                step = _anderson(history).reshape(g.shape) if len(history) > 1 else g
+            X[fp] = step
+            R_step, E_step = self._local(X)
+            if step is not g and not E_step <= energy:       # the plain step never increases E
+                X[fp] = g
+                R_step, E_step = self._local(X)
+                history = history[-1:]
+            R, energy = R_step, E_step
             self.energies.append(energy)
             if change < self.tol:
                 self.converged = True
@@ -237,6 +251,16 @@ class RotationAwareEditor:
         B = 0.5 * (own + other)
         return np.stack([np.bincount(self._kf_row, weights=B[:, c], minlength=self._fp.size)
                          for c in range(3)], axis=1)
+
+
+def _anderson(history):
+    """Anderson-accelerated next iterate from ``(g_k, f_k = g_k - x_k)`` of the last steps:
+    ``g - dG gamma`` with ``gamma`` minimizing ``|f - dF gamma|`` (Walker & Ni 2011)."""
+    G = np.stack([g for g, _ in history], axis=1)
+    Fr = np.stack([f for _, f in history], axis=1)
+    dG, dF = np.diff(G, axis=1), np.diff(Fr, axis=1)
+    gamma = np.linalg.lstsq(dF, Fr[:, -1], rcond=None)[0]
+    return G[:, -1] - dG @ gamma
 
 
 def _closest_rotations(C):
