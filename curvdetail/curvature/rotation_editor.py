@@ -129,7 +129,6 @@ class RotationAwareEditor:
                           shape=(n, n)).tocsr()
         _check_reached(rows, cols, free, n, "position", "handles")
         self.position_constrained, self.roi = pc, np.flatnonzero(in_roi)
-        self.detail = laplacian_product(L, V)
         self.diagonal = bbox_diagonal(V)
         fp = np.flatnonzero(free)
         # S: the vertices whose one-ring holds a free vertex (their rotations enter E's free part)
@@ -140,18 +139,22 @@ class RotationAwareEditor:
         at_s[s_idx] = np.arange(s_idx.size)
         k = in_s[rows]                                     # CSR order: sorted by row
         self._s, self._fp, self._pc = s_idx, fp, pc
-        self._ei, self._ej, self._w = rows[k], cols[k], w[k]
-        self._ej_s = at_s[self._ej]                        # -1: a neighbour outside S
-        self._starts = np.searchsorted(self._ei, s_idx)
-        self._rest_e = V[self._ei] - V[self._ej]
-        self._wrest = self._w[:, None] * self._rest_e
-        self._rest_sq = np.add.reduceat(self._w * np.einsum("ij,ij->i", self._rest_e, self._rest_e), self._starts)
-        # global step over the free rows: the edges (i, j) with i free, their weight and turn
+        self.detail = laplacian_product(L, V)              # sum_j w_ij (v_i - v_j)
+        # per vertex i of S, sparse rows over its neighbours j: w_ij and w_ij (v_i - v_j)[c]
+        ei, ej, we = rows[k], cols[k], w[k]
+        rest_e = V[ei] - V[ej]
+        at_rows = at_s[ei]
+        self._W = sp.csr_matrix((we, (at_rows, ej)), shape=(s_idx.size, n))
+        self._We = [sp.csr_matrix((we * rest_e[:, c], (at_rows, ej)), shape=(s_idx.size, n)) for c in range(3)]
+        self._wsum = np.asarray(self._W.sum(axis=1)).ravel()
+        self._rest_sq = np.bincount(at_rows, weights=we * np.einsum("ij,ij->i", rest_e, rest_e),
+                                    minlength=s_idx.size)
+        # the global step's rows: free i, columns j in S (every neighbour of a free vertex is)
+        kf = free[ei]
         at_f = np.full(n, -1, dtype=np.int64)
         at_f[fp] = np.arange(fp.size)
-        kf = free[self._ei]
-        self._kf = np.flatnonzero(kf)
-        self._kf_row = at_f[self._ei[kf]]
+        self._Wf = [sp.csr_matrix((we[kf] * rest_e[kf, c], (at_f[ei[kf]], at_s[ej[kf]])), shape=(fp.size, s_idx.size))
+                    for c in range(3)]
         self._fp_s = at_s[fp]
         L_free = L[fp]
         self._L_pc = L_free[:, pc].tocsr()
@@ -191,23 +194,23 @@ class RotationAwareEditor:
             If ``positions`` or ``initial`` is not of the right shape of finite numbers.
         """
         Xk = self.V[self._pc] if positions is None else as_values(positions, self._pc.size, "positions")
-        X = self.V.copy()
-        X[self._pc] = Xk
+        # everything about a centre among the handles (large coordinates do not cancel)
+        centre = bbox_centre(Xk) if Xk.size else bbox_centre(self.V)
+        X = self.V - centre
+        X[self._pc] = Xk - centre
         if initial is not None:
-            X[self._fp] = as_values(initial, self.n, "initial")[self._fp]
+            X[self._fp] = as_values(initial, self.n, "initial")[self._fp] - centre
             R, energy = self._local(X)
         else:
             R = _blended_rotations(_best_rotation(self.V[self._pc], Xk), self._blend)
             energy = None
         self.energies = [] if energy is None else [energy]
         self.iterations, self.converged = 0, self._embed is None
-        centre = bbox_centre(Xk) if Xk.size else bbox_centre(self.V)
-        # the constant part of the right-hand side, about the centre (large coordinates)
-        const = -(self._L_pc @ (Xk - centre)) - (self._L_out_V - self._L_out_sum[:, None] * centre)
+        const = -(self._L_pc @ X[self._pc]) - (self._L_out_V - self._L_out_sum[:, None] * centre)
         fp, history = self._fp, []
         while self._embed is not None and self.iterations < self.max_iterations:
             x = X[fp]
-            g = self._embed.solve(self._turned_details(R) + const) + centre
+            g = self._embed.solve(self._turned_details(R) + const)
             self.iterations += 1
             change = np.abs(g - x).max() / self.diagonal      # the plain step's move: the residual
             step = g
@@ -225,15 +228,24 @@ class RotationAwareEditor:
             if change < self.tol:
                 self.converged = True
                 break
+        X += centre
+        X[self._pc] = Xk                                      # exactly, as given
+        outside = np.ones(self.n, dtype=bool)
+        outside[self.roi] = False
+        X[outside] = self.V[outside]
         return X
 
     def _local(self, X):
-        """Rotations (scaled with ``scaling``) of every vertex of S fitted to X, and E(X, R)."""
-        def_e = X[self._ei] - X[self._ej]
-        cov = np.add.reduceat(np.einsum("ki,kj->kij", def_e, self._wrest), self._starts)
+        """Rotations (scaled with ``scaling``) of every vertex of S fitted to X, and E(X, R).
+        ``X`` about a centre near the mesh (the sums below cancel large coordinates)."""
+        Xs = X[self._s]
+        # cov_i = sum_j w_ij (x_i - x_j) (v_i - v_j)^T, column c by column c
+        cov = np.stack([Xs * self.detail[self._s, c, None] - self._We[c] @ X for c in range(3)], axis=2)
         R = _closest_rotations(cov)
         fit = np.einsum("kij,kij->k", R, cov)                # trace(R^T cov)
-        def_sq = np.add.reduceat(self._w * np.einsum("ij,ij->i", def_e, def_e), self._starts)
+        # sum_j w_ij |x_i - x_j|^2
+        def_sq = (self._wsum * np.einsum("ij,ij->i", Xs, Xs) - 2 * np.einsum("ij,ij->i", Xs, self._W @ X)
+                  + self._W @ np.einsum("ij,ij->i", X, X))
         if self.scaling:
             s = np.maximum(fit, 0.0) / np.maximum(self._rest_sq, np.finfo(float).tiny)
             R = R * s[:, None, None]
@@ -243,14 +255,11 @@ class RotationAwareEditor:
         return R, float(energy.sum())
 
     def _turned_details(self, R):
-        """``B_f = sum_j w_ij (R_i + R_j) / 2 (v_i - v_j)`` over the free rows (R scaled)."""
-        kf = self._kf
-        j_s = self._ej_s[kf]                                 # neighbours of free vertices: all in S
-        own = np.einsum("kab,kb->ka", R[self._fp_s][self._kf_row], self._wrest[kf])
-        other = np.einsum("kab,kb->ka", R[j_s], self._wrest[kf])
-        B = 0.5 * (own + other)
-        return np.stack([np.bincount(self._kf_row, weights=B[:, c], minlength=self._fp.size)
-                         for c in range(3)], axis=1)
+        """``B_f = sum_j w_ij (R_i + R_j) / 2 (v_i - v_j)`` over the free rows (R scaled):
+        ``(R_f D_f + sum_j R_j w_ij (v_i - v_j)) / 2``."""
+        own = np.einsum("kab,kb->ka", R[self._fp_s], self.detail[self._fp])
+        other = sum(self._Wf[c] @ np.ascontiguousarray(R[:, :, c]) for c in range(3))
+        return 0.5 * (own + other)
 
 
 def _anderson(history):
