@@ -48,7 +48,7 @@ def top_view(V, F):
     return np.stack([x, np.cross(z, x), z])
 
 
-def draw_mesh(ax, V, F, values=None, *, elev=20.0, azim=-60.0, cmap="viridis", title=""):
+def draw_mesh(ax, V, F, values=None, *, elev=20.0, azim=-60.0, cmap="viridis", title="", vrange=None):
     """Draw a shaded mesh into a 2-D matplotlib axes, fitted to the axes with equal aspect.
 
     Parameters
@@ -60,14 +60,17 @@ def draw_mesh(ax, V, F, values=None, *, elev=20.0, azim=-60.0, cmap="viridis", t
     F : (m, 3) int array
         Triangles.
     values : (n,) float array, optional
-        Per-vertex values; each face is coloured by its vertices' mean, from the values' minimum to
-        their maximum. Without values the mesh is grey.
+        Per-vertex values; each face is coloured by its vertices' mean, from ``vrange`` (default:
+        the values' minimum to their maximum; values beyond it take the end colours). Without
+        values the mesh is grey.
     elev, azim : float
         Camera, as for :func:`camera`.
     cmap : str or matplotlib.colors.Colormap
         Colour map of ``values``.
     title : str
         Panel title.
+    vrange : (float, float), optional
+        The values at the two ends of the colour map.
 
     Returns
     -------
@@ -90,7 +93,7 @@ def draw_mesh(ax, V, F, values=None, *, elev=20.0, azim=-60.0, cmap="viridis", t
         rgb = np.tile(GREY, (F.shape[0], 1))
     else:
         values = np.asarray(values, dtype=np.float64)
-        lo, hi = float(np.nanmin(values)), float(np.nanmax(values))
+        lo, hi = vrange if vrange is not None else (float(np.nanmin(values)), float(np.nanmax(values)))
         cmap = matplotlib.colormaps[cmap] if isinstance(cmap, str) else cmap
         mappable = ScalarMappable(Normalize(lo, hi if hi > lo else lo + 1.0), cmap)
         rgb = mappable.to_rgba(values[F].mean(axis=1))[:, :3]
@@ -107,7 +110,7 @@ def draw_mesh(ax, V, F, values=None, *, elev=20.0, azim=-60.0, cmap="viridis", t
 
 
 def save_panels(path, panels, *, elev=20.0, azim=-60.0, title=None, panel_size=4.0, dpi=100,
-                colorbar=None, overwrite=False):
+                colorbar=None, vrange=None, overwrite=False):
     """Save meshes side by side, seen by one camera, as a PNG, atomically.
 
     Parameters
@@ -126,6 +129,8 @@ def save_panels(path, panels, *, elev=20.0, azim=-60.0, title=None, panel_size=4
         Pixels per inch.
     colorbar : str, optional
         Label of a colour bar drawn under every panel with values; none without it.
+    vrange : (float, float), optional
+        One colour scale for every panel (:func:`draw_mesh`); default: each panel its own.
     overwrite : bool
         Replace an existing file.
 
@@ -146,9 +151,12 @@ def save_panels(path, panels, *, elev=20.0, azim=-60.0, title=None, panel_size=4
     with atomic_write(path, overwrite=overwrite) as tmp:
         fig = Figure(figsize=(panel_size * len(panels), panel_size))
         for ax, (V, F, label, *values) in zip(fig.subplots(1, len(panels), squeeze=False)[0], panels):
-            mappable = draw_mesh(ax, V, F, values[0] if values else None, elev=elev, azim=azim, title=label)
+            mappable = draw_mesh(ax, V, F, values[0] if values else None, elev=elev, azim=azim, title=label,
+                                 vrange=vrange)
             if colorbar and mappable is not None:
-                bar = fig.colorbar(mappable, ax=ax, orientation="horizontal", fraction=0.05, pad=0.02, shrink=0.7)
+                over = vrange is not None and np.nanmax(values[0]) > vrange[1]
+                bar = fig.colorbar(mappable, ax=ax, orientation="horizontal", fraction=0.05, pad=0.02, shrink=0.7,
+                                   extend="max" if over else "neither")
                 bar.set_label(colorbar, fontsize=8)
                 bar.ax.tick_params(labelsize=7)
         if title:
@@ -157,9 +165,12 @@ def save_panels(path, panels, *, elev=20.0, azim=-60.0, title=None, panel_size=4
         fig.savefig(tmp, dpi=dpi, format="png")
 
 
-def save_remeshing_figure(path, V, F, X, Ft, Z, distance, report, *, overwrite=False, dpi=110):
+def save_remeshing_figure(path, V, F, X, Ft, Z, distance, report, *, zero_distance=None, overwrite=False, dpi=110):
     """Save the picture of one remeshing experiment: the source, the rebuilt target coloured by
-    its distance to the source, and the zero-detail baseline, the errors in the titles.
+    its distance to the source, and the zero-detail baseline, the errors in the titles. Both
+    coloured surfaces share one scale, in % of the bbox diagonal, from 0 to the rebuilt
+    surface's Hausdorff maximum its title states (a zero-detail surface farther away takes the
+    top colour there, the colour bar's arrow).
 
     Parameters
     ----------
@@ -171,6 +182,9 @@ def save_remeshing_figure(path, V, F, X, Ft, Z, distance, report, *, overwrite=F
         The rebuilt target; ``Z`` (p, 3) is the zero-detail baseline on the same triangles.
     distance : (p,) float array
         Distance of each vertex of ``X`` to the source.
+    zero_distance : (p,) float array, optional
+        Distance of each vertex of ``Z`` to the source (``run_experiment``'s
+        ``result["zero_distance"]``); the zero-detail panel is grey without it.
     report : dict
         The report of :func:`curvdetail.remesh.remesh_experiment`, measured (``evaluate=True``).
 
@@ -192,14 +206,50 @@ def save_remeshing_figure(path, V, F, X, Ft, Z, distance, report, *, overwrite=F
     V, Z = np.asarray(V, dtype=np.float64), np.asarray(Z, dtype=np.float64)
     R = top_view(V, F)
     e, b, fl = report["error"], report["baseline_zero_detail"], report["floor_retriangulated"]
+    rms, top = "hausdorff_rms_percent_of_diagonal", "hausdorff_max_percent_of_diagonal"
     name = os.path.basename(report["source"].get("path") or "source")
     o = report["options"]
     panels = [(V @ R.T, F, f"{name}: {report['source']['vertices']:,} vertices"),
               (X @ R.T, Ft, f"rebuilt ({o['transfer']}, rows={o['rows']}): {report['target']['vertices']:,} "
-                            f"vertices\nRMS {100 * e['hausdorff_rms']:.3f} %  max {100 * e['hausdorff_max']:.2f} %  "
-                            f"(floor {100 * fl['hausdorff_rms']:.3f} %)",
+                            f"vertices\nRMS {e[rms]:.3f} %  max {e[top]:.2f} %  "
+                            f"(floor {fl[rms]:.3f} %)",
                100 * distance / report["source"]["bbox_diagonal"]),
-              (Z @ R.T, Ft, f"zero detail\nRMS {100 * b['hausdorff_rms']:.2f} %  max {100 * b['hausdorff_max']:.1f} %")]
+              (Z @ R.T, Ft, f"zero detail\nRMS {b[rms]:.2f} %  max {b[top]:.1f} %")
+              + (() if zero_distance is None else (100 * np.asarray(zero_distance) / report["source"]["bbox_diagonal"],))]
     save_panels(path, panels, elev=50.0, azim=20.0, panel_size=4.0, dpi=dpi, overwrite=overwrite,
                 title="Remeshing from curvature detail (all figures: % of the source's bbox diagonal)",
-                colorbar="distance to source, % of bbox diagonal")
+                colorbar="distance to source, % of bbox diagonal", vrange=(0.0, max(e[top], 1e-300)))
+
+
+#: The colour map of the vertex colours written next to a per-vertex error or curvature.
+COLOUR_MAP = "viridis"
+
+
+def vertex_colours(values, vmax, vmin=0.0, cmap=COLOUR_MAP):
+    """Per-vertex RGBA colours, ``cmap`` over ``[vmin, vmax]`` (values beyond it clipped), so that
+    a viewer that shows vertex colours on open (MeshLab) shows the values.
+
+    Parameters
+    ----------
+    values : (n,) float array
+    vmax, vmin : float
+        The values at the two ends of the map (``vmax <= vmin``: every vertex the bottom colour).
+    cmap : str
+        A matplotlib colour map (pymeshlab's ``compute_color_from_scalar_per_vertex`` has the
+        same viridis as ``colormap="Viridis"``).
+
+    Returns
+    -------
+    (n, 4) uint8 array   red, green, blue, alpha (255)
+
+    Examples
+    --------
+    >>> vertex_colours([0.0, 1.0, 2.0], vmax=1.0)[:, :3].tolist()
+    [[68, 1, 84], [253, 231, 37], [253, 231, 37]]
+    """
+    import matplotlib
+
+    values = np.asarray(values, dtype=np.float64)
+    span = vmax - vmin if vmax > vmin else 1.0
+    rgba = matplotlib.colormaps[cmap](np.clip((values - vmin) / span, 0.0, 1.0))
+    return np.rint(rgba * 255.0).astype(np.uint8)

@@ -63,7 +63,7 @@ CONFIGS = [  # (transfer, rows, location)
     ("pointwise", "all", "uv"),
 ]
 #: the retriangulation every transfer configuration of a patch shares, as passed to retriangulate
-SHARED_RETRIANGULATION = {"method": "isotropic", "target_edge": 0.01, "iterations": 10,
+SHARED_RETRIANGULATION = {"method": "isotropic", "target_edge": "1%", "iterations": 10,
                           "max_surface_distance": None, "surface_check": True}
 #: retriangulate's defaults, which run_experiment's own retriangulations take
 RETRIANGULATE_DEFAULTS = {name: p.default for name, p in inspect.signature(retriangulate).parameters.items()
@@ -76,7 +76,8 @@ EXTRA_RUNS_FULL = [("isotropic", "terrainA_100k.ply", 0.01), ("decimate", "terra
 
 
 def pct(x, digits=3):
-    return f"{100 * x:.{digits}f}"
+    """A report's figure (already in % of the diagonal) as text."""
+    return f"{x:.{digits}f}"
 
 
 def _ratio(value, spec, suffix=""):
@@ -96,14 +97,14 @@ def row(name, rep, t_retri=None, method=None):
     e, b, f, s, o = (rep["error"], rep["baseline_zero_detail"], rep["floor_retriangulated"], rep["seconds"],
                      rep["options"])
     improvement = rep["improvement_over_zero_detail"]          # None where an RMS is rounding
-    ok = e["hausdorff_rms"] <= 1e-3 and e["hausdorff_max"] <= 1e-2 and (improvement is None or improvement >= 50)
+    ok = e["hausdorff_rms_percent_of_diagonal"] <= 0.1 and e["hausdorff_max_percent_of_diagonal"] <= 1 and (improvement is None or improvement >= 50)
     loc = o["location"] + (f" ({o['parameterization']})" if o["location"] == "uv" else "")
     total = _total(rep, t_retri)
     t_retri = s["retriangulate"] if t_retri is None else t_retri
     return (f"| {name} | {rep['source']['vertices']:,} | {rep['target']['vertices']:,} | {method or o['method']} | "
-            f"{o['transfer']} | {o['rows']} | {loc} | **{pct(e['hausdorff_rms'], 4)}** / {pct(e['hausdorff_max'])} | "
-            f"{pct(b['hausdorff_rms'], 2)} / {pct(b['hausdorff_max'], 1)} | "
-            f"{pct(f['hausdorff_rms'], 4)} / {pct(f['hausdorff_max'])} | {_ratio(improvement, ',.0f', 'x')} | "
+            f"{o['transfer']} | {o['rows']} | {loc} | **{pct(e['hausdorff_rms_percent_of_diagonal'], 4)}** / {pct(e['hausdorff_max_percent_of_diagonal'])} | "
+            f"{pct(b['hausdorff_rms_percent_of_diagonal'], 2)} / {pct(b['hausdorff_max_percent_of_diagonal'], 1)} | "
+            f"{pct(f['hausdorff_rms_percent_of_diagonal'], 4)} / {pct(f['hausdorff_max_percent_of_diagonal'])} | {_ratio(improvement, ',.0f', 'x')} | "
             f"{_ratio(rep['ratio_to_floor'], '.2f')} | {'yes' if ok else 'NO'} | "
             f"{t_retri:.2f} / {s['parameterize']:.2f} / {s['transfer']:.2f} / {s['reconstruct']:.2f} / "
             f"{s['evaluate']:.2f} / {total:.2f} |")
@@ -121,20 +122,22 @@ def readme_row(name, rep, t_retri=None):
     """One line of README.md's short table (the same figures as :func:`row`'s)."""
     e, b, f = rep["error"], rep["baseline_zero_detail"], rep["floor_retriangulated"]
     return (f"| {name} | {rep['source']['vertices']:,} | {rep['target']['vertices']:,} | "
-            f"**{pct(e['hausdorff_rms'], 4)}** / {pct(e['hausdorff_max'])} | "
-            f"{pct(b['hausdorff_rms'], 2)} / {pct(b['hausdorff_max'], 1)} | "
-            f"{pct(f['hausdorff_rms'], 4)} / {pct(f['hausdorff_max'])} | "
+            f"**{pct(e['hausdorff_rms_percent_of_diagonal'], 4)}** / {pct(e['hausdorff_max_percent_of_diagonal'])} | "
+            f"{pct(b['hausdorff_rms_percent_of_diagonal'], 2)} / {pct(b['hausdorff_max_percent_of_diagonal'], 1)} | "
+            f"{pct(f['hausdorff_rms_percent_of_diagonal'], 4)} / {pct(f['hausdorff_max_percent_of_diagonal'])} | "
             f"{_ratio(rep['improvement_over_zero_detail'], ',.0f', 'x')} | {_total(rep, t_retri):.1f} |")
 
 
 def retriangulation_record(method, target_edge, diagonal, seconds, shared, **settings):
-    """What made a report's target, for the JSON: ``method``, ``target_edge`` (fraction of the
-    source's bbox diagonal) and ``target_edge_length`` (absolute), the other settings of
+    """What made a report's target, for the JSON: ``method``, ``target_edge_percent_of_diagonal``
+    and ``target_edge_model_units`` (``target_edge`` as the functions take it), the other settings of
     :func:`retriangulate` (``settings`` as passed, the rest its defaults), ``seconds``, and
     ``shared``: True where the script made it once for all the patch's configurations (the
     report's ``options.method`` then says "given"), False where ``run_experiment`` made it."""
     relevant = ("iterations", "max_surface_distance", "surface_check") if method == "isotropic" else ("aggressiveness",)
-    record = {"method": method, "target_edge": target_edge, "target_edge_length": target_edge * diagonal}
+    from curvdetail.remesh.units import as_bbox_length, length_figures
+
+    record = {"method": method, **length_figures(as_bbox_length(target_edge), diagonal, "target_edge")}
     record.update({name: settings.get(name, RETRIANGULATE_DEFAULTS[name]) for name in relevant})
     record.update(seconds=None if seconds is None else round(seconds, 4), shared=shared)
     return record
@@ -314,14 +317,14 @@ def main(argv=None):
     for method, name, target_edge in extra_runs:
         V, F = read_mesh(os.path.join(meshes, name))
         try:
-            out = run_experiment(V, F, method=method, target_edge=target_edge, source_path=name)
+            out = run_experiment(V, F, method=method, target_edge=f"{100 * target_edge!r}%", source_path=name)
         except Exception as exc:
             failed(name, dict(method=method, target_edge=target_edge), exc,
-                   retriangulation_record(method, target_edge, bbox_diagonal(V), None, False))
+                   retriangulation_record(method, f"{100 * target_edge!r}%", bbox_diagonal(V), None, False))
             extra.append(f"| {name} | {V.shape[0]:,} | - | {method} | FAILED: {exc} |")
             continue
         rep = out["report"]
-        record(rep, retriangulation_record(method, target_edge, rep["source"]["bbox_diagonal"],
+        record(rep, retriangulation_record(method, f"{100 * target_edge!r}%", rep["source"]["bbox_diagonal"],
                                                  rep["seconds"]["retriangulate"], False))
         short = name.rsplit(".", 1)[0]
         line = row(short + (f" ({100 * target_edge:g} %)" if target_edge != 0.01 else ""), rep)
@@ -405,10 +408,10 @@ def _figure(inputs, path, force=False):
         e, b = rep["error"], rep["baseline_zero_detail"]
         draw_mesh(axes[0], V @ R.T, F, title=f"{name.rsplit('.', 1)[0]}: {V.shape[0]:,} vertices", **view)
         draw_mesh(axes[2], out["Z"] @ R.T, out["Ft"], **view,
-                  title=f"zero detail\nRMS {pct(b['hausdorff_rms'], 2)} %, max {pct(b['hausdorff_max'], 1)} %")
+                  title=f"zero detail\nRMS {pct(b['hausdorff_rms_percent_of_diagonal'], 2)} %, max {pct(b['hausdorff_max_percent_of_diagonal'], 1)} %")
         scale = draw_mesh(axes[1], out["X"] @ R.T, out["Ft"], 100 * out["distance"] / bbox_diagonal(V), cmap=cmap,
-                          title=f"rebuilt, {rep['target']['vertices']:,} vertices\nRMS {pct(e['hausdorff_rms'])} %, "
-                                f"max {pct(e['hausdorff_max'], 2)} %", **view)
+                          title=f"rebuilt, {rep['target']['vertices']:,} vertices\nRMS {pct(e['hausdorff_rms_percent_of_diagonal'])} %, "
+                                f"max {pct(e['hausdorff_max_percent_of_diagonal'], 2)} %", **view)
         # in the panel's own lower margin, so that the rebuilt surface is drawn as large as the others
         bar = fig.colorbar(scale, cax=axes[1].inset_axes([0.15, -0.08, 0.7, 0.035]), orientation="horizontal")
         bar.set_label("distance to the source, % of the bbox diagonal", fontsize=8)

@@ -188,7 +188,7 @@ def test_a_full_stderr_does_not_stop_the_run(tmp_path, monkeypatch, capsys):
 def test_a_full_stderr_does_not_stop_the_progress_of_remesh(tmp_path, monkeypatch):
     monkeypatch.setattr(sys, "stderr", FullStream())
     out = tmp_path / "out.ply"
-    assert main(["remesh", "--example", str(out), "--method", "decimate", "--target-edge", "5",
+    assert main(["remesh", "--example", str(out), "--method", "decimate", "--target-edge", "5%",
                  "--no-evaluate"]) == 0
     assert out.exists()
 
@@ -208,17 +208,17 @@ def test_stdout_on_a_full_device_still_exits_0_with_the_output_written(tmp_path)
 #: A run of ``reconstruct`` whose mesh writer stalls inside atomic_write, its temporary file made.
 _SLOW_WRITE = r"""
 import sys, time
-import curvdetail
+import curvdetail.io.mesh
 from curvdetail.io import atomic_write
 
-def slow_write(path, X, F, quality=None, overwrite=False):
+def slow_write(path, X, F, fields=None, overwrite=False):
     with atomic_write(path, overwrite=overwrite) as tmp:
         with open(tmp, "w") as fh:
             fh.write("partial")
             fh.flush()
             time.sleep(60)
 
-curvdetail.write_mesh = slow_write
+curvdetail.io.mesh.write_mesh_fields = slow_write
 from curvdetail.cli import main
 sys.exit(main(["reconstruct", "--example", sys.argv[1]]))
 """

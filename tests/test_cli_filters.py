@@ -112,7 +112,10 @@ def test_the_note_says_what_an_output_keeps_of_a_coloured_mesh(capsys, tmp_path,
     back = load_meshset(tmp_path / name)                               # what the file holds
     assert back.current_mesh().has_vertex_color() == colours
     assert back.current_mesh().has_vertex_scalar() == colours
-    if colours:
+    if colours:             # the filter's quality (H) coloured them, as it does the layer in Python
+        from curvdetail.filters import apply
+
+        apply(ms, "compute_curvature_detail")
         assert np.abs(back.current_mesh().vertex_color_matrix() - ms.current_mesh().vertex_color_matrix()).max() \
             <= 1 / 255 + 1e-9
 
@@ -132,7 +135,7 @@ def test_apply_chains_through_ply_attributes(capsys, tmp_path):
     run_cli(capsys, "apply", "compute_curvature_detail", NOSE, tmp_path / "d.ply")
     rc, out, _ = run_cli(capsys, "apply", "apply_curvature_reconstruction", tmp_path / "d.ply",
                          tmp_path / "r.ply", "--param", "rows=free")
-    assert rc == 0 and json.loads(out)["max_displacement"] < 1e-9
+    assert rc == 0 and json.loads(out)["max_displacement_percent_of_diagonal"] < 1e-7
     assert np.abs(vertices(tmp_path / "r.ply") - vertices(NOSE)).max() < 1e-9
 
 
@@ -163,7 +166,7 @@ def test_apply_with_added_layer_transfers_between_files(capsys, tmp_path):
     assert rc == 0 and json.loads(out)["detail_total_gap"] < 1e-12
     rc, out, _ = run_cli(capsys, "apply", "apply_curvature_reconstruction", tmp_path / "t.ply",
                          tmp_path / "r.ply", "--param", "rows=free")
-    assert rc == 0 and json.loads(out)["max_displacement"] < 0.01
+    assert rc == 0 and json.loads(out)["max_displacement_percent_of_diagonal"] < 1
     # r.ply is the core rebuild of t.ply's geometry from its stored detail (PLY keeps doubles;
     # measured equal), which the retriangulated surface alone is not; and it is far closer to
     # the source than the zero-detail (harmonic) surface of the same boundary (vertex distance
@@ -346,7 +349,7 @@ def test_a_closed_stderr_does_not_stop_the_work(tmp_path):
     os.close(read_end)
     out = tmp_path / "o.ply"
     try:
-        done = subprocess.run([sys.executable, "-m", "curvdetail", "remesh", NOSE, str(out), "--target-edge", "6",
+        done = subprocess.run([sys.executable, "-m", "curvdetail", "remesh", NOSE, str(out), "--target-edge", "6%",
                                "--method", "decimate", "--no-evaluate"],
                               stdout=subprocess.PIPE, stderr=write_end, timeout=300)
     finally:

@@ -46,7 +46,7 @@ def test_remesh_transfer_rebuild_pipeline():
     assert ms.mesh(1).vertex_number() != ms.mesh(0).vertex_number()          # really retriangulated
     assert steps[2]["figures"]["detail_total_gap"] < 1e-12
     error = steps[-1]["figures"]
-    assert 3.4e-4 < error["hausdorff_rms"] < 4.1e-4 and 3.5e-3 < error["hausdorff_max"] < 3.9e-3
+    assert 3.1e-2 < error["hausdorff_rms_percent_of_diagonal"] < 3.8e-2 and 0.24 < error["hausdorff_max_percent_of_diagonal"] < 0.29
     # the retriangulated surface alone meets those bounds: the rebuilt layer is the core rebuild
     # of it from the transferred detail, with the script's rows="free" (measured equal)
     Vt, Ft = retriangulated["Vt"], ms.mesh(1).face_matrix()
@@ -57,7 +57,7 @@ def test_remesh_transfer_rebuild_pipeline():
     # quality = each vertex's exact distance to the source (the search the Hausdorff maximum uses)
     d = vertex_distance(ms.mesh(1).vertex_matrix(), ms.mesh(0).vertex_matrix(), ms.mesh(0).face_matrix())
     assert np.abs(ms.mesh(1).vertex_scalar_array() - d).max() < 1e-15 * bbox_diagonal(Vt)
-    assert ms.mesh(1).vertex_scalar_array().max() <= error["hausdorff_max"] * bbox_diagonal(ms.mesh(0).vertex_matrix())
+    assert ms.mesh(1).vertex_scalar_array().max() <= error["hausdorff_max_percent_of_diagonal"] / 100 * bbox_diagonal(ms.mesh(0).vertex_matrix())
 
 
 def test_minimal_surface_pipeline():
@@ -69,7 +69,7 @@ def test_minimal_surface_pipeline():
     assert minimal["converged"] and minimal["area_minimal"] < minimal["area_source"]
     error = steps[3]["figures"]
     assert minimal["iterations"] == 22
-    assert 0.0124 < error["hausdorff_rms"] < 0.0137 and 0.0305 < error["hausdorff_max"] < 0.0335
+    assert 1.24 < error["hausdorff_rms_percent_of_diagonal"] < 1.37 and 3.05 < error["hausdorff_max_percent_of_diagonal"] < 3.35
 
 
 def test_remeshing_experiment_pipeline(tmp_path, capsys):
@@ -77,12 +77,12 @@ def test_remeshing_experiment_pipeline(tmp_path, capsys):
     out = tmp_path / "rebuilt.ply"
     assert main(["run", os.path.join(EXAMPLES, "remeshing_experiment.mlx"), example_path(), str(out)]) == 0
     report = json.loads(capsys.readouterr().out)[0]["figures"]
-    assert report["options"]["target_edge"] == 0.02
-    assert report["error"]["hausdorff_rms"] < report["baseline_zero_detail"]["hausdorff_rms"] / 10
+    assert report["options"]["target_edge_percent_of_diagonal"] == 2.0
+    assert report["error"]["hausdorff_rms_percent_of_diagonal"] < report["baseline_zero_detail"]["hausdorff_rms_percent_of_diagonal"] / 10
     ms = load_meshset(out)
     assert ms.current_mesh().vertex_number() == report["target"]["vertices"]
     assert ms.current_mesh().vertex_scalar_array().max() == pytest.approx(
-        report["error"]["vertex_max"] * report["source"]["bbox_diagonal"], rel=1e-12)
+        report["error"]["vertex_max_percent_of_diagonal"] / 100 * report["source"]["bbox_diagonal"], rel=1e-12)
 
 
 @pytest.mark.parametrize("name", sorted(n for n in os.listdir(EXAMPLES) if n.endswith(".mlx")))

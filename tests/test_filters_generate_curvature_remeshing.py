@@ -82,7 +82,7 @@ def test_rebuilt_quality_is_the_distance_to_the_source(terrain_run):
 def test_report_shows_detail_beats_the_zero_detail_baseline(terrain_run):
     # measured at 3 %: RMS 0.055 % (floor 0.053 %) against 1.3 % for the zero-detail surface
     _, report = terrain_run
-    assert report["error"]["hausdorff_rms"] < report["baseline_zero_detail"]["hausdorff_rms"] / 10
+    assert report["error"]["hausdorff_rms_percent_of_diagonal"] < report["baseline_zero_detail"]["hausdorff_rms_percent_of_diagonal"] / 10
     assert report["ratio_to_floor"] < 2.0
     assert set(report["seconds"]) >= {"retriangulate", "transfer", "reconstruct", "evaluate", "total"}
 
@@ -93,7 +93,7 @@ def test_absolute_target_edge_is_converted_to_a_fraction():
     diag = bbox_diagonal(ms.current_mesh().vertex_matrix())
     report = apply(ms, "generate_curvature_remeshing", target_edge=pymeshlab.PureValue(0.025 * diag),
                    evaluate=False, add_baseline=True)
-    assert report["options"]["target_edge"] == pytest.approx(0.025, rel=1e-6)   # PureValue is float32
+    assert report["options"]["target_edge_percent_of_diagonal"] == pytest.approx(2.5, rel=1e-6)   # PureValue is float32
     assert "error" not in report and report["layers"]["zero_detail"] == 2
     # the zero-detail baseline keeps the retriangulation's boundary
     b = boundary_vertices(ms.mesh(1).face_matrix())
@@ -142,7 +142,7 @@ def test_surface_check_is_passed_through_to_the_remesher(isotropic_calls, kwargs
     assert report["options"]["surface_check"] is expected
     # the retriangulated layer is retriangulate's result with that option (the ear at 3 %
     # differs without the check: 644 vertices against 648)
-    Vt, Ft = retriangulate(V, F, target_edge=report["options"]["target_edge"], **kwargs)
+    Vt, Ft = retriangulate(V, F, target_edge=f"{report['options']['target_edge_percent_of_diagonal']!r}%", **kwargs)
     assert np.array_equal(ms.mesh(report["layers"]["retriangulated"]).face_matrix(), Ft)
 
 
@@ -211,7 +211,7 @@ def test_without_evaluation_the_rebuilt_layer_has_no_quality(tmp_path):
     assert not rebuilt.has_vertex_scalar() and not zero.has_vertex_scalar()
     assert rebuilt.label() == "mannequin_nose.obj rebuilt" and zero.label() == "mannequin_nose.obj zero detail"
     # the layers are the experiment's arrays exactly (they went through a binary PLY: doubles)
-    result = run_experiment(ms.mesh(0).vertex_matrix(), ms.mesh(0).face_matrix(), target_edge=0.03, evaluate=False)
+    result = run_experiment(ms.mesh(0).vertex_matrix(), ms.mesh(0).face_matrix(), target_edge="3%", evaluate=False)
     assert np.array_equal(rebuilt.vertex_matrix(), result["X"]) and np.array_equal(zero.vertex_matrix(), result["Z"])
     assert np.array_equal(rebuilt.face_matrix(), result["Ft"]) and np.array_equal(zero.face_matrix(), result["Ft"])
     assert np.array_equal(vertex_attribute(ms, report["layers"]["rebuilt"], "curvature_detail", "point"),

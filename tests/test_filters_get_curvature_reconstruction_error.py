@@ -25,9 +25,9 @@ def test_parallel_planes_are_their_offset_apart():
     ms.add_mesh(pymeshlab.Mesh(V, F.astype(np.int32)), "plane")
     ms.add_mesh(pymeshlab.Mesh(V + [0.0, 0.0, 0.01], F.astype(np.int32)), "lifted")
     figures = apply(ms, "get_curvature_reconstruction_error", samplenum=2000)
-    assert figures["max"] == pytest.approx(0.01, rel=1e-6)
-    assert figures["rms"] == pytest.approx(0.01, rel=1e-6)
-    assert figures["hausdorff_max"] == pytest.approx(0.01 / np.sqrt(2.0), rel=1e-6)
+    assert figures["hausdorff_max_model_units"] == pytest.approx(0.01, rel=1e-6)
+    assert figures["hausdorff_rms_model_units"] == pytest.approx(0.01, rel=1e-6)
+    assert figures["hausdorff_max_percent_of_diagonal"] == pytest.approx(1 / np.sqrt(2.0), rel=1e-6)
     assert np.allclose(ms.mesh(1).vertex_scalar_array(), 0.01, rtol=1e-6)
 
 
@@ -37,14 +37,14 @@ def test_nose_against_its_minimal_surface():
     apply(ms, "generate_minimal_surface", max_iterations=3)
     figures = apply(ms, "get_curvature_reconstruction_error", samplenum=5000)
     diag = bbox_diagonal(ms.mesh(0).vertex_matrix())
-    assert figures["diagonal"] == diag and (figures["sampledmesh"], figures["targetmesh"]) == (1, 0)
-    assert figures["hausdorff_max"] == max(figures["sampled_to_target_max"], figures["target_to_sampled_max"])
-    assert figures["hausdorff_rms"] <= figures["hausdorff_max"]
+    assert figures["bbox_diagonal_model_units"] == diag and (figures["sampledmesh"], figures["targetmesh"]) == (1, 0)
+    assert figures["hausdorff_max_percent_of_diagonal"] == max(figures["sampled_to_target_max_percent_of_diagonal"], figures["target_to_sampled_max_percent_of_diagonal"])
+    assert figures["hausdorff_rms_percent_of_diagonal"] <= figures["hausdorff_max_percent_of_diagonal"]
     # quality: each vertex's distance to the source surface, the same as curvdetail.remesh's
     quality = ms.mesh(1).vertex_scalar_array()
     assert np.array_equal(quality, vertex_distance(ms.mesh(1).vertex_matrix(), ms.mesh(0).vertex_matrix(),
                                                    ms.mesh(0).face_matrix()))
-    assert figures["hausdorff_max"] > 0.05            # a nose is far from its minimal surface
+    assert figures["hausdorff_max_percent_of_diagonal"] > 0.05            # a nose is far from its minimal surface
     assert ms.current_mesh_id() == 1
 
 
@@ -67,7 +67,7 @@ def test_figures_are_the_remeshing_report_measure(monkeypatch):
     (Va, Fa, Vb, Fb, samples), = calls
     assert np.array_equal(Va, ms.mesh(1).vertex_matrix()) and np.array_equal(Vb, ms.mesh(0).vertex_matrix())
     assert np.array_equal(Fa, ms.mesh(1).face_matrix()) and samples == 3000
-    assert figures["hausdorff_max"] == figures["max"] / bbox_diagonal(Vb)
+    assert figures["hausdorff_max_percent_of_diagonal"] == 100 * figures["hausdorff_max_model_units"] / bbox_diagonal(Vb)
 
 
 def test_rebuilt_copy_of_itself_has_no_error():
@@ -77,7 +77,7 @@ def test_rebuilt_copy_of_itself_has_no_error():
     apply(ms, "compute_curvature_detail")
     apply(ms, "apply_curvature_reconstruction")
     figures = apply(ms, "get_curvature_reconstruction_error", samplenum=5000)
-    assert figures["hausdorff_max"] < 1e-6
+    assert figures["hausdorff_max_percent_of_diagonal"] < 1e-4
 
 
 def test_rebuild_of_a_moved_plane_from_its_stored_detail_has_no_error():
@@ -94,13 +94,15 @@ def test_rebuild_of_a_moved_plane_from_its_stored_detail_has_no_error():
     ms.compute_coord_by_function(x="x", y="y", z="1.6*x*(1-x)*y*(1-y)")      # 0 on the boundary
     assert ms.current_mesh().vertex_matrix()[:, 2].max() == pytest.approx(0.1, rel=1e-12)
     lifted = apply(ms, "get_curvature_reconstruction_error", samplenum=5000)
-    assert lifted["sampled_to_target_max"] == pytest.approx(0.1 / np.sqrt(2.0), rel=0.02)
+    assert lifted["sampled_to_target_max_percent_of_diagonal"] == pytest.approx(10 / np.sqrt(2.0), rel=0.02)
     apply(ms, "apply_curvature_reconstruction")
     X = ms.mesh(1).vertex_matrix()
     assert np.abs(X[:, 2]).max() < 1e-12
     assert X[:, :2].min() >= -1e-12 and X[:, :2].max() <= 1 + 1e-12
     figures = apply(ms, "get_curvature_reconstruction_error", samplenum=5000)
-    assert figures["hausdorff_max"] < 1e-9 and figures["hausdorff_rms"] < 1e-9
+    # 0 to the rounding of pymeshlab's single-precision sampling (ROUNDING_RMS: 1e-5 % of the
+    # diagonal; 1.04e-6 % measured after other tests in the process, which draw other samples)
+    assert figures["hausdorff_max_percent_of_diagonal"] < 1e-5 and figures["hausdorff_rms_percent_of_diagonal"] < 1e-5
     assert np.abs(ms.mesh(1).vertex_scalar_array()).max() < 1e-9    # quality: distance to the source
 
 
@@ -164,7 +166,7 @@ def test_quality_is_exact_beside_a_wavy_target():
     exact = triangle_brute_force(P, V, F)
     d = bbox_diagonal(V)
     np.testing.assert_allclose(ms.mesh(1).vertex_scalar_array(), exact, rtol=1e-12, atol=1e-15 * d)
-    assert figures["sampled_to_target_max"] >= exact.max() / d            # the maxima take them in
+    assert figures["sampled_to_target_max_percent_of_diagonal"] >= 100 * exact.max() / d            # the maxima take them in
 
 
 def test_the_sampled_layers_vertices_are_searched_once(monkeypatch):
@@ -205,8 +207,8 @@ def test_figures_are_those_hausdorff_measures_itself(monkeypatch):
     (given_distance, given, measured), = calls
     assert given_distance is not None and given == measured
     assert np.array_equal(ms.mesh(1).vertex_scalar_array(), given_distance)
-    assert (figures["max"], figures["rms"], figures["sampled_to_target_max"]) == \
-        (given["max"], given["rms"], given["a_to_b_max"] / figures["diagonal"])
+    assert (figures["hausdorff_max_model_units"], figures["hausdorff_rms_model_units"], figures["sampled_to_target_max_percent_of_diagonal"]) == \
+        (given["max"], given["rms"], 100 * given["a_to_b_max"] / figures["bbox_diagonal_model_units"])
 
 
 @pytest.mark.parametrize("stray_layer", [0, 1])

@@ -7,7 +7,7 @@ import pymeshlab
 import pytest
 
 from curvdetail.curvature.errors import MeshError
-from curvdetail.curvature.testing import icosphere
+from curvdetail.curvature.testing import grid, icosphere
 from curvdetail.filters import FilterError
 from curvdetail.filters.meshset import (add_layer, layer_id, mesh_arrays, set_vertex_attribute,
                                         set_vertex_positions, set_vertex_quality, vertex_attribute,
@@ -94,3 +94,24 @@ def test_vertex_normals_point_outwards_on_a_sphere():
     N = vertex_normals(V, F)
     assert np.allclose(np.linalg.norm(N, axis=1), 1.0)
     assert np.einsum("ij,ij->i", N, V / 2.0).min() > 0.999
+
+
+def test_a_quality_colours_the_layer_with_viridis_over_its_range_and_a_ply_keeps_it(tmp_path):
+    # MeshLab shows vertex colours on open: a distance from viridis' first colour at 0 to its last
+    # at the max; a signed quality symmetric about 0 (the middle colour)
+    from curvdetail.filters.files import load_meshset, save_current_mesh
+    from curvdetail.filters.meshset import set_vertex_quality
+    from curvdetail.plot import vertex_colours
+
+    V, F = grid(5, 5)
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(V, F.astype(np.int32)))
+    q = np.linspace(0.0, 2.0, V.shape[0])
+    assert set_vertex_quality(ms, 0, q) == (0.0, 2.0)
+    save_current_mesh(ms, tmp_path / "q.ply")
+    back = load_meshset(tmp_path / "q.ply")                  # kept alive while its mesh is read
+    rgb = np.rint(back.current_mesh().vertex_color_matrix()[:, :3] * 255)
+    expected = vertex_colours(q, 2.0)[:, :3]
+    assert np.abs(rgb[[0, -1]] - expected[[0, -1]]).max() <= 1        # viridis' ends at 0 and at the max
+    assert np.abs(rgb - expected).max() <= 20          # pymeshlab's viridis: a coarser table (19/255 measured)
+    assert set_vertex_quality(ms, 0, q - 0.5) == (-1.5, 1.5)

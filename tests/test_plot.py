@@ -23,7 +23,7 @@ def _vivid(img):
 def result():
     V, F = disk(n_rings=10)
     V[:, 2] = 0.2 * np.exp(-3.0 * (V[:, :2] ** 2).sum(1))
-    return V, F, run_experiment(V, F, target_edge=0.06)
+    return V, F, run_experiment(V, F, target_edge="6%")
 
 
 def test_panels_are_a_png_of_the_size_asked_showing_every_mesh(tmp_path):
@@ -107,11 +107,36 @@ def test_remeshing_figure_refuses_an_unmeasured_report_or_mismatched_distances(t
 
 def test_the_remeshing_figure_of_a_closed_surface_shows_all_three_panels(tmp_path):
     V, F = _octahedron(0.3)
-    report = {"error": {"hausdorff_rms": 0.001, "hausdorff_max": 0.01},
-              "baseline_zero_detail": {"hausdorff_rms": 0.1, "hausdorff_max": 0.2},
-              "floor_retriangulated": {"hausdorff_rms": 0.0}, "options": {"transfer": "mean", "rows": "free"},
+    report = {"error": {"hausdorff_rms_percent_of_diagonal": 0.001, "hausdorff_max_percent_of_diagonal": 0.01},
+              "baseline_zero_detail": {"hausdorff_rms_percent_of_diagonal": 0.1, "hausdorff_max_percent_of_diagonal": 0.2},
+              "floor_retriangulated": {"hausdorff_rms_percent_of_diagonal": 0.0}, "options": {"transfer": "mean", "rows": "free"},
               "source": {"path": None, "vertices": 6, "bbox_diagonal": 2.0}, "target": {"vertices": 6}}
     path = tmp_path / "octahedron.png"
     save_remeshing_figure(path, V, F, V, F, 0.8 * V, np.linspace(0.0, 0.01, 6), report, dpi=50)
     img = mpimg.imread(str(path))
     assert min(_drawn(img[:, cols]) for cols in np.array_split(np.arange(img.shape[1]), 3)) > 0.08
+
+
+def test_the_remeshing_colour_scale_ends_at_the_max_the_title_states_for_both_surfaces(tmp_path, result,
+                                                                                    monkeypatch):
+    import curvdetail.plot as plot
+
+    V, F, r = result
+    seen = {}
+    monkeypatch.setattr(plot, "save_panels", lambda path, panels, **kw: seen.update(panels=panels, **kw))
+    save_remeshing_figure(tmp_path / "f.png", V, F, r["X"], r["Ft"], r["Z"], r["distance"], r["report"],
+                          zero_distance=r["zero_distance"])
+    top = r["report"]["error"]["hausdorff_max_percent_of_diagonal"]
+    assert seen["vrange"] == (0.0, top) and f"max {top:.2f} %" in seen["panels"][1][2]
+    rebuilt, zero = seen["panels"][1][3], seen["panels"][2][3]          # both in % of the diagonal
+    d = r["report"]["source"]["bbox_diagonal"]
+    assert np.allclose(zero, 100 * r["zero_distance"] / d) and rebuilt.max() <= top
+    assert zero.max() > top                       # beyond the scale: the top colour (the bar's arrow)
+
+
+def test_vertex_colours_run_viridis_from_0_to_the_max_clipped_beyond():
+    from curvdetail.plot import vertex_colours
+
+    rgba = vertex_colours([0.0, 0.5, 1.0, 3.0], vmax=1.0)
+    assert rgba.dtype == np.uint8 and (rgba[:, 3] == 255).all()
+    assert rgba[0, :3].tolist() == [68, 1, 84] and rgba[2, :3].tolist() == rgba[3, :3].tolist() == [253, 231, 37]

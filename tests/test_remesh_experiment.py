@@ -5,6 +5,8 @@ import json
 import numpy as np
 import pytest
 
+from curvdetail.curvature.errors import CurvdetailError
+
 from curvdetail.curvature import boundary_vertices
 from curvdetail.curvature.testing import disk
 from curvdetail.remesh import (NotADiskError, RemeshError, WorseThanZeroDetailWarning, hausdorff, remesh_experiment,
@@ -30,23 +32,23 @@ def height_field():
 
 def test_gaussian_height_field_is_rebuilt_close_to_the_analytic_surface(height_field):
     V, F = height_field
-    (X, Ft), report = remesh_experiment(V, F, target_edge=0.03)
+    (X, Ft), report = remesh_experiment(V, F, target_edge="3%")
     err = np.abs(X[:, 2] - _gaussians(X[:, :2])).max()
     # The retriangulated vertices themselves lie on the piecewise-linear source, up to 3.4e-3
     # below/above the analytic bumps (the source's own interpolation error at 24 rings); the
     # rebuilt surface must stay within 0.01 of the analytic one (4 % of the tallest bump), while
     # the zero-detail surface misses it by ~0.25 (RMS: 0.05 % of the bbox diagonal against 2.2 %).
     assert err < 0.01
-    assert report["error"]["hausdorff_rms"] < 0.05 * report["baseline_zero_detail"]["hausdorff_rms"]
+    assert report["error"]["hausdorff_rms_percent_of_diagonal"] < 0.05 * report["baseline_zero_detail"]["hausdorff_rms_percent_of_diagonal"]
 
 
 def test_report_has_every_documented_key_and_is_json(height_field):
     V, F = height_field
-    _, report = remesh_experiment(V, F, target_edge=0.04, source_path="bumps.obj")
+    _, report = remesh_experiment(V, F, target_edge="4%", source_path="bumps.obj")
     assert report["source"]["path"] == "bumps.obj"
     assert {"vertices", "faces"} <= set(report["source"]) and {"vertices", "faces"} <= set(report["target"])
     for key in ("error", "baseline_zero_detail", "floor_retriangulated"):
-        assert {"hausdorff_max", "hausdorff_rms"} <= set(report[key])
+        assert {"hausdorff_max_percent_of_diagonal", "hausdorff_rms_percent_of_diagonal"} <= set(report[key])
     assert set(report["seconds"]) == {"retriangulate", "parameterize", "transfer", "reconstruct", "evaluate",
                                       "total"}
     assert report["options"]["transfer"] == "conservative" and report["options"]["rows"] == "free"
@@ -55,29 +57,29 @@ def test_report_has_every_documented_key_and_is_json(height_field):
 
 def test_error_is_within_twice_the_floor_and_far_below_zero_detail(height_field):
     V, F = height_field
-    _, r = remesh_experiment(V, F, target_edge=0.04)
+    _, r = remesh_experiment(V, F, target_edge="4%")
     # The floor (the retriangulated surface's own distance) is not a lower bound: rebuilt
     # vertices may move off the source's piecewise-linear surface. The product target is
     # "within 2x of the floor"; here the error measures 0.9x of it.
-    assert r["error"]["hausdorff_rms"] <= 2.0 * r["floor_retriangulated"]["hausdorff_rms"]
-    assert r["error"]["hausdorff_rms"] < 0.05 * r["baseline_zero_detail"]["hausdorff_rms"]
+    assert r["error"]["hausdorff_rms_percent_of_diagonal"] <= 2.0 * r["floor_retriangulated"]["hausdorff_rms_percent_of_diagonal"]
+    assert r["error"]["hausdorff_rms_percent_of_diagonal"] < 0.05 * r["baseline_zero_detail"]["hausdorff_rms_percent_of_diagonal"]
 
 
 def test_report_figures_are_the_distances_over_the_source_diagonal(height_field):
     V, F = height_field
-    target = retriangulate(V, F, target_edge=0.04)
+    target = retriangulate(V, F, target_edge="4%")
     (X, Ft), r = remesh_experiment(V, F, target=target)
     d = np.linalg.norm(np.ptp(V, axis=0))
     for key, P in (("error", X), ("floor_retriangulated", target[0])):
         h = hausdorff(P, Ft, V, F)                     # the same engine and seeded samples
         # (pymeshlab's face sampling is not repeatable to the last digit: ~0.1 %)
-        assert r[key]["hausdorff_rms"] == pytest.approx(h["rms"] / d, rel=0.02)
-        assert r[key]["hausdorff_max"] == pytest.approx(h["max"] / d, rel=0.05)
-    assert r["error"]["vertex_max"] == pytest.approx(vertex_distance(X, V, F).max() / d, rel=1e-12)
-    rms = r["error"]["hausdorff_rms"]
-    assert r["improvement_over_zero_detail"] == pytest.approx(r["baseline_zero_detail"]["hausdorff_rms"] / rms)
+        assert r[key]["hausdorff_rms_percent_of_diagonal"] == pytest.approx(100 * h["rms"] / d, rel=0.02)
+        assert r[key]["hausdorff_max_percent_of_diagonal"] == pytest.approx(100 * h["max"] / d, rel=0.05)
+    assert r["error"]["vertex_max_percent_of_diagonal"] == pytest.approx(100 * vertex_distance(X, V, F).max() / d, rel=1e-12)
+    rms = r["error"]["hausdorff_rms_percent_of_diagonal"]
+    assert r["improvement_over_zero_detail"] == pytest.approx(r["baseline_zero_detail"]["hausdorff_rms_percent_of_diagonal"] / rms)
     assert r["improvement_over_zero_detail"] > 20
-    assert r["ratio_to_floor"] == pytest.approx(rms / r["floor_retriangulated"]["hausdorff_rms"])
+    assert r["ratio_to_floor"] == pytest.approx(rms / r["floor_retriangulated"]["hausdorff_rms_percent_of_diagonal"])
 
 
 def test_a_parameterization_without_uv_location_is_refused_not_ignored(height_field):
@@ -88,7 +90,7 @@ def test_a_parameterization_without_uv_location_is_refused_not_ignored(height_fi
 
 def test_uv_location_and_given_target_run_and_record_the_parameterization(height_field):
     V, F = height_field
-    target = retriangulate(V, F, target_edge=0.04)
+    target = retriangulate(V, F, target_edge="4%")
     (X, Ft), r = remesh_experiment(V, F, location="uv", transfer="pointwise", rows="all", target=target,
                                    evaluate=False)
     assert np.array_equal(Ft, target[1])
@@ -114,7 +116,7 @@ def test_closed_source_is_refused(sphere):
 
 def test_absurd_target_edge_is_refused(height_field):
     with pytest.raises(RemeshError, match="fewer than 50"):
-        remesh_experiment(*height_field, target_edge=0.5)
+        remesh_experiment(*height_field, target_edge="50%")
 
 
 def test_unknown_option_value_is_refused(height_field):
@@ -127,11 +129,11 @@ def test_run_experiment_returns_exact_per_vertex_distances(height_field):
     from curvdetail.remesh.experiment import run_experiment
 
     V, F = height_field
-    r = run_experiment(V, F, target_edge=0.05)
+    r = run_experiment(V, F, target_edge="5%")
     # the tree search's distances (exact at any distance), the ones the maxima are taken over
     assert np.array_equal(r["distance"], vertex_distance(r["X"], V, F))
     assert np.array_equal(r["zero_distance"], vertex_distance(r["Z"], V, F))
-    assert r["distance"].max() / r["report"]["source"]["bbox_diagonal"] == r["report"]["error"]["vertex_max"]
+    assert 100 * r["distance"].max() / r["report"]["source"]["bbox_diagonal"] == r["report"]["error"]["vertex_max_percent_of_diagonal"]
 
 
 def test_unknown_backend_is_refused_before_retriangulating(height_field, monkeypatch):
@@ -146,7 +148,7 @@ def test_unknown_backend_is_refused_before_retriangulating(height_field, monkeyp
 
 @pytest.mark.parametrize("kwargs, error, words", [
     # with a ready target, target_edge is only recorded: it was not checked at all
-    ({"target": "ready", "target_edge": -1}, RemeshError, "target_edge=-1 must be a positive fraction"),
+    ({"target": "ready", "target_edge": -1}, CurvdetailError, "target_edge=-1 is not a positive length"),
     ({"target": 5}, ValueError, r"target must be a pair \(Vt, Ft\).*got int"),
     ({"progress": 5}, ValueError, "progress must be callable.*got int"),
     ({"evaluate": "no"}, ValueError, "evaluate='no' must be True or False"),   # "no" counted as True
@@ -176,20 +178,20 @@ def test_a_two_triangle_square_is_rebuilt_and_measured():
     (X, _), report = remesh_experiment(V, F, target=(V, F))
     # a flat square rebuilt from its own (zero) detail is itself
     assert np.abs(X - V).max() < 1e-12
-    assert report["error"]["hausdorff_max"] < 1e-6 and report["baseline_zero_detail"]["hausdorff_max"] < 1e-12
+    assert report["error"]["hausdorff_max_percent_of_diagonal"] < 1e-6 and report["baseline_zero_detail"]["hausdorff_max_percent_of_diagonal"] < 1e-12
 
 
 def test_report_says_a_given_target_was_not_made_by_the_experiment(height_field):
     V, F = height_field
-    target = retriangulate(V, F, method="decimate", target_edge=0.06)
+    target = retriangulate(V, F, method="decimate", target_edge="6%")
     _, given = remesh_experiment(V, F, target=target, evaluate=False)
-    assert given["options"]["method"] == "given" and given["options"]["target_edge"] is None
+    assert given["options"]["method"] == "given" and given["options"]["target_edge_percent_of_diagonal"] is None
     assert given["seconds"]["retriangulate"] == 0.0
-    _, made = remesh_experiment(V, F, method="decimate", target_edge=0.06, evaluate=False)
-    assert made["options"]["method"] == "decimate" and made["options"]["target_edge"] == 0.06
+    _, made = remesh_experiment(V, F, method="decimate", target_edge="6%", evaluate=False)
+    assert made["options"]["method"] == "decimate" and made["options"]["target_edge_percent_of_diagonal"] == 6.0
     # the fraction of the diagonal and the length it stands for, both named
-    assert made["options"]["target_edge_length"] == pytest.approx(0.06 * made["source"]["bbox_diagonal"])
-    assert given["options"]["target_edge_length"] is None
+    assert made["options"]["target_edge_model_units"] == pytest.approx(0.06 * made["source"]["bbox_diagonal"])
+    assert given["options"]["target_edge_model_units"] is None
     assert made["target"]["vertices"] == given["target"]["vertices"]      # the same decimation
 
 
@@ -239,7 +241,7 @@ def test_a_float32_target_far_from_the_origin_is_taken():
     # 2.8 m diagonal, and 102 of 333 boundary vertices of such a terrain were refused
     V, F = disk(n_rings=10)
     V = (V + [5000.0, 0.0, 0.0]).astype(np.float32).astype(np.float64)
-    Vt, Ft = retriangulate(V, F, target_edge=0.05)
+    Vt, Ft = retriangulate(V, F, target_edge="5%")
     Vt = Vt.astype(np.float32).astype(np.float64)
     (X, _), report = remesh_experiment(V, F, target=(Vt, Ft), evaluate=False)
     assert report["target"]["vertices"] == Vt.shape[0]
@@ -254,7 +256,7 @@ def test_the_zero_detail_baseline_is_the_harmonic_surface_for_both_row_modes(hei
     from curvdetail.remesh.experiment import run_experiment
 
     V, F = height_field
-    runs = {rows: run_experiment(V, F, target_edge=0.05, rows=rows, evaluate=False) for rows in ("free", "all")}
+    runs = {rows: run_experiment(V, F, target_edge="5%", rows=rows, evaluate=False) for rows in ("free", "all")}
     Vt, Ft, Z = runs["all"]["Vt"], runs["all"]["Ft"], runs["all"]["Z"]
     free = np.setdiff1d(np.arange(Vt.shape[0]), boundary_vertices(Ft))
     LZ = cotan_laplacian(Vt, Ft) @ Z
@@ -274,7 +276,7 @@ def test_function_defaults_are_the_documented_defaults():
 
     from curvdetail.remesh.experiment import DEFAULTS, run_experiment
 
-    assert DEFAULTS["target_edge"] == 0.01 and DEFAULTS["method"] == "isotropic"
+    assert DEFAULTS["target_edge"] == "1%" and DEFAULTS["method"] == "isotropic"
     for function in (remesh_experiment, run_experiment):
         parameters = inspect.signature(function).parameters
         assert {k: parameters[k].default for k in DEFAULTS} == DEFAULTS, function.__name__
@@ -283,22 +285,22 @@ def test_function_defaults_are_the_documented_defaults():
 @pytest.mark.parametrize("kwargs, expected", [({}, True), ({"surface_check": False}, False)])
 def test_surface_check_reaches_the_remesher_and_the_report(load_mesh, isotropic_calls, kwargs, expected):
     V, F = load_mesh("mannequin_ear.obj")
-    (X, Ft), report = remesh_experiment(V, F, target_edge=0.03, evaluate=False, **kwargs)
+    (X, Ft), report = remesh_experiment(V, F, target_edge="3%", evaluate=False, **kwargs)
     assert [call["checksurfdist"] for call in isotropic_calls] == [expected]
     assert report["options"]["surface_check"] is expected
     # the ear at 3 % retriangulates differently without the check: the experiment rebuilds
     # that retriangulation
-    Vt, Ft_direct = retriangulate(V, F, target_edge=0.03, **kwargs)
+    Vt, Ft_direct = retriangulate(V, F, target_edge="3%", **kwargs)
     np.testing.assert_array_equal(Ft, Ft_direct)
     assert X.shape == Vt.shape
 
 
 def test_surface_check_is_recorded_as_none_where_no_isotropic_remeshing_ran(height_field):
     V, F = height_field
-    _, decimated = remesh_experiment(V, F, method="decimate", target_edge=0.06, surface_check=False,
+    _, decimated = remesh_experiment(V, F, method="decimate", target_edge="6%", surface_check=False,
                                      evaluate=False)
     assert decimated["options"]["surface_check"] is None
-    Vt, Ft = retriangulate(V, F, target_edge=0.06)
+    Vt, Ft = retriangulate(V, F, target_edge="6%")
     _, given = remesh_experiment(V, F, target=(Vt, Ft), evaluate=False)
     assert given["options"]["surface_check"] is None
 
@@ -307,7 +309,7 @@ def test_surface_check_is_recorded_as_none_where_no_isotropic_remeshing_ran(heig
 def test_a_surface_check_that_is_not_a_bool_is_refused_before_any_work(height_field, isotropic_calls, value):
     V, F = height_field
     with pytest.raises(ValueError, match=f"surface_check={value!r} must be True or False"):
-        remesh_experiment(V, F, target_edge=0.05, surface_check=value)
+        remesh_experiment(V, F, target_edge="5%", surface_check=value)
     assert isotropic_calls == []
 
 
@@ -332,14 +334,14 @@ def test_a_rebuild_farther_than_zero_detail_is_said_with_what_to_try():
     V, F = noisy_disk()
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        _, report = remesh_experiment(V, F, target_edge=0.08, transfer="pointwise")
-    rms, zero = report["error"]["hausdorff_rms"], report["baseline_zero_detail"]["hausdorff_rms"]
+        _, report = remesh_experiment(V, F, target_edge="8%", transfer="pointwise")
+    rms, zero = report["error"]["hausdorff_rms_percent_of_diagonal"], report["baseline_zero_detail"]["hausdorff_rms_percent_of_diagonal"]
     assert rms > 2 * zero                            # measured 4.9x: the case is a clear one
     worse = [w for w in caught if issubclass(w.category, WorseThanZeroDetailWarning)]
     assert len(worse) == 1, [str(w.message) for w in caught]
     message = str(worse[0].message)
     assert message.startswith(f"the rebuilt surface is farther from the source than the zero-detail surface (RMS "
-                              f"{100 * rms:.4g} % against {100 * zero:.4g} % of the bbox diagonal)")
+                              f"{rms:.4g} % against {zero:.4g} % of the bbox diagonal)")
     assert "transfer='conservative'" in message and "--transfer" not in message
     assert worse[0].filename == __file__             # the caller's line, not the package's
 
@@ -349,7 +351,7 @@ def test_a_rebuild_nearer_than_zero_detail_says_nothing(height_field):
 
     with warnings.catch_warnings():
         warnings.simplefilter("error", WorseThanZeroDetailWarning)
-        _, report = remesh_experiment(*height_field, target_edge=0.04)
+        _, report = remesh_experiment(*height_field, target_edge="4%")
     assert report["improvement_over_zero_detail"] > 1
 
 
@@ -364,12 +366,12 @@ def test_a_rebuild_nearer_than_zero_detail_says_nothing(height_field):
 def test_what_to_try_follows_the_options_that_failed(options, cli, says):
     from curvdetail.remesh.experiment import worse_than_zero_detail
 
-    report = {"options": options, "error": {"hausdorff_rms": 0.3}, "baseline_zero_detail": {"hausdorff_rms": 0.2}}
+    report = {"options": options, "error": {"hausdorff_rms_percent_of_diagonal": 30}, "baseline_zero_detail": {"hausdorff_rms_percent_of_diagonal": 20}}
     message = worse_than_zero_detail(report, cli=cli)
     assert all(words in message for words in says), message
     assert ("--" in message) == cli and ("='" in message) == (not cli), message
     assert "RMS 30 % against 20 %" in message
-    report["error"]["hausdorff_rms"] = 0.2                      # as near as zero detail: nothing said
+    report["error"]["hausdorff_rms_percent_of_diagonal"] = 0.2                      # as near as zero detail: nothing said
     assert worse_than_zero_detail(report, cli=cli) is None
     assert worse_than_zero_detail({"options": options}, cli=cli) is None     # not measured
 
@@ -392,7 +394,7 @@ def test_each_vertex_set_is_searched_once(height_field, monkeypatch):
         return spy
 
     monkeypatch.setattr(evaluate, "_surface_distance", spying(evaluate._surface_distance))
-    r = run_experiment(V, F, target_edge=0.05)
+    r = run_experiment(V, F, target_edge="5%")
     p = r["X"].shape[0]
     assert r["Ft"].shape[0] != F.shape[0]                # the spy tells the surfaces apart
     assert sum(rows) == 3 * p + BASELINE_SAMPLES, rows
@@ -415,12 +417,12 @@ def test_report_figures_are_those_hausdorff_measures_itself(height_field, monkey
         return given
 
     monkeypatch.setattr(experiment, "hausdorff", spy)
-    r = experiment.run_experiment(V, F, target_edge=0.05)
+    r = experiment.run_experiment(V, F, target_edge="5%")
     assert len(calls) == 3
     for (dist, given, measured), key in zip(calls, ("error", "baseline_zero_detail", "floor_retriangulated")):
         assert dist is not None and given == measured
-        assert r["report"][key] == {**r["report"][key], "hausdorff_max": given["max"] / d,
-                                    "hausdorff_rms": given["rms"] / d}
+        assert r["report"][key] == {**r["report"][key], "hausdorff_max_percent_of_diagonal": 100 * given["max"] / d,
+                                    "hausdorff_rms_percent_of_diagonal": 100 * given["rms"] / d}
     assert calls[0][0] is r["distance"] and calls[1][0] is r["zero_distance"]
 
 
@@ -434,11 +436,11 @@ def test_rebuilt_vertex_distances_are_exact_beside_a_wavy_source(monkeypatch):
     V, F = wavy_source_and_a_rebuild_beside_it(monkeypatch)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", WorseThanZeroDetailWarning)      # it is worse: forced off
-        r = run_experiment(V, F, target_edge=0.05)
+        r = run_experiment(V, F, target_edge="5%")
     d = r["report"]["source"]["bbox_diagonal"]
     exact = triangle_brute_force(r["X"], V, F)
     np.testing.assert_allclose(r["distance"], exact, rtol=1e-12, atol=1e-15 * d)
-    assert r["report"]["error"]["vertex_max"] == pytest.approx(exact.max() / d, rel=1e-12)
+    assert r["report"]["error"]["vertex_max_percent_of_diagonal"] == pytest.approx(100 * exact.max() / d, rel=1e-12)
     np.testing.assert_allclose(r["zero_distance"], triangle_brute_force(r["Z"], V, F), rtol=1e-12, atol=1e-15 * d)
 
 
@@ -454,8 +456,8 @@ def test_ratios_of_a_flat_patch_are_none_with_the_reason():
     V, F = grid(12, 12)
     with warnings.catch_warnings():
         warnings.simplefilter("error", WorseThanZeroDetailWarning)        # nor is it worse
-        _, r = remesh_experiment(V, F, target_edge=0.03)
-    assert r["baseline_zero_detail"]["hausdorff_rms"] < 1e-12 and r["error"]["hausdorff_rms"] < 1e-7
+        _, r = remesh_experiment(V, F, target_edge="3%")
+    assert r["baseline_zero_detail"]["hausdorff_rms_percent_of_diagonal"] < 1e-12 and r["error"]["hausdorff_rms_percent_of_diagonal"] < 1e-7
     assert r["improvement_over_zero_detail"] is None and r["ratio_to_floor"] is None
     assert r["ratio_notes"]["improvement_over_zero_detail"].startswith(
         "the zero-detail surface lies on the source to rounding")
@@ -466,10 +468,10 @@ def test_ratios_of_a_flat_patch_are_none_with_the_reason():
 
 
 def test_ratios_of_a_curved_patch_are_the_rms_quotients(height_field):
-    _, r = remesh_experiment(*height_field, target_edge=0.04)
-    rms = r["error"]["hausdorff_rms"]
-    assert r["improvement_over_zero_detail"] == r["baseline_zero_detail"]["hausdorff_rms"] / rms
-    assert r["ratio_to_floor"] == rms / r["floor_retriangulated"]["hausdorff_rms"]
+    _, r = remesh_experiment(*height_field, target_edge="4%")
+    rms = r["error"]["hausdorff_rms_percent_of_diagonal"]
+    assert r["improvement_over_zero_detail"] == r["baseline_zero_detail"]["hausdorff_rms_percent_of_diagonal"] / rms
+    assert r["ratio_to_floor"] == rms / r["floor_retriangulated"]["hausdorff_rms_percent_of_diagonal"]
     assert "ratio_notes" not in r
 
 
@@ -497,14 +499,14 @@ def test_an_array_or_list_for_an_option_is_refused_by_name_before_any_work(heigh
     V, F = height_field
     stages = []
     with pytest.raises(ValueError, match=rf"{option}=.*\((ndarray|list), not a single str\) is not one of"):
-        remesh_experiment(V, F, target_edge=0.08, evaluate=False, progress=stages.append, **{option: value})
+        remesh_experiment(V, F, target_edge="8%", evaluate=False, progress=stages.append, **{option: value})
     assert stages == []
 
 
 def test_numpy_strings_for_options_are_recorded_as_plain_strings(height_field):
     # the report is JSON-ready: its options are the plain strings, whatever str subclass came in
     V, F = height_field
-    _, report = remesh_experiment(V, F, target_edge=0.08, evaluate=False, transfer=np.str_("pointwise"),
+    _, report = remesh_experiment(V, F, target_edge="8%", evaluate=False, transfer=np.str_("pointwise"),
                                   rows=np.str_("all"))
     assert type(report["options"]["transfer"]) is str and type(report["options"]["rows"]) is str
     assert (report["options"]["transfer"], report["options"]["rows"]) == ("pointwise", "all")
@@ -526,3 +528,12 @@ def test_a_planar_map_that_collapses_a_target_triangle_is_refused_by_the_option(
                                           r"\(first: \d+\) to zero area in the plane.*Use parameterization "
                                           r"\"harmonic\" .* or location \"closest\""):
         remesh_experiment(V, F, target=(V, F), location="uv", parameterization="lscm", evaluate=False)
+
+
+def test_the_evaluation_reports_each_measurement_through_progress(height_field):
+    from curvdetail.remesh.experiment import EVALUATION_STEPS
+
+    calls = []
+    remesh_experiment(*height_field, target_edge="8%", progress=lambda *a: calls.append(a))
+    assert [c[0] for c in calls if len(c) == 1] == ["retriangulate", "transfer", "reconstruct", "evaluate"]
+    assert [c for c in calls if len(c) == 3] == [("evaluate", k, EVALUATION_STEPS) for k in range(1, 6)]

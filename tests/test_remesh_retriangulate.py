@@ -16,7 +16,7 @@ def _boundary_distance(V, F, Vt, Ft):
     return d.max() / bbox_diagonal(V)
 
 
-@pytest.mark.parametrize("method,target_edge", [("isotropic", 0.03), ("decimate", 0.06)])
+@pytest.mark.parametrize("method,target_edge", [("isotropic", "3%"), ("decimate", "6%")])
 @pytest.mark.parametrize("name", ["mannequin_nose.obj", "terrainA_1k.obj"])
 def test_every_boundary_vertex_stays_on_the_source_boundary(load_mesh, name, method, target_edge):
     V, F = load_mesh(name)
@@ -27,20 +27,20 @@ def test_every_boundary_vertex_stays_on_the_source_boundary(load_mesh, name, met
 
 def test_isotropic_edges_are_near_the_target_length(load_mesh):
     V, F = load_mesh("terrainA_1k.obj")
-    Vt, Ft = retriangulate(V, F, method="isotropic", target_edge=0.03)
+    Vt, Ft = retriangulate(V, F, method="isotropic", target_edge="3%")
     E = np.linalg.norm(Vt[Ft[:, [1, 2, 0]]] - Vt[Ft], axis=2)
     # isotropic remeshing keeps edges within [4/5, 4/3] of the target; the median sits close to it
     assert np.median(E) / (0.03 * bbox_diagonal(V)) == pytest.approx(1.0, abs=0.2)
 
 
-@pytest.mark.parametrize("target_edge, aggressiveness", [(0.03, 7), (0.06, 7), (0.06, 3), (0.06, 1), (0.06, 0)])
+@pytest.mark.parametrize("target_edge, aggressiveness", [(3, 7), (6, 7), (6, 3), (6, 1), (6, 0)])
 def test_decimation_reaches_the_triangle_count_of_the_target_edge(load_mesh, target_edge, aggressiveness):
     # at any aggressiveness: with the patch as it came, agg=1 removed 14 of 2,048 triangles
     from curvdetail.curvature.geometry import face_double_areas
 
     V, F = load_mesh("terrainA_1k.obj")
-    Vt, Ft = retriangulate(V, F, method="decimate", target_edge=target_edge, aggressiveness=aggressiveness)
-    h = target_edge * bbox_diagonal(V)
+    Vt, Ft = retriangulate(V, F, method="decimate", target_edge=f"{target_edge}%", aggressiveness=aggressiveness)
+    h = target_edge / 100 * bbox_diagonal(V)
     equilateral = 0.5 * face_double_areas(V, F).sum() / (np.sqrt(3.0) / 4.0 * h * h)   # 1283 / 321
     assert Ft.shape[0] == pytest.approx(equilateral, rel=0.05)
 
@@ -52,7 +52,7 @@ def test_default_decimation_collapses_in_order_and_keeps_the_shape(load_mesh):
     from curvdetail.remesh import hausdorff
 
     V, F = load_mesh("mannequin_ear.obj")
-    Vt, Ft = retriangulate(V, F, method="decimate", target_edge=0.03)
+    Vt, Ft = retriangulate(V, F, method="decimate", target_edge="3%")
     assert hausdorff(V, F, Vt, Ft)["rms"] / bbox_diagonal(V) < 0.025e-2
 
 
@@ -62,8 +62,8 @@ def test_decimation_does_not_depend_on_units_or_position(load_mesh, scale, shift
     # collapsed nothing and the source came back as its own "decimation"
     V, F = load_mesh("terrainA_1k.obj")
     offset = shift * bbox_diagonal(V)
-    Vt, Ft = retriangulate(V, F, method="decimate", target_edge=0.06)
-    Vs, Fs = retriangulate(V * scale + offset, F, method="decimate", target_edge=0.06)
+    Vt, Ft = retriangulate(V, F, method="decimate", target_edge="6%")
+    Vs, Fs = retriangulate(V * scale + offset, F, method="decimate", target_edge="6%")
     np.testing.assert_array_equal(Fs, Ft)
     assert np.abs((Vs - offset) / scale - Vt).max() <= 1e-9 * bbox_diagonal(V)
 
@@ -73,8 +73,8 @@ def test_isotropic_remeshing_at_extreme_units_matches_unit_scale(load_mesh, scal
     # the isotropic remesher flips discrete choices on last-bit differences, so the
     # triangulations are compared by their size and edge lengths, not triangle by triangle
     V, F = load_mesh("mannequin_nose.obj")
-    Vt, Ft = retriangulate(V, F, method="isotropic", target_edge=0.05)
-    Vs, Fs = retriangulate(V * scale, F, method="isotropic", target_edge=0.05)
+    Vt, Ft = retriangulate(V, F, method="isotropic", target_edge="5%")
+    Vs, Fs = retriangulate(V * scale, F, method="isotropic", target_edge="5%")
     assert Vs.shape[0] == pytest.approx(Vt.shape[0], rel=0.02)
 
     def median_edge(X, T):
@@ -99,7 +99,7 @@ def test_decimation_refuses_to_refine(load_mesh):
     V, F = load_mesh("mannequin_nose.obj")
     with pytest.raises(RemeshError, match=r"decimation can only coarsen.*decimation takes target edges from 3\.06 % "
                                           r"to 10\.6 % of the bbox diagonal .*; choose one there or " + _USE_ISOTROPIC):
-        retriangulate(V, F, method="decimate", target_edge=0.005)
+        retriangulate(V, F, method="decimate", target_edge="0.5%")
 
 
 def _percents(message):
@@ -109,7 +109,7 @@ def _percents(message):
     return [float(x) / 100 for x in re.findall(r"(\d+(?:\.\d+)?) %", message)[-2:]]
 
 
-@pytest.mark.parametrize("target_edge", [0.4, 1e-300])
+@pytest.mark.parametrize("target_edge", ["40%", 1e-300])
 def test_a_decimation_out_of_range_is_given_decimations_own_range(load_mesh, target_edge):
     # --method decimate --target-edge 40 advised "between 0.0335 % and 10.6 %", the isotropic
     # range, and every target below ~3.1 % of it was then refused ("can only coarsen"). Both
@@ -123,10 +123,10 @@ def test_a_decimation_out_of_range_is_given_decimations_own_range(load_mesh, tar
     shortest, longest = _percents(message)
     assert shortest == pytest.approx(0.0306) and longest == pytest.approx(0.106)
     for edge in (shortest, longest):
-        Vt, Ft = retriangulate(V, F, method="decimate", target_edge=edge)
+        Vt, Ft = retriangulate(V, F, method="decimate", target_edge=f"{100 * edge!r}%")
         assert 50 <= Vt.shape[0] and Ft.shape[0] < F.shape[0]
     with pytest.raises(RemeshError, match="decimation can only coarsen"):
-        retriangulate(V, F, method="decimate", target_edge=0.99 * shortest)     # below 3.054 %
+        retriangulate(V, F, method="decimate", target_edge=f"{99 * shortest!r}%")     # below 3.054 %
 
 
 def test_the_isotropic_range_given_is_admissible_at_both_ends(load_mesh):
@@ -134,7 +134,7 @@ def test_the_isotropic_range_given_is_admissible_at_both_ends(load_mesh):
 
     V, F = load_mesh("mannequin_nose.obj")
     with pytest.raises(RemeshError) as refused:
-        retriangulate(V, F, target_edge=0.9)
+        retriangulate(V, F, target_edge="90%")
     shortest, longest = _percents(str(refused.value))
     d = bbox_diagonal(V)
     assert 50 <= estimated_vertices(V, F, longest * d) and estimated_vertices(V, F, shortest * d) <= 5_000_000
@@ -146,7 +146,7 @@ def test_a_patch_too_small_to_decimate_says_so(load_mesh):
     V, F = disk(n_rings=4)                                  # 61 vertices, 96 triangles
     with pytest.raises(RemeshError, match=r"this 61-vertex patch is too small to decimate to 50 vertices or more "
                                           r"\(96 triangles\); " + _USE_ISOTROPIC):
-        retriangulate(V, F, method="decimate", target_edge=0.3)
+        retriangulate(V, F, method="decimate", target_edge="30%")
 
 
 def test_failed_decimation_points_to_isotropic_for_api_and_command_line(load_mesh, monkeypatch):
@@ -163,7 +163,7 @@ def test_failed_decimation_points_to_isotropic_for_api_and_command_line(load_mes
     monkeypatch.setattr(module, "check_disk", no_decimated_disk)
     V, F = load_mesh("mannequin_nose.obj")
     with pytest.raises(RemeshError, match=r"non-manifold edges \(decimation with agg=.*, 3 and 1\); " + _USE_ISOTROPIC):
-        retriangulate(V, F, method="decimate", target_edge=0.06)
+        retriangulate(V, F, method="decimate", target_edge="6%")
 
 
 def test_unknown_method_is_refused(load_mesh):
@@ -185,20 +185,14 @@ def test_a_method_that_is_not_one_str_is_refused_as_such(load_mesh, method):
     ({"iterations": 0}, "at least 1"),
     ({"iterations": "ten"}, "must be a whole number"),
     ({"iterations": 2.5}, "must be a whole number"),
-    ({"max_surface_distance": -0.01}, "positive fraction"),
-    ({"max_surface_distance": float("nan")}, "positive fraction"),
     ({"method": "decimate", "aggressiveness": float("nan")}, "from 0 to 10"),
     ({"method": "decimate", "aggressiveness": 11}, "from 0 to 10"),
     # bools were taken as 1, huge ints raised a TypeError, strings were parsed
     ({"iterations": True}, "iterations=True must be a whole number"),
     # 2**31 raised pybind11's RuntimeError "Unable to cast Python instance of type int"
     ({"iterations": 2 ** 31}, r"iterations=2147483648 is more than 1,000: each is a full pass"),
-    ({"max_surface_distance": 10 ** 400}, "positive fraction"),
-    ({"max_surface_distance": True}, "positive fraction"),
     ({"method": "decimate", "aggressiveness": 10 ** 30}, "from 0 to 10"),
     ({"method": "decimate", "aggressiveness": True}, "from 0 to 10"),
-    ({"target_edge": True}, "target_edge=True must be a positive fraction"),
-    ({"target_edge": "0.05"}, "target_edge='0.05' must be a positive fraction"),
     # target_edge ** 2 raised an OverflowError: the admissible range is given instead
     ({"target_edge": 1e300}, r"fewer than 50; choose a target edge between 0.\d+ % and \d+.\d+ %"),
     ({"target_edge": 1e-300}, r"about inf target vertices, more than 5,000,000; choose a target edge between"),
@@ -213,13 +207,36 @@ def test_out_of_range_remesher_options_are_refused_before_remeshing(load_mesh, k
     # distance and a NaN aggressiveness were handed to the remeshers
     V, F = load_mesh("mannequin_nose.obj")
     with pytest.raises(RemeshError, match=words):
-        retriangulate(V, F, **{"target_edge": 0.05, **kwargs})
+        retriangulate(V, F, **{"target_edge": "5%", **kwargs})
+
+
+@pytest.mark.parametrize("name, value", [("max_surface_distance", -0.01), ("max_surface_distance", float("nan")),
+                                         ("max_surface_distance", 10 ** 400), ("max_surface_distance", True),
+                                         ("target_edge", True), ("target_edge", "0.05"), ("target_edge", "-1%"),
+                                         ("target_edge", "1 percent")])
+def test_a_length_that_is_no_positive_number_or_percentage_is_refused_by_name(load_mesh, name, value):
+    from curvdetail.curvature.errors import CurvdetailError
+
+    V, F = load_mesh("mannequin_nose.obj")
+    with pytest.raises(CurvdetailError) as refused:
+        retriangulate(V, F, **{"target_edge": "5%", name: value})
+    assert refused.value.parameter == name
+
+
+@pytest.mark.parametrize("unit", ["model", "percent"])
+def test_a_plain_target_edge_is_in_model_units(load_mesh, unit):
+    # terrainA_1k's diagonal is 15.27 km: 0.458 model units is 3 %, as "3%" is
+    V, F = load_mesh("terrainA_1k.obj")
+    h = 0.03 * bbox_diagonal(V)
+    Vt, Ft = retriangulate(V, F, target_edge=h if unit == "model" else "3%")
+    E = np.linalg.norm(Vt[Ft[:, [1, 2, 0]]] - Vt[Ft], axis=2)
+    assert np.median(E) / h == pytest.approx(1.0, abs=0.2)
 
 
 def test_decimation_keeps_the_source_boundary_vertices_bit_for_bit(load_mesh):
     # preserve_border keeps them; the decimation frame's round trip must not move them by rounding
     V, F = load_mesh("mannequin_ear.obj")
-    Vt, Ft = retriangulate(V, F, method="decimate", target_edge=0.03)
+    Vt, Ft = retriangulate(V, F, method="decimate", target_edge="3%")
     _, _, loop = check_disk(V, F)
     _, _, loop_t = check_disk(Vt, Ft)
     assert sorted(map(tuple, Vt[loop_t])) == sorted(map(tuple, V[loop]))
@@ -230,7 +247,7 @@ def test_decimation_keeps_the_source_boundary_vertices_bit_for_bit(load_mesh):
                                               ({"surface_check": np.bool_(False)}, False)])
 def test_surface_check_is_passed_to_pymeshlab_as_checksurfdist(load_mesh, isotropic_calls, kwargs, expected):
     V, F = load_mesh("mannequin_nose.obj")
-    retriangulate(V, F, target_edge=0.05, **kwargs)
+    retriangulate(V, F, target_edge="5%", **kwargs)
     (call,) = isotropic_calls
     assert call["checksurfdist"] is expected            # a plain bool, as pymeshlab wants
     # the surface distance is passed either way (pymeshlab keeps values from earlier calls)
@@ -239,8 +256,8 @@ def test_surface_check_is_passed_to_pymeshlab_as_checksurfdist(load_mesh, isotro
 
 def test_decimation_does_not_call_the_isotropic_remesher(load_mesh, isotropic_calls):
     V, F = load_mesh("mannequin_nose.obj")
-    a = retriangulate(V, F, method="decimate", target_edge=0.06)
-    b = retriangulate(V, F, method="decimate", target_edge=0.06, surface_check=False)
+    a = retriangulate(V, F, method="decimate", target_edge="6%")
+    b = retriangulate(V, F, method="decimate", target_edge="6%", surface_check=False)
     assert isotropic_calls == []
     np.testing.assert_array_equal(a[1], b[1])
     np.testing.assert_array_equal(a[0], b[0])
@@ -253,14 +270,14 @@ def test_without_the_surface_check_the_ear_retriangulates_otherwise_but_still_a_
     # alike both ways, choose a patch or target where the check bites (the option reaching
     # pymeshlab is tested above, from the parameters it is called with)
     V, F = load_mesh("mannequin_ear.obj")
-    checked = retriangulate(V, F, target_edge=0.03)
-    unchecked = retriangulate(V, F, target_edge=0.03, surface_check=False)
+    checked = retriangulate(V, F, target_edge="3%")
+    unchecked = retriangulate(V, F, target_edge="3%", surface_check=False)
     assert checked[0].shape != unchecked[0].shape or not np.array_equal(checked[0], unchecked[0])
     for Vt, Ft in (checked, unchecked):
         assert _boundary_distance(V, F, Vt, Ft) <= 1e-9
     # pymeshlab carries parameters over between calls: the default after an unchecked call is
     # the checked result again, bit for bit
-    again = retriangulate(V, F, target_edge=0.03)
+    again = retriangulate(V, F, target_edge="3%")
     np.testing.assert_array_equal(again[0], checked[0])
     np.testing.assert_array_equal(again[1], checked[1])
 
@@ -271,7 +288,7 @@ def test_a_smooth_patch_gives_a_disk_near_the_target_edge_either_way():
     V, F = disk(n_rings=16)
     V[:, 2] = 0.2 * (1 - (V[:, :2] ** 2).sum(1))
     for surface_check in (True, False):
-        Vt, Ft = retriangulate(V, F, target_edge=0.04, surface_check=surface_check)
+        Vt, Ft = retriangulate(V, F, target_edge="4%", surface_check=surface_check)
         assert _boundary_distance(V, F, Vt, Ft) <= 1e-9
         E = np.linalg.norm(Vt[Ft[:, [1, 2, 0]]] - Vt[Ft], axis=2)
         assert np.median(E) / (0.04 * bbox_diagonal(V)) == pytest.approx(1.0, abs=0.2)
@@ -290,7 +307,7 @@ def test_a_long_run_is_not_announced_for_a_decimation_that_will_be_refused(load_
     assert module.long_run_vertices(V, F, finer, method="isotropic") is not None
     assert module.long_run_vertices(V, F, finer, method="decimate") is None             # refused: refines
     with pytest.raises(RemeshError, match="decimation can only coarsen"):
-        retriangulate(V, F, method="decimate", target_edge=0.02)
+        retriangulate(V, F, method="decimate", target_edge="2%")
     assert module.long_run_vertices(V, F, coarser, method="decimate") is not None
     # without the measurements a decimation takes seconds (490k -> 251k vertices: 18 s)
     assert module.long_run_vertices(V, F, coarser, method="decimate", evaluate=False) is None
@@ -331,7 +348,7 @@ def test_a_non_manifold_edge_in_the_source_is_given_a_repair_not_a_cut():
     with pytest.raises(NotADiskError, match=rf"^the source is not manifold: 1 edge is shared by more than two "
                                             rf"triangles \(first: \({min(a, b)}, {max(a, b)}\)\); repair the mesh, "
                                             r"e\.g\. with pymeshlab's meshing_repair_non_manifold_edges") as refused:
-        retriangulate(V2, F2, target_edge=0.1)
+        retriangulate(V2, F2, target_edge="10%")
     assert "cut one out" not in str(refused.value)
     # and the repair named does it
     ms = pymeshlab.MeshSet()
@@ -377,7 +394,7 @@ def test_a_boundary_side_of_one_long_edge_is_split_along_it():
     # segments with the nearest midpoints were all on the short sides, so they measured 0.13 of
     # the diagonal off the boundary and the retriangulation was refused
     V, F = _square_with_one_long_side()
-    Vt, Ft = retriangulate(V, F, method="isotropic", target_edge=0.03)
+    Vt, Ft = retriangulate(V, F, method="isotropic", target_edge="3%")
     _, _, loop_t = check_disk(Vt, Ft)
     bottom = loop_t[np.abs(Vt[loop_t, 1]) <= 1e-12]
     # the bottom side is the x axis in z = 0 exactly: its vertices come back on it, inside it,
@@ -400,7 +417,7 @@ def test_a_decimation_the_boundary_keeps_from_its_target_is_refused_not_returned
                                           r"triangles, but a disk with the source's 402 boundary vertices has at "
                                           r"least 400, and it falls short of a count below 500 \(1.25 x that\); "
                                           r"decimation takes target edges from 1.21 % to 1.51 %"):
-        retriangulate(V, F, method="decimate", target_edge=0.02)
+        retriangulate(V, F, method="decimate", target_edge="2%")
 
 
 @pytest.mark.parametrize("where", [0.0, 0.5, 1.0])
@@ -413,7 +430,7 @@ def test_every_decimation_target_in_the_range_is_reached(load_mesh, where):
     V, F = load_mesh("terrainA_1k.obj")
     lo, hi = target_edge_range(V, F, "decimate")
     target_edge = float(np.exp(np.log(lo * 1.001) + where * (np.log(hi * 0.999) - np.log(lo * 1.001))))
-    Vt, Ft = retriangulate(V, F, method="decimate", target_edge=target_edge)
+    Vt, Ft = retriangulate(V, F, method="decimate", target_edge=f"{100 * target_edge!r}%")
     h = target_edge * bbox_diagonal(V)
     asked = 0.5 * face_double_areas(V, F).sum() / (np.sqrt(3.0) / 4.0 * h * h)
     assert Ft.shape[0] == pytest.approx(asked, rel=0.05)

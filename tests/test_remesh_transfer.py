@@ -43,7 +43,7 @@ def test_pointwise_transfer_onto_the_same_mesh_is_exact(load_mesh):
 
 def test_conservative_transfer_keeps_the_total_detail(load_mesh):
     V, F = load_mesh("mannequin_nose.obj")
-    Vt, Ft = retriangulate(V, F, target_edge=0.03)
+    Vt, Ft = retriangulate(V, F, target_edge="3%")
     Ds = curvature_detail(V, F)
     scale = np.abs(Ds).sum()
     Dt = transfer_curvature(V, F, Vt, Ft, method="conservative")
@@ -58,7 +58,7 @@ def test_conservative_transfer_keeps_the_total_detail(load_mesh):
 def test_sphere_cap_detail_is_two_over_r_normal_on_the_target(method, location):
     R = 2.0
     V, F = _cap(R)
-    Vt, Ft = retriangulate(V, F, target_edge=0.04)
+    Vt, Ft = retriangulate(V, F, target_edge="4%")
     uv = None
     if location == "uv":
         from curvdetail.remesh import parameterize
@@ -266,7 +266,7 @@ def test_coordinates_off_by_rounding_are_taken():
 @pytest.mark.parametrize("method", ["conservative", "pointwise"])
 def test_a_given_detail_equal_to_the_geometrys_changes_nothing(load_mesh, method):
     V, F = load_mesh("mannequin_nose.obj")
-    Vt, Ft = retriangulate(V, F, target_edge=0.03)
+    Vt, Ft = retriangulate(V, F, target_edge="3%")
     own = transfer_curvature(V, F, Vt, Ft, method=method)
     given = transfer_curvature(V, F, Vt, Ft, method=method, detail=curvature_detail(V, F))
     assert np.abs(given - own).max() < 1e-12 * np.abs(own).max()       # measured 8e-15
@@ -292,7 +292,7 @@ def test_a_given_detail_onto_the_same_mesh_comes_back_exactly(load_mesh, method)
 
 def test_a_given_detail_keeps_its_total_on_a_retriangulation(load_mesh):
     V, F, D, Z = _moved_nose(load_mesh)
-    Zt, Ft = retriangulate(Z, F, target_edge=0.02)
+    Zt, Ft = retriangulate(Z, F, target_edge="2%")
     Dt = transfer_curvature(Z, F, Zt, Ft, detail=D)
     assert np.abs(Dt.sum(0) - D.sum(0)).max() <= 1e-12 * np.abs(D).sum()
 
@@ -309,7 +309,7 @@ def test_a_moved_source_rebuilt_from_its_given_detail_comes_back(load_mesh, meth
     from curvdetail.remesh import vertex_distance
 
     V, F, D, Z = _moved_nose(load_mesh)
-    Zt, Ft = retriangulate(Z, F, target_edge=0.02)
+    Zt, Ft = retriangulate(Z, F, target_edge="2%")
     b = boundary_vertices(Ft)
     diagonal = bbox_diagonal(V)
 

@@ -22,8 +22,9 @@ import warnings
 
 from .options import (AMPLIFIED, NOT_CONVERGED, Progress, add_backend, add_fix, add_input_output,
                           add_overwrite, check_outputs, choice, diagonal, figures_status, fixed_vertices,
-                          error_line, input_output, note_dropped, percentage, positive_number, print_figures,
-                          quality_for, read_checked, run_on_file, say, show_warning, whole_number_from_one)
+                          error_line, input_output, length, note_dropped, positive_number, print_figures,
+                          quality_for, read_checked, run_on_file, say, show_warning, whole_number_from_one,
+                          write_measured)
 
 __all__ = ["AMPLIFIED", "NOT_CONVERGED", "Terminated", "build_parser", "error_line", "main",
            "positive_number", "whole_number_from_one"]
@@ -59,7 +60,7 @@ def _reconstruct(parser):
     def run(args):
         import numpy as np
 
-        from .. import Reconstructor, curvature_detail, write_mesh
+        from .. import Reconstructor, curvature_detail
 
         inputs = input_output(args)
         check_outputs(args, [("OUTPUT", args.output, True)], **inputs)
@@ -70,7 +71,7 @@ def _reconstruct(parser):
         X = rec.solve(curvature_detail(V, F), V[rec.fixed])
         seconds = time.perf_counter() - t
         dist = np.linalg.norm(X - V, axis=1)
-        write_mesh(args.output, X, F, quality=quality_for(args.output, dist), overwrite=args.overwrite)
+        write_measured(args.output, X, F, dist, diagonal_of=V, overwrite=args.overwrite)
         print_figures(f"max vertex error {dist.max() / diagonal(V):.3e} of the bbox diagonal ({V.shape[0]} "
                       f"vertices, {fixed.size} fixed, rows={args.rows}, {seconds:.3f} s)")
         note_dropped(args.output, quality=True)
@@ -99,7 +100,7 @@ def _minimal(parser):
     def run(args):
         import numpy as np
 
-        from .. import boundary_vertices, minimal_surface, write_mesh
+        from .. import boundary_vertices, minimal_surface
         from ..curvature.errors import ConstraintError
 
         inputs = input_output(args)
@@ -115,8 +116,7 @@ def _minimal(parser):
         X = minimal_surface(V, F, fixed, max_iterations=args.max_iterations, tol=args.tol, step=args.step,
                             backend=args.backend, callback=lambda i, s: progress.stage(f"step {i}"))
         progress.close()
-        write_mesh(args.output, X, F, quality=quality_for(args.output, np.linalg.norm(X - V, axis=1)),
-                   overwrite=args.overwrite)
+        write_measured(args.output, X, F, np.linalg.norm(X - V, axis=1), diagonal_of=V, overwrite=args.overwrite)
         state = "converged" if X.converged else "stopped (not converged)"
         step = X.last_step if args.step == "normal" else X.last_full_step
         print_figures(f"{state} after {X.iterations} step{'' if X.iterations == 1 else 's'}, last step {step:.2e} of the bbox diagonal "
@@ -135,8 +135,9 @@ def _remesh(parser):
     add_input_output(parser, "source mesh: a disk-topology patch (one boundary loop)",
                       "rebuilt target mesh; quality = distance to the source (.ply keeps it)")
     choice(parser, "--method", ("isotropic", "decimate"), "isotropic", "retriangulation (default: isotropic)")
-    parser.add_argument("--target-edge", type=percentage, default=1.0, metavar="PCT",
-                        help="target edge length in %% of the source's bbox diagonal, e.g. 1 or 1%% (default: 1)")
+    parser.add_argument("--target-edge", type=length, default="1%", metavar="LENGTH",
+                        help="target edge length: a percentage of the source's bbox diagonal such as 1%%, or "
+                             "a plain number in model units (default: 1%%)")
     choice(parser, "--transfer", ("conservative", "pointwise"), "conservative", "detail transfer (default: conservative)")
     choice(parser, "--rows", ("all", "free"), "free", "residual rows of the reconstruction energy (default: free)")
     choice(parser, "--location", ("closest", "uv"), "closest",
@@ -158,7 +159,8 @@ def _remesh(parser):
 
         from ..curvature.errors import CurvdetailError
         from ..io import atomic_write, read_mesh, write_mesh
-        from ..remesh.experiment import WorseThanZeroDetailWarning, run_experiment, worse_than_zero_detail
+        from ..plot import COLOUR_MAP
+        from ..remesh.experiment import MAX, RMS, WorseThanZeroDetailWarning, run_experiment, worse_than_zero_detail
         from ..remesh.retriangulate import long_run_reason, long_run_vertices
 
         inputs = input_output(args)
@@ -171,16 +173,20 @@ def _remesh(parser):
         check_outputs(args, [("OUTPUT", args.output, True), ("--report", args.report, False),
                              ("--image", args.image, False)], **inputs)
         V, F = read_mesh(args.input)
-        fraction = args.target_edge / 100.0
-        count = long_run_vertices(V, F, fraction * diagonal(V), method=args.method, evaluate=not args.no_evaluate)
+        edge = args.target_edge
+        percent = 100 * edge.fraction(diagonal(V))
+        if not edge.percent:
+            say(f"note: --target-edge {edge} is in model units: {percent:.3g} % of the bbox diagonal "
+                f"({diagonal(V):.4g}); write {percent:.3g}% for a percentage")
+        count = long_run_vertices(V, F, edge.resolve(diagonal(V)), method=args.method, evaluate=not args.no_evaluate)
         if count is not None:
-            say(f"note: a {args.target_edge:g} % target edge gives about {count:,.0f} target vertices; this takes "
+            say(f"note: a {percent:.3g} % target edge gives about {count:,.0f} target vertices; this takes "
                 f"minutes. {long_run_reason(args.method, evaluate=not args.no_evaluate, cli=True)}")
         stages = 3 + (not args.no_evaluate) + (args.location == "uv") + (args.image is not None)
         progress = Progress(stages, enabled=not args.quiet)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", WorseThanZeroDetailWarning)     # said below, after the figures
-            result = run_experiment(V, F, method=args.method, target_edge=fraction, transfer=args.transfer,
+            result = run_experiment(V, F, method=args.method, target_edge=edge, transfer=args.transfer,
                                     rows=args.rows, location=args.location, parameterization=args.parameterization,
                                     backend=args.backend, evaluate=not args.no_evaluate,
                                     source_path=os.path.abspath(args.input), progress=progress.stage,
@@ -191,21 +197,27 @@ def _remesh(parser):
 
             progress.stage("image")
             save_remeshing_figure(args.image, V, F, result["X"], result["Ft"], result["Z"], result["distance"], report,
-                                  overwrite=args.overwrite)
+                                  zero_distance=result["zero_distance"], overwrite=args.overwrite)
         progress.close()
+        if not args.no_evaluate and quality_for(args.output, True):
+            report["output"] = {"quality": "distance to the source, model units", "vertex_colours": COLOUR_MAP,
+                                "colour_range_percent_of_diagonal": [0.0, report["error"]["vertex_max_percent_of_diagonal"]]}
         if args.report is not None:
             with atomic_write(args.report, overwrite=args.overwrite) as tmp, open(tmp, "w", encoding="utf-8") as fh:
                 fh.write(json.dumps(report, indent=2) + "\n")
-        write_mesh(args.output, result["X"], result["Ft"], quality=quality_for(args.output, result["distance"]),
-                   overwrite=args.overwrite)
+        if args.no_evaluate:
+            write_mesh(args.output, result["X"], result["Ft"], overwrite=args.overwrite)
+        else:
+            write_measured(args.output, result["X"], result["Ft"], result["distance"], diagonal_of=V,
+                           overwrite=args.overwrite)
         counts = f"{report['source']['vertices']:,} -> {report['target']['vertices']:,} vertices"
         if args.no_evaluate:
             print_figures(f"{counts}; not measured (--no-evaluate); {report['seconds']['total']:.2f} s")
             return 0
         e, b, fl = report["error"], report["baseline_zero_detail"], report["floor_retriangulated"]
-        print_figures(f"{counts}; RMS {100 * e['hausdorff_rms']:.4f} %, max {100 * e['hausdorff_max']:.3f} % of the "
-                      f"bbox diagonal (zero detail {100 * b['hausdorff_rms']:.3f} % / {100 * b['hausdorff_max']:.2f} %, "
-                      f"floor {100 * fl['hausdorff_rms']:.4f} % / {100 * fl['hausdorff_max']:.3f} %); "
+        print_figures(f"{counts}; RMS {e[RMS]:.4f} %, max {e[MAX]:.3f} % of the "
+                      f"bbox diagonal (zero detail {b[RMS]:.3f} % / {b[MAX]:.2f} %, "
+                      f"floor {fl[RMS]:.4f} % / {fl[MAX]:.3f} %); "
                       f"{report['seconds']['total']:.2f} s")
         note_dropped(args.output, quality=True)
         worse = worse_than_zero_detail(report, cli=True)
@@ -333,7 +345,6 @@ def _edit(parser):
     def run(args):
         import numpy as np
 
-        from .. import write_mesh
         from ..curvature.geometry import folded_triangles
         from ..curvature.errors import CurvdetailError, UndeterminedEditError
         from ..io.deformation import edit_with_selection, read_selection, read_transform
@@ -361,7 +372,7 @@ def _edit(parser):
             save_panels(args.image, [(V, F, "rest (status 0/1/2)", status),
                                      (X, F, f"edited ({args.method})", moved)],
                                   overwrite=args.overwrite)
-        write_mesh(args.output, X, F, quality=quality_for(args.output, moved), overwrite=args.overwrite)
+        write_measured(args.output, X, F, moved, diagonal_of=V, overwrite=args.overwrite)
         counts = np.bincount(status, minlength=3)
         solver = (f"{editor.rank_deficient} rank-deficient rings, {editor.detail_islands} island vertices" if paper
                   else f"{editor.iterations} iterations{'' if editor.converged else ' (not converged)'}")

@@ -36,9 +36,17 @@ def positive_number(text):
     return value
 
 
-def percentage(text):
-    """``--target-edge``: a positive number of percent, with or without a trailing ``%``."""
-    return positive_number(text.strip().removesuffix("%"))
+def length(text):
+    """A length option (``--target-edge``): a positive number in model units, or a percentage of
+    the bbox diagonal such as ``1%`` (:func:`curvdetail.remesh.units.as_bbox_length`)."""
+    from ..remesh.units import as_bbox_length
+
+    number = text if text.strip().endswith("%") else positive_number(text)
+    try:
+        return as_bbox_length(number, "target_edge")
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a positive length (e.g. 0.05, or 1% of the "
+                                         "bbox diagonal)") from None
 
 
 def _vertex_indices(text):
@@ -170,21 +178,38 @@ def print_figures(text):
 
 
 class Progress:
-    """Stage-by-stage progress on stderr: ``[2/5] parameterize ... 0.41 s``."""
+    """Stage-by-stage progress on stderr: ``[2/5] parameterize ... 0.41 s``; within a long stage
+    (``stage(name, done, total)``) a line per step with the rate and the time to go:
+    ``[5/5] evaluate 2/5 (1.20 s, 1.7 per s, ~1.8 s to go)``, from ``quiet_for`` seconds into it."""
+
+    quiet_for = 2.0
 
     def __init__(self, total, enabled=True):
         self.total, self.done, self.enabled, self._t = total, 0, enabled, None
+        self._name, self._steps = None, False
 
-    def stage(self, name):
+    def stage(self, name, *counts):
+        if counts and self._t is not None:
+            self._step(*counts)
+            return
         self.close()
         self.done += 1
-        self._t = time.perf_counter()
+        self._t, self._name, self._steps = time.perf_counter(), name, False
         if self.enabled:
             say(f"[{self.done}/{self.total}] {name} ...", end="")
 
+    def _step(self, done, total):
+        elapsed = time.perf_counter() - self._t
+        rate = done / max(elapsed, 1e-9)
+        if self.enabled and elapsed >= self.quiet_for:        # a long stage only
+            self._steps = True
+            say(f"[{self.done}/{self.total}] {self._name} {done}/{total} ({elapsed:.2f} s, {rate:.3g} per s, "
+                f"~{(total - done) / rate:.1f} s to go)")
+
     def close(self):
         if self._t is not None and self.enabled:
-            say(f" {time.perf_counter() - self._t:.2f} s")
+            seconds = time.perf_counter() - self._t
+            say(f"[{self.done}/{self.total}] {self._name} done, {seconds:.2f} s" if self._steps else f" {seconds:.2f} s")
         self._t = None
 
 
@@ -238,6 +263,32 @@ def check_outputs(args, outputs, *, inputs=(), other_inputs=(), mesh_check=None)
 def quality_for(path, quality):
     """``quality`` where ``path``'s format keeps it (PLY), else None."""
     return quality if _is_ply(path) else None
+
+
+def write_measured(path, V, F, quality, *, diagonal_of, overwrite):
+    """Write OUTPUT with its per-vertex ``quality`` (model units) and, in a PLY, vertex colours
+    from :data:`curvdetail.plot.COLOUR_MAP` over [0, max |quality|], which MeshLab shows on open.
+    Returns that colour range in % of the bbox diagonal of ``diagonal_of`` (vertices; the
+    figures' reference), or None where the format keeps neither quality nor colours."""
+    import numpy as np
+
+    from ..io.mesh import check_mesh_output, write_mesh, write_mesh_fields
+    from ..plot import vertex_colours
+
+    if not _is_ply(path):
+        write_mesh(path, V, F, overwrite=overwrite)
+        return None
+    check_mesh_output(path, overwrite)
+    quality = np.asarray(quality, dtype=np.float64)
+    top = float(np.abs(quality).max(initial=0.0))
+    rgba = vertex_colours(np.abs(quality), top)
+    write_mesh_fields(path, V, F, {"quality": quality, **{c: rgba[:, k] for k, c in enumerate(RGBA)}},
+                      overwrite=overwrite)
+    return [0.0, 100 * top / diagonal(diagonal_of)]
+
+
+#: The PLY vertex properties of a colour.
+RGBA = ("red", "green", "blue", "alpha")
 
 
 def _is_ply(path):
@@ -352,10 +403,11 @@ def show_warning(message, category, filename, lineno, file=None, line=None):
     """A library warning as one line: a note where it announces a long run or a finding, a
     warning where an edit folded or amplified; other warnings as Python shows them."""
     from ..curvature.errors import FoldedTrianglesWarning
+    from ..filters import ScaleWarning
     from ..filters.editing import AmplifiedEditWarning
     from ..remesh import LongRunWarning, WorseThanZeroDetailWarning
 
-    if issubclass(category, (LongRunWarning, WorseThanZeroDetailWarning)):
+    if issubclass(category, (LongRunWarning, WorseThanZeroDetailWarning, ScaleWarning)):
         say(f"note: {message}")
     elif issubclass(category, (FoldedTrianglesWarning, AmplifiedEditWarning)):
         say(f"curvdetail: warning: {message}")

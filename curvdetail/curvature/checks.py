@@ -8,9 +8,8 @@ import numbers
 
 import numpy as np
 
-from .geometry import corner_cotangents
-from .errors import ConstraintError, MeshError, counted, first_indices, them
-from .geometry import bbox_diagonal, face_double_areas
+from .errors import ConstraintError, CurvdetailError, MeshError, counted, first_indices, them
+from .geometry import bbox_diagonal, corner_cotangents, face_double_areas
 from .topology import as_faces, non_manifold_edges, repeated_triangles
 
 #: Largest coordinate magnitude taken: triangle areas square the cross products of edge vectors
@@ -41,21 +40,24 @@ def as_vertices(V, name="V", dim=3, max_coordinate=MAX_COORDINATE):
     try:
         arr = np.asarray(V)
     except Exception as exc:  # ragged lists and the like
-        raise MeshError(f"{name} could not be read as an array ({exc}); pass an (n, {dim}) float array.") from None
+        raise MeshError(f"{name} could not be read as an array ({exc}); pass an (n, {dim}) float array.",
+                        parameter=name) from None
     if arr.dtype == object or not (np.issubdtype(arr.dtype, np.floating) or np.issubdtype(arr.dtype, np.integer)):
-        raise MeshError(f"{name} has dtype {arr.dtype}; pass an (n, {dim}) array of real numbers.")
+        raise MeshError(f"{name} has dtype {arr.dtype}; pass an (n, {dim}) array of real numbers.", parameter=name)
     if arr.ndim != 2 or arr.shape[1] != dim:
-        raise MeshError(f"{name} has shape {arr.shape}; vertex positions must be an (n, {dim}) array.")
+        raise MeshError(f"{name} has shape {arr.shape}; vertex positions must be an (n, {dim}) array.",
+                        parameter=name)
     if arr.shape[0] == 0:
-        raise MeshError(f"{name} is empty (0 vertices); pass a mesh with at least one triangle.")
+        raise MeshError(f"{name} is empty (0 vertices); pass a mesh with at least one triangle.", parameter=name,
+                        count=0)
     arr = np.ascontiguousarray(arr, dtype=np.float64)
     if not np.isfinite(arr).all():      # one flat pass; the per-row search below only on failure
         bad = np.flatnonzero(~np.isfinite(arr).all(axis=1))
         raise MeshError(
             f"{name}: {counted(bad.size, 'vertex', 'vertices', verb='have')} NaN or infinite coordinates "
             f"(first: {first_indices(bad)}); "
-            f"remove or repair {them(bad.size)} before computing curvature."
-        )
+            f"remove or repair {them(bad.size)} before computing curvature.",
+            parameter=name, count=int(bad.size), first=bad[:3].tolist())
     _check_magnitude(arr, name, MeshError, "scale the mesh down", max_coordinate)
     return arr
 
@@ -66,7 +68,8 @@ def _check_magnitude(arr, name, error, fix, limit=MAX_COORDINATE):
         bad = np.flatnonzero((np.abs(arr) > limit).any(axis=1))
         raise error(f"{name}: {counted(bad.size, 'row', verb='reach')} {np.abs(arr).max():.3g} "
                     f"(first: {first_indices(bad)}); "
-                    f"beyond {limit:.0e} the geometry overflows double precision: {fix}.")
+                    f"beyond {limit:.0e} the geometry overflows double precision: {fix}.",
+                    parameter=name, count=int(bad.size), first=bad[:3].tolist())
 
 
 def check_mesh(V, F, *, check_manifold=True, check_unreferenced=True):
@@ -140,7 +143,8 @@ def _check_mesh(V, F, check_manifold, check_unreferenced, cotangents=False):
         raise MeshError(f"{counted(zero.size, 'triangle', verb='have')} zero area (first: {first_indices(zero)}; "
                         f"areas up to {ZERO_AREA_RELATIVE:g} of the bbox diagonal squared count); "
                         f"{ZERO_AREA_ADVICE.replace('them', them(zero.size), 1)}, "
-                        "before computing curvature.")
+                        "before computing curvature.", parameter="F", count=int(zero.size),
+                        first=zero[:3].tolist())
     if check_manifold or cotangents:           # cotangents: the caller counts the edges itself, after this
         duplicates = repeated_triangles(F, V.shape[0])
         if duplicates is not None:
@@ -164,8 +168,8 @@ def check_referenced(n, F, name=None):
         raise MeshError(
             f"{name + ': ' if name else ''}{counted(unused.size, 'vertex', 'vertices', verb='are')} not used by "
             f"any triangle (first: {first_indices(unused)}); "
-            f"remove {them(unused.size)}, e.g. with pymeshlab's meshing_remove_unreferenced_vertices."
-        )
+            f"remove {them(unused.size)}, e.g. with pymeshlab's meshing_remove_unreferenced_vertices.",
+            parameter=name or "V", count=int(unused.size), first=unused[:3].tolist())
 
 
 def duplicate_triangles_error(pairs):
@@ -173,7 +177,8 @@ def duplicate_triangles_error(pairs):
     shown = ", ".join(f"({i}, {j})" for i, j in pairs[:3])
     return MeshError(f"F: {counted(pairs.shape[0], 'triangle', verb='repeat')} the three vertices of an earlier "
                      f"one (first pairs: {shown}): a repeated triangle counts its area and curvature twice. Remove the "
-                     "duplicates, e.g. with pymeshlab's meshing_remove_duplicate_faces.")
+                     "duplicates, e.g. with pymeshlab's meshing_remove_duplicate_faces.", parameter="F",
+                     count=int(pairs.shape[0]), first=pairs[:3, 1].tolist())
 
 
 def tiny_mesh_error(diag, n):
@@ -181,10 +186,11 @@ def tiny_mesh_error(diag, n):
     vertices."""
     if diag == 0.0:
         return MeshError(f"the mesh is 0 across (bbox diagonal): all {n} vertices lie at one point, so every "
-                         "triangle has zero area; pass the mesh's real vertex positions.")
+                         "triangle has zero area; pass the mesh's real vertex positions.", parameter="V", value=diag)
     return MeshError(f"the mesh is {diag:.3g} across (bbox diagonal), below {MIN_DIAGONAL:.0e}: its triangle "
                      "areas (fourth powers of its lengths) underflow double precision and lose their digits; "
-                     f"scale it up, e.g. to unit size (V / {diag:.3g}), and scale the results back.")
+                     f"scale it up, e.g. to unit size (V / {diag:.3g}), and scale the results back.", parameter="V",
+                     value=diag)
 
 
 def non_manifold_error(count, first):
@@ -192,67 +198,51 @@ def non_manifold_error(count, first):
     pairs = ", ".join(f"({a}, {b})" for a, b in first)
     return MeshError(
         f"{counted(count, 'edge', verb='are')} shared by more than two triangles (first: {pairs}); "
-        "the mesh is not manifold. Repair it, e.g. with pymeshlab's meshing_repair_non_manifold_edges."
-    )
+        "the mesh is not manifold. Repair it, e.g. with pymeshlab's meshing_repair_non_manifold_edges.",
+        parameter="F", count=int(count), first=[tuple(int(v) for v in e) for e in first])
 
 
 def as_index_set(indices, n, name):
-    """Return ``indices`` as a duplicate-free int64 array in [0, n), in the order given (a
-    boolean mask gives its true positions in increasing order), or raise ConstraintError."""
+    """Return ``indices`` as a duplicate-free int64 array in [0, n), in the order given, or raise
+    ConstraintError (with ``parameter``, ``count`` and ``first``). Takes what numpy users pass: an
+    int array or list, whole floats (3.0), a (k, 1) column, or an (n,) boolean mask (its true
+    positions, increasing)."""
+    def refuse(problem, bad=None, values=None, count=None):
+        first = None if bad is None else (values if values is not None else arr)[bad[:3]].tolist()
+        count = count if count is not None else None if bad is None else int(bad.size)
+        return ConstraintError(f"{name}: {problem}", parameter=name, count=count, first=first)
+
     try:
         arr = np.asarray(indices)
     except Exception as exc:
-        raise ConstraintError(f"{name} could not be read as an index array ({exc}).") from None
+        raise ConstraintError(f"{name} could not be read as an index array ({exc}).", parameter=name) from None
     if arr.dtype == bool:
         if arr.shape != (n,):
-            raise ConstraintError(f"{name} is a boolean mask of shape {arr.shape}; it must have shape ({n},).")
+            raise refuse(f"a boolean mask of shape {arr.shape}; it must have shape ({n},).")
         return np.flatnonzero(arr)
     if sum(d > 1 for d in arr.shape) > 1:
         # an edge list (k, 2) or faces (m, 3): flattened, their shared vertices were called repeats
-        raise ConstraintError(f"{name} has shape {arr.shape}; pass a 1-D array of vertex indices (a "
-                              "column (k, 1) is taken too), e.g. np.unique(E) for the vertices of edges E.")
+        raise refuse(f"shape {arr.shape}; pass a 1-D array of vertex indices (a column (k, 1) is taken too), "
+                     "e.g. np.unique(E) for the vertices of edges E.")
     arr = arr.reshape(-1)
-    if arr.dtype == object and arr.size and all(isinstance(i, numbers.Integral) and not isinstance(i, bool)
-                                                for i in arr):
-        # Python ints (some beyond int64, or given as an object array): checked as they are
-        out = np.flatnonzero([not 0 <= i < n for i in arr])
-        if out.size:
-            raise ConstraintError(f"{name}: {counted(out.size, 'index', 'indices', verb='are')} outside "
-                                  f"[0, {n}) (first: "
-                                  f"{', '.join(str(i) for i in arr[out[:3]])}); indices are 0-based into V.")
-        arr = arr.astype(np.int64)
-    if arr.size and not np.issubdtype(arr.dtype, np.integer):
-        if not np.issubdtype(arr.dtype, np.floating):
-            raise ConstraintError(f"{name} has dtype {arr.dtype}; pass integer vertex indices.")
+    if arr.size and arr.dtype.kind not in "iuf":
+        raise refuse(f"dtype {arr.dtype}; pass integer vertex indices.")
+    if arr.dtype.kind == "f":
         error = non_whole_index_error(arr, name)
         if error is not None:
             raise error
-        if np.abs(arr).max() >= 2.0 ** 62:      # would not survive the cast to int64
-            bad = np.flatnonzero((arr < 0) | (arr >= n))
-            raise ConstraintError(f"{name}: {counted(bad.size, 'index', 'indices', verb='are')} outside "
-                                  f"[0, {n}) (first: {arr[bad[0]]:.3g}); "
-                                  "indices are 0-based into V.")
-    elif arr.dtype == np.uint64 and arr.size and arr.max() > np.iinfo(np.int64).max:
-        raise ConstraintError(f"{name}: indices up to {arr.max()} are outside [0, {n}); indices are 0-based into V.")
-    arr = arr.astype(np.int64)
-    out = np.flatnonzero((arr < 0) | (arr >= n))
+    with np.errstate(invalid="ignore"):
+        out = np.flatnonzero((arr < 0) | (arr >= n))
     if out.size:
-        raise ConstraintError(
-            f"{name}: {counted(out.size, 'index', 'indices', verb='are')} outside [0, {n}) "
-            f"(first: {first_indices(arr[out])}); "
-            "indices are 0-based into V."
-        )
+        raise refuse(f"{counted(out.size, 'index', 'indices', verb='are')} outside [0, {n}) (first: "
+                     f"{', '.join(f'{v:g}' for v in arr[out[:3]].tolist())}); indices are 0-based into V.", out)
+    arr = arr.astype(np.int64)
     uniq, counts = np.unique(arr, return_counts=True)
     if uniq.size != arr.size:
-        # a 0/1 mask of integers (mask.astype(int), a MeshLab selection) is the likely mistake
-        mask = arr.size == n and uniq.size <= 2 and set(uniq.tolist()) <= {0, 1}
-        hint = (f" It looks like a 0/1 mask of all {n} vertices: pass it as booleans "
-                f"({name}=mask.astype(bool)) or as indices (np.flatnonzero(mask)).") if mask else ""
-        raise ConstraintError(
-            f"{name}: {counted(arr.size - uniq.size, 'index', 'indices', verb='are')} repeated "
-            f"(first: {first_indices(uniq[counts > 1])}); "
-            f"list each vertex once.{hint}"
-        )
+        repeated = uniq[counts > 1]
+        raise refuse(f"{counted(arr.size - uniq.size, 'index', 'indices', verb='are')} repeated (first: "
+                     f"{first_indices(repeated)}); list each vertex once (a 0/1 mask: pass it as booleans).",
+                     np.arange(repeated.size), repeated, count=int(arr.size - uniq.size))
     return arr
 
 
@@ -274,16 +264,19 @@ def non_whole_index_error(values, name, error=ConstraintError):
     if not bad.size:
         return None
     what = "is not a whole number" if bad.size == 1 else "are not whole numbers"
-    return error(f"{name}: {counted(bad.size, 'value')} {what} (first: {float(arr[bad[0]])!r}, at position "
-                 f"{bad[0]}); vertex indices are whole numbers: pass integers (or whole floats such as 3.0), "
-                 "not positions or weights.")
+    message = (f"{name}: {counted(bad.size, 'value')} {what} (first: {float(arr[bad[0]])!r}, at position "
+               f"{bad[0]}); vertex indices are whole numbers: pass integers (or whole floats such as 3.0), "
+               "not positions or weights.")
+    if isinstance(error, type) and issubclass(error, CurvdetailError):
+        return error(message, parameter=name, count=int(bad.size), first=bad[:3].tolist())
+    return error(message)
 
 
 def check_bool(value, name):
     """``bool(value)`` for True / False (numpy's too), else ValueError: ``"no"`` or ``0`` would
     otherwise count as an answer."""
     if not isinstance(value, (bool, np.bool_)):
-        raise ValueError(f"{name}={value!r} must be True or False.")
+        raise CurvdetailError(f"{name}={value!r} must be True or False.", parameter=name, value=value)
     return bool(value)
 
 
@@ -305,9 +298,9 @@ def as_count(value, name, minimum=1):
     scalars, 0-d arrays; not a bool or a string), or raise ValueError naming the argument."""
     number = as_float(value)
     if number is None or not math.isfinite(number) or number != round(number):
-        raise ValueError(f"{name}={value!r} must be a whole number >= {minimum}.")
+        raise CurvdetailError(f"{name}={value!r} must be a whole number >= {minimum}.", parameter=name, value=value)
     if number < minimum:
-        raise ValueError(f"{name}={value!r} must be at least {minimum}.")
+        raise CurvdetailError(f"{name}={value!r} must be at least {minimum}.", parameter=name, value=value)
     value = value.item() if isinstance(value, np.ndarray) else value
     return int(value) if isinstance(value, numbers.Integral) else int(number)
 
@@ -316,7 +309,7 @@ def as_positive_number(value, name, hint=""):
     """Return ``value`` as a finite float > 0 (see :func:`as_float`), or raise ValueError."""
     number = as_float(value)
     if number is None or not (math.isfinite(number) and number > 0):
-        raise ValueError(f"{name}={value!r} must be a positive number{hint}.")
+        raise CurvdetailError(f"{name}={value!r} must be a positive number{hint}.", parameter=name, value=value)
     return number
 
 
@@ -361,10 +354,12 @@ def is_choice(value, choices):
     return isinstance(value, str) and value in choices
 
 
-def check_choice(value, name, choices, advice, error=ValueError):
+def check_choice(value, name, choices, advice, error=None):
     """``value`` if it is a str among ``choices``, else ``error(f"{name}={shown}{advice}")``."""
     if is_choice(value, choices):
         return str(value)
+    if error is None:
+        raise CurvdetailError(f"{name}={shown_choice(value)}{advice}", parameter=name, value=value)
     raise error(f"{name}={shown_choice(value)}{advice}")
 
 

@@ -11,6 +11,8 @@ runs its filters on a MeshSet the way pymeshlab runs its own::
     filters.apply(ms, "compute_curvature_detail")          # attributes + quality on layer 0
     filters.apply(ms, "apply_curvature_reconstruction", rows="free")
     filters.run_script(ms, "pipeline.mlx")                   # mixes pymeshlab's filters and ours
+    filters.apply_native(ms, "meshing_isotropic_explicit_remeshing", targetlen=pymeshlab.PercentageValue(1))
+    filters.save_script(ms, "recorded.mlx")                  # every step above, for `curvdetail run`
 
 Every filter lives in its own module named as the filter and is declared with
 :func:`~curvdetail.filters.registry.filter`; importing this package registers them all.
@@ -19,9 +21,10 @@ Every filter lives in its own module named as the filter and is declared with
 import importlib
 
 from .dispatch import apply
-from .errors import FilterError, FilterParameterError, ScriptError, UnknownFilterError
+from .errors import FilterError, FilterParameterError, ScaleWarning, ScriptError, UnknownFilterError
 from .mlx import run_script, save_script
 from .parameters import BBoxLength, Parameter
+from .recording import apply_native
 from .registry import (FilterSpec, filter, get_filter, list_filters, print_filter_list,
                        print_filter_parameter_list)
 
@@ -41,7 +44,7 @@ for _module in FILTER_MODULES:
 del _module
 
 __all__ = [
-    "BBoxLength", "FilterError", "FilterParameterError", "FilterSpec", "Parameter", "ScriptError",
-    "UnknownFilterError", "apply", "filter", "get_filter", "list_filters", "print_filter_list",
+    "BBoxLength", "FilterError", "FilterParameterError", "FilterSpec", "Parameter", "ScaleWarning", "ScriptError",
+    "UnknownFilterError", "apply", "apply_native", "filter", "get_filter", "list_filters", "print_filter_list",
     "print_filter_parameter_list", "run_script", "save_script",
 ]

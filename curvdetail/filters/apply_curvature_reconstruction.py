@@ -62,8 +62,8 @@ def apply_curvature_reconstruction(ms, *, rows, fix_boundary, fix_selected, back
     set_vertex_quality(ms, mid, moved)
     diag = bbox_diagonal(V)
     return {
-        "max_displacement": float(moved.max() / diag),
-        "rms_displacement": float(np.sqrt(np.mean(moved ** 2)) / diag),
+        "max_displacement_percent_of_diagonal": float(100 * moved.max() / diag),
+        "rms_displacement_percent_of_diagonal": float(100 * np.sqrt(np.mean(moved ** 2)) / diag),
         "fixed_vertices": int(fixed.size),
         "free_vertices": int(V.shape[0] - fixed.size),
         "rows": rows,

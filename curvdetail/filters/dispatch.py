@@ -3,6 +3,7 @@
 
 from .errors import FilterError, FilterParameterError
 from .meshset import layer_id
+from .recording import history, record, step_element
 from .registry import close_matches, get_filter
 
 
@@ -36,7 +37,8 @@ def apply(ms, name, **params):
     The filter works on the current mesh, or on the layers named by its layer-id parameters
     (``sourcemesh``, ``targetmesh``, ...). Parameters left out take their defaults (never values
     from an earlier call). A filter that creates a mesh adds it as a new layer and makes it
-    current, as pymeshlab's ``generate_*`` filters do.
+    current, as pymeshlab's ``generate_*`` filters do. The step is recorded on ``ms`` for
+    :func:`~curvdetail.filters.save_script` (with every parameter, the defaults included).
 
     Parameters
     ----------
@@ -76,8 +78,10 @@ def apply(ms, name, **params):
     for p in spec.parameters:
         if p.type == "mesh" and values[p.name] is not None:
             layer_id(ms, values[p.name], role=p.name)
+    start = len(history(ms))
     try:
         result = spec.function(ms, **values)
     except pymeshlab.PyMeshLabException as exc:
         raise FilterError(f"{name}: pymeshlab failed: {str(exc).strip()}") from None
+    record(ms, start, step_element(spec, values))
     return dict(result or {})

@@ -237,7 +237,7 @@ def apply_curvature_editing(ms, *, handles, region_radius, transform, method, de
     folded = folded_triangles(V, F, X, T[:3, :3])
     rank_deficient, widened = _region_ring_counts(V, F, roi, editor)
     figures = {
-        "max_displacement": float(moved.max() / diagonal),
+        "max_displacement_percent_of_diagonal": float(100 * moved.max() / diagonal),
         # far above 1: the curvature stage amplified the handle details (see docs/editing.md);
         # None where the handles are not placed or do not move (a ratio of rounding, or of a pure
         # detail edit, which detail_amplification measures)
@@ -329,7 +329,7 @@ def _warn_if_amplified(figures, folded, m, moved, D, D0, options):
         parts.append(f"{counted(folded.size, 'triangle')} of {m} folded over (normal against the rest "
                      f"shape's; first: {first_indices(folded)})")
     moved_most = int(np.argmax(moved))
-    parts.append(f"vertices moved up to {100 * figures['max_displacement']:.3g} % of the bbox diagonal "
+    parts.append(f"vertices moved up to {figures['max_displacement_percent_of_diagonal']:.3g} % of the bbox diagonal "
                  f"(vertex {moved_most})" + (f", {ratio:.1f} times as far as the handles" if ratio is not None
                                              else ""))
     if detail_ratio is not None:

@@ -22,3 +22,9 @@ class FilterParameterError(FilterError):
 
 class ScriptError(FilterError):
     """A MeshLab filter script (.mlx) is malformed or one of its steps failed (names the step)."""
+
+
+class ScaleWarning(UserWarning):
+    """Said by :func:`~curvdetail.filters.run_script` (``curvdetail run`` says it as a note) when a
+    script gives a length in model units far from the mesh's size: likely sized for another mesh
+    (the message names the ratio to the bbox diagonal). Write such lengths as percentages."""

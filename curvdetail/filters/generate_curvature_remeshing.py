@@ -26,8 +26,8 @@ from .transfer_curvature_detail import planar_map
         to the source, none without evaluate; attribute 'curvature_detail' = the transferred
         detail) and, on request, the zero-detail baseline (quality = its distance to the source);
         each quality is the exact distance, the one the Hausdorff maxima are taken over. Returns
-        the report of curvdetail.remesh.remesh_experiment (error and baselines as fractions of the
-        source's bbox diagonal, sizes, options, seconds per stage; source.path the absolute path
+        the report of curvdetail.remesh.remesh_experiment (error and baselines in % of the
+        source's bbox diagonal, the unit in each key, sizes, options, seconds per stage; source.path the absolute path
         of the file the current layer was read from where curvdetail loaded it (the CLI, or
         curvdetail.filters.files.load_meshset) and unchanged since, as curvdetail remesh reports
         it, else None; source.label the layer's label) with the new layer ids; a rebuild farther
@@ -40,7 +40,7 @@ from .transfer_curvature_detail import planar_map
                   "'decimate'", choices=("isotropic", "decimate")),
         Parameter("target_edge", "PercentageValue", BBoxLength(1.0, percent=True),
                   "target edge length: a percentage of the bbox diagonal (pymeshlab.PercentageValue, "
-                  "'1%') or an absolute length", positive=True),
+                  "'1%') or a plain number in model units", positive=True),
         Parameter("transfer", "str", "conservative",
                   "how detail is carried over: 'conservative' (measure, totals kept) or 'pointwise' "
                   "(the paper: K interpolated, times the target's area)",
@@ -77,13 +77,13 @@ def generate_curvature_remeshing(ms, *, method, target_edge, transfer, rows, loc
     path = loaded_from(ms, mid)
     diagonal = bbox_diagonal(V)
     length = target_edge.resolve(diagonal)
-    fraction = length / diagonal
+    fraction = target_edge.fraction(diagonal)
 
-    def progress(stage):            # said once the checks have passed, before the work
+    def progress(stage, *counts):   # said once the checks have passed, before the work
         if stage == "retriangulate":
             _warn_of_a_big_target(V, F, target_edge, length, fraction, method, evaluate)
 
-    result = run_experiment(V, F, method=method, target_edge=fraction, transfer=transfer, rows=rows,
+    result = run_experiment(V, F, method=method, target_edge=target_edge, transfer=transfer, rows=rows,
                             location=location, parameterization=planar_map(location, parameterization),
                             backend=backend, evaluate=evaluate, source_path=path, surface_check=surface_check,
                             progress=progress)

@@ -60,5 +60,5 @@ def generate_minimal_surface(ms, *, max_iterations, tol, step, backend):
         "last_step": float(X.last_step),
         "area_source": float(face_double_areas(V, F).sum() / 2.0),
         "area_minimal": float(face_double_areas(np.asarray(X), F).sum() / 2.0),
-        "max_displacement": float(moved.max() / bbox_diagonal(V)),
+        "max_displacement_percent_of_diagonal": float(100 * moved.max() / bbox_diagonal(V)),
     }

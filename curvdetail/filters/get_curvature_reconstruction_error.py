@@ -21,11 +21,13 @@ from .registry import PAPER, filter
         figures as the remeshing report; layers more than
         one bounding-box diagonal apart are measured with its exact engine instead, and the
         figures say which engine ran). Returns the
-        maximum and RMS distances as fractions of the target's bounding-box diagonal (the
+        maximum and RMS distances in % of the target's bounding-box diagonal and in model units
+        (the unit in each key) (the
         evaluation of the paper's remeshing experiment, Fig. 3), and the one-sided figures. With
-        set_quality the sampled layer's vertex quality becomes its distance to the target, so
-        MeshLab colours the error: the exact distance of each vertex, the one the maxima are
-        taken over. {PAPER}, section "Remeshing", Fig. 3.
+        set_quality the sampled layer's vertex quality becomes its distance to the target in
+        model units (the exact distance of each vertex, the one the maxima are taken over), and
+        its vertex colours viridis over [0, its max], which MeshLab shows on open; that range is
+        the figure colour_range_percent_of_diagonal. {PAPER}, section "Remeshing", Fig. 3.
     """,
     parameters=[
         Parameter("sampledmesh", "mesh", None, "layer whose error is measured (default: current)"),
@@ -57,23 +59,26 @@ def get_curvature_reconstruction_error(ms, *, sampledmesh, targetmesh, samplenum
     except MeshError as exc:
         raise _naming_the_layer(exc, ms, ("sampledmesh", sampled, Va, Fa),
                                 ("targetmesh", target, Vb, Fb)) from None
-    if set_quality:
-        set_vertex_quality(ms, sampled, distance)
     diag = bbox_diagonal(Vb)
+    colours = {}
+    if set_quality:
+        lo, hi = set_vertex_quality(ms, sampled, distance)
+        colours = {"colour_range_percent_of_diagonal": [100 * lo / diag, 100 * hi / diag]}
     return {
-        "hausdorff_max": h["max"] / diag,
-        "hausdorff_rms": h["rms"] / diag,
-        "hausdorff_mean": h["mean"] / diag,
-        "sampled_to_target_max": h["a_to_b_max"] / diag,
-        "target_to_sampled_max": h["b_to_a_max"] / diag,
-        "max": h["max"],
-        "rms": h["rms"],
-        "mean": h["mean"],
-        "diagonal": diag,
+        "hausdorff_max_percent_of_diagonal": 100 * h["max"] / diag,
+        "hausdorff_rms_percent_of_diagonal": 100 * h["rms"] / diag,
+        "hausdorff_mean_percent_of_diagonal": 100 * h["mean"] / diag,
+        "sampled_to_target_max_percent_of_diagonal": 100 * h["a_to_b_max"] / diag,
+        "target_to_sampled_max_percent_of_diagonal": 100 * h["b_to_a_max"] / diag,
+        "hausdorff_max_model_units": h["max"],
+        "hausdorff_rms_model_units": h["rms"],
+        "hausdorff_mean_model_units": h["mean"],
+        "bbox_diagonal_model_units": diag,
         "samples": h["samples"],
         "engine": h["engine"],
         "sampledmesh": sampled,
         "targetmesh": target,
+        **colours,
     }
 
 

@@ -152,12 +152,32 @@ def set_vertex_attribute(ms, mesh_id, name, values):
 
 
 def set_vertex_quality(ms, mesh_id, quality):
-    """Set a layer's per-vertex quality (MeshLab colours by it) in place."""
+    """Set a layer's per-vertex quality in place, and its vertex colours from it
+    (:func:`colour_by_quality`); returns the colour range ``(lo, hi)``."""
     mesh = get_mesh(ms, mesh_id)
     q = _as_columns(mesh, quality, 1, "vertex quality")
     with _current(ms, mesh_id):
         ms.compute_scalar_by_function_per_vertex(q=_scratch(mesh, q), normalize=False, map=False,
                                                  onselected=False)
+    return colour_by_quality(ms, mesh_id, q)
+
+
+#: pymeshlab's name of the colour map of the vertex colours set from a quality (matplotlib's viridis).
+COLOUR_MAP = "Viridis"
+
+
+def colour_by_quality(ms, mesh_id, quality):
+    """Colour a layer's vertices by its quality, which MeshLab shows on open and a PLY keeps:
+    :data:`COLOUR_MAP` over [0, max] for a quality of one sign (a distance), over [-m, m], m the
+    largest magnitude, for a signed one (a mean curvature), so that 0 is the middle colour.
+    Returns ``(lo, hi)``, in the quality's units."""
+    q = np.asarray(quality, dtype=np.float64)
+    top = float(np.abs(q).max(initial=0.0))
+    lo, hi = (0.0, top) if q.size == 0 or q.min() >= 0 else (-top, top)
+    with _current(ms, mesh_id):
+        ms.compute_color_from_scalar_per_vertex(minval=lo, maxval=hi if hi > lo else lo + 1.0, perc=0.0,
+                                                zerosym=False, colormap=COLOUR_MAP)
+    return lo, hi
 
 
 def set_vertex_positions(ms, mesh_id, X):
@@ -172,7 +192,8 @@ def set_vertex_positions(ms, mesh_id, X):
 def add_layer(ms, V, F, label, *, quality=None, attributes=None):
     """Add ``(V, F)`` as a new layer called ``label`` and make it current; return its id.
 
-    ``quality`` (n,) becomes the vertex quality; ``attributes`` maps names to (n, 3) point or
+    ``quality`` (n,) becomes the vertex quality and the vertex colours (:func:`colour_by_quality`);
+    ``attributes`` maps names to (n, 3) point or
     (n,) scalar custom attributes."""
     import pymeshlab
 
@@ -183,6 +204,8 @@ def add_layer(ms, V, F, label, *, quality=None, attributes=None):
                           face_matrix=np.ascontiguousarray(F, dtype=np.int32), **kwargs)
     ms.add_mesh(mesh, label)
     mid = int(ms.current_mesh_id())
+    if quality is not None:
+        colour_by_quality(ms, mid, quality)
     # attributes go onto the MeshSet's own copy: pymeshlab's add_mesh copies custom attributes in
     # a way its PLY exporter later crashes on (segmentation fault)
     for name, values in (attributes or {}).items():

@@ -24,22 +24,18 @@ other ``<filter>`` / ``<xmlfilter>`` (MeshLab GUI names) is handed to pymeshlab 
 at a time, through a temporary script and ``load_filter_script`` / ``apply_filter_script``.
 """
 
-import contextlib
-import functools
 import os
 import re
-import sys
-import tempfile
 import xml.etree.ElementTree as ET
 
 from ..io.atomic import atomic_write, check_output_path
 from .dispatch import apply
 from .errors import FilterError, ScriptError
+from .parameters import BBoxLength
+from .errors import ScaleWarning
+from .native import check_native_parameters, far_lengths, run_native
+from .recording import recorded_steps, step_element
 from .registry import _REGISTRY, close_matches, get_filter
-
-_RICH_TYPES = {"bool": "RichBool", "int": "RichInt", "float": "RichFloat", "str": "RichString",
-               "PercentageValue": "RichAbsPerc", "mesh": "RichMesh"}
-
 
 def _script_path(path):
     """``path`` as a str, or ScriptError if it is not a path (os.fspath raised a TypeError)."""
@@ -97,127 +93,6 @@ def _our_parameters(spec, element, where):
     return params
 
 
-@contextlib.contextmanager
-def _quiet_output():
-    """pymeshlab prints 'Reading filter with name ...' when it loads a script; its failures come
-    back as exceptions, so its console output is kept from the console while a native step runs.
-    Yields a list that holds the output (one str) once the block has ended."""
-    saved, captured = [], []
-    with tempfile.TemporaryFile() as sink:
-        try:
-            for stream in (sys.stdout, sys.stderr):
-                with contextlib.suppress(AttributeError, OSError, ValueError):
-                    stream.flush()
-            for fd in (1, 2):                  # pymeshlab writes to the process's own descriptors
-                with contextlib.suppress(OSError):
-                    saved.append((fd, os.dup(fd)))
-            for fd, _ in saved:
-                os.dup2(sink.fileno(), fd)
-            yield captured
-        finally:
-            _flush_c_streams()              # what pymeshlab's C++ side still buffers goes to the sink
-            for fd, copy in saved:
-                os.dup2(copy, fd)
-                os.close(copy)
-            sink.seek(0)
-            captured.append(sink.read().decode("utf-8", "replace"))
-
-
-def _flush_c_streams():
-    try:
-        import ctypes
-
-        ctypes.CDLL(None).fflush(None)
-    except (OSError, AttributeError):      # no C library to ask (not on a POSIX system)
-        pass
-
-
-#: How MeshLab reads a ``<Param>`` value of each type it checks: a bool is false only as the
-#: exact text "false" ("0", "False" are true), an int or a float that does not parse is 0, and a
-#: ``RichAbsPerc`` without both ``min`` and ``max`` attributes is ignored (measured with pymeshlab
-#: 2023.12). So what it would read against the writer's meaning is refused before any step runs;
-#: "True" or "1", read as true, pass.
-_INTEGER = re.compile(r"\s*[+-]?\d+\s*")
-_TRUE = ("true", "1", "yes", "on")
-_NATIVE_CHECKS = {
-    "RichBool": (lambda v: v == "false" or v.strip().lower() in _TRUE,
-                 "'true' or 'false' (MeshLab reads any text but 'false' as true)"),
-    "RichInt": (lambda v: bool(_INTEGER.fullmatch(v)), "a whole number (MeshLab reads other text as 0)"),
-    "RichEnum": (lambda v: bool(_INTEGER.fullmatch(v)), "the index of the choice, a whole number"),
-    "RichMesh": (lambda v: bool(_INTEGER.fullmatch(v)), "a layer index, a whole number"),
-    "RichFloat": (lambda v: _finite(v), "a finite number with a decimal point (MeshLab reads other text as 0)"),
-    "RichDynamicFloat": (lambda v: _finite(v), "a finite number with a decimal point"),
-    "RichAbsPerc": (lambda v: _finite(v), "a finite number with a decimal point, in model units"),
-}
-
-
-def _finite(text):
-    if "_" in text:                     # Python's float reads 3_0 as 30, MeshLab's as 0
-        return False
-    try:
-        return abs(float(text)) < float("inf")
-    except ValueError:
-        return False
-
-
-def _name_key(name):
-    """A parameter name as MeshLab and pymeshlab both spell it: pymeshlab's Python names are
-    MeshLab's in lower case, a Python keyword with "_" appended ('lambda' -> 'lambda_')."""
-    return re.sub(r"[^a-z0-9]+", "", name.lower())
-
-
-@functools.lru_cache(maxsize=None)
-def _native_parameter_names(meshlab_name):
-    """pymeshlab's Python names of a MeshLab filter's parameters, found through its rename table
-    and a one-triangle MeshSet; None where either fails."""
-    import numpy as np
-    import pymeshlab
-
-    python_name = _pymeshlab_renames().get(_snake(meshlab_name))
-    if python_name is None:
-        return None
-    ms = pymeshlab.MeshSet()
-    ms.add_mesh(pymeshlab.Mesh(np.eye(3), np.array([[0, 1, 2]], dtype=np.int32)))
-    try:
-        with _quiet_output():
-            return frozenset(ms.filter_parameter_values(python_name))
-    except Exception:
-        return None
-
-
-def _check_native_parameters(element, where):
-    """Refuse what MeshLab would misread in a native step's parameters without a word: values
-    of the wrong kind for their type (see ``_NATIVE_CHECKS``), a parameter given twice, and
-    names the filter does not have (checked in lower case against pymeshlab's names; MeshLab's
-    own check, case-sensitive, runs with the step)."""
-    names = _native_parameter_names(element.get("name"))
-    keys = None if names is None else {_name_key(n) for n in names}
-    seen = set()
-    for child in element:
-        if child.tag != "Param":
-            continue
-        name, value, kind = child.get("name"), child.get("value"), child.get("type")
-        if name is None:
-            raise ScriptError(f"{where}: a <Param> lacks a name.")
-        if name in seen:
-            raise ScriptError(f"{where}: parameter {name!r} is given twice; keep one <Param name={name!r}>.")
-        seen.add(name)
-        if keys is not None and _name_key(name) not in keys:
-            raise ScriptError(f"{where}: this MeshLab filter has no parameter {name!r} (pymeshlab ignores it "
-                              f"without a word); its parameters, in pymeshlab's lower case: "
-                              f"{', '.join(sorted(names))}.")
-        check, meaning = _NATIVE_CHECKS.get(kind, (None, None))
-        if check is not None and (value is None or not check(value if kind == "RichBool" else value.strip())):
-            raise ScriptError(f"{where}: parameter {name!r} ({kind}) has value {value!r}; write {meaning}.")
-        if kind == "RichAbsPerc" and (child.get("min") is None or child.get("max") is None):
-            raise ScriptError(f"{where}: parameter {name!r} (RichAbsPerc) needs min and max attributes, "
-                              "as MeshLab writes them (e.g. min=\"0\" max=\"1\"); without them MeshLab "
-                              "ignores its value.")
-
-
-_IGNORED_PARAMETER = re.compile(r"Warning: parameter (\S*) not required by filter")
-
-
 def _refuse_a_near_miss(name, where):
     """A snake_case step name that is not ours but close to one of ours is a typo, not one of
     MeshLab's filters (whose script names are words with spaces): pymeshlab would only report
@@ -226,96 +101,6 @@ def _refuse_a_near_miss(name, where):
         matches = close_matches(name, _REGISTRY)
         if matches:
             raise ScriptError(f"{where}: no filter is called {name!r}; did you mean {', '.join(matches)}?")
-
-
-@functools.lru_cache(maxsize=1)
-def _pymeshlab_renames():
-    """pymeshlab's table of its old Python names (MeshLab's script names in snake case, e.g.
-    ``remove_duplicate_vertices``) to its current ones (``meshing_remove_duplicate_vertices``);
-    empty if it is not there."""
-    import pymeshlab
-
-    try:
-        with open(os.path.join(os.path.dirname(pymeshlab.__file__), "keys.txt"), encoding="utf-8") as f:
-            return dict(line.split()[:2] for line in f if len(line.split()) >= 2)
-    except OSError:
-        return {}
-
-
-def _snake(meshlab_name):
-    return re.sub(r"[^a-z0-9]+", "_", meshlab_name.lower()).strip("_")
-
-
-def _creates_a_mesh(meshlab_name):
-    """Whether a MeshLab filter (by its script name, e.g. "Sphere") makes a mesh from nothing:
-    pymeshlab's ``create_*`` filters, found through the old-to-new name table it ships."""
-    return _pymeshlab_renames().get(_snake(meshlab_name), "").startswith("create_")
-
-
-#: MeshLab's own words for "I know no filter of this name" (its script runner says no more).
-_UNKNOWN_STEP = "Something really bad happened"
-
-_HOW_NAMES_ARE_WRITTEN = ("A step names MeshLab's filter with its capitals and spaces, as MeshLab writes "
-                          "it (Filters > Show current filter script) or pymeshlab's "
-                          "MeshSet.save_filter_script does.")
-
-
-def _unknown_native_step(name):
-    """Why MeshLab failed on a step called ``name`` without a reason: pymeshlab's Python name used in a script,
-    MeshLab's name spelled with other capitals or spaces, or a close match (MeshLab's names
-    in the words of pymeshlab's rename table, which holds the filters renamed since 2022)."""
-    import pymeshlab
-
-    renames = _pymeshlab_renames()
-    if re.fullmatch(r"[a-z0-9_]+", name) and (name in renames.values() or hasattr(pymeshlab.MeshSet, name)):
-        old = next((o for o, new in renames.items() if new == name), None)
-        words = f" (its words, in lower case and without punctuation: {old.replace('_', ' ')!r})" if old else ""
-        return (f"{name!r} is pymeshlab's Python name, not MeshLab's{words}. {_HOW_NAMES_ARE_WRITTEN}")
-    key = _snake(name)
-    if key in renames:
-        return (f"MeshLab's name for this filter (pymeshlab's {renames[key]}) has these words, "
-                f"{key.replace('_', ' ')!r}, with other capitals or punctuation (a colon, a comma, a "
-                f"dash). {_HOW_NAMES_ARE_WRITTEN}")
-    matches = close_matches(key, renames, cutoff=0.75)
-    if matches:
-        return (f"MeshLab has no filter called {name!r}; did you mean "
-                f"{', '.join(repr(m.replace('_', ' ')) for m in matches)} (their words, in lower case "
-                f"and without punctuation)? {_HOW_NAMES_ARE_WRITTEN}")
-    return (f"pymeshlab failed without a reason ({_UNKNOWN_STEP!r}); the usual cause is a filter name "
-            f"MeshLab does not know. {_HOW_NAMES_ARE_WRITTEN}")
-
-
-def _run_native(ms, element, where):
-    import pymeshlab
-
-    # pymeshlab's script runner crashes the process (segmentation fault) when a filter that needs
-    # a mesh meets an empty MeshSet
-    if ms.mesh_number() == 0 and not _creates_a_mesh(element.get("name")):
-        raise ScriptError(f"{where}: the MeshSet holds no mesh, and this filter needs one; load a mesh "
-                          "(or create one in an earlier step) first.")
-    script = ET.Element("FilterScript")
-    script.append(element)
-    fd, tmp = tempfile.mkstemp(prefix="curvdetail-step-", suffix=".mlx")
-    os.close(fd)
-    try:
-        with open(tmp, "w", encoding="utf-8") as out:
-            out.write("<!DOCTYPE FilterScript>\n" + ET.tostring(script, encoding="unicode") + "\n")
-        try:
-            with _quiet_output() as output:
-                ms.load_filter_script(tmp)
-                ms.apply_filter_script()
-        except pymeshlab.PyMeshLabException as exc:
-            detail = " ".join(str(exc).split())
-            reason = _unknown_native_step(element.get("name", "")) if _UNKNOWN_STEP in detail else \
-                f"pymeshlab failed: {detail}"
-            raise ScriptError(f"{where}: {reason}") from None
-    finally:
-        os.remove(tmp)
-    ignored = _IGNORED_PARAMETER.findall(output[0])
-    if ignored:      # a name right but for its capitals: MeshLab's check is case-sensitive
-        raise ScriptError(f"{where}: pymeshlab ran this step without parameter(s) {', '.join(map(repr, ignored))}, "
-                          "which the filter does not know under that spelling (MeshLab's names are "
-                          "case-sensitive, e.g. 'TargetLen'); the MeshSet holds the step's result.")
 
 
 def run_script(ms, path, *, progress=None):
@@ -371,13 +156,14 @@ def run_script(ms, path, *, progress=None):
         name = element.get("name")
         if progress is not None:
             progress(k, len(steps), name)
+        _note_far_lengths(ms, where, element, params)
         if params is not None:
             try:
                 figures = apply(ms, name, **params)
             except ValueError as exc:
                 raise ScriptError(f"{where}: {exc}") from None
         else:
-            _run_native(ms, element, where)
+            run_native(ms, element, where)
             figures = {}
         if ms.mesh_number() == 0 and k == len(steps):
             raise ScriptError(f"{where} deleted the last mesh: the script ends with none", parameter="script",
@@ -429,29 +215,25 @@ def check_script(path):
         else:
             _refuse_a_near_miss(name, where)
             if element.tag == "filter":
-                _check_native_parameters(element, where)
+                check_native_parameters(element, where)
         checked.append((element, where, params))
     return checked
 
 
-def _param_element(p, value):
-    attrs = {"name": p.name, "value": p.format(value), "type": _RICH_TYPES[p.type],
-             "description": p.name, "tooltip": p.description}
-    if p.type == "str" and p.choices is not None:
-        attrs["type"] = "RichEnum"
-        attrs["value"] = str(p.choices.index(value))
-        attrs["enum_cardinality"] = str(len(p.choices))
-        for i, c in enumerate(p.choices):
-            attrs[f"enum_val{i}"] = c
-    return ET.Element("Param", attrs)
-
-
 def save_script(path, steps, *, overwrite=False):
-    """Write our filters as a MeshLab filter script that :func:`run_script` runs.
+    """Write a MeshLab filter script that :func:`run_script` runs: the pipeline run on a MeshSet
+    (``save_script(ms, path)``), or our filters named in a list (``save_script(path, steps)``).
+
+    ``save_script(ms, path)`` writes every step run on ``ms`` from Python, in order: ours (run by
+    :func:`~curvdetail.filters.apply`) and pymeshlab's (run by
+    :func:`~curvdetail.filters.apply_native`, whose lengths and floats replay to the last digit,
+    or on the MeshSet directly, as pymeshlab recorded them). ``curvdetail run`` replays it on the
+    same input to the same result.
 
     Parameters
     ----------
-    path : str or os.PathLike   destination (.mlx); written atomically
+    path : str or os.PathLike   destination (.mlx); written atomically (or the MeshSet, then
+                                ``steps`` is the destination)
     steps : list   each a filter name or ``(name, {parameter: value})``; every parameter is
                    written (defaults for those not given), except a layer id left to the current
                    mesh where that is its default (a layer id whose default is a layer, set to
@@ -462,7 +244,8 @@ def save_script(path, steps, *, overwrite=False):
     ------
     FileExistsError        ``path`` exists and ``overwrite`` is False
     FileNotFoundError      the destination folder does not exist
-    ScriptError            ``steps`` is not a list of names or (name, parameters) pairs
+    ScriptError            ``steps`` is not a list of names or (name, parameters) pairs; a
+                           MeshSet on which no filter has run
     UnknownFilterError, FilterParameterError   as :func:`~curvdetail.filters.apply`
 
     Examples
@@ -474,27 +257,60 @@ def save_script(path, steps, *, overwrite=False):
     >>> "apply_curvature_reconstruction" in open(path).read()
     True
     """
+    import pymeshlab
+
     from .dispatch import complete_parameters
 
+    if isinstance(path, pymeshlab.MeshSet):
+        ms, path = path, steps
+        path = check_output_path(path, overwrite)
+        elements = recorded_steps(ms)
+        if not elements:
+            raise ScriptError("no filter has run on this MeshSet", parameter="ms",
+                              hint="run filters with curvdetail.filters.apply / apply_native first")
+        return _write(path, elements, overwrite)
     path = check_output_path(path, overwrite)
     if isinstance(steps, str) or not isinstance(steps, (list, tuple)):
         raise ScriptError(f"steps must be a list of filter names or (name, parameters) pairs; got "
                           f"{type(steps).__name__}.")
-    root = ET.Element("FilterScript")
+    elements = []
     for k, step in enumerate(steps, start=1):
         if not isinstance(step, str) and not (isinstance(step, (list, tuple)) and len(step) == 2
                                               and isinstance(step[1], (dict, type(None)))):
             raise ScriptError(f"step {k} is {step!r}; give a filter name or a (name, {{parameter: value}}) pair.")
         name, params = (step, {}) if isinstance(step, str) else (step[0], dict(step[1] or {}))
         spec = get_filter(name)
-        values = complete_parameters(spec, params)
-        element = ET.SubElement(root, "filter", {"name": name})
-        for p in spec.parameters:
-            if p.type == "mesh" and values[p.name] is None and p.default is None:
-                continue            # left out: its default is the current mesh
-            element.append(_param_element(p, values[p.name]))   # None (current) as value=""
+        elements.append(step_element(spec, complete_parameters(spec, params)))
+    _write(path, elements, overwrite)
+
+
+def _write(path, elements, overwrite):
+    root = ET.Element("FilterScript")
+    root.extend(elements)
     ET.indent(root, space=" ")
     text = "<!DOCTYPE FilterScript>\n" + ET.tostring(root, encoding="unicode") + "\n"
     with atomic_write(path, overwrite=overwrite) as tmp:
         with open(tmp, "w", encoding="utf-8") as out:
             out.write(text)
+
+
+def _note_far_lengths(ms, where, element, params):
+    """A :class:`ScaleWarning` for each length of a step given in model units far from the
+    current mesh's size (see :data:`~.native.FAR_LENGTH`): likely sized for another mesh."""
+    from ..curvature.errors import warn
+    from ..curvature.geometry import bbox_diagonal
+    from .native import FAR_LENGTH
+
+    if ms.mesh_number() == 0:
+        return
+    diagonal = bbox_diagonal(ms.current_mesh().vertex_matrix())
+    if params is None:
+        far = far_lengths(ms, element)
+    else:
+        far = [(name, repr(v.value), v.value / diagonal) for name, v in params.items()
+               if isinstance(v, BBoxLength) and not v.percent
+               and not FAR_LENGTH[0] <= v.value / diagonal <= FAR_LENGTH[1]]
+    for name, value, ratio in far:
+        warn(f"{where}: {name} {value} (model units) is {100 * ratio:.3g} % of the current mesh's bbox diagonal "
+             f"({diagonal:.4g}); was it sized for another mesh? A percentage of the diagonal (value=\"2%\") "
+             "suits any mesh.", ScaleWarning)

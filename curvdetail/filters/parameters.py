@@ -30,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..curvature.checks import as_float
+from ..remesh.units import BBoxLength
 from .errors import FilterParameterError
 
 #: Largest magnitude of an int parameter or layer id (pymeshlab passes them as C++ ints).
@@ -38,21 +39,6 @@ INT_MAX = 2 ** 31 - 1
 
 #: The parameter types a filter may declare.
 TYPES = ("bool", "int", "float", "str", "PercentageValue", "mesh")
-
-
-@dataclass(frozen=True)
-class BBoxLength:
-    """A length given as a percentage of a bounding-box diagonal or as an absolute value."""
-
-    value: float
-    percent: bool
-
-    def resolve(self, diagonal):
-        """The absolute length for a mesh whose bounding-box diagonal is ``diagonal``."""
-        return self.value / 100.0 * float(diagonal) if self.percent else self.value
-
-    def __str__(self):
-        return f"{self.value!r}%" if self.percent else repr(self.value)
 
 
 def _numbers_as_text(value):

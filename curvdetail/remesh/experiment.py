@@ -16,10 +16,11 @@ from .evaluate import hausdorff, vertex_distance
 from .parameterize import METHODS as PARAMETERIZATIONS
 from .parameterize import parameterize
 from .retriangulate import METHODS as RETRIANGULATIONS
-from .retriangulate import check_target_edge, retriangulate
+from .retriangulate import retriangulate
 from .transfer import LOCATIONS
 from .transfer import METHODS as TRANSFERS
 from .transfer import squashed_in_plane, transfer_curvature
+from .units import as_bbox_length, length_figures
 
 #: Face samples per direction for the zero-detail baseline. It lies ~10 % of the bbox diagonal
 #: from the source, where pymeshlab's grid search is slow (minutes); it is measured with
@@ -31,7 +32,8 @@ BASELINE_SAMPLES = 20000
 #: with the exact engine as well (see :func:`hausdorff`).
 FAR_SURFACE = 0.02
 
-#: RMS distances (fractions of the source's bbox diagonal) below which a figure is rounding, not
+#: RMS distances (in the report's unit, % of the source's bbox diagonal; the figures below are
+#: fractions of it) below which a figure is rounding, not
 #: a measurement, by the engine that measured it (see :func:`hausdorff`): pymeshlab's works in
 #: single precision (a flat square against its retriangulation: RMS 3e-11 to 1.6e-10, max up
 #: to 5e-8, where the distances are 0), the exact engine in double (1e-17 to 1e-16). On a
@@ -40,11 +42,17 @@ FAR_SURFACE = 0.02
 #: out 0 to 7e-6 and the ratio to the floor 0.3 to 1.3; with a divisor of exactly 0, clamped to
 #: 1e-300, up to ~1e284). The report's ratios with such a figure are None, with the reason in
 #: ``ratio_notes``; a rebuild that close is never said to be worse than zero detail.
-ROUNDING_RMS = {"meshlab": 1e-7, "exact": 1e-12}
+ROUNDING_RMS = {"meshlab": 1e-5, "exact": 1e-10}       # 1e-7 and 1e-12 of the diagonal
+
+#: The report's distance keys: % of the source's bbox diagonal.
+RMS, MAX = "hausdorff_rms_percent_of_diagonal", "hausdorff_max_percent_of_diagonal"
+
+#: Measurements of the evaluate stage, reported one by one as ``progress("evaluate", done, total)``.
+EVALUATION_STEPS = 5
 
 STAGES = ("retriangulate", "parameterize", "transfer", "reconstruct", "evaluate")
 
-DEFAULTS = {"method": "isotropic", "target_edge": 0.01, "transfer": "conservative", "rows": "free",
+DEFAULTS = {"method": "isotropic", "target_edge": "1%", "transfer": "conservative", "rows": "free",
             "location": "closest", "parameterization": None, "backend": "auto", "surface_check": True}
 
 
@@ -71,7 +79,7 @@ def worse_than_zero_detail(report, cli=False):
     instead of the function's parameters."""
     if "error" not in report or "baseline_zero_detail" not in report:
         return None
-    rms, zero = report["error"]["hausdorff_rms"], report["baseline_zero_detail"]["hausdorff_rms"]
+    rms, zero = report["error"][RMS], report["baseline_zero_detail"][RMS]
     if not (rms > zero and rms >= ROUNDING_RMS[report["error"].get("engine", "exact")]):
         return None                                 # not worse, or rounding (a flat patch)
     options = report.get("options", {})
@@ -90,12 +98,12 @@ def worse_than_zero_detail(report, cli=False):
         tries.append(f"a shorter target edge ({edge}: a coarse target cannot carry the source's detail), or "
                      f"{_option('method', 'decimate', cli)}, and check the source for noise or sliver triangles")
     return (f"the rebuilt surface is farther from the source than the zero-detail surface (RMS "
-            f"{100 * rms:.4g} % against {100 * zero:.4g} % of the bbox diagonal): the transferred detail made it "
+            f"{rms:.4g} % against {zero:.4g} % of the bbox diagonal): the transferred detail made it "
             f"worse than no detail at all, so this configuration failed on this patch. Try "
             f"{'; and '.join(tries)}. docs/remeshing.md has what was measured.")
 
 
-def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="conservative", rows="free",
+def remesh_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="conservative", rows="free",
                       location="closest", parameterization=None, backend="auto", evaluate=True,
                       source_path=None, progress=None, target=None, surface_check=True):
     """Retriangulate a disk patch, carry its curvature detail over, rebuild it, and measure.
@@ -113,7 +121,9 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="c
     ----------
     V : (n, 3) float array, F : (m, 3) int array   the source, a disk-topology patch
     method : {"isotropic", "decimate"}         retriangulation
-    target_edge : float                        target edge length, fraction of the bbox diagonal
+    target_edge : float or str                 target edge length: model units, or a percentage of
+                                               the bbox diagonal ("1%", PercentageValue(1); see
+                                               :func:`~.units.as_length`)
     transfer : {"conservative", "pointwise"}   how detail is carried over (conservative: measured better)
     rows : {"free", "all"}                     residual rows of the reconstruction energy
     location : {"closest", "uv"}               3D closest point, or a shared planar domain
@@ -130,15 +140,17 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="c
                                                diagonal, 0.8 %, apart over three calls; the
                                                maxima, at vertices, stay the same)
     source_path : str or None                  recorded in the report
-    progress : callable or None                called with each stage name as it starts
+    progress : callable or None                called with each stage name as it starts, and in
+                                               the evaluation (the longest stage of a big run)
+                                               as ``progress("evaluate", done, total)`` after
+                                               each of its ``EVALUATION_STEPS`` measurements
     target : tuple (Vt, Ft) or None            a ready retriangulation to use instead of making one
                                                (a disk whose boundary vertices lie on the source's
                                                boundary polyline); ``method`` / ``target_edge`` are then
                                                unused (but still checked), the report's
                                                ``options.method`` is ``"given"`` and its
-                                               ``options.target_edge`` (fraction of the
-                                               diagonal) and ``target_edge_length``
-                                               (absolute) None, and
+                                               ``options.target_edge_model_units`` and
+                                               ``target_edge_percent_of_diagonal`` None, and
                                                ``seconds.retriangulate`` is 0
     surface_check : bool                       isotropic retriangulation: check the distance an edge
                                                collapse or flip moves the surface (pymeshlab's
@@ -153,13 +165,14 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="c
     mesh : tuple ``(X, Ft)``   the rebuilt target: (p, 3) positions and (q, 3) triangles
     report : dict              JSON-ready: ``source.{path, vertices, faces, bbox_diagonal}``,
         ``target.{vertices, faces, boundary_vertices}``, ``options``, ``error``,
-        ``baseline_zero_detail`` and ``floor_retriangulated`` (each ``{hausdorff_max, hausdorff_rms}``
-        as fractions of the source bbox diagonal; ``error`` also has ``vertex_max``, the largest
+        ``baseline_zero_detail`` and ``floor_retriangulated`` (each
+        ``{hausdorff_max_percent_of_diagonal, hausdorff_rms_percent_of_diagonal}``, % of the
+        source bbox diagonal; ``error`` also has ``vertex_max_percent_of_diagonal``, the largest
         distance of a rebuilt vertex to the source, exact),
         ``improvement_over_zero_detail`` (zero-detail RMS / error RMS) and ``ratio_to_floor``
         (error RMS / floor RMS), each None where one of its two RMS values is rounding, not a
-        measurement (below ``ROUNDING_RMS``: 1e-7 of the diagonal as pymeshlab's single-precision
-        engine measures, 1e-12 as the exact engine does; e.g. every surface of a flat patch, or
+        measurement (below ``ROUNDING_RMS``: 1e-5 % of the diagonal as pymeshlab's single-precision
+        engine measures, 1e-10 % as the exact engine does; e.g. every surface of a flat patch, or
         a target equal to the source), with the reason under ``ratio_notes``
         (``{ratio name: reason}``, present only then),
         ``parameterization`` (flip counts, for ``location="uv"``) and
@@ -171,8 +184,8 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="c
     Raises
     ------
     MeshError, NotADiskError   malformed source or not a disk (says what was found)
-    RemeshError                absurd target edge (with the numbers; not a positive number even
-                               with a ``target``), a failed retriangulation, or a ``target`` with
+    CurvdetailError            ``target_edge`` not a positive length (even with a ``target``)
+    RemeshError                absurd target edge (with the numbers), a failed retriangulation, or a ``target`` with
                                boundary vertices off the source's boundary polyline (by more than
                                ``TARGET_BOUNDARY_TOLERANCE`` = 1e-6 of the larger of the bbox
                                diagonal and the largest coordinate)
@@ -193,8 +206,8 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="c
     --------
     >>> from curvdetail.curvature.testing import disk
     >>> V, F = disk(n_rings=16); V[:, 2] = 0.3 * np.exp(-4 * (V[:, :2] ** 2).sum(1))
-    >>> (X, Ft), report = remesh_experiment(V, F, target_edge=0.04)
-    >>> report["error"]["hausdorff_rms"] < 0.1 * report["baseline_zero_detail"]["hausdorff_rms"]
+    >>> (X, Ft), report = remesh_experiment(V, F, target_edge="4%")
+    >>> report["error"][RMS] < 0.1 * report["baseline_zero_detail"][RMS]
     True
     """
     result = run_experiment(V, F, method=method, target_edge=target_edge, transfer=transfer, rows=rows,
@@ -220,12 +233,12 @@ def _ratios(report, engines):
     None where one of its RMS figures is below the ``ROUNDING_RMS`` of the engine that measured
     it (``engines``: figure key -> engine), and ``ratio_notes`` saying why, where one is None."""
     def rounding(key, what, then):
-        rms = report[key]["hausdorff_rms"]
+        rms = report[key][RMS]
         floor = ROUNDING_RMS[engines[key]]
         if rms >= floor:
             return None
-        return (f"{what} lies on the source to rounding (RMS {rms:.3g} of the bbox diagonal, below the "
-                f"{floor:g} its {engines[key]} engine resolves): {then}")
+        return (f"{what} lies on the source to rounding (RMS {rms:.3g} % of the bbox diagonal, below the "
+                f"{floor:g} % its {engines[key]} engine resolves): {then}")
 
     out, notes = {}, {}
     rebuilt = "the rebuilt surface"
@@ -240,7 +253,7 @@ def _ratios(report, engines):
               ("error", rebuilt, "the ratio would be one of rounding noise")))):
         reason = next(filter(None, (rounding(*r) for r in reasons)), None)
         if reason is None:
-            out[name] = report[top]["hausdorff_rms"] / report[bottom]["hausdorff_rms"]
+            out[name] = report[top][RMS] / report[bottom][RMS]
         else:
             out[name] = None
             notes[name] = reason
@@ -255,7 +268,7 @@ def _check_choice(name, value, choices):
     return check_choice(value, name, choices, f" is not one of {', '.join(map(repr, choices))}.")
 
 
-def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="conservative", rows="free",
+def run_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="conservative", rows="free",
                    location="closest", parameterization=None, backend="auto", evaluate=True,
                    source_path=None, progress=None, target=None, surface_check=True):
     """:func:`remesh_experiment` returning everything as a dict: ``X``, ``Ft``, ``Vt`` (the
@@ -277,7 +290,7 @@ def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="cons
     resolve_backend(backend)               # an unknown or missing backend fails before the work
     # checked even with a ready target, where it is only recorded: a bad value is a mistake
     # either way (as pymeshlab checks every parameter of a filter)
-    target_edge = check_target_edge(target_edge)
+    length = as_bbox_length(target_edge, "target_edge")
     if target is not None and (not isinstance(target, (tuple, list)) or len(target) != 2):
         raise ValueError(f"target must be a pair (Vt, Ft), a ready retriangulation, or None; got "
                          f"{type(target).__name__}.")
@@ -296,9 +309,13 @@ def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="cons
             progress(name)
         return time.perf_counter()
 
+    def measured(done):                     # within the evaluation: measurements done so far
+        if progress is not None:
+            progress("evaluate", done, EVALUATION_STEPS)
+
     if target is None:
         t = stage("retriangulate")
-        Vt, Ft = retriangulate(V, F, method=method, target_edge=target_edge, surface_check=surface_check)
+        Vt, Ft = retriangulate(V, F, method=method, target_edge=length, surface_check=surface_check)
         seconds["retriangulate"] = time.perf_counter() - t
     else:
         Vt, Ft, loop_given = check_disk(*target, "the target")
@@ -337,8 +354,8 @@ def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="cons
         "target": {"vertices": int(Vt.shape[0]), "faces": int(Ft.shape[0]),
                    "boundary_vertices": int(loop_t.size)},
         "options": {"method": "given" if target is not None else method,
-                    "target_edge": float(target_edge) if target is None else None,
-                    "target_edge_length": float(target_edge * d) if target is None else None,
+                    **(length_figures(length, d, "target_edge") if target is None else
+                       dict.fromkeys(("target_edge_model_units", "target_edge_percent_of_diagonal"))),
                     "transfer": transfer, "rows": rows,
                     "location": location, "parameterization": parameterization if location == "uv" else None,
                     "backend": solver,
@@ -354,7 +371,9 @@ def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="cons
         # (quality, vertex_max) and hausdorff takes them for its maxima, in its own frame, so
         # its figures are those it would measure itself
         out["distance"] = vertex_distance(X, V, F)
+        measured(1)
         out["zero_distance"] = vertex_distance(Z, V, F)
+        measured(2)
         # pymeshlab's grid search slows down with the cube of the distance: surfaces that are
         # far apart (a failed rebuild, the zero-detail baseline) use the exact engine.
         far = out["distance"].max() > FAR_SURFACE * d
@@ -364,10 +383,11 @@ def run_experiment(V, F, *, method="isotropic", target_edge=0.01, transfer="cons
                 ("baseline_zero_detail", Z, out["zero_distance"], BASELINE_SAMPLES, "exact"),
                 ("floor_retriangulated", Vt, vertex_distance(Vt, V, F), None, "meshlab")):
             h = hausdorff(P, Ft, V, F, samples=n, engine=engine, a_vertex_distance=dist)
-            report[key] = {"hausdorff_max": h["max"] / d, "hausdorff_rms": h["rms"] / d}
+            report[key] = {MAX: 100 * h["max"] / d, RMS: 100 * h["rms"] / d}
             engines[key] = h["engine"]
+            measured(2 + len(engines))
         report["error"]["engine"] = engines["error"]            # the engine that ran (hausdorff may switch)
-        report["error"]["vertex_max"] = float(out["distance"].max() / d)
+        report["error"]["vertex_max_percent_of_diagonal"] = float(100 * out["distance"].max() / d)
         report.update(_ratios(report, engines))
         seconds["evaluate"] = time.perf_counter() - t
         worse = worse_than_zero_detail(report)

@@ -4,11 +4,12 @@ import math
 
 import numpy as np
 
-from ..curvature.checks import as_count, as_float, as_positive_number, check_bool, check_choice
+from ..curvature.checks import as_count, as_float, check_bool, check_choice
 from ..curvature.geometry import bbox_diagonal, face_double_areas
 from ..curvature.topology import boundary_edges
 from ..curvature.errors import counted
 from ._disk import NotADiskError, Polyline, RemeshError, check_disk
+from .units import as_bbox_length
 
 METHODS = ("isotropic", "decimate")
 
@@ -122,7 +123,8 @@ def _decimation_refines(count, faces):
 
 
 def target_edge_range(V, F, method="isotropic"):
-    """``(shortest, longest)`` target edge, as fractions of the bbox diagonal, that
+    """``(shortest, longest)`` target edge, as fractions of the bbox diagonal (the error
+    messages say them in %), that
     :func:`retriangulate` accepts for the patch ``(V, F)`` with ``method``: from
     ``MAX_VERTICES`` to ``MIN_VERTICES`` estimated vertices; decimation, which only coarsens,
     from about the source's own edge length (fewer triangles than the source has) up. For a
@@ -165,12 +167,6 @@ def _range_advice(V, F, method, why=True):
             f"{_percent(longest, False)} % of the bbox diagonal for {patch}; choose one there or {_USE_ISOTROPIC}")
 
 
-def check_target_edge(target_edge):
-    """``target_edge`` as a positive finite float (bools and strings refused), or RemeshError."""
-    return _as(as_positive_number, target_edge, "target_edge",
-               "must be a positive fraction of the bbox diagonal (e.g. 0.01 for 1 %).")
-
-
 def _as(check, value, name, requirement):
     """``check(value, name)``; its ValueError re-raised as RemeshError: ``name=value requirement``."""
     try:
@@ -179,7 +175,7 @@ def _as(check, value, name, requirement):
         raise RemeshError(f"{name}={value!r} {requirement}") from None
 
 
-def retriangulate(V, F, *, method="isotropic", target_edge=0.01, iterations=10, max_surface_distance=None,
+def retriangulate(V, F, *, method="isotropic", target_edge="1%", iterations=10, max_surface_distance=None,
                   aggressiveness=7.0, surface_check=True):
     """Retriangulate a disk-topology patch; every boundary vertex of the result stays on the
     source's boundary polyline.
@@ -194,13 +190,14 @@ def retriangulate(V, F, *, method="isotropic", target_edge=0.01, iterations=10, 
         ``"decimate"``: ``fast_simplification.simplify(..., preserve_border=True)`` (quadric edge
         collapse that never touches a boundary vertex) down to the triangle count of an
         equilateral mesh with the target edge length; it can only coarsen.
-    target_edge : float
-        target edge length as a fraction of the source's bounding-box diagonal (0.01 = 1 %).
+    target_edge : float, str or pymeshlab.PercentageValue
+        target edge length: a number in model units, or a percentage of the source's
+        bounding-box diagonal (``"1%"``, ``PercentageValue(1)``; see :func:`~.units.as_length`).
     iterations : int
         isotropic remeshing iterations, 1 to ``MAX_ITERATIONS`` (1,000).
-    max_surface_distance : float or None
-        isotropic only: the largest distance (fraction of the bbox diagonal) an edge collapse or
-        flip may move the surface; ``None`` = ``target_edge``. Unused with
+    max_surface_distance : float, str, pymeshlab.PercentageValue or None
+        isotropic only: the largest distance an edge collapse or flip may move the surface (a
+        length as ``target_edge``); ``None`` = ``target_edge``. Unused with
         ``surface_check=False`` (but still checked).
     surface_check : bool
         isotropic only: pymeshlab's ``checksurfdist``, refuse an edge collapse or flip that moves
@@ -227,10 +224,11 @@ def retriangulate(V, F, *, method="isotropic", target_edge=0.01, iterations=10, 
     Raises
     ------
     MeshError, NotADiskError   the source is malformed or not a disk (says what was found)
-    RemeshError                unknown method, ``iterations`` not a whole number from 1 to 1,000, a
-                               ``target_edge`` or ``max_surface_distance`` that is not a positive
-                               finite number, ``aggressiveness`` outside [0, 10] (bools and
-                               strings are refused for all of them), ``surface_check`` not
+    CurvdetailError            a ``target_edge`` or ``max_surface_distance`` that is not a positive
+                               length (``parameter`` names it)
+    RemeshError                unknown method, ``iterations`` not a whole number from 1 to 1,000,
+                               ``aggressiveness`` outside [0, 10] (bools and
+                               strings are refused), ``surface_check`` not
                                True or False, a
                                target edge length that would give fewer than
                                50 or more than 5,000,000 vertices (the numbers are given), a
@@ -243,7 +241,7 @@ def retriangulate(V, F, *, method="isotropic", target_edge=0.01, iterations=10, 
     --------
     >>> from curvdetail.curvature.testing import disk
     >>> V, F = disk(n_rings=12); V[:, 2] = 0.2 * (1 - (V[:, :2] ** 2).sum(1))
-    >>> Vt, Ft = retriangulate(V, F, method="isotropic", target_edge=0.05)
+    >>> Vt, Ft = retriangulate(V, F, method="isotropic", target_edge="5%")
     >>> 50 < Vt.shape[0] < 5000
     True
     """
@@ -251,15 +249,14 @@ def retriangulate(V, F, *, method="isotropic", target_edge=0.01, iterations=10, 
                           "'decimate'.", RemeshError)
     V, F, loop = check_disk(V, F, "the source")
     d = bbox_diagonal(V)
-    target_edge = check_target_edge(target_edge)
+    target_edge = as_bbox_length(target_edge, "target_edge").fraction(d)
     iterations = _as(as_count, iterations, "iterations",
                      "must be a whole number of at least 1 (isotropic remeshing iterations, e.g. 10).")
     if iterations > MAX_ITERATIONS:      # pymeshlab takes a 32-bit int: 2**31 raised its cast error
         raise RemeshError(f"iterations={iterations!r} is more than {MAX_ITERATIONS:,}: each is a full pass of the "
                           "isotropic remeshing (split, collapse, flip, smooth); 10 is the default.")
     if max_surface_distance is not None:
-        max_surface_distance = _as(as_positive_number, max_surface_distance, "max_surface_distance",
-                                   "must be a positive fraction of the bbox diagonal, or None for the target edge.")
+        max_surface_distance = as_bbox_length(max_surface_distance, "max_surface_distance").fraction(d)
     aggressiveness = _check_aggressiveness(aggressiveness)
     surface_check = _as(check_bool, surface_check, "surface_check",
                         "must be True or False (check the distance an edge collapse or flip moves the surface).")
