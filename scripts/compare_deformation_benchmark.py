@@ -191,10 +191,13 @@ def main(argv=None):
     print(text)
     _files.write_json(json_path, {"methods": METHODS, "igl_arap_iterations": MAX_ITER, "rows": rows,
                                   **_files.measured_conditions()}, args.force, indent=2, end="\n")
+    images = "".join(f"\n![{n}]({os.path.relpath(p, os.path.dirname(os.path.abspath(md_path)))})\n"
+                     for n, p in zip(CASES, map(os.path.abspath, pictures)))
     _files.write_text(md_path, "# Deformation benchmark (Botsch & Sorkine 2008)\n\n"
-                      "Written by scripts/compare_deformation_benchmark.py; distances and edge changes over the "
-                      "rest bbox diagonal / rest lengths, areas as fractions of the rest areas.\n\n" + text + "\n",
-                      args.force)
+                      "Written by `python scripts/compare_deformation_benchmark.py --pictures docs/results --force` "
+                      "(see docs/editing.md); distances over the rest bbox diagonal, edge-length change relative "
+                      "to the rest lengths, areas as fractions of the rest areas; load and host in "
+                      "deformation.json.\n\n" + text + "\n" + images, args.force)
     return 0
 
 

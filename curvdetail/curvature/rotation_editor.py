@@ -24,22 +24,25 @@ class RotationAwareEditor:
 
         ``E(X, R) = sum_{i in S} sum_{j ~ i} w_ij |(x_i - x_j) - s_i R_i (v_i - v_j)|^2``
 
-    with ``w_ij = -L_ij`` the cotangent weights of the rest mesh ``V`` and ``S`` the vertices
-    with a free vertex in their closed one-ring (the as-rigid-as-possible energy of Sorkine &
-    Alexa 2007). :meth:`solve` alternates two steps, each minimizing ``E`` exactly over its
-    variables, so ``E`` never increases from one iteration to the next (``energies``):
+    with ``w_ij = max(-L_ij, 0)`` the cotangent weights of the rest mesh ``V`` clamped at zero (a
+    negative weight makes ``E`` unbounded below) and ``S`` the vertices with a free vertex in
+    their closed one-ring (the as-rigid-as-possible energy of Sorkine & Alexa 2007).
+    :meth:`solve` alternates two steps, each minimizing ``E`` exactly over its variables:
 
-    - local: every ``R_i`` in closed form from the SVD of the 3x3 covariance
-      ``sum_j w_ij (x_i - x_j) (v_i - v_j)^T``, all vertices at once;
-    - global: the embedding ``(L X)_f = B_f`` over the free vertices ``f``, with the turned
-      rest details ``B_i = sum_j w_ij (s_i R_i + s_j R_j) / 2 (v_i - v_j)``; where the
-      neighbourhood turns as one, ``B_i = s R D_i`` for the rest detail ``D = L V``.
+    - local: every ``R_i`` in closed form, the rotation nearest the 3x3 covariance
+      ``sum_j w_ij (x_i - x_j) (v_i - v_j)^T`` (all vertices at once, reflections excluded);
+    - global: the embedding ``(L X)_f = B_f`` over the free vertices ``f`` (``L`` with the
+      weights ``w``), with the turned rest details ``B_i = sum_j w_ij (s_i R_i + s_j R_j) / 2
+      (v_i - v_j)``; where the neighbourhood turns as one, ``B_i = s R D_i``.
 
-    The rotations start at the best-fit rotation of the handles (rest to given positions), so
-    a rigid motion of every handle with ``roi=None`` is reproduced in the first iteration. The
-    iterations stop when no vertex moved more than ``tol`` times the bbox diagonal, or after
-    ``max_iterations``. The constructor does all factoring; an iteration of :meth:`solve` is one
-    back-substitution plus the batched local fits.
+    Steps are Anderson-accelerated (:attr:`anderson_memory`); an accelerated step is kept only
+    where it lowers ``E``, so ``E`` never increases from one iteration to the next
+    (``energies``). The rotations start at the best-fit rotation of the handles (rest to given
+    positions), blended towards the identity at the fixed part by a harmonic weight, so a rigid
+    motion of every handle with ``roi=None`` is reproduced in the first iteration. The
+    iterations stop when the plain step would move no vertex more than ``tol`` times the bbox
+    diagonal, or after ``max_iterations``. The constructor does all factoring; an iteration of
+    :meth:`solve` is one back-substitution plus the batched local fits.
 
     Parameters
     ----------
@@ -63,7 +66,8 @@ class RotationAwareEditor:
     Attributes
     ----------
     detail : (n, 3) float array
-        Rest detail ``D = L V``.
+        Rest detail ``D_i = sum_j w_ij (v_i - v_j)``: the curvature detail ``L V`` wherever no
+        weight was clamped.
     iterations : int
         Iterations of the last :meth:`solve` (global steps).
     converged : bool

@@ -274,7 +274,7 @@ def _rotation_edit(ms, mid, V, F, h, roi, T, backend, t):
     diagonal = bbox_diagonal(V)
     folded = folded_triangles(V, F, X, T[:3, :3])
     figures = {
-        "max_displacement": float(moved.max() / diagonal),
+        "max_displacement_percent_of_diagonal": float(100 * moved.max() / diagonal),
         "amplification": float(moved.max() / moved[h].max()) if moved[h].max() > 1e-12 * diagonal else None,
         "detail_amplification": None,
         "folded_triangles": int(folded.size),
