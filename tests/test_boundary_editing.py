@@ -11,8 +11,8 @@ from curvdetail.curvature.errors import ConstraintError, FoldedTrianglesWarning,
 from curvdetail.curvature.testing import cylinder, grid
 
 
-# 5 % of the extent in three periods folds one triangle with the one-ring stage (it turns by 120
-# degrees, measured 2026-12-01) and warns; where the boundary lands is what is tested here
+# 5 % of the extent in three periods folds a triangle with the one-ring stage and warns; where
+# the boundary lands is what is tested here
 @pytest.mark.filterwarnings("ignore::curvdetail.curvature.errors.FoldedTrianglesWarning")
 def test_boundary_lands_exactly_on_the_sine_displacement(load_mesh):
     V, F = load_mesh("terrainA_1k.obj")
@@ -90,15 +90,12 @@ def test_a_mesh_with_two_boundary_loops_is_refused():
 
 def test_displacement_array_of_the_wrong_shape_is_refused(load_mesh):
     V, F = load_mesh("mannequin_nose.obj")
-    with pytest.raises(ConstraintError, match="displacement has shape"):
-        edit_boundary(V, F, np.zeros((3, 3)))
-    with pytest.raises(ValueError, match="callable returned shape"):
-        edit_boundary(V, F, lambda s, P: np.zeros(3))
-    # complex or bool values are refused as in an array, not cast (imaginary part dropped, 0/1)
-    with pytest.raises(ValueError, match="callable returned dtype complex128"):
-        edit_boundary(V, F, lambda s, P: np.zeros((s.size, 3)) + 1j)
-    with pytest.raises(ValueError, match="callable returned dtype bool"):
-        edit_boundary(V, F, lambda s, P: np.ones((s.size, 3), dtype=bool))
+    # given or returned by a callable alike; complex or bool values are refused, not cast
+    for displacement in (np.zeros((3, 3)), lambda s, P: np.zeros(3), lambda s, P: np.zeros((s.size, 3)) + 1j,
+                         lambda s, P: np.ones((s.size, 3), dtype=bool)):
+        with pytest.raises(ConstraintError) as e:
+            edit_boundary(V, F, displacement)
+        assert e.value.parameter == "displacement"
 
 
 def test_rest_boundary_detail_keeps_the_inside_detail(load_mesh):
@@ -155,9 +152,9 @@ def test_the_mesh_is_checked_and_its_laplacian_assembled_once(monkeypatch):
     calls = []
     real = module._assemble_upper
 
-    def counting(V, F, cot, check_manifold, edge_counts=None):
+    def counting(V, F, cot, check_manifold):
         calls.append(check_manifold)
-        return real(V, F, cot, check_manifold, edge_counts)
+        return real(V, F, cot, check_manifold)
 
     monkeypatch.setattr(module, "_assemble_upper", counting)
     V, F = grid(10, 10)
@@ -273,9 +270,9 @@ def test_a_displacement_that_collapses_the_boundary_is_refused_without_warnings(
     # first, then "details: 36 rows are NaN or infinite", naming values the caller never passed
     V, F = grid(10, 10)
     V[:, 2] = 0.1 * np.sin(3 * V[:, 0])
-    with pytest.raises(ConstraintError, match=rf"the displacement {message}: (1 triangle|\d+ triangles) of the "
-                                              r"provisional surface .* (has|have) zero area .*boundary_detail='rest'"):
+    with pytest.raises(ConstraintError, match=message) as e:
         edit_boundary(V, F, displacement)
+    assert e.value.parameter == "displacement" and e.value.count >= 1
     # the advice: defined, no numpy warnings (a loop collapsed onto a point or a line does fold
     # the inside, and the fold warning says so)
     with warnings.catch_warnings(record=True) as caught:
@@ -289,9 +286,9 @@ def test_a_displacement_that_collapses_the_boundary_is_refused_without_warnings(
 def test_a_displaced_boundary_beyond_1e75_is_refused_before_any_algebra():
     # the callable's result was only checked for NaN: overflow warnings, then the editor's "positions"
     V, F = grid(10, 10)
-    with pytest.raises(ConstraintError, match=r"the displaced boundary \(its positions plus the displacement\): "
-                                              r"36 rows reach 1e\+80 .*use a smaller displacement"):
+    with pytest.raises(ConstraintError) as e:
         edit_boundary(V, F, lambda s, P: np.full(P.shape, 1e80))
+    assert (e.value.parameter, e.value.count, e.value.first) == ("displacement", 36, [0, 1, 2])
 
 
 @pytest.mark.filterwarnings("error")
@@ -310,10 +307,9 @@ def test_a_displacement_callable_with_non_finite_values_is_named_as_such():
         d[0, 2] = np.nan
         return d
 
-    # it was "returned shape (20, 3) (or non-finite values)", for a shape that was right
-    with pytest.raises(ValueError, match=r"the displacement callable returned NaN or infinite values in 1 rows "
-                                         r"\(first: 0\)"):
+    with pytest.raises(ConstraintError) as e:
         edit_boundary(V, F, nan_at_the_start)
+    assert (e.value.parameter, e.value.count, e.value.first) == ("displacement", 1, [0])
 
 
 @pytest.mark.parametrize("kwargs, error, message", [
@@ -356,9 +352,9 @@ def test_a_displacement_callable_that_does_not_take_s_and_p_is_named_before_it_r
 
 def test_a_displacement_callable_with_a_ragged_result_is_named_as_such():
     V, F = grid(6, 6)
-    with pytest.raises(ValueError, match=r"the displacement callable returned a list that numpy cannot read as "
-                                         r"an array \(.*\); it must return a \(20, 3\) float array"):
+    with pytest.raises(ConstraintError) as e:
         edit_boundary(V, F, lambda s, P: [[0.0, 0.0, 0.0], [0.0]])
+    assert e.value.parameter == "displacement"
 
 
 def _folded_against_rest(V, F, X):
@@ -374,9 +370,8 @@ def _loop_extent(V, F):
 
 
 def test_a_small_boundary_move_that_folds_the_inside_warns_with_the_count_and_the_amplification(load_mesh):
-    # the review's trunk case on the nose: the boundary moves 1.9 % of the diagonal, the paper's
-    # one-ring stage amplifies its detail change ~7 times and folds ~78 of 1206 triangles
-    # (measured 2026-12-01); silently, before
+    # the boundary moves 1.9 % of the diagonal; the one-ring stage amplifies its detail change
+    # and folds triangles
     V, F = load_mesh("mannequin_nose.obj")
     f = sine_displacement(0.02 * _loop_extent(V, F), periods=2, axis=1)
     with pytest.warns(FoldedTrianglesWarning) as caught:

@@ -94,8 +94,9 @@ def test_circles_too_far_apart_collapse_with_a_clear_error():
 
 def test_no_fixed_vertex_is_refused():
     V, F = grid(4, 4)
-    with pytest.raises(ConstraintError, match="no fixed vertices"):
+    with pytest.raises(ConstraintError) as e:
         minimal_surface(V, F, [])
+    assert (e.value.parameter, e.value.count) == ("fixed", 0)
 
 
 def test_fixed_out_of_range_is_refused_with_the_index():
@@ -315,10 +316,9 @@ def test_a_neck_pinching_into_needles_is_refused_not_converged():
     # absolute zero-area threshold, and the result came back converged after 10 steps with a
     # neck of radius 2e-7
     V, F = cylinder(radius=1.0, height=2.0, n_around=24, n_along=8)
-    with pytest.raises(MeshError, match=r"^minimal surface iteration 9: 48 triangles collapsed into needles "
-                                        r"\(first: 72, 73, 74; an angle within 1e-6 rad .* no minimal surface "
-                                        r"of this topology \(e\.g\. two circles too far apart"):
+    with pytest.raises(MeshError, match="no minimal surface of this topology") as e:
         minimal_surface(V, F, boundary_vertices(F))
+    assert (e.value.count, e.value.first) == (48, [72, 73, 74])
 
 
 def test_healthy_results_keep_their_angles_clear_of_the_needle_threshold(load_mesh):
@@ -354,13 +354,13 @@ def test_free_boundary_vertices_are_refused():
     # at z = 0 (area 0.10 of 6.27) and the result came back converged after 2 steps
     V, F = cylinder(radius=1.0, height=1.0, n_around=32, n_along=17)
     ring = np.flatnonzero(np.isclose(V[:, 2], 0.0))
-    with pytest.raises(ConstraintError, match=r"^64 boundary vertices are not fixed \(of 64; first: 0, 1, 2\): a "
-                                              r"surface with a free boundary has no minimal surface.*Fix the whole "
-                                              r"boundary too, e\.g\. np\.union1d\(fixed, boundary_vertices\(F\)\)"):
+    with pytest.raises(ConstraintError) as e:
         minimal_surface(V, F, ring)
+    assert (e.value.parameter, e.value.count, e.value.first) == ("fixed", 64, [0, 1, 2])
     b = boundary_vertices(F)
-    with pytest.raises(ConstraintError, match=r"^1 boundary vertex is not fixed \(of 64; first: 7\)"):
+    with pytest.raises(ConstraintError) as e:
         minimal_surface(V, F, np.union1d(ring, np.delete(b, 7)))
+    assert (e.value.parameter, e.value.count, e.value.first) == ("fixed", 1, [7])
     # the ring and both rims: three curves, a valid constraint
     X = minimal_surface(V, F, np.union1d(ring, b))
     assert X.converged and np.array_equal(X[ring], V[ring])

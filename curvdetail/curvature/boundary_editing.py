@@ -9,9 +9,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import depth_first_order
 
-from .geometry import folded_triangles, ignoring_underflow
 from .checks import MIN_DIAGONAL, ZERO_AREA_RELATIVE, _check_magnitude, as_faces, as_values, as_vertices, check_bool, check_choice, check_mesh
-from .geometry import bbox_diagonal, face_double_areas
+from .geometry import bbox_diagonal, face_double_areas, folded_triangles, ignoring_underflow
 from .topology import _compact_ids, boundary_edges, check_oriented, vertex_components
 from .cotan_laplacian import _cotan_laplacian_unchecked, laplacian_product
 from .curvature_coefficients import DEFAULT_RCOND, check_rcond
@@ -25,12 +24,11 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
                   rcond=DEFAULT_RCOND, backend="auto", return_info=False):
     """Move the boundary of a disk-topology patch and rebuild the surface from its detail.
 
-    The boundary loop is moved by ``displacement``; its curvature detail is updated (with
-    ``boundary_detail="deformed"``, the paper: the details of a provisional surface, the boundary's
-    best-fitting similarity applied to the patch and the rest of the move spread harmonically
-    inside; with ``"rest"`` the rest details are kept); then a :class:`CurvatureEditor` with the
-    boundary's positions and details constrained rebuilds the interior. A boundary rotated, scaled
-    or moved as a whole moves the patch with it. See docs/editing.md, "Shape editing of a boundary".
+    The boundary loop is moved by ``displacement`` and its curvature detail updated (``"deformed"``,
+    the paper: the details of a provisional surface, the boundary's best-fitting similarity applied
+    to the patch and the rest of the move spread harmonically inside; ``"rest"``: kept); then a
+    :class:`CurvatureEditor` with the boundary's positions and details constrained rebuilds the
+    interior. See docs/editing.md, "Shape editing of a boundary".
 
     Parameters
     ----------
@@ -52,11 +50,11 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
     backend : str
         Sparse solver backend.
     return_info : bool
-        Also return a dict with ``boundary`` (loop order), ``arc_length``, ``boundary_detail``
-        (the updated (b, 3) details), ``editor`` (for re-solves), ``folded_triangles`` (triangles
-        whose normal turned against their rest normal, the boundary's rotation discounted),
-        ``max_displacement`` and ``boundary_displacement`` (largest move of any vertex / of a
-        boundary vertex over the rest bbox diagonal) and ``amplification`` (their ratio, or None).
+        Also return a dict: ``boundary`` (loop order), ``arc_length``, ``boundary_detail`` (b, 3),
+        ``editor`` (for re-solves), ``folded_triangles`` (normal against the rest one, the
+        boundary's rotation discounted), ``max_displacement`` / ``boundary_displacement`` (largest
+        move of any / a boundary vertex over the rest bbox diagonal), ``amplification`` (their
+        ratio, None for an unmoved boundary).
 
     Returns
     -------
@@ -68,19 +66,17 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
     Warns
     -----
     FoldedTrianglesWarning
-        When ``folded_triangles > 0``, with the count, the amplification and what to try (the
-        other ``relations``, a smaller displacement, ``boundary_detail="rest"``).
+        When ``folded_triangles > 0``, with the figures and what to try.
 
     Raises
     ------
     MeshError
         If the mesh is malformed or has not exactly one boundary loop.
     ConstraintError
-        If the displacements have the wrong shape, are not finite or too large, or collapse the
-        loop (``"deformed"``).
+        If the displacements (given or returned) have the wrong shape or dtype, are not finite or
+        too large, or collapse the loop (``"deformed"``).
     ValueError
-        If the displacement callable does not take ``(s, P)`` or returns the wrong shape or
-        non-finite values, or an option is not one of its values.
+        If the displacement callable does not take ``(s, P)``, or an option is not one of its values.
     SolverError
         If ``backend`` is unknown or not installed.
 
@@ -94,7 +90,7 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
     >>> bool(np.allclose(X[b, 2] - V[b, 2], 0.1 * np.sin(2 * np.pi * 2 * info["arc_length"])))
     True
     """
-    # the options before the mesh and the displacement callable (the editor checks them again)
+    # the options before the mesh and the displacement callable
     boundary_detail = check_choice(boundary_detail, "boundary_detail", ("deformed", "rest"),
                               "; use 'deformed' or 'rest'.")
     _check_relations(relations)
@@ -102,7 +98,7 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
     resolve_backend(backend)
     check_bool(return_info, "return_info")
     V = as_vertices(V)
-    F = as_faces(F, V.shape[0])        # shapes and indices; the editor below runs every mesh check
+    F = as_faces(F, V.shape[0])        # the editor below runs every mesh check
     try:
         loop = boundary_loop(F)
     except MeshError:
@@ -116,31 +112,9 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
     s = np.concatenate([[0.0], np.cumsum(seg)[:-1]]) / seg.sum()
     if callable(displacement):
         _check_displacement_signature(displacement, loop.size)
-        # called outside any try: an error inside the user's function (an IndexError, a ValueError
-        # of its own) reaches the caller unchanged, with its traceback; it was re-labelled as "the
-        # displacement callable failed" and the traceback dropped, which hid where it went wrong
-        d = displacement(s.copy(), P.copy())
-        try:
-            d = np.asarray(d)
-        except (TypeError, ValueError) as exc:            # ragged lists and the like
-            raise ValueError(f"the displacement callable returned a {type(d).__name__} that numpy cannot "
-                             f"read as an array ({exc}); it must return a ({loop.size}, 3) float array.") from None
-        if d.dtype.kind not in "fiu":   # complex would lose its imaginary part, bool mean 0/1
-            raise ValueError(f"the displacement callable returned dtype {d.dtype}; it must return a "
-                             f"({loop.size}, 3) array of real numbers.")
-        d = d.astype(np.float64)
-        if d.shape != (loop.size, 3):
-            raise ValueError(f"the displacement callable returned shape {d.shape}; it must return a "
-                             f"({loop.size}, 3) array, one row per boundary vertex.")
-        if not np.all(np.isfinite(d)):
-            bad = np.flatnonzero(~np.isfinite(d).all(axis=1))
-            raise ValueError(f"the displacement callable returned NaN or infinite values in {bad.size} rows "
-                             f"(first: {first_indices(bad)}); it must return finite displacements.")
-    else:
-        d = as_values(displacement, loop.size, "displacement")
-    Q = P + d                                   # the boundary's new positions
-    # before any algebra: beyond 1e75 the provisional surface's areas overflow (warnings, then a
-    # refusal of the editor's "positions", which the caller never passed)
+        displacement = displacement(s.copy(), P.copy())     # the user's own errors reach the caller
+    Q = P + as_values(displacement, loop.size, "displacement")       # the boundary's new positions
+    # before any algebra: beyond 1e75 the provisional surface's areas overflow
     _check_magnitude(Q, "the displaced boundary (its positions plus the displacement)", ConstraintError,
                      "use a smaller displacement")
     editor = CurvatureEditor(V, F, loop, loop, relations=relations, rcond=rcond, backend=backend)
@@ -150,7 +124,12 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
     else:                                       # editor.laplacian: of the rest shape
         Db = _deformed_boundary_detail(V, F, editor.laplacian, loop, P, Q, s_, R, t, backend)
     X = editor.solve(positions=Q, details=Db)
-    figures, folded = _figures(V, F, X, loop, R)
+    folded = folded_triangles(V, F, X, R)          # a patch turned as a whole counts none
+    diag, moved = bbox_diagonal(V), np.linalg.norm(X - V, axis=1)
+    on_loop = moved[loop].max()
+    figures = {"folded_triangles": int(folded.size), "max_displacement": float(moved.max() / diag),
+               "boundary_displacement": float(on_loop / diag),
+               "amplification": float(moved.max() / on_loop) if on_loop > 1e-12 * diag else None}
     if folded.size:
         _warn_folded(figures, folded, F.shape[0], boundary_detail, relations)
     if not return_info:
@@ -159,17 +138,12 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
 
 
 def _deformed_boundary_detail(V, F, L, loop, P, Q, s_, R, t, backend):
-    """The boundary's details on the provisional surface (``boundary_detail="deformed"``): the
-    patch moved by the boundary's best-fitting similarity ``(s_, R, t)``, plus the rest of the
-    boundary's move spread harmonically (rest cotangent weights ``L``) into the inside."""
+    """The boundary's details on the provisional surface: the patch moved by the boundary's
+    best-fitting similarity ``(s_, R, t)``, the rest of the move spread harmonically (``L``)."""
     n = V.shape[0]
     free = np.ones(n, dtype=bool)
     free[loop] = False
     inner = np.flatnonzero(free)
-    # the similarity part of the boundary's move (least squares) moves the whole patch, the rest
-    # is spread harmonically: a rotated or scaled boundary then gives the details s R D_b exactly
-    # (the cotangent weights are similarity-invariant), where spreading all of it bent a curved
-    # patch (trunk turned by 30 degrees: 1.8 diagonals off)
     Vp = s_ * V @ R.T + t
     U = np.zeros((n, 3))
     U[loop] = Q - Vp[loop]
@@ -179,25 +153,6 @@ def _deformed_boundary_detail(V, F, L, loop, P, Q, s_, R, t, backend):
     Vp += U
     _check_provisional_surface(Vp, F, P, Q)
     return laplacian_product(_cotan_laplacian_unchecked(Vp, F), Vp)[loop]
-
-
-def _figures(V, F, X, loop, R):
-    """``(figures, folded)``: the result's figures for ``info`` and the warning, and the folded
-    triangles (increasing). ``folded_triangles`` counts the triangles whose normal in ``X``
-    points against both their rest normal and their rest normal turned by ``R``, the rotation of
-    the boundary's best-fitting similarity (as the editing filter counts them against the
-    handles' turn), so that a patch turned as a whole counts none; ``max_displacement`` and
-    ``boundary_displacement`` are the largest vertex moves, overall and on the loop, over the
-    rest bbox diagonal (as the filter's ``max_displacement``), ``amplification`` their ratio
-    (None where the boundary does not move, as in the filter)."""
-    folded = folded_triangles(V, F, X, R)
-    diag = bbox_diagonal(V)
-    moved = np.linalg.norm(X - V, axis=1)
-    on_loop = moved[loop].max()
-    return {"folded_triangles": int(folded.size),
-            "max_displacement": float(moved.max() / diag),
-            "boundary_displacement": float(on_loop / diag),
-            "amplification": float(moved.max() / on_loop) if on_loop > 1e-12 * diag else None}, folded
 
 
 def _warn_folded(figures, folded, m, boundary_detail, relations):
@@ -221,9 +176,8 @@ def _warn_folded(figures, folded, m, boundary_detail, relations):
 
 
 def _check_displacement_signature(displacement, b):
-    """ValueError if ``displacement`` cannot be called as ``displacement(s, P)`` (two positional
-    arguments), checked on its signature before the call, so that a TypeError raised inside it
-    is not taken for a wrong signature; callables without a readable signature pass."""
+    """ValueError if the signature of ``displacement`` does not take ``(s, P)`` (checked before the
+    call: a TypeError inside it is the user's own); callables without a readable signature pass."""
     try:
         signature = inspect.signature(displacement)
     except (TypeError, ValueError):             # some builtins and extension types
@@ -237,11 +191,8 @@ def _check_displacement_signature(displacement, b):
 
 
 def _check_provisional_surface(Vp, F, P, Q):
-    """ConstraintError if the provisional surface ``Vp`` (whose detail gives the boundary's; the
-    loop moved from ``P`` to ``Q``) has triangles of zero area, as check_mesh counts them: a
-    displacement that collapses the boundary loop (onto a point or a line, or scales it to
-    nothing) collapses the harmonic inside with it, and its cotangent weights divided by zero
-    (numpy warnings, then NaN details refused as the caller's "details")."""
+    """ConstraintError if the provisional surface ``Vp`` (the loop moved from ``P`` to ``Q``) has
+    triangles of zero area, as check_mesh counts them: the displacement collapsed the loop."""
     diag = bbox_diagonal(Vp)
     dbl = face_double_areas(Vp, F)
     zero = np.flatnonzero(~(dbl > 2.0 * ZERO_AREA_RELATIVE * diag ** 2))      # NaN included
@@ -260,17 +211,16 @@ def _check_provisional_surface(Vp, F, P, Q):
         f"the displacement {what}: {counted(zero.size, 'triangle')} of the provisional surface whose detail gives the "
         f"boundary's (boundary_detail='deformed') {'has' if zero.size == 1 else 'have'} zero area (first: {first_indices(zero)}), so the "
         "boundary's new curvature detail is undefined. Use a displacement that keeps the loop open, or "
-        "boundary_detail='rest' (the boundary keeps its rest detail).")
+        "boundary_detail='rest' (the boundary keeps its rest detail).", parameter="displacement",
+        count=int(zero.size), first=zero[:3].tolist())
 
 
 def _similarity(P, Q):
     """``(s, R, t)`` with ``Q ~ s P R^T + t`` in least squares (Umeyama 1991): s > 0, R a
-    rotation (no reflection); the identity where ``P`` has no extent."""
+    rotation (no reflection)."""
     mp, mq = P.mean(axis=0), Q.mean(axis=0)
     A, B = P - mp, Q - mq
-    spread = float((A ** 2).sum())
-    if not spread > 0:
-        return 1.0, np.eye(3), mq - mp
+    spread = float((A ** 2).sum())               # > 0: a loop of one point was refused
     U, S, Wt = np.linalg.svd(B.T @ A)
     D = np.ones(3)
     D[2] = np.sign(np.linalg.det(U @ Wt)) or 1.0
@@ -311,7 +261,6 @@ def sine_displacement(amplitude, periods=1, axis=1, phase=0.0):
     >>> f(np.array([0.0, 0.25]), np.zeros((2, 3)))[:, 2].round(12).tolist()
     [0.0, 2.0]
     """
-    # an integer only: 2.0 passes `in (0, 1, 2)` but cannot index the output's columns
     if isinstance(axis, (bool, np.bool_)) or not isinstance(axis, numbers.Integral) or axis not in (0, 1, 2):
         raise ValueError(f"axis={axis!r}; use 0, 1 or 2 for x, y or z.")
     axis = int(axis)
@@ -338,14 +287,13 @@ def boundary_loop(F):
     Returns
     -------
     loop : (b,) int64 array
-        Boundary vertices in order, each once; ``loop[0]`` is the smallest index and each
-        ``(loop[i], loop[i + 1])`` runs as in its triangle (counter-clockwise seen from the normals).
+        Boundary vertices in order from the smallest index, each ``(loop[i], loop[i + 1])`` as in
+        its triangle (counter-clockwise seen from the normals).
 
     Raises
     ------
     MeshError
-        If the mesh has no boundary, several loops, a vertex where the boundary touches itself,
-        misoriented triangles, or ``F`` is malformed.
+        If ``F`` is malformed or has not one simple boundary loop (the cause named).
 
     Examples
     --------
@@ -360,8 +308,7 @@ def boundary_loop(F):
         problem = exc
     if E.shape[0] == 0:                 # closed: nothing more to say
         raise problem
-    # name the cause where it is not the boundary itself: repeated or reversed triangles,
-    # several pieces
+    # name the cause where it is not the boundary itself: repeated or reversed triangles, pieces
     _, F = _compact_ids(as_faces(F, None))
     corners = np.sort(F, axis=1)
     _, first, counts = np.unique(corners, axis=0, return_index=True, return_counts=True)
@@ -382,8 +329,7 @@ def boundary_loop(F):
 
 
 def loop_of_boundary_edges(E):
-    """:func:`boundary_loop` from the boundary edges ``E`` (k, 2) of :func:`boundary_edges`
-    (for callers that have them: finding them sorts every half-edge of the mesh)."""
+    """:func:`boundary_loop` from the boundary edges ``E`` (k, 2) of :func:`boundary_edges`."""
     if E.shape[0] == 0:
         raise MeshError("the mesh is closed (no boundary loop); shape editing of a boundary needs "
                         "a patch with one boundary loop.")
@@ -393,9 +339,7 @@ def loop_of_boundary_edges(E):
         raise MeshError(f"{counted(bad.size, 'boundary vertex', 'boundary vertices', verb='are')} on more than one "
                         f"boundary edge pair (first: {', '.join(map(str, bad[:3]))}); the boundary touches itself. "
                         "Repair the mesh so that its boundary is one simple loop.")
-    # every vertex has at most one edge out: the walk from the smallest start is the depth-first
-    # order of the successor graph (no Python step per boundary vertex: a 1M-vertex strip's
-    # boundary is all of it)
+    # every vertex has at most one edge out: the walk is the successor graph's depth-first order
     n = int(E.max()) + 1
     successor = sp.csr_matrix((np.ones(E.shape[0], dtype=np.int8), (E[:, 0], E[:, 1])), shape=(n, n))
     start = int(E[:, 0].min())

@@ -12,23 +12,16 @@ from .errors import ConstraintError, CurvdetailError, MeshError, counted, first_
 from .geometry import bbox_diagonal, corner_cotangents, face_double_areas
 from .topology import as_faces, non_manifold_edges, repeated_triangles
 
-#: Largest coordinate magnitude taken: triangle areas square the cross products of edge vectors
-#: (coordinates squared), which overflow double precision from ~1e77 (mean_curvature_normal then
-#: returned inf / NaN without a word).
+#: Largest coordinate magnitude taken: triangle areas (coordinates to the fourth) overflow from ~1e77.
 MAX_COORDINATE = 1e75
 
-#: Smallest bbox diagonal taken. Triangle areas square the cross products of edge vectors
-#: (fourth powers of lengths): a triangle that passes the zero-area check (area above
-#: ``ZERO_AREA_RELATIVE`` of the diagonal squared) then has a squared cross product of at least
-#: 4e-28 diag^4 = 4e-268, clear of the subnormals below 2.2e-308. Smaller meshes lost digits
-#: without a word (the nose scaled by 1e-78: K 1e-4 off, a reconstruction 5e-7) before whole
-#: areas came out as zero.
+#: Smallest bbox diagonal taken: a triangle passing the zero-area check then has a squared cross
+#: product of at least 4e-28 diag^4 = 4e-268, clear of the subnormals.
 MIN_DIAGONAL = 1e-60
 
-# A triangle whose area is below this fraction of the squared bbox diagonal is degenerate:
-# its cotangents overflow. 1e-14 leaves room for meshes of ~1e12 well-shaped triangles.
+#: A triangle whose area is below this fraction of the squared bbox diagonal is degenerate.
 ZERO_AREA_RELATIVE = 1e-14
-#: what to do about them: removing one leaves a slit in the surface where it was
+#: What to do about them (removing one leaves a slit in the surface).
 ZERO_AREA_ADVICE = ("flip or collapse them away, e.g. with pymeshlab's meshing_remove_t_vertices(method=1) "
                     "for flat slivers (meshing_remove_null_faces drops exactly-zero triangles only, and "
                     "leaves a slit where each was)")
@@ -42,7 +35,7 @@ def as_vertices(V, name="V", dim=3, max_coordinate=MAX_COORDINATE):
     except Exception as exc:  # ragged lists and the like
         raise MeshError(f"{name} could not be read as an array ({exc}); pass an (n, {dim}) float array.",
                         parameter=name) from None
-    if arr.dtype == object or not (np.issubdtype(arr.dtype, np.floating) or np.issubdtype(arr.dtype, np.integer)):
+    if arr.dtype.kind not in "fiu":
         raise MeshError(f"{name} has dtype {arr.dtype}; pass an (n, {dim}) array of real numbers.", parameter=name)
     if arr.ndim != 2 or arr.shape[1] != dim:
         raise MeshError(f"{name} has shape {arr.shape}; vertex positions must be an (n, {dim}) array.",
@@ -73,31 +66,35 @@ def _check_magnitude(arr, name, error, fix, limit=MAX_COORDINATE):
 
 
 def check_mesh(V, F, *, check_manifold=True, check_unreferenced=True):
-    """Validate a triangle mesh and return ``(V, F)`` as float64 / int64 arrays.
+    """Validate a triangle mesh and return ``(V, F)`` as new float64 / int64 arrays.
 
     Checks, in order: shapes and dtypes, emptiness, NaN/inf, coordinates beyond
-    ``MAX_COORDINATE`` (1e75: the areas would overflow), index range, repeated indices in a face,
-    a bbox diagonal below ``MIN_DIAGONAL`` (1e-60: the areas would underflow), zero-area faces
-    (below ``ZERO_AREA_RELATIVE`` times the squared bbox diagonal), duplicate triangles (the
-    same three vertices in any order; with ``check_manifold``), non-manifold edges (an edge in
-    more than two triangles) and unreferenced vertices.
+    ``MAX_COORDINATE``, index range, repeated indices in a face, a bbox diagonal below
+    ``MIN_DIAGONAL``, zero-area faces (below ``ZERO_AREA_RELATIVE`` times the squared diagonal),
+    duplicate triangles and non-manifold edges (with ``check_manifold``), unreferenced vertices.
 
     Parameters
     ----------
-    V : (n, 3) array of real numbers    vertex positions (integers are converted)
-    F : (m, 3) array of integers        triangles (integral floats are accepted)
-    check_manifold : bool               refuse duplicate triangles and edges shared by more than
-                                        two triangles
-    check_unreferenced : bool           refuse vertices used by no triangle
+    V : (n, 3) array of real numbers
+        Vertex positions.
+    F : (m, 3) array of integers
+        Triangles (whole floats are taken).
+    check_manifold : bool
+        Refuse repeated triangles and edges shared by more than two triangles.
+    check_unreferenced : bool
+        Refuse vertices used by no triangle.
 
     Returns
     -------
-    V : (n, 3) float64 C-contiguous array, a new one (never the input itself or a view of it)
-    F : (m, 3) int64 C-contiguous array, likewise new
+    V : (n, 3) float64 array
+        C-contiguous, never the input itself or a view of it.
+    F : (m, 3) int64 array
+        Likewise.
 
     Raises
     ------
-    MeshError   naming the problem, how many elements have it, the first few indices and the fix
+    MeshError
+        Naming the problem, with ``parameter``, ``count`` and ``first`` (the first indices).
 
     Examples
     --------
@@ -112,15 +109,13 @@ def check_mesh(V, F, *, check_manifold=True, check_unreferenced=True):
     (dtype('float64'), dtype('int64'))
     """
     checked = _check_mesh(V, F, check_manifold, check_unreferenced)[:2]
-    # float64 / int64 C inputs pass the conversions as themselves: copy, so that writing to the
-    # result cannot change the caller's mesh (and a read-only or memmapped input comes back writable)
+    # float64 / int64 C inputs pass the conversions as themselves: copy them
     return tuple(out.copy() if isinstance(given, np.ndarray) and np.may_share_memory(out, given) else out
                  for out, given in zip(checked, (V, F)))
 
 
 def checked_arrays(V, F, *, check_manifold=True, check_unreferenced=True):
-    """:func:`check_mesh` without its copy, for callers that only read the arrays (a float64 /
-    int64 C input comes back as itself)."""
+    """:func:`check_mesh` without its copy, for callers that only read the arrays."""
     return _check_mesh(V, F, check_manifold, check_unreferenced)[:2]
 
 
@@ -128,11 +123,16 @@ def _check_mesh(V, F, check_manifold, check_unreferenced, cotangents=False):
     V = as_vertices(V)
     F = as_faces(F, V.shape[0])
     diag = bbox_diagonal(V)
+    if diag == 0.0:
+        raise MeshError(f"the mesh is 0 across (bbox diagonal): all {V.shape[0]} vertices lie at one point, so "
+                        "every triangle has zero area; pass the mesh's real vertex positions.", parameter="V",
+                        value=diag)
     if diag < MIN_DIAGONAL:
-        raise tiny_mesh_error(diag, V.shape[0])
+        raise MeshError(f"the mesh is {diag:.3g} across (bbox diagonal), below {MIN_DIAGONAL:.0e}: its triangle "
+                        "areas (fourth powers of its lengths) underflow double precision and lose their digits; "
+                        f"scale it up, e.g. to unit size (V / {diag:.3g}), and scale the results back.",
+                        parameter="V", value=diag)
     cot = None
-    # zero areas are refused below; underflow: squares of a tiny cross-product component (a
-    # triangle almost in a coordinate plane) are negligible next to the others, not an error
     with np.errstate(divide="ignore", invalid="ignore", under="ignore"):
         if cotangents:
             cot, _, dbl = corner_cotangents(V, F, lengths=False)
@@ -146,9 +146,13 @@ def _check_mesh(V, F, check_manifold, check_unreferenced, cotangents=False):
                         "before computing curvature.", parameter="F", count=int(zero.size),
                         first=zero[:3].tolist())
     if check_manifold or cotangents:           # cotangents: the caller counts the edges itself, after this
-        duplicates = repeated_triangles(F, V.shape[0])
-        if duplicates is not None:
-            raise duplicate_triangles_error(duplicates)
+        pairs = repeated_triangles(F, V.shape[0])
+        if pairs is not None:
+            shown = ", ".join(f"({i}, {j})" for i, j in pairs[:3])
+            raise MeshError(f"F: {counted(pairs.shape[0], 'triangle', verb='repeat')} the three vertices of an "
+                            f"earlier one (first pairs: {shown}): a repeated triangle counts its area and curvature "
+                            "twice. Remove the duplicates, e.g. with pymeshlab's meshing_remove_duplicate_faces.",
+                            parameter="F", count=int(pairs.shape[0]), first=pairs[:3, 1].tolist())
     if check_manifold:
         bad = non_manifold_edges(F)
         if bad.shape[0]:
@@ -160,7 +164,7 @@ def _check_mesh(V, F, check_manifold, check_unreferenced, cotangents=False):
 
 def check_referenced(n, F, name=None):
     """MeshError for vertices ``0 .. n - 1`` that no triangle of ``F`` uses; ``name``: the
-    argument the message starts with (``"Vs: ..."``), or none."""
+    argument named first in the message, if any."""
     used = np.zeros(n, dtype=bool)
     used[F.ravel()] = True
     unused = np.flatnonzero(~used)
@@ -170,27 +174,6 @@ def check_referenced(n, F, name=None):
             f"any triangle (first: {first_indices(unused)}); "
             f"remove {them(unused.size)}, e.g. with pymeshlab's meshing_remove_unreferenced_vertices.",
             parameter=name or "V", count=int(unused.size), first=unused[:3].tolist())
-
-
-def duplicate_triangles_error(pairs):
-    """The MeshError for :func:`repeated_triangles`' ``pairs`` (first, repeat)."""
-    shown = ", ".join(f"({i}, {j})" for i, j in pairs[:3])
-    return MeshError(f"F: {counted(pairs.shape[0], 'triangle', verb='repeat')} the three vertices of an earlier "
-                     f"one (first pairs: {shown}): a repeated triangle counts its area and curvature twice. Remove the "
-                     "duplicates, e.g. with pymeshlab's meshing_remove_duplicate_faces.", parameter="F",
-                     count=int(pairs.shape[0]), first=pairs[:3, 1].tolist())
-
-
-def tiny_mesh_error(diag, n):
-    """The MeshError for a mesh ``diag`` across (bbox diagonal), below ``MIN_DIAGONAL``, of ``n``
-    vertices."""
-    if diag == 0.0:
-        return MeshError(f"the mesh is 0 across (bbox diagonal): all {n} vertices lie at one point, so every "
-                         "triangle has zero area; pass the mesh's real vertex positions.", parameter="V", value=diag)
-    return MeshError(f"the mesh is {diag:.3g} across (bbox diagonal), below {MIN_DIAGONAL:.0e}: its triangle "
-                     "areas (fourth powers of its lengths) underflow double precision and lose their digits; "
-                     f"scale it up, e.g. to unit size (V / {diag:.3g}), and scale the results back.", parameter="V",
-                     value=diag)
 
 
 def non_manifold_error(count, first):
@@ -204,12 +187,9 @@ def non_manifold_error(count, first):
 
 def as_index_set(indices, n, name):
     """Return ``indices`` as a duplicate-free int64 array in [0, n), in the order given, or raise
-    ConstraintError (with ``parameter``, ``count`` and ``first``). Takes what numpy users pass: an
-    int array or list, whole floats (3.0), a (k, 1) column, or an (n,) boolean mask (its true
-    positions, increasing)."""
-    def refuse(problem, bad=None, values=None, count=None):
-        first = None if bad is None else (values if values is not None else arr)[bad[:3]].tolist()
-        count = count if count is not None else None if bad is None else int(bad.size)
+    ConstraintError (with ``parameter``, ``count`` and ``first``). Takes an int array or list,
+    whole floats (3.0), a (k, 1) column, or an (n,) boolean mask (its true positions)."""
+    def refuse(problem, count=None, first=None):
         return ConstraintError(f"{name}: {problem}", parameter=name, count=count, first=first)
 
     try:
@@ -220,8 +200,7 @@ def as_index_set(indices, n, name):
         if arr.shape != (n,):
             raise refuse(f"a boolean mask of shape {arr.shape}; it must have shape ({n},).")
         return np.flatnonzero(arr)
-    if sum(d > 1 for d in arr.shape) > 1:
-        # an edge list (k, 2) or faces (m, 3): flattened, their shared vertices were called repeats
+    if sum(d > 1 for d in arr.shape) > 1:      # an edge list (k, 2) or faces (m, 3)
         raise refuse(f"shape {arr.shape}; pass a 1-D array of vertex indices (a column (k, 1) is taken too), "
                      "e.g. np.unique(E) for the vertices of edges E.")
     arr = arr.reshape(-1)
@@ -235,21 +214,21 @@ def as_index_set(indices, n, name):
         out = np.flatnonzero((arr < 0) | (arr >= n))
     if out.size:
         raise refuse(f"{counted(out.size, 'index', 'indices', verb='are')} outside [0, {n}) (first: "
-                     f"{', '.join(f'{v:g}' for v in arr[out[:3]].tolist())}); indices are 0-based into V.", out)
+                     f"{', '.join(f'{v:g}' for v in arr[out[:3]].tolist())}); indices are 0-based into V.",
+                     int(out.size), arr[out[:3]].tolist())
     arr = arr.astype(np.int64)
     uniq, counts = np.unique(arr, return_counts=True)
     if uniq.size != arr.size:
         repeated = uniq[counts > 1]
         raise refuse(f"{counted(arr.size - uniq.size, 'index', 'indices', verb='are')} repeated (first: "
                      f"{first_indices(repeated)}); list each vertex once (a 0/1 mask: pass it as booleans).",
-                     np.arange(repeated.size), repeated, count=int(arr.size - uniq.size))
+                     int(arr.size - uniq.size), repeated[:3].tolist())
     return arr
 
 
 def non_whole_index_error(values, name, error=ConstraintError):
-    """The ``error`` for index values that are not whole numbers (3.5, NaN, inf), naming how many,
-    the first and its position, and the fix; None where every value is whole (3.0 is an index,
-    as pymeshlab's and libigl's float index arrays are). ``values``: real numbers, flattened.
+    """The ``error`` (a CurvdetailError class) for index values that are not whole numbers (3.5,
+    NaN, inf), or None where every value is whole (3.0 is an index). ``values``: real numbers.
 
     Examples
     --------
@@ -267,22 +246,19 @@ def non_whole_index_error(values, name, error=ConstraintError):
     message = (f"{name}: {counted(bad.size, 'value')} {what} (first: {float(arr[bad[0]])!r}, at position "
                f"{bad[0]}); vertex indices are whole numbers: pass integers (or whole floats such as 3.0), "
                "not positions or weights.")
-    if isinstance(error, type) and issubclass(error, CurvdetailError):
-        return error(message, parameter=name, count=int(bad.size), first=bad[:3].tolist())
-    return error(message)
+    return error(message, parameter=name, count=int(bad.size), first=bad[:3].tolist())
 
 
 def check_bool(value, name):
-    """``bool(value)`` for True / False (numpy's too), else ValueError: ``"no"`` or ``0`` would
-    otherwise count as an answer."""
+    """``bool(value)`` for True / False (numpy's too), else a ValueError (``"no"`` is no answer)."""
     if not isinstance(value, (bool, np.bool_)):
         raise CurvdetailError(f"{name}={value!r} must be True or False.", parameter=name, value=value)
     return bool(value)
 
 
 def as_float(value):
-    """``value`` as a float if it is a real number (numpy scalars and 0-d arrays included; a
-    number too large for a double becomes inf), else None (bools and strings included)."""
+    """``value`` as a float if it is a real number (numpy scalars and 0-d arrays included; too
+    large for a double: inf), else None (bools and strings included)."""
     if isinstance(value, np.ndarray) and value.ndim == 0:
         value = value.item()
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
@@ -294,8 +270,8 @@ def as_float(value):
 
 
 def as_count(value, name, minimum=1):
-    """Return ``value`` as an int >= ``minimum`` (a whole number: ints, whole floats, numpy
-    scalars, 0-d arrays; not a bool or a string), or raise ValueError naming the argument."""
+    """Return ``value`` as an int >= ``minimum`` (ints, whole floats, numpy scalars, 0-d arrays;
+    not a bool or a string), or raise a ValueError naming the argument."""
     number = as_float(value)
     if number is None or not math.isfinite(number) or number != round(number):
         raise CurvdetailError(f"{name}={value!r} must be a whole number >= {minimum}.", parameter=name, value=value)
@@ -315,20 +291,23 @@ def as_positive_number(value, name, hint=""):
 
 def as_values(values, count, name, dim=3):
     """Return ``values`` as a (count, dim) float64 array of finite numbers within
-    ``MAX_COORDINATE`` or raise ConstraintError."""
+    ``MAX_COORDINATE`` or raise ConstraintError (``parameter=name``)."""
     try:
         arr = np.asarray(values)
     except Exception as exc:
-        raise ConstraintError(f"{name} could not be read as a float array ({exc}).") from None
+        raise ConstraintError(f"{name} could not be read as a float array ({exc}).", parameter=name) from None
     if arr.dtype.kind not in "fiu":            # complex would lose its imaginary part, bool mean 0/1
-        raise ConstraintError(f"{name} has dtype {arr.dtype}; pass a ({count}, {dim}) array of real numbers.")
+        raise ConstraintError(f"{name} has dtype {arr.dtype}; pass a ({count}, {dim}) array of real numbers.",
+                              parameter=name)
     arr = arr.astype(np.float64, copy=False)
     if arr.shape != (count, dim):
-        raise ConstraintError(f"{name} has shape {arr.shape}; expected ({count}, {dim}), one row per vertex.")
-    if not np.isfinite(arr).all():      # one flat pass; the per-row search below only on failure
+        raise ConstraintError(f"{name} has shape {arr.shape}; expected ({count}, {dim}), one row per vertex.",
+                              parameter=name)
+    if not np.isfinite(arr).all():
         bad = np.flatnonzero(~np.isfinite(arr).all(axis=1))
         raise ConstraintError(f"{name}: {counted(bad.size, 'row', verb='are')} NaN or infinite "
-                              f"(first: {first_indices(bad)}).")
+                              f"(first: {first_indices(bad)}).", parameter=name, count=int(bad.size),
+                              first=bad[:3].tolist())
     _check_magnitude(arr, name, ConstraintError, "scale the problem down")
     return np.ascontiguousarray(arr)
 
@@ -341,31 +320,19 @@ def check_transformed_values(values, what, fix, error=ConstraintError):
                     f"where the geometry overflows double precision; {fix}.")
 
 
-def shown_choice(value):
-    """How an option value that is not one of its choices is shown in a refusal: a str as its
-    repr, anything else with its type, as not a single str (an array compared with ``in`` is
-    compared element-wise: np.array(["all"]) passed as "all", two entries raised numpy's "truth
-    value ... is ambiguous")."""
-    return repr(value) if isinstance(value, str) else f"{value!r} ({type(value).__name__}, not a single str)"
-
-
-def is_choice(value, choices):
-    """Whether ``value`` is a str among ``choices`` (see :func:`shown_choice`)."""
-    return isinstance(value, str) and value in choices
-
-
 def check_choice(value, name, choices, advice, error=None):
-    """``value`` if it is a str among ``choices``, else ``error(f"{name}={shown}{advice}")``."""
-    if is_choice(value, choices):
+    """``value`` if it is a str among ``choices`` (not an array, which ``in`` compares element-wise),
+    else ``error(f"{name}={shown}{advice}")`` (default: CurvdetailError with ``parameter``)."""
+    if isinstance(value, str) and value in choices:
         return str(value)
+    shown = repr(value) if isinstance(value, str) else f"{value!r} ({type(value).__name__}, not a single str)"
     if error is None:
-        raise CurvdetailError(f"{name}={shown_choice(value)}{advice}", parameter=name, value=value)
-    raise error(f"{name}={shown_choice(value)}{advice}")
+        raise CurvdetailError(f"{name}={shown}{advice}", parameter=name, value=value)
+    raise error(f"{name}={shown}{advice}")
 
 
 def real_word(word):
-    """``float(word)`` for a number written in a text file or parameter, but ValueError for
-    Python's digit separators too (``1_0`` would be read as 10)."""
+    """``float(word)``, but a ValueError for Python's digit separators too (``1_0``)."""
     if "_" in word:
         raise ValueError(f"{word!r} is not a number")
     return float(word)
@@ -373,9 +340,7 @@ def real_word(word):
 
 def affine_transform_problem(T):
     """What is wrong with the (4, 4) handle transform ``T`` for an edit, or None: a last row other
-    than (0, 0, 0, 1), or a linear part that collapses a direction (smallest over largest
-    singular value below 1e-12: scale-free, so a uniform 1e-5 scaling passes and diag(1e6,
-    1e6, 1e-12) does not)."""
+    than (0, 0, 0, 1), or a linear part that collapses a direction (singular value ratio < 1e-12)."""
     if not np.allclose(T[3], [0.0, 0.0, 0.0, 1.0], atol=1e-12):
         return f"the last row is {T[3].tolist()}; an affine transform has (0, 0, 0, 1) there"
     sigma = np.linalg.svd(T[:3, :3], compute_uv=False)

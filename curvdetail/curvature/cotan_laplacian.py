@@ -3,9 +3,8 @@
 import numpy as np
 import scipy.sparse as sp
 
-from .geometry import corner_cotangents, thread_pool
 from .checks import _check_mesh, non_manifold_error
-from .geometry import bbox_centre
+from .geometry import bbox_centre, corner_cotangents
 
 
 def cotan_laplacian(V, F):
@@ -50,78 +49,54 @@ def cotan_laplacian(V, F):
 
 
 def checked_cotan_laplacian(V, F):
-    """Every :func:`check_mesh` check and ``L`` in one pass: ``(V, F, L)`` with V, F converted
-    (the non-manifold edge check is folded into the assembly)."""
+    """Every :func:`check_mesh` check and ``L`` in one pass: ``(V, F, L)``, V and F converted."""
     V, F, U, diagonal = checked_cotan_triangle(V, F)
     return V, F, _symmetric_from_upper(U, diagonal)
 
 
-def checked_cotan_triangle(V, F, *, edge_counts=None):
+def checked_cotan_triangle(V, F):
     """Like :func:`checked_cotan_laplacian`, with ``L`` as its strict upper triangle ``U`` (CSR,
-    sorted, explicit zeros kept: it has the edge pattern) and its diagonal: ``(V, F, U, diagonal)``.
-    A caller that needs only part of ``L`` is spared building all of it.
-    ``edge_counts``: :func:`_edge_pattern` of these triangles where the caller has it already."""
+    sorted, explicit zeros kept: the edge pattern) and its diagonal: ``(V, F, U, diagonal)``."""
     V, F, cot = _check_mesh(V, F, check_manifold=False, check_unreferenced=True, cotangents=True)
-    U, diagonal = _assemble_upper(V, F, cot, check_manifold=True, edge_counts=edge_counts)
+    U, diagonal = _assemble_upper(V, F, cot, check_manifold=True)
     return V, F, U, diagonal
 
 
-def _cotan_laplacian_unchecked(V, F, cot=None):
-    """``L`` without input checks; ``cot``: corner cotangents already computed for (V, F)."""
-    if cot is None:
-        cot, _, _ = corner_cotangents(V, F, lengths=False)
+def _cotan_laplacian_unchecked(V, F):
+    """``L`` without input checks."""
+    cot, _, _ = corner_cotangents(V, F, lengths=False)
     return _symmetric_from_upper(*_assemble_upper(V, F, cot, check_manifold=False))
 
 
-def _assemble_upper(V, F, cot, check_manifold, edge_counts=None):
+def _assemble_upper(V, F, cot, check_manifold):
     """Strict upper triangle ``U`` and diagonal of ``L``; ``check_manifold`` refuses an edge of
-    more than two triangles (counted by :func:`_edge_pattern`, or taken from ``edge_counts``)."""
+    more than two triangles."""
     n = V.shape[0]
-    # the edge opposite corner k joins corners k+1 and k+2; assemble the strict upper triangle
-    # (one entry per half-edge, summed per edge); L = U + U^T - diag(row sums). The half-edges
-    # are listed corner by corner from the (3, m) transposes, which are contiguous (cot comes from
-    # corner_cotangents that way): 0.33 -> 0.25 s at 2M triangles, the same L bit for bit
-    lo, hi = _half_edges(F, n)
-    counting = None
-    if check_manifold and edge_counts is None:
-        # SciPy's COO -> CSR releases the GIL: count the triangles on each edge alongside the
-        # weights' assembly (1M vertices: 0.5 s for one complex-valued pass, 0.2 s for these two)
-        counting = thread_pool().submit(_edge_pattern, F, n, (lo, hi))
-    w = np.ascontiguousarray(cot.T).ravel() * -0.5
-    U = sp.csr_matrix((w, (lo, hi)), shape=(n, n))
-    U.sum_duplicates()
-    U.has_sorted_indices = True          # sum_duplicates sorted them
-    if check_manifold:
-        _refuse_non_manifold(edge_counts if counting is None else counting.result())
-    diagonal = -(U @ np.ones(n) + np.bincount(U.indices, U.data, minlength=n))
-    return U, diagonal
-
-
-def _half_edges(F, n):
-    """(lo, hi) vertex pair of the edge opposite each corner, corner by corner (corner 0 of every
-    triangle, then corner 1, then corner 2)."""
+    # the edge opposite corner k joins corners k+1 and k+2, listed corner by corner (the layout
+    # of cot.T); one entry per half-edge, summed per edge; L = U + U^T - diag(row sums)
     index = np.int32 if n < 2**31 - 1 else np.int64
     Ft = F.T.astype(index)
-    i = Ft[[1, 2, 0]].ravel()
-    j = Ft[[2, 0, 1]].ravel()
-    return np.minimum(i, j), np.maximum(i, j, out=i)
-
-
-def _edge_pattern(F, n, half_edges=None):
-    """The pattern of ``L``'s strict upper triangle from the triangles alone: a CSR matrix with
-    the same ``indptr`` and ``indices`` as the ``U`` of :func:`checked_cotan_triangle` (values:
-    triangles per edge). ``half_edges``: :func:`_half_edges` of ``F`` where already at hand."""
-    lo, hi = _half_edges(F, n) if half_edges is None else half_edges
-    P = sp.csr_matrix((np.ones(lo.size, dtype=np.float32), (lo, hi)), shape=(n, n))
-    P.sum_duplicates()
-    return P
+    i, j = Ft[[1, 2, 0]].ravel(), Ft[[2, 0, 1]].ravel()
+    lo, hi = np.minimum(i, j), np.maximum(i, j, out=i)
+    if check_manifold:
+        counts = sp.csr_matrix((np.ones(lo.size, dtype=np.float32), (lo, hi)), shape=(n, n))
+        counts.sum_duplicates()
+        bad = np.flatnonzero(counts.data > 2.5)
+        if bad.size:
+            rows = np.searchsorted(counts.indptr, bad, side="right") - 1
+            raise non_manifold_error(bad.size, zip(rows[:3], counts.indices[bad[:3]]))
+    U = sp.csr_matrix((np.ascontiguousarray(cot.T).ravel() * -0.5, (lo, hi)), shape=(n, n))
+    U.sum_duplicates()
+    U.has_sorted_indices = True          # sum_duplicates sorted them
+    diagonal = -(U @ np.ones(n) + np.bincount(U.indices, U.data, minlength=n))
+    return U, diagonal
 
 
 def _symmetric_from_upper(U, diagonal):
     """``L = U + U^T + diag(diagonal)`` as CSR with sorted indices."""
     n = U.shape[0]
-    # lower triangle, diagonal, upper triangle in this order: the stable row sort of the COO -> CSR
-    # conversion then leaves every row's columns increasing, with no duplicates to sum
+    # lower triangle, diagonal, upper triangle in this order: the stable row sort of COO -> CSR
+    # leaves every row's columns increasing, with no duplicates to sum
     ur = np.repeat(np.arange(n, dtype=U.indices.dtype), np.diff(U.indptr))
     uc, uv = U.indices, U.data
     every = np.arange(n, dtype=U.indices.dtype)
@@ -130,20 +105,9 @@ def _symmetric_from_upper(U, diagonal):
                          shape=(n, n))
 
 
-def _refuse_non_manifold(counts):
-    """``counts``: :func:`_edge_pattern` (triangles per edge)."""
-    bad = np.flatnonzero(counts.data > 2.5)
-    if bad.size:
-        rows = np.searchsorted(counts.indptr, bad, side="right") - 1
-        raise non_manifold_error(bad.size, zip(rows[:3], counts.indices[bad[:3]]))
-
-
 def laplacian_product(L, V, centre=None):
-    """``L @ V`` for positions ``V`` (n, 3), computed as ``L @ (V - c)``: equal in exact
-    arithmetic (the rows of ``L`` sum to zero), but without the cancellation of large
-    coordinates. Far from the origin (UTM, ECEF) ``L @ V`` sums terms ``w x`` of the coordinates'
-    size to a result of the detail's size: a 1 mm sphere 1e6 m out lost six digits of ``K``.
-    ``c`` is ``centre`` or the bounding box's centre; ``V - c`` is exact for coordinates within a
-    factor two of it."""
+    """``L @ V`` for positions ``V`` (n, 3), computed as ``L @ (V - c)`` (``c``: ``centre`` or the
+    bbox centre): equal in exact arithmetic (rows of ``L`` sum to zero), without the cancellation
+    of large coordinates far from the origin (UTM, ECEF)."""
     V = np.asarray(V, dtype=np.float64)
     return L @ (V - (bbox_centre(V) if centre is None else centre))

@@ -5,20 +5,25 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from .geometry import ignoring_underflow
 from .checks import as_count, as_float, check_bool
-from .geometry import centroid_diameter
+from .errors import CurvdetailError
+from .geometry import centroid_diameter, ignoring_underflow
 from .cotan_laplacian import checked_cotan_laplacian, laplacian_product
 from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
 
-#: Default relative threshold on the singular values of a one-ring's detail matrix (see
-#: :func:`curvature_coefficients`). The 3x3 Gram matrices carry ~1e-16 relative error in their
-#: eigenvalues, i.e. ~1.5e-8 in the singular values, so thresholds below ~1e-7 select noise.
+#: Default relative singular-value threshold (below ~1e-7 it selects the Gram matrices' roundoff).
 DEFAULT_RCOND = 1e-6
 
-#: Default widest ring (see :func:`curvature_coefficients`): a ring that cannot represent its
-#: vertex's detail is widened to the two-ring, then the three-ring.
+#: Default widest ring: a ring that cannot represent its vertex's detail is widened up to this.
 DEFAULT_MAX_RING = 3
+
+#: Gram matrices with ``det(G) > WELL_CONDITIONED * trace(G)^3`` (hence ``cond(G) < 1e6``) are
+#: inverted in closed form; the others go through the eigendecomposition.
+WELL_CONDITIONED = 1e-6
+
+#: A ring goes through the SVD of its ring matrix where one of its singular value ratios
+#: ``sigma_k / sigma_1`` (from ``G_i``'s eigenvalues) lies in this band (see :func:`_coefficients`).
+SVD_BAND = (1e-7, 1e-3)
 
 
 @dataclass(frozen=True)
@@ -123,9 +128,11 @@ def curvature_coefficients(V, F, *, rcond=DEFAULT_RCOND, max_ring=DEFAULT_MAX_RI
     n = V.shape[0]
     D = laplacian_product(L, V)
     A = _mixed_voronoi_area_unchecked(V, F)
-    rows, cols, indptr = _one_ring_of_laplacian(L, F)
-    C, rank, scale, ring = _coefficients(D, A, rows, cols, n, rcond, centroid_diameter(V),
-                                         want_scale=return_info, max_ring=max_ring, indptr=indptr)
+    # the one-ring pairs from L's pattern (every edge both ways, every diagonal entry, sorted)
+    diag_rows = np.repeat(np.arange(n), np.diff(L.indptr))
+    off = L.indices != diag_rows
+    C, rank, scale, ring = _coefficients(D, A, diag_rows[off], L.indices[off].astype(np.int64), n, rcond,
+                                         centroid_diameter(V), want_scale=return_info, max_ring=max_ring)
     if not return_info:
         return C
     residual = np.linalg.norm(D - C @ D, axis=1)
@@ -137,7 +144,7 @@ def curvature_coefficients(V, F, *, rcond=DEFAULT_RCOND, max_ring=DEFAULT_MAX_RI
 
 
 def check_max_ring(max_ring):
-    """``max_ring`` as an int >= 1, or ValueError naming the value and the fix."""
+    """``max_ring`` as an int >= 1, or a ValueError (``parameter="max_ring"``)."""
     return as_count(max_ring, "max_ring", minimum=1)
 
 
@@ -152,55 +159,27 @@ def _one_ring_pairs(F, n):
     return rows, P.indices.astype(np.int64)
 
 
-def _one_ring_of_laplacian(L, F):
-    """The one-ring pairs as :func:`_one_ring_pairs` gives them, plus their row pointers (n + 1,),
-    read off the cotangent Laplacian's pattern: it stores every mesh edge in both directions
-    (explicit zeros kept) and every diagonal entry, sorted. That saves building the pattern
-    again from the triangles (0.3-0.5 s at 1M vertices); a Laplacian not stored so (unsorted or
-    duplicate indices, a diagonal entry missing) takes the triangles' route."""
-    n = L.shape[0]
-    if L.has_canonical_format:                      # sorted, no duplicates
-        rows = np.repeat(np.arange(n), np.diff(L.indptr))
-        off = L.indices != rows
-        if np.array_equal(rows[~off], np.arange(n)):                # every diagonal entry
-            return rows[off], L.indices[off].astype(np.int64), L.indptr - np.arange(n + 1)
-    rows, cols = _one_ring_pairs(F, n)
-    return rows, cols, _row_pointers(rows, n)
-
-
-#: Gram matrices with ``det(G) > WELL_CONDITIONED * trace(G)^3`` (hence ``cond(G) < 1e6``) are
-#: inverted in closed form; the others go through the eigendecomposition.
-WELL_CONDITIONED = 1e-6
-
-
 def check_rcond(rcond):
-    """``rcond`` as a float in (0, 1), or ValueError naming the value and the fix."""
-    number = as_float(rcond)           # a real number only: float("1e-6") and float(True) would pass
+    """``rcond`` as a float in (0, 1), or a ValueError (``parameter="rcond"``)."""
+    number = as_float(rcond)
     if number is None:
-        raise ValueError(f"rcond={rcond!r} is not a number; pass a threshold in (0, 1), e.g. 1e-6.")
+        raise CurvdetailError(f"rcond={rcond!r} is not a number; pass a threshold in (0, 1), e.g. 1e-6.",
+                              parameter="rcond", value=rcond)
     if not 0.0 < number < 1.0:
-        raise ValueError(f"rcond={rcond!r} is outside (0, 1); pass a relative threshold such as 1e-6.")
+        raise CurvdetailError(f"rcond={rcond!r} is outside (0, 1); pass a relative threshold such as 1e-6.",
+                              parameter="rcond", value=rcond)
     return number
 
 
-#: A ring goes through the SVD of its ring matrix where one of its singular value ratios
-#: ``sigma_k / sigma_1`` (from ``G_i``'s eigenvalues) lies in this band (see :func:`_coefficients`).
-SVD_BAND = (1e-7, 1e-3)
-
-
 @ignoring_underflow
-def _coefficients(D, A, rows, cols, n, rcond, size, *, want_scale=False, max_ring=1, adjacency=None,
-                  indptr=None):
+def _coefficients(D, A, rows, cols, n, rcond, size, *, want_scale=False, max_ring=1, adjacency=None):
     """Batched truncated pseudo-inverse solve over the pattern (rows, cols), sorted by row.
 
     Rows whose fit leaves a residual above the threshold are widened by one ring of ``adjacency``
     (the one-ring pairs, sorted by row; default (rows, cols)) at a time, ``max_ring - 1`` times
-    at most, and no further once a widening adds no vertex (a whole small component, a vertex
-    without neighbours). ``indptr``: the pattern's row pointers where the caller has them.
-    Returns (C, rank, scale or None, ring): ``C`` on the (widened) pattern, explicit zeros kept;
+    at most, and no further once a widening adds no vertex. Returns (C, rank, scale or None, ring): ``C`` on the (widened) pattern, explicit zeros kept;
     ``ring`` (n,) the number of rings each row's coefficients span (1 = the given pattern)."""
-    if indptr is None:
-        indptr = _row_pointers(rows, n)
+    indptr = _row_pointers(rows, n)
     Dj = D[cols]
     # the 6 distinct entries of G_i = sum_j D_j D_j^T
     g = {}
@@ -224,8 +203,7 @@ def _coefficients(D, A, rows, cols, n, rcond, size, *, want_scale=False, max_rin
         # clears the threshold; cond(G) <= tr^3 / det keeps the adjugate accurate
         good = (det > WELL_CONDITIONED * tr ** 3) & \
                (np.sqrt(np.maximum(det, 0.0)) / tr > rcond * np.maximum(np.sqrt(tr), area_scale))
-        # on every row (the same operations as on the good rows alone); the others are
-        # overwritten below
+        # on every row; the others are overwritten below
         d0, d1, d2 = D[:, 0], D[:, 1], D[:, 2]
         w = np.stack([(c00 * d0 + c01 * d1 + c02 * d2) / det,
                       (c01 * d0 + c11 * d1 + c12 * d2) / det,
@@ -233,8 +211,7 @@ def _coefficients(D, A, rows, cols, n, rcond, size, *, want_scale=False, max_rin
     rank = np.full(n, 3, dtype=np.int64)
     scale = None
     if want_scale:
-        # sigma_1 of the well-conditioned rows: the largest eigenvalue of G is accurate (the
-        # other rows take theirs from their fit below)
+        # sigma_1 of the well-conditioned rows from G's largest eigenvalue (the others: their fit)
         scale = area_scale.copy()
         scale[good] = np.maximum(np.sqrt(np.maximum(np.linalg.eigvalsh(_gram(g, good))[:, 2], 0.0)),
                                  area_scale[good])
@@ -242,15 +219,12 @@ def _coefficients(D, A, rows, cols, n, rcond, size, *, want_scale=False, max_rin
     hard = np.flatnonzero(~good)
     if hard.size:
         s_hard, residual = np.empty(hard.size), np.empty(hard.size)
-        # G's eigenvalues carry ~1e-16 of the largest, so a singular value between ~1e-7 and
-        # 1e-3 of the largest (near the threshold, or kept with a large weight 1 / sigma^2) is
-        # known only to 1e-10 ... 1e-2 of itself: those rows (fandisk: 46 of them changed by up to
-        # 5e-5 under a rotation) go through the SVD of the ring matrix itself. Rows certain to
-        # go there skip the eigendecomposition (a smooth surface's rings: nearly all of them)
+        # G's eigenvalues carry ~1e-16 of the largest, so a singular value in SVD_BAND is known
+        # only to 1e-10 ... 1e-2 of itself: those rows go through the SVD of the ring matrix
+        # itself; rows certain to go there skip the eigendecomposition
         sure = _surely_in_svd_band(c00[hard], c11[hard], c22[hard], tr[hard])
         redo = sure.copy()
-        # G = 0 (every neighbour's detail is 0: a flat grid's inside) has no singular direction
-        # to keep: w = 0 and rank 0, as its eigendecomposition would give them, without it
+        # G = 0 (a flat grid's inside): w = 0 and rank 0, as the eigendecomposition would give
         zero = tr[hard] == 0.0
         w[hard[zero]], rank[hard[zero]], s_hard[zero] = 0.0, 0, area_scale[hard[zero]]
         residual[zero] = np.linalg.norm(D[hard[zero]], axis=1)
@@ -266,68 +240,36 @@ def _coefficients(D, A, rows, cols, n, rcond, size, *, want_scale=False, max_rin
         redo = np.flatnonzero(redo)
         if redo.size:
             rows_redo = hard[redo]
-            if rows_redo.size > n // 8:           # most rows (a smooth surface): one pass of masks
-                which = np.zeros(n, dtype=bool)
-                which[rows_redo] = True
-                cols_redo = cols[which[rows]]
-            else:
-                cols_redo = cols[_rows_of(indptr, rows_redo)]
+            cols_redo = cols[_rows_of(indptr, rows_redo)]
             w[rows_redo], rank[rows_redo], s_hard[redo], residual[redo] = _truncated_fit(
                 D, A, rows_redo, indptr[rows_redo + 1] - indptr[rows_redo], cols_redo, rcond, size,
                 area_scale=area_scale[rows_redo])
         if want_scale:
             scale[hard] = s_hard
-        # widen the rings that cannot represent their own detail (a valence-2 corner's two
-        # neighbours span a plane its detail leaves): the residual would otherwise be a constant
-        # that no similarity of the constraints moves (see CurvatureEditor)
+        # widen the rings that cannot represent their own detail (a valence-2 corner)
         grow = residual > rcond * s_hard
         if max_ring > 1 and grow.any():
             wide = _widen(D, A, w, rank, scale, ring, hard[grow], rows, cols, indptr, n, rcond, size,
                           max_ring, adjacency)
-            if wide is not None:
+            if wide is not None:           # widened rows take their wide ring's pattern
                 wide_rows, wide_cols = wide
-                wide_vals = np.einsum("ea,ea->e", D[wide_cols], w[wide_rows])
-                # the given pattern's entries of widened rows are left out below (their w is the
-                # wide ring's)
-                vals = np.einsum("ea,ea->e", Dj, w[rows])
-                return _splice(indptr, rows, cols, vals, ring > 1, wide_rows, wide_cols, wide_vals,
-                               n), rank, scale, ring
+                kept = ring[rows] == 1
+                rows, cols = np.concatenate([rows[kept], wide_rows]), np.concatenate([cols[kept], wide_cols])
+                vals = np.einsum("ea,ea->e", D[cols], w[rows])
+                return sp.csr_matrix((vals, (rows, cols)), shape=(n, n)), rank, scale, ring
     # C_ij = D_j . w_i  (w_i = G_i^+ D_i)
     vals = np.einsum("ea,ea->e", Dj, w[rows])
     return sp.csr_matrix((vals, cols, indptr), shape=(n, n)), rank, scale, ring
 
 
-def _splice(indptr, rows, cols, vals, replaced, wide_rows, wide_cols, wide_vals, n):
-    """CSR (n, n) of the row-sorted pattern (``indptr``, ``rows``, ``cols``) and its ``vals``, with
-    the rows ``replaced`` (n,) bool taking the entries (``wide_rows``, ``wide_cols``,
-    ``wide_vals``) instead: each such row's entries are contiguous there, columns increasing.
-    Placed by position (no sort of the whole pattern, which a COO build would do)."""
-    order = np.argsort(wide_rows, kind="stable")
-    wide_cols, wide_vals = wide_cols[order], wide_vals[order]
-    new_counts = np.where(replaced, np.bincount(wide_rows, minlength=n), np.diff(indptr))
-    new_indptr = _cumulative(new_counts)
-    out_cols = np.empty(int(new_indptr[-1]), dtype=cols.dtype)
-    out_vals = np.empty(int(new_indptr[-1]))
-    kept = np.flatnonzero(~replaced[rows])
-    # a kept row's entries keep their order; the row moves by the change of its start
-    dest = kept + (new_indptr[:-1] - indptr[:-1])[rows[kept]]
-    out_cols[dest], out_vals[dest] = cols[kept], vals[kept]
-    dest = np.flatnonzero(np.repeat(replaced, new_counts))
-    out_cols[dest], out_vals[dest] = wide_cols, wide_vals
-    return sp.csr_matrix((out_vals, out_cols, new_indptr), shape=(n, n))
-
-
 def _surely_in_svd_band(c00, c11, c22, tr):
-    """Rows whose Gram matrix ``G`` certainly has ``sigma_2 / sigma_1`` inside :data:`SVD_BAND`
-    as ``G``'s eigenvalues give it, told from its invariants alone (no eigendecomposition: 1.4 s
-    at 1M vertices); (k,) bool. ``c00, c11, c22`` (k,): the diagonal cofactors, ``tr`` the trace.
+    """Rows whose Gram matrix ``G`` certainly has ``sigma_2 / sigma_1`` inside :data:`SVD_BAND`,
+    told from its invariants alone (no eigendecomposition); (k,) bool. ``c00, c11, c22`` (k,):
+    the diagonal cofactors, ``tr`` the trace.
 
-    With ``S = lambda_2 + lambda_3`` and ``q = (c00 + c11 + c22) / tr^2 = (lambda_1 S +
-    lambda_2 lambda_3) / tr^2``, ``lambda_2 / lambda_1`` lies in ``[q / 2, q]`` up to ``O(q^2)``
-    and roundoff (~1e-13 even at valence 1000, where the summed ``G`` may be indefinite by that
-    much; an eigensolver's eigenvalues are off by ~1e-15 of ``lambda_1``). The band kept here
-    leaves a margin of 1e-4 of the limit at the top and a factor 100 at the bottom; rows outside
-    it (non-finite ``q`` included) are decided by their eigenvalues."""
+    ``q = (c00 + c11 + c22) / tr^2 = (lambda_1 (lambda_2 + lambda_3) + lambda_2 lambda_3) / tr^2``
+    puts ``lambda_2 / lambda_1`` in ``[q / 2, q]`` up to ``O(q^2)`` and roundoff; the band kept
+    leaves a margin of 1e-4 at the top and a factor 100 at the bottom."""
     low, high = SVD_BAND
     with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
         q = (c00 + c11 + c22) / tr ** 2
@@ -335,19 +277,17 @@ def _surely_in_svd_band(c00, c11, c22, tr):
 
 
 def _widen(D, A, w, rank, scale, ring, target, rows, cols, indptr, n, rcond, size, max_ring, adjacency):
-    """Refit the rows ``target`` (increasing) over wider rings until their detail is represented,
-    the ring stops growing or ``max_ring`` is reached. Updates ``w``, ``rank``, ``scale`` (where
-    not None) and ``ring`` in place; returns the widened rows' pattern ``(rows, cols)`` (each row's
-    columns increasing), or None where no row took a wider ring."""
+    """Refit the rows ``target`` over wider rings until their detail is represented, the ring
+    stops growing or ``max_ring`` is reached. Updates ``w``, ``rank``, ``scale`` (where not None)
+    and ``ring`` in place; returns the widened rows' pattern ``(rows, cols)``, or None."""
     if adjacency is None:
         P = sp.csr_matrix((np.ones(cols.size, dtype=bool), cols, indptr), shape=(n, n))
     else:
         ar, ac = adjacency
         P = sp.csr_matrix((np.ones(ac.size, dtype=bool), ac, _row_pointers(ar, n)), shape=(n, n))
-    # the rows' current rings (without the vertex itself) as CSR pieces over ``target``
-    counts = indptr[target + 1] - indptr[target]
+    counts = indptr[target + 1] - indptr[target]          # the rows' rings, without the vertex
     ring_cols = cols[_rows_of(indptr, target)]
-    wide_rows, wide_cols = [], []
+    pieces = []                                           # (rows, cols, ring) of every refit
     for extra in range(1, max_ring):
         R = sp.csr_matrix((np.ones(ring_cols.size, dtype=bool), ring_cols, _cumulative(counts)),
                           shape=(target.size, n))
@@ -356,39 +296,28 @@ def _widen(D, A, w, rank, scale, ring, target, rows, cols, indptr, n, rcond, siz
         at = np.repeat(np.arange(target.size), np.diff(R.indptr))
         keep = R.indices != target[at]
         new_counts = np.bincount(at[keep], minlength=target.size)
-        new_cols = R.indices[keep].astype(np.int64)
         # a ring that adds no vertex (the row's whole component already) keeps its narrower fit
-        grew = new_counts > counts
-        if extra > 1 and not grew.all():
-            stuck = np.flatnonzero(~grew)
-            wide_rows.append(np.repeat(target[stuck], counts[stuck]))
-            wide_cols.append(ring_cols[_rows_of(_cumulative(counts), stuck)])
-        if not grew.any():
+        moved = np.flatnonzero(new_counts > counts)
+        if not moved.size:
             break
-        if not grew.all():
-            moved = np.flatnonzero(grew)
-            new_cols = new_cols[_rows_of(_cumulative(new_counts), moved)]
-            target, new_counts = target[moved], new_counts[moved]
-        counts, ring_cols = new_counts, new_cols
+        ring_cols = R.indices[keep].astype(np.int64)[_rows_of(_cumulative(new_counts), moved)]
+        target, counts = target[moved], new_counts[moved]
         w_t, rank_t, s_t, residual_t = _truncated_fit(D, A, target, counts, ring_cols, rcond, size)
-        # a wider ring never fits worse: take it (its pattern replaces the narrower one)
+        # a wider ring never fits worse: take it
         w[target], rank[target], ring[target] = w_t, rank_t, extra + 1
         if scale is not None:
             scale[target] = s_t
-        still = residual_t > rcond * s_t
-        if extra == max_ring - 1 or not still.any():     # every row's widest fit is final
-            wide_rows.append(np.repeat(target, counts))
-            wide_cols.append(ring_cols)
+        pieces.append((np.repeat(target, counts), ring_cols, extra + 1))
+        still = np.flatnonzero(residual_t > rcond * s_t)
+        ring_cols = ring_cols[_rows_of(_cumulative(counts), still)]
+        target, counts = target[still], counts[still]
+        if not target.size:
             break
-        done = np.flatnonzero(~still)
-        wide_rows.append(np.repeat(target[done], counts[done]))
-        wide_cols.append(ring_cols[_rows_of(_cumulative(counts), done)])
-        carry = np.flatnonzero(still)
-        ring_cols = ring_cols[_rows_of(_cumulative(counts), carry)]
-        target, counts = target[carry], counts[carry]
-    if not wide_rows:
+    if not pieces:
         return None
-    return np.concatenate(wide_rows), np.concatenate(wide_cols)
+    wide_rows, wide_cols = (np.concatenate([p[k] for p in pieces]) for k in (0, 1))
+    last = ring[wide_rows] == np.concatenate([np.full(p[0].size, p[2]) for p in pieces])
+    return wide_rows[last], wide_cols[last]
 
 
 def _gram(g, which):
@@ -423,35 +352,23 @@ def _rows_of(indptr, which):
 def _truncated_fit(D, A, target, counts, cols, rcond, size, *, area_scale=None):
     """Truncated minimum-norm fit of ``D_i`` by its ring's details for the rows ``target``
     (``counts`` (t,) ring sizes; ``cols`` the rings' vertices, row after row), through batched
-    SVDs of the zero-padded ring matrices. Returns (w (t, 3), rank (t,), s_i (t,),
-    residual (t,)), where ``C_ij = D_j . w_i``. ``area_scale`` (t,): the rings'
-    ``sqrt(sum_j A_j^2) / size`` where the caller has it.
-
-    Rings are batched by size (up to 16, larger ones padded to the next power of two), not all
-    padded to the largest (one high-valence pole would make every ring that large)."""
+    SVDs of the ring matrices, zero-padded in batches by size (up to 16, larger ones to the next
+    power of two). Returns (w (t, 3), rank (t,), s_i (t,), residual (t,)), where
+    ``C_ij = D_j . w_i``. ``area_scale`` (t,): the rings' ``sqrt(sum_j A_j^2) / size`` if at hand."""
     if area_scale is None:
         at = np.repeat(np.arange(target.size), counts)
         area_scale = (np.sqrt(np.bincount(at, weights=A[cols] ** 2, minlength=target.size))
                       / max(size, np.finfo(float).tiny))
     width = np.where(counts <= 16, np.maximum(counts, 3), 1 << np.ceil(np.log2(np.maximum(counts, 1))).astype(np.int64))
-    widths = np.unique(width)
-    entry_width = np.repeat(width, counts) if widths.size > 1 else None
+    entry_width = np.repeat(width, counts)
     sigma, U = np.zeros((target.size, 3)), np.zeros((target.size, 3, 3))
-    for w in widths:
-        w = int(w)
-        if entry_width is None:                      # one batch: every row, every entry
-            group, cols_group, counts_group = slice(None), cols, counts
-        else:
-            group = np.flatnonzero(width == w)
-            cols_group, counts_group = cols[entry_width == w], counts[group]
-        size_group = counts_group.size
-        if np.all(counts_group == w):                # no padding: the ring matrices as they lie
-            M = D[cols_group].reshape(size_group, w, 3)
-        else:
-            # entry e of the group's row r goes to slot e - first(r) of that row's padded block
-            shift = np.arange(size_group) * w - _cumulative(counts_group)[:-1]
-            M = np.zeros((size_group, w, 3))
-            M.reshape(-1, 3)[np.arange(cols_group.size) + np.repeat(shift, counts_group)] = D[cols_group]
+    for w in np.unique(width):
+        group = np.flatnonzero(width == w)
+        cols_group, counts_group = cols[entry_width == w], counts[group]
+        # entry e of the group's row r goes to slot e - first(r) of that row's padded block
+        shift = np.arange(group.size) * w - _cumulative(counts_group)[:-1]
+        M = np.zeros((group.size, w, 3))
+        M.reshape(-1, 3)[np.arange(cols_group.size) + np.repeat(shift, counts_group)] = D[cols_group]
         # M = D_N^T; D_N's left singular vectors are M's right ones
         with np.errstate(over="ignore", invalid="ignore"):
             _, sigma_g, Vt = np.linalg.svd(M, full_matrices=False)      # descending

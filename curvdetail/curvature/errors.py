@@ -1,18 +1,15 @@
-"""Exceptions raised for malformed input, and the warning of a result that folded.
+"""Exceptions for malformed input (all ``ValueError`` subclasses) and the folded-result warning."""
 
-Every exception class derives from ``ValueError`` so that ``except ValueError`` keeps working for
-callers who do not care about the details; the message always says what is wrong, how much,
-where (the first offending indices) and what to do about it.
-"""
+import sys
+import warnings
 
 
 class CurvdetailError(ValueError):
-    """Base of the package's input errors: the message, and the facts as fields.
+    """Base of the package's input errors: the message and the facts as fields.
 
-    ``parameter`` (the argument at fault, by its Python name), ``value`` (what was given),
-    ``hint`` (what to do, in neutral words; appended to the message), ``count`` and ``first``
-    (how many things are wrong and the first indices). A front end (the CLI, the filters) reads
-    the fields and says it in its own terms; ``problem`` is the message without the hint.
+    ``parameter`` (the argument at fault), ``value`` (what was given), ``hint`` (what to do;
+    appended to the message), ``count`` and ``first`` (how many things are wrong, the first
+    indices); ``problem`` is the message without the hint.
     """
 
     def __init__(self, problem="", *, parameter=None, value=None, hint=None, count=None, first=None):
@@ -22,8 +19,7 @@ class CurvdetailError(ValueError):
 
 
 class MeshError(CurvdetailError):
-    """A mesh ``(V, F)`` is malformed: shapes, dtypes, non-finite values, bad indices,
-    degenerate or non-manifold elements, unreferenced vertices, wrong topology."""
+    """A mesh ``(V, F)`` is malformed (shapes, values, indices, degenerate elements, topology)."""
 
 
 class ConstraintError(CurvdetailError):
@@ -31,11 +27,8 @@ class ConstraintError(CurvdetailError):
 
 
 class UndeterminedEditError(ConstraintError):
-    """The constraints of an edit leave part of it undetermined: a connected free region that no
-    constraint reaches, or a curvature stage singular to working precision (see
-    ``CurvatureEditor.rest_error``). ``problem`` is what was found and ``advice`` what to change
-    in the editor's terms; callers with their own way of giving constraints (a selection file, a
-    filter's parameters) raise it again with their own advice."""
+    """An edit's constraints leave part of it undetermined; ``problem`` is what was found and
+    ``advice`` what to change in the editor's terms (front ends give their own)."""
 
     def __init__(self, problem, advice):
         super().__init__(f"{problem} {advice}")
@@ -43,19 +36,12 @@ class UndeterminedEditError(ConstraintError):
 
 
 class FoldedTrianglesWarning(UserWarning):
-    """Said when triangles of an edit's result fold over (their normals point against the rest
-    shape's), e.g. by :func:`edit_boundary`: the edit ran, but the surface is not usable as it
-    is. The message gives the count, the first folded triangles, how far the vertices moved and
-    what to try; the same figures are in the function's ``info``. Turn it into an error with
-    ``warnings.simplefilter("error", FoldedTrianglesWarning)``."""
+    """Triangles of an edit's result folded over (normals against the rest shape's): the edit ran,
+    but the surface is not usable as it is."""
 
 
 def warn(message, category):
-    """``warnings.warn`` naming the first caller outside curvdetail: the warning points at the
-    user's line (and is shown once per such line, not once per process)."""
-    import sys
-    import warnings
-
+    """``warnings.warn`` pointing at the first caller outside curvdetail (the user's line)."""
     frame, level = sys._getframe(1), 2
     while frame is not None and frame.f_globals.get("__name__", "").startswith("curvdetail"):
         frame, level = frame.f_back, level + 1
@@ -63,9 +49,8 @@ def warn(message, category):
 
 
 def first_indices(indices, count=3):
-    """Format the first few offending indices for an error message: ``'17, 402, 9311'``."""
-    indices = [int(i) for i in list(indices)[:count]]
-    return ", ".join(str(i) for i in indices)
+    """The first few offending indices for a message: ``'17, 402, 9311'``."""
+    return ", ".join(str(int(i)) for i in list(indices)[:count])
 
 
 #: The singular of the verbs the messages put after a count (the rest take an "s").
@@ -73,10 +58,8 @@ _SINGULAR_VERBS = {"are": "is", "have": "has", "were": "was", "reach": "reaches"
 
 
 def counted(count, noun, plural=None, verb=None):
-    """A count with its noun (and the verb after it) in the right number, for a message:
-    ``counted(1, "edge", verb="are")`` is ``'1 edge is'``, ``counted(3, "vertex", "vertices")``
-    ``'3 vertices'``. ``plural`` defaults to ``noun + "s"``; ``verb`` is given in the plural
-    (``"are"``, ``"have"``, ``"lie"``, ...).
+    """A count with its noun (and verb, given in the plural) in the right number; ``plural``
+    defaults to ``noun + "s"``.
 
     Examples
     --------

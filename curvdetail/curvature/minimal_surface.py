@@ -4,9 +4,9 @@ import numpy as np
 
 from .checks import ZERO_AREA_RELATIVE, as_count, as_index_set, as_positive_number, check_choice
 from .geometry import bbox_centre, bbox_diagonal, corner_cotangents, ignoring_underflow, vertex_normals
-from .topology import boundary_vertices, check_every_component_fixed, misoriented_edges, undirected_edges, vertex_components
+from .topology import boundary_vertices, check_every_component_fixed, edge_keys, misoriented_edges, vertex_components
 from .cotan_laplacian import _assemble_upper, checked_cotan_triangle
-from .errors import ConstraintError, MeshError, counted, first_indices, them
+from .errors import ConstraintError, CurvdetailError, MeshError, counted, first_indices, them
 from .reconstruct import _FreeSystemLayout
 from .sparse_solver import factorize
 
@@ -35,39 +35,30 @@ class MinimalSurfaceResult(np.ndarray):
 
     _FIGURES = ("iterations", "converged", "last_step", "last_full_step", "contraction", "remaining_estimate")
 
-    def __array_finalize__(self, obj):
-        # views, copies and ufunc results start from ``obj``'s figures (None from a plain array)
+    def __array_finalize__(self, obj):           # views, copies, ufunc results: obj's figures
         for name in self._FIGURES:
             setattr(self, name, getattr(obj, name, None))
 
-    def __reduce__(self):
-        # ndarray's pickle state is the array's alone: the figures ride along at its end
+    def __reduce__(self):                        # the figures ride along at the end of the state
         constructor, arguments, state = super().__reduce__()
         return constructor, arguments, state + (tuple(getattr(self, name, None) for name in self._FIGURES),)
 
     def __setstate__(self, state):
-        if len(state) == 5:                 # ndarray's own state: pickled before the figures rode along
-            super().__setstate__(state)
-            return
         *array_state, figures = state
         super().__setstate__(tuple(array_state))
         for name, value in zip(self._FIGURES, figures):
             setattr(self, name, value)
 
 
-#: Default stopping tolerance of :func:`minimal_surface`: the last step moved the shape by less
-#: than 1e-4 of the bbox diagonal (0.01 %). That bounds the step, not the distance to the
-#: iteration's limit (see docs/benchmarks.md, "minimal_surface: what the tolerance means").
+#: Default stopping tolerance: the last step moved the shape by less than 1e-4 of the bbox
+#: diagonal (a bound on the step, not on the distance to the iteration's limit).
 DEFAULT_TOL = 1e-4
 
-#: Largest ``|cot|`` of a corner in a usable result: an angle within 1e-6 rad of 0 or 180 degrees.
-#: Results on real patches (trunk, camelhead, mannequin_disk_1k, the nose after 500 steps) stay
-#: below ~100; a pinching neck or a collapsing free rim passes 1e3, 1e4, ... within a step or two
-#: (the 24 x 8 cylinder of height 2 reached 3.4e7 and was returned as converged).
+#: Largest ``|cot|`` of a corner in a usable result (an angle within 1e-6 rad of 0 or 180 degrees);
+#: real results stay below ~100, a pinching neck passes 1e3, 1e4, ... within a step or two.
 DEGENERATE_COTANGENT = 1e6
 
-#: A triangle counts as degenerated only where its ``|cot|`` also grew this many times over the
-#: input's: an input sliver that the checks accept (down to ZERO_AREA_RELATIVE) is not refused.
+#: ... where it also grew this many times over the input's (an input sliver is not refused).
 DEGENERATE_GROWTH = 100.0
 
 
@@ -82,10 +73,7 @@ def _piece_diagonals(V, F, adjacency):
     starts = np.flatnonzero(np.r_[True, np.diff(labels[order]) != 0])
     sorted_V = V[order]
     extent = np.maximum.reduceat(sorted_V, starts) - np.minimum.reduceat(sorted_V, starts)
-    # a piece of zero extent (unreferenced vertices are refused, so at least a triangle) cannot
-    # occur in a checked mesh; the floor keeps the division finite regardless
-    piece = np.maximum(np.linalg.norm(extent, axis=1), np.finfo(float).tiny)
-    return piece[labels], (labels, order, starts)
+    return np.linalg.norm(extent, axis=1)[labels], (labels, order, starts)
 
 
 @ignoring_underflow
@@ -99,8 +87,7 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, step="n
     diagonal of the vertex's connected piece (tangential sliding, which degrades triangles and
     never stops on irregular meshes, is not counted), or after ``max_iterations`` steps. A piece
     whose step falls below ``tol`` keeps its positions while the others go on. A step that
-    collapses triangles raises MeshError. See docs/benchmarks.md, "minimal_surface: what the
-    tolerance means".
+    collapses triangles raises MeshError.
 
     Parameters
     ----------
@@ -130,12 +117,11 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, step="n
     Raises
     ------
     MeshError
-        If the mesh is malformed, or triangles collapsed during the iteration (the message says
-        the likely cause).
+        If the mesh is malformed, or triangles collapsed (the message says the likely cause).
     ConstraintError
         If ``fixed`` is refused, a piece has no fixed vertex, or a boundary vertex is left free.
     ValueError
-        If ``max_iterations``, ``tol`` or ``step`` is not one of its allowed values.
+        If ``max_iterations``, ``tol``, ``step`` or ``callback`` is not allowed.
     SolverError
         If ``backend`` is unknown or not installed.
 
@@ -153,32 +139,34 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, step="n
     step = check_choice(step, "step", ("normal", "full"), "; use 'normal' (the step across the surface) "
                         "or 'full' (the whole vertex displacement).")
     if callback is not None and not callable(callback):
-        raise ValueError(f"callback={callback!r} is not callable; pass a function (iteration, step) or None.")
+        raise CurvdetailError(f"callback={callback!r} is not callable; pass a function (iteration, step) or None.",
+                              parameter="callback", value=callback)
     V, F, U, diagonal = checked_cotan_triangle(V, F)     # every mesh check; L of the first step
     n = V.shape[0]
     fixed = as_index_set(fixed, n, "fixed")
     if fixed.size == 0:
         raise ConstraintError("no fixed vertices: a minimal surface needs a fixed boundary; pass e.g. "
-                              "boundary_vertices(F).")
+                              "boundary_vertices(F).", parameter="fixed", count=0)
     check_every_component_fixed(F, n, fixed, adjacency=U)
     is_free = np.ones(n, dtype=bool)
     is_free[fixed] = False
-    _check_boundary_fixed(F, is_free)
-    # the step is measured along vertex normals, which reversed triangles cancel: the iteration
-    # ran to max_iterations "not converged". Where triangles are not consistently oriented (or
-    # cannot be: a Moebius strip), the normals are summed sign-aligned instead (1M vertices: the
-    # check ~0.9 s, a fifth of a step)
+    # a free rim has no minimal surface: it shrinks onto the fixed vertices
+    boundary = boundary_vertices(F)
+    loose = boundary[is_free[boundary]]
+    if loose.size:
+        raise ConstraintError(
+            f"{counted(loose.size, 'boundary vertex', 'boundary vertices', verb='are')} not fixed (of "
+            f"{boundary.size}; first: {first_indices(loose)}): a surface with a free boundary has no "
+            "minimal surface (it shrinks onto the fixed vertices until its triangles collapse). Fix the "
+            "whole boundary too, e.g. np.union1d(fixed, boundary_vertices(F)).",
+            parameter="fixed", count=int(loose.size), first=loose[:3].tolist())
+    # the step is measured along vertex normals, which reversed triangles would cancel
     aligned = step == "normal" and misoriented_edges(F).shape[0] > 0
     free = np.flatnonzero(is_free)
     diag = bbox_diagonal(V)
-    # steps are measured against the diagonal of each vertex's own piece: against the whole
-    # mesh's, a small piece next to a big one (or far from it) counted as settled long before it
-    # was (a nose beside an ear 10 units away stopped after 4 of its 44 steps)
+    # steps relative to each vertex's own piece; a piece whose step fell below tol stays put
     scale, pieces = _piece_diagonals(V, F, U)
-    # a piece whose step fell below tol keeps its positions while the others go on: it went on
-    # sliding otherwise (the ear beside the nose: 41 steps past its own 3, 1.2e-2 of its diagonal)
-    settled = None
-    factor = None
+    settled = factor = cot = None
     centre = bbox_centre(V[fixed])
     layout = _FreeSystemLayout(U, is_free, fixed)    # the same for every step: F does not change
     X = V.copy()
@@ -190,8 +178,7 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, step="n
         if it > 0:                          # weights of the current surface
             U, diagonal = _assemble_upper(X, F, cot, check_manifold=False)
         system, L_fc = layout.values(U, diagonal)
-        # the pattern of L_ff never changes: the solver keeps its ordering and symbolic analysis
-        # and redoes only the numeric factorization (PARDISO, 1M vertices: ~1.5 of ~5.5 s)
+        # the pattern of L_ff never changes: refactor redoes the numeric factorization only
         if factor is None:
             factor = factorize(system, symmetric=True, backend=backend, upper=True)
         else:
@@ -199,20 +186,23 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, step="n
         X_new = X.copy()
         # about the fixed vertices' centre: large coordinates (UTM, ECEF) do not cancel
         X_new[free] = factor.solve(-(L_fc @ (X[fixed] - centre))) + centre
-        if settled is not None:             # the pieces do not couple: the others' steps are as before
+        if settled is not None:
             X_new[settled] = X[settled]
         # one cross product per triangle serves the collapse check and the normals
         cross = np.cross(X_new[F[:, 1]] - X_new[F[:, 0]], X_new[F[:, 2]] - X_new[F[:, 0]])
         dbl = np.sqrt(np.einsum("ij,ij->i", cross, cross))
         collapsed = np.flatnonzero(dbl <= 2.0 * ZERO_AREA_RELATIVE * diag ** 2)
         if collapsed.size == 0:
-            # the next step's weights; an area check alone is absolute: a pinching neck of needles
-            # (area 1e-7 of their start) passed it and came back "converged"
+            # the next step's weights; needles pass an area check, not this one
             cot, _, _ = corner_cotangents(X_new, F, lengths=False)
-            if np.abs(cot).max() > DEGENERATE_COTANGENT:
-                collapsed = _degenerated_triangles(V, F, cot)
+            largest = np.abs(cot).max(axis=1)
+            if largest.max() > DEGENERATE_COTANGENT:
+                candidates = np.flatnonzero(largest > DEGENERATE_COTANGENT)
+                rest, _, _ = corner_cotangents(V, F[candidates], lengths=False)
+                collapsed = candidates[largest[candidates] > DEGENERATE_GROWTH * np.abs(rest).max(axis=1)]
         if collapsed.size:
-            raise MeshError(_collapse_message(it + 1, collapsed, dbl, V, F, fixed, U, measured, step, tol))
+            raise MeshError(_collapse_message(it + 1, collapsed, dbl, V, F, fixed, U, measured, step, tol),
+                            count=int(collapsed.size), first=collapsed[:3].tolist())
         move = X_new - X
         each = np.linalg.norm(move, axis=1) / scale
         full_step = float(each.max())
@@ -235,10 +225,8 @@ def minimal_surface(V, F, fixed, *, max_iterations=200, tol=DEFAULT_TOL, step="n
 
 
 def _remaining_estimate(last, previous):
-    """``(rho, last * rho / (1 - rho))`` with ``rho = last / previous``: the contraction of the
-    last two steps and how far steps contracting at that rate would still go (the error bound of
-    a contraction); ``(nan, inf)`` without a step before, ``(nan, 0)`` after none at all or a
-    step of exactly 0 (a fixed point: nothing is left to go)."""
+    """``(rho, last * rho / (1 - rho))`` with ``rho = last / previous`` (a contraction's error
+    bound); ``(nan, inf)`` without a step before, ``(nan or 0, 0)`` after a step of exactly 0."""
     if last == 0.0:
         return (np.nan if np.isnan(previous) else 0.0), 0.0
     if not previous > 0.0:              # nan: one step only
@@ -247,34 +235,9 @@ def _remaining_estimate(last, previous):
     return rho, (last * rho / (1.0 - rho) if rho < 1.0 else np.inf)
 
 
-def _check_boundary_fixed(F, is_free):
-    """Raise ConstraintError if a boundary vertex is free: a free rim has no minimal surface (the
-    area falls towards zero as the rim shrinks onto the fixed vertices), and the iteration
-    flattened it instead (a cylinder held at its middle ring: every vertex at z = 0, area 0.1 of
-    6.3, "converged" after 2 steps)."""
-    boundary = boundary_vertices(F)
-    loose = boundary[is_free[boundary]]
-    if loose.size:
-        raise ConstraintError(
-            f"{counted(loose.size, 'boundary vertex', 'boundary vertices', verb='are')} not fixed (of "
-            f"{boundary.size}; first: {first_indices(loose)}): a surface with a free boundary has no "
-            "minimal surface (it shrinks onto the fixed vertices until its triangles collapse). Fix the "
-            "whole boundary too, e.g. np.union1d(fixed, boundary_vertices(F))."
-        )
-
-
-def _degenerated_triangles(V, F, cot):
-    """Triangles whose largest ``|cot|`` passes DEGENERATE_COTANGENT and grew DEGENERATE_GROWTH
-    times over the input's, increasing (the input's cotangents of the candidates only)."""
-    largest = np.abs(cot).max(axis=1)
-    candidates = np.flatnonzero(largest > DEGENERATE_COTANGENT)
-    rest, _, _ = corner_cotangents(V, F[candidates], lengths=False)
-    return candidates[largest[candidates] > DEGENERATE_GROWTH * np.abs(rest).max(axis=1)]
-
-
 def _collapse_message(iteration, triangles, dbl, V, F, fixed, adjacency, last_step, step, tol):
-    """The MeshError text for triangles that collapsed in step ``iteration``: what happened, how far
-    the iteration had got, and the likely cause from the piece's topology (the first triangle's)."""
+    """The MeshError text for triangles that collapsed in step ``iteration``, with the likely
+    cause from the topology of the first triangle's piece."""
     zero_area = bool(np.all(dbl[triangles] <= 2.0 * ZERO_AREA_RELATIVE * bbox_diagonal(V) ** 2))
     how = ("to zero area", "") if zero_area else ("into needles", "; an angle within 1e-6 rad of 0 or 180 degrees")
     text = (f"minimal surface iteration {iteration}: {counted(triangles.size, 'triangle')} collapsed {how[0]} "
@@ -289,10 +252,9 @@ def _collapse_message(iteration, triangles, dbl, V, F, fixed, adjacency, last_st
     piece_faces = F[in_piece[F[:, 0]]]
     boundary = boundary_vertices(piece_faces)
     inner_fixed = np.setdiff1d(fixed[in_piece[fixed]], boundary)
-    edges = np.unique(undirected_edges(piece_faces), axis=0).shape[0]
+    edges = np.unique(edge_keys(piece_faces)[0]).size
     euler = np.count_nonzero(in_piece) - edges + piece_faces.shape[0]       # 1: a disk (a boundary, genus 0)
     larger_tol = f"a larger tol, e.g. the default {DEFAULT_TOL:g}" if tol < DEFAULT_TOL else "a larger tol"
-    # the first step itself: no tol or max_iterations stops before it
     how_earlier = f"({larger_tol}, or max_iterations below {iteration})"
     earlier = f", or stop earlier {how_earlier}" if iteration > 1 else ""
     if inner_fixed.size:

@@ -6,8 +6,7 @@
 
 ``"auto"`` (also the environment variable ``CURVDETAIL_SOLVER``, which a named backend
 overrides) takes SuperLU below ``SMALL_SYSTEM_NNZ`` stored entries and otherwise the first
-installed of PARDISO, CHOLMOD (symmetric systems only) and SuperLU. All agree to ~1e-12 relative
-on the systems used here. docs/results/solver_ab.json has the measurements behind the choice.
+installed of PARDISO, CHOLMOD (symmetric systems only) and SuperLU (docs/results/solver_ab.json).
 """
 
 import os
@@ -22,26 +21,23 @@ from .errors import CurvdetailError
 
 BACKENDS = ("pardiso", "cholmod", "splu")
 
-#: Below this many stored entries ``"auto"`` takes SuperLU: there the choice is worth
-#: milliseconds, and SuperLU's start-up is the shortest.
+#: Below this many stored entries ``"auto"`` takes SuperLU (the shortest start-up).
 SMALL_SYSTEM_NNZ = 50_000
 
 #: What ``"auto"`` picks, in a line (for parameter descriptions and help texts).
 AUTO_RULE = (f"auto = SuperLU below {SMALL_SYSTEM_NNZ:,} stored entries, else the first installed of "
              "PARDISO, CHOLMOD, SuperLU")
 
-#: PARDISO's settings (pypardiso's 1-based iparm numbers): METIS ordering (3: its parallel
-#: version), no iterative refinement, pivot perturbation 1e-8 / 1e-13, scaling and matching
-#: for nonsymmetric matrices; symmetric ones get the two-level factorization with the parallel
-#: forward/backward solve (three right-hand sides in one call: 0.045 s against 0.10 s at 100k).
+#: PARDISO's settings (1-based iparm numbers): METIS ordering, no iterative refinement, pivot
+#: perturbation 1e-8 / 1e-13, scaling and matching for nonsymmetric matrices; symmetric ones
+#: get the two-level factorization with the parallel forward/backward solve.
 _IPARM = {True: {1: 1, 8: 0, 10: 8, 11: 0, 13: 0, 24: 1, 25: 2},
           False: {1: 1, 8: 0, 10: 13, 11: 1, 13: 1, 24: 0, 25: 0}}
 
 #: From this many unknowns PARDISO orders with parallel METIS (iparm 2 = 3).
 PARALLEL_ORDERING = 50_000
 
-#: Number of numeric factorizations in this process (a solver that promises back-substitution
-#: only can be checked against it).
+#: Number of numeric factorizations in this process (for tests of back-substitution only).
 factorization_count = 0
 
 
@@ -70,8 +66,8 @@ def available_backends():
 
 
 def _requested(backend):
-    """``(name, where)``: ``backend`` as a lower-case name and ``"backend"``, or for ``"auto"``
-    the setting of ``CURVDETAIL_SOLVER`` and that variable's name where it is set."""
+    """``(name, where)``: ``backend`` lower-cased and ``"backend"``, or for ``"auto"`` the setting
+    of ``CURVDETAIL_SOLVER`` and that name where it is set."""
     if backend is not None and not isinstance(backend, str):
         raise SolverError(f"backend={backend!r} ({type(backend).__name__}, not a single str) is not a "
                           "solver backend", parameter="backend", value=backend,
@@ -84,9 +80,8 @@ def _requested(backend):
 
 
 def resolve_backend(backend="auto", *, symmetric=True, nnz=None):
-    """The installed backend that ``backend`` names or ``"auto"`` picks for a matrix with ``nnz``
-    stored entries (None: a large one); SolverError where there is none (``parameter`` is
-    ``"backend"`` or, for a setting of the environment variable, ``"CURVDETAIL_SOLVER"``)."""
+    """The installed backend that ``backend`` names or ``"auto"`` picks for ``nnz`` stored entries
+    (None: many); SolverError (``parameter``: ``"backend"`` or ``"CURVDETAIL_SOLVER"``) if none."""
     name, where = _requested(backend)
     if name == "auto":
         if nnz is not None and nnz < SMALL_SYSTEM_NNZ:
@@ -133,7 +128,8 @@ class Factorization:
 
     Attributes
     ----------
-    backend : str     the backend that holds the factors
+    backend : str
+        The backend that holds the factors.
     shape : (int, int)
     """
 
@@ -155,9 +151,8 @@ class Factorization:
         self._factor(A)
 
     def refactor(self, A):
-        """Factor new values on the stored pattern of the first matrix (same shape, pattern and
-        ``upper`` convention; explicit zeros count as stored). SolverError otherwise, or where the
-        factorization fails (no solve is possible until a refactor succeeds)."""
+        """Factor new values on the stored pattern of the first matrix (explicit zeros count);
+        SolverError otherwise or where it fails (no solve until a refactor succeeds)."""
         A = sp.csr_matrix(A, dtype=np.float64)
         A.sort_indices()
         if A.shape != self.shape or not (np.array_equal(A.indptr, self._pattern[0])
@@ -190,7 +185,7 @@ class Factorization:
         import pypardiso
         from pypardiso.pardiso_wrapper import PyPardisoError
 
-        # pypardiso searches for MKL in every new solver object (0.1 s) unless this is set
+        # pypardiso searches for MKL in every new solver object unless this is set
         os.environ.setdefault("PYPARDISO_MKL_RT", pypardiso.ps.libmkl._name)
         solver = getattr(self, "_pardiso", None)
         try:
@@ -210,8 +205,8 @@ class Factorization:
                               parameter="A") from None
         perturbed = int(solver.iparm[13])
         if perturbed and not self.symmetric:
-            # static pivoting replaced tiny pivots: the factors are of a nearby matrix (a nearly
-            # singular 50 x 50 one came out 14 % off); "auto" takes SuperLU's partial pivoting
+            # static pivoting replaced tiny pivots (the factors are of a nearby matrix): "auto"
+            # takes SuperLU's partial pivoting
             if not self._automatic:
                 raise SolverError(f"PARDISO perturbed {perturbed} pivots of this nonsymmetric matrix: it is "
                                   "singular or nearly so", parameter="backend", value="pardiso", count=perturbed,
@@ -265,8 +260,8 @@ class Factorization:
 
         Raises
         ------
-        SolverError   ``b`` complex or of the wrong shape; a non-finite solution (singular matrix);
-                      the last :meth:`refactor` failed
+        SolverError
+            If ``b`` is complex or misshapen, the solution is not finite or the last refactor failed.
         """
         if np.iscomplexobj(b) or np.ndim(b) not in (1, 2) or np.shape(b)[0] != self.shape[0]:
             raise SolverError(f"the right-hand side must be real of shape ({self.shape[0]},) or "
@@ -290,17 +285,22 @@ def factorize(A, *, symmetric=True, backend="auto", upper=False):
     Parameters
     ----------
     A : (n, n) scipy.sparse matrix
-    symmetric : bool   True for a symmetric positive definite ``A`` (Cholesky-type factorization)
-    backend : str      ``"auto"``, ``"pardiso"``, ``"cholmod"`` or ``"splu"`` (see the module)
-    upper : bool       ``A`` holds only the upper triangle (diagonal included) of a symmetric matrix
+    symmetric : bool
+        True for a symmetric positive definite ``A``.
+    backend : {"auto", "pardiso", "cholmod", "splu"}
+        See the module.
+    upper : bool
+        ``A`` holds only the upper triangle (diagonal included) of a symmetric matrix.
 
     Returns
     -------
-    Factorization   with ``.solve(b)``, ``.refactor(A)``, ``.backend`` and ``.shape``
+    Factorization
+        With ``.solve(b)``, ``.refactor(A)``, ``.backend`` and ``.shape``.
 
     Raises
     ------
-    SolverError   unknown or uninstalled backend, non-square or singular matrix
+    SolverError
+        If the backend is unknown or not installed, or ``A`` is non-square or singular.
 
     Examples
     --------

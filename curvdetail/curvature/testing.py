@@ -61,16 +61,13 @@ def cylinder(radius=1.0, height=1.0, n_around=64, n_along=33, *, z0=None):
     return V, F
 
 
-def disk(n_rings=20, n_around=None, radius=1.0):
-    """Flat triangulated unit disk (z = 0) built from concentric rings; normals +z.
-
-    ``n_rings`` rings around a centre vertex, ring r with ``6 r`` vertices (or ``n_around`` fixed),
-    triangulated between consecutive rings by angle. One boundary loop: the outer ring.
-    """
+def disk(n_rings=20, radius=1.0):
+    """Flat triangulated disk (z = 0) of ``n_rings`` rings around a centre vertex, ring r with
+    ``6 r`` vertices, triangulated between consecutive rings by angle; normals +z."""
     pts = [np.zeros((1, 2))]
     angles = [np.zeros(1)]
     for r in range(1, n_rings + 1):
-        k = n_around if n_around else 6 * r
+        k = 6 * r
         a = 2.0 * np.pi * (np.arange(k) + 0.5 * (r % 2)) / k
         pts.append(np.column_stack([np.cos(a), np.sin(a)]) * (radius * r / n_rings))
         angles.append(a)

@@ -1,6 +1,5 @@
-"""Mesh topology from the triangles alone: edges, boundary, pieces, manifoldness and
-orientation. Every function takes ``F`` as an (m, 3) integer array."""
-
+"""Mesh topology from the triangles ``F`` (m, 3) alone: edges, boundary, pieces, manifoldness
+and orientation."""
 
 import numpy as np
 import scipy.sparse as sp
@@ -50,16 +49,9 @@ def as_faces(F, n_vertices, name="F"):
 
 def repeated_triangles(F, n):
     """Triangles with the vertices of an earlier one, in any order or orientation: None where
-    there are none, else a (k, 2) array of pairs ``(first, repeat)``, ordered by ``repeat``, one
-    per triangle that repeats an earlier one. ``n``: the number of vertices (indices below it).
-
-    A duplicate inside a larger mesh makes an edge of three triangles (the non-manifold check
-    would name it so, with the wrong fix); an isolated pair passes every other check and doubles
-    the area. The faces are grouped by their smallest vertex with a sparse matrix whose column
-    encodes the other two (SciPy's COO -> CSR conversion: a counting sort and sorts of a few
-    entries a row, no sort of all faces): 1M-vertex grid (2M triangles) 0.04 s in its own face
-    order, 0.075 s shuffled, against 0.15 s for sorting one key per face (the Laplacian's checks
-    and assembly take ~0.2 / 0.35 s there; 2 busy cores, so +-0.03 s)."""
+    there are none, else a (k, 2) array of pairs ``(first, repeat)``, ordered by ``repeat``.
+    ``n``: the number of vertices. The faces are counted per (smallest vertex, other two) in a
+    sparse matrix (no sort of all faces); only a repeat sorts them."""
     m = F.shape[0]
     a, b, c = F[:, 0], F[:, 1], F[:, 2]
     low = np.minimum(np.minimum(a, b), c)
@@ -74,7 +66,6 @@ def repeated_triangles(F, n):
         counts = sp.csr_matrix((np.ones(m, dtype=np.int32), (low, rest)), shape=(n, n * n))
         if counts.nnz == m:                    # no (low, mid, high) twice: the usual case
             return None
-    # some triangle repeats: find which (np.unique sorts every row; error path only)
     _, first, inverse = np.unique(np.sort(F, axis=1), axis=0, return_index=True, return_inverse=True)
     repeat = np.flatnonzero(first[inverse.reshape(-1)] != np.arange(m))
     if not repeat.size:
@@ -82,16 +73,9 @@ def repeated_triangles(F, n):
     return np.column_stack([first[inverse.reshape(-1)][repeat], repeat])
 
 
-def undirected_edges(F):
-    """All half-edges as sorted pairs, shape (3m, 2), in face order (edge k of face f at 3f+k,
-    edge k joins corners k+1 and k+2, i.e. it is opposite corner k)."""
-    E = np.stack([F[:, [1, 2]], F[:, [2, 0]], F[:, [0, 1]]], axis=1).reshape(-1, 2)
-    return np.sort(E, axis=1)
-
-
 def edge_keys(F):
-    """Key ``min * n + max`` of every half-edge's undirected edge, shape (3m,), in the order of
-    :func:`undirected_edges`, and that ``n``."""
+    """Key ``min * n + max`` of every half-edge's undirected edge, shape (3m,) (half-edge 3f + k
+    is opposite corner k of face f), and that ``n``."""
     n = int(F.max()) + 1
     b = F[:, [1, 2, 0]].ravel()          # half-edge 3f + k joins corners k+1 and k+2 of face f
     c = F[:, [2, 0, 1]].ravel()
@@ -108,25 +92,23 @@ def non_manifold_edges(F):
 
 
 def boundary_edges(F):
-    """Edges used by exactly one triangle, shape (k, 2), each oriented as in its triangle (so
-    a consistently oriented disk's boundary runs counter-clockwise seen from its normals side).
-    ``F`` is checked as in :func:`check_mesh` (shape, integer entries, no negative or repeated
-    index in a triangle): MeshError otherwise.
+    """Edges used by exactly one triangle, each oriented as in its triangle.
 
     Parameters
     ----------
-    F : (m, 3) int array   triangles (integral floats are accepted); no vertex positions are needed,
-                           and indices need not be contiguous
+    F : (m, 3) int array
+        Triangles (whole floats are taken); indices need not be contiguous.
 
     Returns
     -------
-    E : (k, 2) int64 array   boundary edges as (from, to) in their triangle's winding, rows ordered
-                             by the sorted pair (min, max); (0, 2) for a closed surface
+    E : (k, 2) int64 array
+        Boundary edges as (from, to) in their triangle's winding (counter-clockwise seen from the
+        normals of a consistently oriented disk), rows ordered by (min, max); (0, 2) if closed.
 
     Raises
     ------
-    MeshError   ``F`` not an (m, 3) integer array, empty, or with a negative or repeated index
-                in a triangle
+    MeshError
+        If ``F`` is not an (m, 3) integer array, is empty, or has a negative or repeated index.
 
     Examples
     --------
@@ -172,21 +154,19 @@ def misoriented_edges(F):
 
 def check_oriented(F, what="the mesh", error=MeshError):
     """Raise ``error`` if triangles of ``F`` are wound against their neighbours (see
-    :func:`misoriented_edges`). A reversed triangle at the boundary makes the boundary look
-    pinched or split, and the fix is to orient the triangles, not to cut the mesh; the boundary
-    checks call this on their error paths only (it sorts every half-edge)."""
+    :func:`misoriented_edges`), naming ``what``."""
     E = misoriented_edges(F)
     if E.shape[0]:
         pairs = ", ".join(f"({a}, {b})" for a, b in E[:3])
         raise error(f"{what} is not consistently oriented: {E.shape[0]} interior edges run the same way "
                     f"in both their triangles (first: {pairs}); orient the triangles consistently (e.g. "
-                    "pymeshlab's meshing_re_orient_faces_coherently) and try again.")
+                    "pymeshlab's meshing_re_orient_faces_coherently) and try again.", parameter="F",
+                    count=int(E.shape[0]), first=[tuple(int(v) for v in e) for e in E[:3]])
 
 
 def _compact_ids(F):
-    """``(ids, F')`` with ``F = ids[F']`` and ``F'`` numbered ``0 .. len(ids) - 1``, where ``F``'s
-    largest index is far above its number of corners (unchecked triangles, e.g. 2**32 - 1 as
-    "no vertex": per-vertex arrays would take gigabytes and the edge keys ``min * n + max``
+    """``(ids, F')`` with ``F = ids[F']`` and ``F'`` numbered ``0 .. len(ids) - 1`` where ``F``'s
+    largest index is far above its number of corners (per-vertex arrays would be huge, edge keys
     overflow); ``(None, F)`` otherwise."""
     if F.size == 0 or int(F.max()) < 2 * F.size + 1024:
         return None, F
@@ -195,23 +175,22 @@ def _compact_ids(F):
 
 
 def boundary_vertices(F):
-    """Sorted indices of the vertices on a boundary edge; empty for a closed surface.
-
-    A boundary edge is one used by exactly one triangle (as in :func:`boundary_edges`).
+    """Sorted indices of the vertices on an edge of exactly one triangle.
 
     Parameters
     ----------
-    F : (m, 3) int array   triangles (integral floats are accepted), checked as in
-                           :func:`boundary_edges`
+    F : (m, 3) int array
+        Triangles, as for :func:`boundary_edges`.
 
     Returns
     -------
-    b : (k,) int64 array   vertex indices in increasing order, each once
+    b : (k,) int64 array
+        Vertex indices, increasing, each once; empty for a closed surface.
 
     Raises
     ------
-    MeshError   ``F`` not an (m, 3) integer array, empty, or with a negative or repeated index
-                in a triangle
+    MeshError
+        As :func:`boundary_edges`.
 
     Examples
     --------
@@ -223,10 +202,7 @@ def boundary_vertices(F):
     """
     F = as_faces(F, None)
     ids, F = _compact_ids(F)
-    # triangles per undirected edge by a sparse COO -> CSR pass (no sort of all half-edges:
-    # 1M vertices 0.35 s against 1.0 s for np.unique of boundary_edges); cotan_laplacian's
-    # _edge_pattern counts the same way, but the reconstruction tests check that its checks do
-    # not count twice by disabling that one
+    # triangles per undirected edge by a sparse COO -> CSR pass (no sort of all half-edges)
     n = int(F.max()) + 1
     b, c = F[:, [1, 2, 0]].ravel(), F[:, [2, 0, 1]].ravel()
     counts = sp.csr_matrix((np.ones(b.size, dtype=np.int32), (np.minimum(b, c), np.maximum(b, c))), shape=(n, n))
@@ -240,11 +216,8 @@ def boundary_vertices(F):
 
 def vertex_components(F, n, adjacency=None):
     """Connected-component label per vertex, shape (n,), and the number of components.
-
-    ``adjacency``: an (n, n) sparse matrix with the mesh's edge pattern (e.g. its cotangent
-    Laplacian), used instead of building one from ``F``."""
-    if adjacency is None:
-        # two edges per triangle connect all three corners
+    ``adjacency``: an (n, n) sparse matrix with the mesh's edge pattern, if at hand."""
+    if adjacency is None:                   # two edges per triangle connect all three corners
         rows = np.concatenate([F[:, 0], F[:, 1]])
         cols = np.concatenate([F[:, 1], F[:, 2]])
         adjacency = sp.csr_matrix((np.ones(rows.size, dtype=np.int8), (rows, cols)), shape=(n, n))
@@ -253,8 +226,8 @@ def vertex_components(F, n, adjacency=None):
 
 
 def check_every_component_fixed(F, n, fixed, adjacency=None):
-    """Raise ConstraintError if a connected component has no fixed vertex (the system is singular).
-    ``adjacency``: see :func:`vertex_components`."""
+    """Raise ConstraintError if a connected component has no fixed vertex (``first``: a vertex of
+    each such piece). ``adjacency``: see :func:`vertex_components`."""
     labels, count = vertex_components(F, n, adjacency)
     has = np.zeros(count, dtype=bool)
     has[labels[fixed]] = True
@@ -264,5 +237,5 @@ def check_every_component_fixed(F, n, fixed, adjacency=None):
         raise ConstraintError(
             f"{missing.size} of {count} connected components have no fixed vertex (e.g. the pieces "
             f"containing vertex {', '.join(map(str, example))}); their position is undetermined. "
-            "Fix at least one vertex in every piece, or split the mesh."
-        )
+            "Fix at least one vertex in every piece, or split the mesh.", parameter="fixed",
+            count=int(missing.size), first=example)
