@@ -352,13 +352,13 @@ def _edit(parser):
 
         check_outputs(args, [("OUTPUT", args.output, True), ("--image", args.image, False)],
                       inputs=[("MESH", args.mesh)], other_inputs=[("--sel", args.sel), ("--def", args.transform)])
-        V, F = read_checked(args.mesh)
-        status = read_selection(args.sel, V.shape[0])
-        T = read_transform(args.transform)
         paper = args.method == "paper"
         if not paper and (args.handle_detail or args.relations):
             raise CurvdetailError("--handle-detail and --relations apply to --method paper only",
                                   parameter="--method", hint="add --method paper, or drop them")
+        V, F = read_checked(args.mesh)
+        status = read_selection(args.sel, V.shape[0])
+        T = read_transform(args.transform)
         t = time.perf_counter()
         try:
             X, editor = edit_with_selection(V, F, status, T, method=args.method, handle_detail=args.handle_detail,
