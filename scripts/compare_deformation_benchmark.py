@@ -48,7 +48,6 @@ def _edges(F):
 
 
 def _ours(V, F, status, T, method):
-    t = time.perf_counter()
     if method == "rotation":
         X = edit_with_selection(V, F, status, T)                    # the default settings
         h = np.flatnonzero(status == 2)
@@ -66,14 +65,13 @@ def _ours(V, F, status, T, method):
                    "resolve_iterations": ed.iterations, "backend": ed.backend}
     relations = "one+two-ring" if method.endswith("one+two-ring") else "one-ring"
     X, ed = edit_with_selection(V, F, status, T, method="paper", relations=relations, return_editor=True)
-    total = time.perf_counter() - t
     h = ed.position_constrained
     details = ed.detail[h] @ T[:3, :3].T
     ed.solve(positions=X[h], details=details)                  # warm-up
     t = time.perf_counter()
     ed.solve(positions=X[h], details=details)
     resolve = time.perf_counter() - t
-    return X, {"setup_s": total - resolve, "iterations": None, "iteration_s": None, "resolve_s": resolve,
+    return X, {"setup_s": sum(ed.timings.values()), "iterations": None, "iteration_s": None, "resolve_s": resolve,
                "backend": ed.backend}
 
 
@@ -189,15 +187,17 @@ def main(argv=None):
             _files.render_panels(pictures[k], panels, args.force, elev=elev, azim=azim, panel_size=2.6)
     text = table(rows)
     print(text)
-    _files.write_json(json_path, {"methods": METHODS, "igl_arap_iterations": MAX_ITER, "rows": rows,
-                                  **_files.measured_conditions()}, args.force, indent=2, end="\n")
+    conditions = _files.measured_conditions()
+    _files.write_json(json_path, {"methods": METHODS, "igl_arap_iterations": MAX_ITER, "rows": rows, **conditions},
+                      args.force, indent=2, end="\n")
     images = "".join(f"\n![{n}]({os.path.relpath(p, os.path.dirname(os.path.abspath(md_path)))})\n"
                      for n, p in zip(CASES, map(os.path.abspath, pictures)))
     _files.write_text(md_path, "# Deformation benchmark (Botsch & Sorkine 2008)\n\n"
                       "Written by `python scripts/compare_deformation_benchmark.py --pictures docs/results --force` "
                       "(see docs/editing.md); distances over the rest bbox diagonal, edge-length change relative "
-                      "to the rest lengths, areas as fractions of the rest areas; load and host in "
-                      "deformation.json.\n\n" + text + "\n" + images, args.force)
+                      "to the rest lengths, areas as fractions of the rest areas. Times on a shared host, load "
+                      f"average {conditions['load_average'][0]:.1f} at the end (deformation.json): "
+                      "compare them within a run only.\n\n" + text + "\n" + images, args.force)
     return 0
 
 
