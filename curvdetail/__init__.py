@@ -4,7 +4,7 @@ Store the detail of a surface as mean-curvature normals, rebuild it from them, e
 carry it across a retriangulation (Zhejiang Univ. Sci. A 7(7):1210, 2006).
 """
 
-from .curvature import (ConstraintError, CurvatureEditor, MeshError, Reconstructor, SolverError,
+from .curvature import (ConstraintError, CurvatureEditor, MeshError, Reconstructor, SolverError, anchor_vertices,
                         available_backends, boundary_edges, boundary_vertices, check_mesh, cotan_laplacian,
                         curvature_coefficients, curvature_detail, edit_boundary, mean_curvature_normal,
                         minimal_surface, mixed_voronoi_area, reconstruct, sine_displacement)
@@ -13,7 +13,8 @@ from .io import read_mesh, write_mesh
 __version__ = "0.1.0"
 
 __all__ = [
-    "ConstraintError", "CurvatureEditor", "MeshError", "Reconstructor", "SolverError", "available_backends",
+    "ConstraintError", "CurvatureEditor", "MeshError", "Reconstructor", "SolverError", "anchor_vertices",
+    "available_backends",
     "boundary_edges", "boundary_vertices", "check_mesh", "cotan_laplacian", "curvature_coefficients",
     "curvature_detail", "edit_boundary", "mean_curvature_normal", "minimal_surface", "mixed_voronoi_area",
     "read_mesh", "reconstruct", "sine_displacement", "write_mesh",

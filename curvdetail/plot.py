@@ -203,7 +203,7 @@ def save_remeshing_figure(path, V, F, X, Ft, Z, distance, report, *, zero_distan
     if distance.shape != (X.shape[0],) or not np.isfinite(distance).all():
         raise ValueError(f"distance has shape {distance.shape} for {X.shape[0]} rebuilt vertices: pass one finite "
                          "distance per vertex of X (run_experiment's result['distance'])")
-    V, Z = np.asarray(V, dtype=np.float64), np.asarray(Z, dtype=np.float64)
+    V = np.asarray(V, dtype=np.float64)
     R = top_view(V, F)
     e, b, fl = report["error"], report["baseline_zero_detail"], report["floor_retriangulated"]
     rms, top = "hausdorff_rms_percent_of_diagonal", "hausdorff_max_percent_of_diagonal"
@@ -213,9 +213,11 @@ def save_remeshing_figure(path, V, F, X, Ft, Z, distance, report, *, zero_distan
               (X @ R.T, Ft, f"rebuilt ({o['transfer']}, rows={o['rows']}): {report['target']['vertices']:,} "
                             f"vertices\nRMS {e[rms]:.3f} %  max {e[top]:.2f} %  "
                             f"(floor {fl[rms]:.3f} %)",
-               100 * distance / report["source"]["bbox_diagonal"]),
-              (Z @ R.T, Ft, f"zero detail\nRMS {b[rms]:.2f} %  max {b[top]:.1f} %")
-              + (() if zero_distance is None else (100 * np.asarray(zero_distance) / report["source"]["bbox_diagonal"],))]
+               100 * distance / report["source"]["bbox_diagonal"])]
+    if Z is not None and b is not None:     # none for a closed piece (it collapses onto its anchor)
+        panels.append((np.asarray(Z, dtype=np.float64) @ R.T, Ft, f"zero detail\nRMS {b[rms]:.2f} %  max {b[top]:.1f} %")
+                      + (() if zero_distance is None else
+                         (100 * np.asarray(zero_distance) / report["source"]["bbox_diagonal"],)))
     save_panels(path, panels, elev=50.0, azim=20.0, panel_size=4.0, dpi=dpi, overwrite=overwrite,
                 title="Remeshing from curvature detail (all figures: % of the source's bbox diagonal)",
                 colorbar="distance to source, % of bbox diagonal", vrange=(0.0, max(e[top], 1e-300)))

@@ -56,6 +56,15 @@ def test_reconstruct_a_closed_mesh_with_named_fixed_vertices(tmp_path):
     assert np.array_equal(X[[0, 1000, 2000]], V[[0, 1000, 2000]])
 
 
+def test_reconstruct_a_closed_mesh_without_fix_uses_one_anchor(tmp_path, capsys):
+    out = tmp_path / "spot.ply"
+    assert main(["reconstruct", SPOT, str(out)]) == 0
+    V, _ = read_mesh(SPOT)
+    X, _ = read_mesh(out)
+    assert np.abs(X - V).max() <= 1e-9 * diagonal(V)
+    assert "2930 vertices, 1 fixed," in capsys.readouterr().out
+
+
 def test_reconstruct_example_prints_the_readme_line(tmp_path, capsys):
     assert main(["reconstruct", "--example", str(tmp_path / "t.ply")]) == 0
     out = capsys.readouterr().out
@@ -90,7 +99,6 @@ def test_an_obj_output_gets_a_note_that_the_quality_is_dropped(tmp_path, capsys,
 
 
 @pytest.mark.parametrize("argv, option", [
-    (["reconstruct", SPOT], "--fix"),                           # closed: no boundary to fix
     (["reconstruct", NOSE, "--fix"], "--fix"),                  # --fix without indices
     (["minimal", NOSE, "--fix", "300"], "--fix-boundary"),      # a free boundary
     (["reconstruct", NOSE, "--fix", "3", "640"], "--fix"),      # out of range

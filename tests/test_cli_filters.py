@@ -571,11 +571,12 @@ def test_a_backend_error_names_the_backend_param(capsys, tmp_path, monkeypatch, 
     assert_failed(capsys, ["apply", name, NOSE, tmp_path / "o.ply", *argv], "(--param backend: ", tmp_path / "o.ply")
 
 
-def test_a_closed_mesh_rebuilt_by_apply_names_fix_boundary(capsys, tmp_path):
+def test_a_closed_mesh_rebuilt_by_apply_gets_one_anchor(capsys, tmp_path):
     detail = tmp_path / "d.ply"
     assert run_cli(capsys, "apply", "compute_curvature_detail", SPOT, detail)[0] == 0
-    assert_failed(capsys, ["apply", "apply_curvature_reconstruction", detail, tmp_path / "r.ply"],
-                  "(--param fix_boundary: ", tmp_path / "r.ply")
+    rc, out, _ = run_cli(capsys, "apply", "apply_curvature_reconstruction", detail, tmp_path / "r.ply")
+    figures = json.loads(out)
+    assert rc == 0 and figures["anchors"] == 1 and figures["max_displacement_percent_of_diagonal"] < 1e-10
 
 
 def test_a_required_parameter_left_out_of_apply_names_it(capsys, tmp_path):

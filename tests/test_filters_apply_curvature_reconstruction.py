@@ -6,7 +6,7 @@ import numpy as np
 import pymeshlab
 import pytest
 
-from curvdetail import ConstraintError, boundary_vertices
+from curvdetail import boundary_vertices
 from curvdetail.curvature.geometry import bbox_diagonal
 from curvdetail.filters import FilterError, apply
 from curvdetail.filters.meshset import set_vertex_positions
@@ -62,11 +62,13 @@ def test_selected_vertices_stay_fixed_on_a_closed_mesh():
     assert np.abs(ms.current_mesh().vertex_matrix() - V).max() < 1e-9 * bbox_diagonal(V)
 
 
-def test_closed_mesh_without_selection_is_refused():
+def test_closed_mesh_without_selection_is_rebuilt_from_one_anchor():
     ms = meshset("spot.obj")
     apply(ms, "compute_curvature_detail")
-    with pytest.raises(ConstraintError, match="no vertex to keep fixed.*0 boundary and 0 selected"):
-        apply(ms, "apply_curvature_reconstruction")
+    V = ms.current_mesh().vertex_matrix().copy()
+    figures = apply(ms, "apply_curvature_reconstruction")
+    assert figures["anchors"] == 1 and figures["fixed_vertices"] == 1
+    assert np.abs(ms.current_mesh().vertex_matrix() - V).max() < 1e-9 * bbox_diagonal(V)
 
 
 def test_missing_detail_attribute_says_what_to_run():

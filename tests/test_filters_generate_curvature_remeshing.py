@@ -100,11 +100,18 @@ def test_absolute_target_edge_is_converted_to_a_fraction():
     assert np.array_equal(ms.mesh(2).vertex_matrix()[b], ms.mesh(1).vertex_matrix()[b])
 
 
-def test_closed_mesh_is_refused_with_what_was_found():
+def test_closed_mesh_is_remeshed_with_one_anchor():
     ms = pymeshlab.MeshSet()
     ms.load_new_mesh(os.path.join(DATA, "spot.obj"))
-    with pytest.raises(NotADiskError, match="closed"):
-        apply(ms, "generate_curvature_remeshing", evaluate=False)
+    report = apply(ms, "generate_curvature_remeshing", target_edge=pymeshlab.PercentageValue(3.0), evaluate=False)
+    assert report["anchors"] == 1 and report["target"]["boundary_vertices"] == 0 and ms.mesh_number() == 3
+
+
+def test_uv_location_on_a_closed_mesh_is_refused_as_not_a_disk():
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(os.path.join(DATA, "spot.obj"))
+    with pytest.raises(NotADiskError):
+        apply(ms, "generate_curvature_remeshing", location="uv", evaluate=False)
     assert ms.mesh_number() == 1
 
 
@@ -189,11 +196,18 @@ def test_a_big_target_is_said_beforehand_with_the_unit_of_a_plain_number(monkeyp
         warnings.simplefilter("error", LongRunWarning)          # a smaller target: nothing said
         ms.set_current_mesh(0)
         apply(ms, "generate_curvature_remeshing", target_edge=1.3, evaluate=False)
-        # a mesh the checks refuse: the refusal alone, no "this takes minutes" before it
-        closed = pymeshlab.MeshSet()
-        closed.load_new_mesh(os.path.join(DATA, "spot.obj"))
-        with pytest.raises(NotADiskError):
-            apply(closed, "generate_curvature_remeshing", target_edge=pymeshlab.PercentageValue(0.5), evaluate=False)
+        # a mesh the checks refuse (an edge in three triangles): the refusal alone, no "this takes
+        # minutes" before it
+        from curvdetail import MeshError
+        from curvdetail.curvature.testing import disk
+
+        V, F = disk(n_rings=12)
+        fin = pymeshlab.MeshSet()
+        fin.add_mesh(pymeshlab.Mesh(np.vstack([V, [[0.0, 0.0, 0.05]]]),
+                                    np.vstack([F, [[F[0, 0], F[0, 1], V.shape[0]]]]).astype(np.int32)))
+        with pytest.raises(MeshError) as refused:
+            apply(fin, "generate_curvature_remeshing", target_edge=pymeshlab.PercentageValue(0.5), evaluate=False)
+        assert refused.value.count == 1
 
 
 def test_without_evaluation_the_rebuilt_layer_has_no_quality(tmp_path):

@@ -43,13 +43,24 @@ def test_missing_source_fails_and_writes_nothing(tmp_path, capsys):
     assert os.listdir(tmp_path) == []
 
 
-def test_non_disk_source_fails_saying_what_was_found(tmp_path, capsys):
+def test_uv_location_on_a_non_disk_source_fails_saying_what_was_found(tmp_path, capsys):
     src = tmp_path / "tube.ply"
     write_mesh(str(src), *cylinder(n_around=16, n_along=6))
-    rc = main(["remesh", str(src), str(tmp_path / "o.ply"), "--image", str(tmp_path / "f.png"), "--quiet"])
+    rc = main(["remesh", str(src), str(tmp_path / "o.ply"), "--location", "uv", "--image", str(tmp_path / "f.png"),
+               "--quiet"])
     assert rc == 1
     assert "2 boundary loops" in capsys.readouterr().err
     assert sorted(os.listdir(tmp_path)) == ["tube.ply"]
+
+
+def test_a_closed_model_is_remeshed_with_one_anchor_and_pictured(tmp_path, capsys):
+    report = tmp_path / "r.json"
+    rc = main(["remesh", os.path.join(DATA, "spot.obj"), str(tmp_path / "o.ply"), "--target-edge", "3%",
+               "--report", str(report), "--image", str(tmp_path / "f.png"), "--quiet"])
+    assert rc == 0
+    rep = json.loads(report.read_text())
+    assert rep["anchors"] == 1 and rep["baseline_zero_detail"] is None
+    assert "1 anchor;" in capsys.readouterr().out and (tmp_path / "f.png").stat().st_size > 0
 
 
 @pytest.mark.parametrize("pct", ["0.0001", "90"])

@@ -109,9 +109,10 @@ def test_uv_location_and_given_target_run_and_record_the_parameterization(height
     assert np.array_equal(X[b], target[0][b])
 
 
-def test_closed_source_is_refused(sphere):
-    with pytest.raises(NotADiskError, match="closed"):
-        remesh_experiment(*sphere)
+def test_uv_location_on_a_closed_source_is_refused_as_not_a_disk(sphere):
+    # the planar parameterization needs a disk; the default closest-point location does not
+    with pytest.raises(NotADiskError):
+        remesh_experiment(*sphere, location="uv")
 
 
 def test_absurd_target_edge_is_refused(height_field):
@@ -178,7 +179,9 @@ def test_a_two_triangle_square_is_rebuilt_and_measured():
     (X, _), report = remesh_experiment(V, F, target=(V, F))
     # a flat square rebuilt from its own (zero) detail is itself
     assert np.abs(X - V).max() < 1e-12
-    assert report["error"]["hausdorff_max_percent_of_diagonal"] < 1e-6 and report["baseline_zero_detail"]["hausdorff_max_percent_of_diagonal"] < 1e-12
+    # the error is measured by pymeshlab in single precision: ~1e-7 of the diagonal
+    assert report["error"]["hausdorff_max_percent_of_diagonal"] < 1e-4
+    assert report["baseline_zero_detail"]["hausdorff_max_percent_of_diagonal"] < 1e-10
 
 
 def test_report_says_a_given_target_was_not_made_by_the_experiment(height_field):

@@ -48,7 +48,8 @@ class Terminated(KeyboardInterrupt):
 
 # --- reconstruct / minimal ------------------------------------------------------------------
 
-@command("reconstruct", help="rebuild a mesh from its own curvature detail with the boundary fixed")
+@command("reconstruct", help="rebuild a mesh from its own curvature detail with the boundary fixed (and one "
+                             "anchor vertex on each closed piece)")
 def _reconstruct(parser):
     add_input_output(parser, "mesh file", "rebuilt mesh; quality = distance to INPUT (.ply keeps it)")
     choice(parser, "--rows", ("all", "free"), "all",
@@ -60,12 +61,13 @@ def _reconstruct(parser):
     def run(args):
         import numpy as np
 
-        from .. import Reconstructor, curvature_detail
+        from .. import Reconstructor, anchor_vertices, curvature_detail
 
         inputs = input_output(args)
         check_outputs(args, [("OUTPUT", args.output, True)], **inputs)
         V, F = read_checked(args.input)
-        fixed = fixed_vertices(args, V, F, purpose="to rebuild a closed mesh")
+        # the boundary (or --fix), and an anchor on each piece with no fixed vertex (a closed one)
+        fixed = anchor_vertices(V, F, fixed=None if args.fix is None else fixed_vertices(args, V, F, purpose=""))
         t = time.perf_counter()
         rec = Reconstructor(V, F, fixed, rows=args.rows, backend=args.backend)
         X = rec.solve(curvature_detail(V, F), V[rec.fixed])
@@ -129,10 +131,10 @@ def _minimal(parser):
 
 # --- remesh ---------------------------------------------------------------------------------
 
-@command("remesh", help="retriangulate a disk patch, rebuild it from its curvature detail, and measure "
-                        "the error (the paper's Fig. 3)")
+@command("remesh", help="retriangulate a mesh (closed, holes, pieces), rebuild it from its curvature detail, "
+                        "and measure the error (the paper's Fig. 3)")
 def _remesh(parser):
-    add_input_output(parser, "source mesh: a disk-topology patch (one boundary loop)",
+    add_input_output(parser, "source mesh: a manifold surface (a disk-topology patch for --location uv)",
                       "rebuilt target mesh; quality = distance to the source (.ply keeps it)")
     choice(parser, "--method", ("isotropic", "decimate"), "isotropic", "retriangulation (default: isotropic)")
     parser.add_argument("--target-edge", type=length, default="1%", metavar="LENGTH",
@@ -215,8 +217,10 @@ def _remesh(parser):
             print_figures(f"{counts}; not measured (--no-evaluate); {report['seconds']['total']:.2f} s")
             return 0
         e, b, fl = report["error"], report["baseline_zero_detail"], report["floor_retriangulated"]
-        print_figures(f"{counts}; RMS {e[RMS]:.4f} %, max {e[MAX]:.3f} % of the "
-                      f"bbox diagonal (zero detail {b[RMS]:.3f} % / {b[MAX]:.2f} %, "
+        zero = "none" if b is None else f"{b[RMS]:.3f} % / {b[MAX]:.2f} %"
+        anchors = f"; {report['anchors']} anchor{'s' * (report['anchors'] != 1)}" if report["anchors"] else ""
+        print_figures(f"{counts}{anchors}; RMS {e[RMS]:.4f} %, max {e[MAX]:.3f} % of the "
+                      f"bbox diagonal (zero detail {zero}, "
                       f"floor {fl[RMS]:.4f} % / {fl[MAX]:.3f} %); "
                       f"{report['seconds']['total']:.2f} s")
         note_dropped(args.output, quality=True)

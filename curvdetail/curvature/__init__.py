@@ -3,6 +3,7 @@
 numpy/scipy only. Every function takes ``(V, F)`` arrays and validates them at its boundary.
 """
 
+from .anchors import anchor_vertices
 from .checks import check_mesh
 from .topology import boundary_edges, boundary_vertices
 from .boundary_editing import boundary_loop, edit_boundary, sine_displacement
@@ -20,7 +21,7 @@ from .sparse_solver import SolverError, available_backends
 
 __all__ = [
     "CoefficientInfo", "ConstraintError", "CurvatureEditor", "MeshError", "Reconstructor", "RotationAwareEditor",
-    "SolverError",
+    "SolverError", "anchor_vertices",
     "available_backends", "boundary_edges", "boundary_loop", "boundary_vertices", "check_mesh",
     "cotan_laplacian", "curvature_coefficients", "curvature_detail", "edit_boundary", "mean_curvature_normal",
     "minimal_surface", "mixed_voronoi_area", "reconstruct", "sine_displacement",

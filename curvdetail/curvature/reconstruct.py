@@ -32,7 +32,9 @@ class Reconstructor:
     F : (m, 3) int array
         Triangles.
     fixed : (k,) int array or (n,) bool mask
-        Constrained vertices; every connected piece needs one.
+        Constrained vertices; every connected piece needs one. For a closed surface, several
+        boundary loops or several pieces, :func:`anchor_vertices` gives every boundary vertex
+        and one anchor per closed piece.
     rows : {"all", "free"}
         Which residual rows enter the energy.
     backend : str
@@ -105,8 +107,10 @@ class Reconstructor:
         self.n = n
         self.fixed = as_index_set(fixed, n, "fixed")
         if self.fixed.size == 0:
-            raise ConstraintError("no fixed vertices: the reconstruction is only determined up to a "
-                                  "translation. Fix at least one vertex per connected piece, e.g. the boundary.")
+            raise ConstraintError("no fixed vertices: the reconstruction is only determined up to a translation",
+                                  parameter="fixed", count=0,
+                                  hint="fix at least one vertex per connected piece: the boundary, and on a closed "
+                                       "piece an anchor (curvdetail.anchor_vertices(V, F) gives both)")
         # U, L's strict upper triangle, has the edge pattern at half L's size
         check_every_component_fixed(F, n, self.fixed, adjacency=U)
         is_free = np.ones(n, dtype=bool)
@@ -309,7 +313,8 @@ def reconstruct(V_ref, F, detail, fixed, fixed_positions, *, rows="all", backend
     detail : (n, 3) float array
         Target curvature detail ``D = K A``.
     fixed : (k,) int array or (n,) bool mask
-        Constrained vertices.
+        Constrained vertices, e.g. :func:`anchor_vertices` (the boundary and one anchor per
+        closed piece).
     fixed_positions : (k, 3) float array
         Their positions, row r for vertex ``fixed[r]`` (for a mask: in increasing index order).
     rows : {"all", "free"}

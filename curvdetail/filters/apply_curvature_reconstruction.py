@@ -2,13 +2,12 @@
 
 import numpy as np
 
-from ..curvature import reconstruct
+from ..curvature import anchor_vertices, reconstruct
 from ..curvature.geometry import bbox_diagonal
 from ..curvature.topology import boundary_vertices
-from ..curvature.errors import ConstraintError
 from ..curvature.sparse_solver import AUTO_RULE, BACKENDS as _SOLVERS
 from .detail_attributes import load_detail
-from .meshset import get_mesh, layer_id, mesh_arrays, selected_vertices, set_vertex_positions, set_vertex_quality
+from .meshset import layer_id, mesh_arrays, selected_vertices, set_vertex_positions, set_vertex_quality
 from .parameters import Parameter
 from .registry import PAPER, filter
 
@@ -26,7 +25,8 @@ BACKEND_DESCRIPTION = "sparse solver backend; " + AUTO_RULE
         attribute comes from compute_curvature_detail (then the mesh is reproduced to solver
         precision) or from transfer_curvature_detail (a retriangulation rebuilt from another
         mesh's curvature). Vertices move in place; the vertex quality is set to the distance each
-        vertex moved. A closed mesh needs selected vertices. {PAPER}, sections "Base
+        vertex moved. A connected piece with no fixed vertex (a closed surface, or every piece when
+        nothing is fixed) gets one anchor, its flattest vertex (curvdetail.anchor_vertices). {PAPER}, sections "Base
         presentation" (E_Q) and "Embedding".
     """,
     parameters=[
@@ -48,14 +48,8 @@ def apply_curvature_reconstruction(ms, *, rows, fix_boundary, fix_selected, back
         parts.append(boundary_vertices(F))
     if fix_selected:
         parts.append(selected_vertices(ms, mid))
-    fixed = np.unique(np.concatenate(parts)) if parts else np.zeros(0, dtype=np.int64)
-    if fixed.size == 0:
-        raise ConstraintError(
-            f"layer {mid} ({get_mesh(ms, mid).label()!r}): no vertex to keep fixed "
-            f"(fix_boundary={fix_boundary}, fix_selected={fix_selected}, "
-            f"{boundary_vertices(F).size} boundary and {selected_vertices(ms, mid).size} selected "
-            "vertices); the positions are undetermined", parameter="fix_boundary", hint="select vertices to keep "
-            "(e.g. with compute_selection_by_condition_per_vertex) or fix the boundary")
+    given = np.unique(np.concatenate(parts)) if parts else np.zeros(0, dtype=np.int64)
+    fixed = anchor_vertices(V, F, detail=D, fixed=given)
     X = reconstruct(V, F, D, fixed, V[fixed], rows=rows, backend=backend)
     moved = np.linalg.norm(X - V, axis=1)
     set_vertex_positions(ms, mid, X)
@@ -65,6 +59,7 @@ def apply_curvature_reconstruction(ms, *, rows, fix_boundary, fix_selected, back
         "max_displacement_percent_of_diagonal": float(100 * moved.max() / diag),
         "rms_displacement_percent_of_diagonal": float(100 * np.sqrt(np.mean(moved ** 2)) / diag),
         "fixed_vertices": int(fixed.size),
+        "anchors": int(fixed.size - given.size),
         "free_vertices": int(V.shape[0] - fixed.size),
         "rows": rows,
     }

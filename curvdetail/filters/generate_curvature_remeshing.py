@@ -16,10 +16,12 @@ from .transfer_curvature_detail import planar_map
     name="generate_curvature_remeshing",
     category="Curvature detail",
     description=f"""
-        Run the whole remeshing experiment on the current mesh (a disk-topology patch):
-        retriangulate it (pymeshlab isotropic remeshing or fast-simplification decimation, the
-        boundary kept on the source boundary), carry its curvature detail over to the new
-        triangulation, rebuild the new triangulation from that detail with its boundary fixed, and
+        Run the whole remeshing experiment on the current mesh (any manifold surface: closed,
+        with holes, several pieces; a disk-topology patch for location 'uv'): retriangulate it
+        (pymeshlab isotropic remeshing or fast-simplification decimation, every boundary loop kept
+        on the source's), carry its curvature detail over to the new triangulation, rebuild the
+        new triangulation from that detail with its boundary fixed and one anchor vertex on each
+        closed piece (the report's 'anchors'), and
         measure the two-sided Hausdorff distance to the source next to two baselines (the
         zero-detail surface with the same boundary and the retriangulated surface itself, the
         floor). Adds the retriangulated layer and the rebuilt layer (current; quality = distance
@@ -64,7 +66,8 @@ from .transfer_curvature_detail import planar_map
                   "measure the distances to the source (half or more of the time on big meshes with "
                   "decimation, up to half with isotropic remeshing); false leaves the rebuilt and "
                   "zero-detail layers without a vertex quality, so a PLY of them holds none"),
-        Parameter("add_baseline", "bool", False, "also add the zero-detail baseline as a layer"),
+        Parameter("add_baseline", "bool", False, "also add the zero-detail baseline as a layer (none where "
+                  "the mesh has a closed piece: with zero detail it collapses onto its anchor)"),
     ],
 )
 def generate_curvature_remeshing(ms, *, method, target_edge, transfer, rows, location,
@@ -92,7 +95,7 @@ def generate_curvature_remeshing(ms, *, method, target_edge, transfer, rows, loc
               "retriangulated": add_layer(ms, result["Vt"], Ft, f"{label} retriangulated")}
     # without evaluation the measured layers get no quality at all, not pymeshlab's zeros
     measured_layer = add_layer if evaluate else _add_layer_without_quality
-    if add_baseline:
+    if add_baseline and result["Z"] is not None:        # a closed piece has no zero-detail surface
         # the distances the experiment measured for the baseline's Hausdorff maximum (None
         # without evaluation)
         layers["zero_detail"] = measured_layer(ms, result["Z"], Ft, f"{label} zero detail",

@@ -27,9 +27,9 @@ def planar_map(location, parameterization, default="harmonic"):
     name="transfer_curvature_detail",
     category="Curvature detail",
     description=f"""
-        Carry the curvature detail of the source layer (a disk-topology patch) over to the target
-        layer (a retriangulation of it, also a disk), the transfer step of the paper's remeshing
-        experiment. The detail carried is the source's stored 'curvature_detail' where it holds
+        Carry the curvature detail of the source layer (a manifold surface; a disk-topology
+        patch for location 'uv') over to the target layer (a retriangulation of it), the transfer
+        step of the paper's remeshing experiment. The detail carried is the source's stored 'curvature_detail' where it holds
         one (from compute_curvature_detail, kept while its vertices were moved; refused if the
         source was retriangulated since, as apply_curvature_reconstruction refuses it), else the
         detail of its current geometry; the returned 'detail_source' says which ('stored' or
@@ -60,7 +60,7 @@ def planar_map(location, parameterization, default="harmonic"):
     ],
 )
 def transfer_curvature_detail(ms, *, sourcemesh, targetmesh, method, location, parameterization):
-    from ..remesh import check_disk, parameterize, transfer_curvature
+    from ..remesh import check_surface, parameterize, transfer_curvature
     from ..remesh.transfer import squashed_in_plane
 
     parameterization = planar_map(location, parameterization)
@@ -71,8 +71,8 @@ def transfer_curvature_detail(ms, *, sourcemesh, targetmesh, method, location, p
                           hint="load or generate the retriangulation as another layer (e.g. layer 1)")
     Vs, Fs = mesh_arrays(ms, source)
     Vt, Ft = mesh_arrays(ms, target)
-    check_disk(Vs, Fs, f"the source (layer {source})")
-    check_disk(Vt, Ft, f"the target (layer {target})")
+    check_surface(Vs, Fs, f"the source (layer {source})")       # location='uv': parameterize asks for disks
+    check_surface(Vt, Ft, f"the target (layer {target})")
     # stored detail outlives moved vertices (the editing use); a broken stamp is refused in load_detail
     stored = vertex_attribute(ms, source, DETAIL, "point") is not None
     Ds = load_detail(ms, source, Fs) if stored else curvature_detail(Vs, Fs)

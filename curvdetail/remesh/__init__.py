@@ -1,11 +1,11 @@
-"""The remeshing experiment of the paper's Fig. 3: retriangulate a disk patch, carry its
+"""The remeshing experiment of the paper's Fig. 3: retriangulate a surface (closed, holes, pieces), carry its
 curvature detail to the new triangulation, rebuild it from that detail, and measure.
 
 Depends on :mod:`curvdetail.curvature` (operators and solvers), pymeshlab (isotropic remeshing,
 Hausdorff distance), libigl (closest points) and fast-simplification (decimation).
 """
 
-from ._disk import NotADiskError, RemeshError, check_disk
+from ._disk import NotADiskError, RemeshError, check_disk, check_surface
 from .closest_point import closest_points
 from .evaluate import hausdorff, vertex_distance
 from .experiment import WorseThanZeroDetailWarning, remesh_experiment
@@ -15,7 +15,8 @@ from .retriangulate import LongRunWarning, retriangulate
 from .transfer import edge_curvature_measure, transfer_curvature
 
 __all__ = [
-    "LongRunWarning", "NotADiskError", "RemeshError", "WorseThanZeroDetailWarning", "check_disk", "closest_points",
+    "LongRunWarning", "NotADiskError", "RemeshError", "WorseThanZeroDetailWarning", "check_disk", "check_surface",
+    "closest_points",
     "edge_curvature_measure", "flipped_triangles", "harmonic_map", "hausdorff", "interpolate", "locate",
     "parameterize", "remesh_experiment", "retriangulate", "spread", "transfer_curvature", "vertex_distance",
 ]

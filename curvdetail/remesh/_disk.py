@@ -1,9 +1,10 @@
-"""Disk-topology checks and projection onto the boundary polyline.
+"""Surface checks (any topology, and disks) and projection onto boundary polylines.
 
-Used across :mod:`curvdetail.remesh`, which exports ``check_disk``, ``NotADiskError`` and
-``RemeshError`` from here. A *disk* here is a triangle mesh that is one
-connected, edge- and vertex-manifold piece with exactly one boundary loop and Euler
-characteristic 1 (no handles).
+Used across :mod:`curvdetail.remesh`, which exports ``check_surface``, ``check_disk``,
+``NotADiskError`` and ``RemeshError`` from here. A *surface* is an edge- and vertex-manifold,
+consistently oriented triangle mesh: closed or with any number of boundary loops, pieces and
+handles. A *disk* is one connected piece with exactly one boundary loop and Euler
+characteristic 1 (no handles): the planar parameterization needs one.
 """
 
 import numpy as np
@@ -68,24 +69,7 @@ def check_disk(V, F, what="the source"):
     need = ("a disk-topology patch is needed: one connected piece with exactly one boundary loop "
             "and no handles (cut one out, e.g. with pymeshlab's compute_selection_by_condition_per_"
             "vertex + meshing_remove_selected_vertices, and keep its largest piece)")
-    nm = None
-    try:
-        V, F = check_mesh(V, F)
-    except MeshError:
-        try:
-            nm = non_manifold_edges(as_faces(F, None))    # checked: a cast would truncate 1.5 to 1
-        except Exception:  # F too malformed to look at: the original message says why
-            nm = None
-        if nm is not None and nm.shape[0]:
-            pairs = ", ".join(f"({a}, {b})" for a, b in nm[:3])
-            # a repair, not a cut: such edges are mostly a few stray triangles (a fin, a doubled face)
-            raise _refuse(f"{what} is not manifold: {counted(nm.shape[0], 'edge', verb='are')} shared by more "
-                          f"than two triangles (first: {pairs})",
-                          "repair the mesh, e.g. with pymeshlab's meshing_repair_non_manifold_edges (it deletes "
-                          "the smallest triangles on each such edge until two are left) and "
-                          "meshing_remove_unreferenced_vertices; the result must be a disk-topology patch: one "
-                          "connected piece with exactly one boundary loop and no handles") from None
-        raise
+    V, F = _checked(V, F, what, NotADiskError)
     n = V.shape[0]
     _, pieces = vertex_components(F, n)
     if pieces > 1:
@@ -111,8 +95,7 @@ def check_disk(V, F, what="the source"):
         raise _refuse(f"{what} has {loops} boundary loops (holes)", need)
     # check_mesh refused edges in more than two triangles: every interior edge is two of the 3m
     # half-edges, every boundary edge one (np.unique over the edge rows took 1.6 s at 200k faces)
-    n_edges = (3 * F.shape[0] + B.shape[0]) // 2
-    chi = n - n_edges + F.shape[0]
+    chi = euler_characteristic(F, n, B.shape[0])
     if chi != 1:
         raise _refuse(f"{what} has one boundary loop but Euler characteristic {chi} "
                       f"({counted((1 - chi) // 2, 'handle')})", need)
@@ -121,6 +104,101 @@ def check_disk(V, F, what="the source"):
     except MeshError:
         check_oriented(F, what, error=NotADiskError)
         raise
+
+
+def _checked(V, F, what, error=MeshError):
+    """:func:`check_mesh`, with edges shared by more than two triangles named as ``error``
+    (``count``, ``first`` set) with the repair to make."""
+    try:
+        return check_mesh(V, F)
+    except MeshError:
+        try:
+            nm = non_manifold_edges(as_faces(F, None))    # checked: a cast would truncate 1.5 to 1
+        except Exception:  # F too malformed to look at: the original message says why
+            nm = None
+        if nm is None or not nm.shape[0]:
+            raise
+    pairs = ", ".join(f"({a}, {b})" for a, b in nm[:3])
+    # a repair, not a cut: such edges are mostly a few stray triangles (a fin, a doubled face)
+    problem = (f"{what} is not manifold: {counted(nm.shape[0], 'edge', verb='are')} shared by more than two "
+               f"triangles (first: {pairs})")
+    hint = ("repair the mesh, e.g. with pymeshlab's meshing_repair_non_manifold_edges (it deletes the smallest "
+            "triangles on each such edge until two are left) and meshing_remove_unreferenced_vertices")
+    raise error(problem, hint=hint, count=int(nm.shape[0]), first=nm[:3].tolist()) from None
+
+
+def check_surface(V, F, what="the source"):
+    """Validate ``(V, F)`` as an oriented manifold surface of any topology (closed, with holes,
+    several pieces, handles) and return ``(V, F, loops)``.
+
+    Parameters
+    ----------
+    V : (n, 3) float array   vertex positions (checked as in :func:`check_mesh`)
+    F : (m, 3) int array     triangles, consistently oriented; every vertex used
+    what : str               how the messages name the mesh
+
+    Returns
+    -------
+    V : (n, 3) float64 array, F : (m, 3) int64 array   the checked arrays
+    loops : list of (k,) int64 arrays   the boundary loops, each ordered as the faces wind and
+                                        starting at its smallest vertex, by that vertex; [] if closed
+
+    Raises
+    ------
+    MeshError   malformed mesh; edges shared by more than two triangles (``count``, ``first``:
+                the first edges), a boundary passing a vertex twice, or misoriented triangles
+
+    Examples
+    --------
+    >>> from curvdetail.curvature.testing import cylinder, icosphere
+    >>> len(check_surface(*icosphere(subdivisions=1))[2]), len(check_surface(*cylinder(n_along=3))[2])
+    (0, 2)
+    """
+    V, F = _checked(V, F, what)
+    check_oriented(F, what)                 # a closed surface shows no boundary where it is not
+    return V, F, boundary_loops(F, V.shape[0], what)
+
+
+def boundary_loops(F, n, what="the mesh"):
+    """The boundary loops of the manifold ``F`` (n vertices), as in :func:`check_surface`."""
+    B = boundary_edges(F)
+    if B.shape[0] == 0:
+        return []
+    pinched = np.flatnonzero((np.bincount(B[:, 0], minlength=n) > 1) | (np.bincount(B[:, 1], minlength=n) > 1))
+    if pinched.size:
+        check_oriented(F, what)
+        raise MeshError(f"{what} is not vertex-manifold: the boundary passes "
+                        f"{counted(pinched.size, 'vertex', 'vertices')} more than once "
+                        f"(first: {first_indices(pinched)})",
+                        hint="split those vertices, e.g. with pymeshlab's meshing_repair_non_manifold_vertices",
+                        count=int(pinched.size), first=pinched[:3].tolist())
+    successor = np.full(n, -1, dtype=np.int64)
+    successor[B[:, 0]] = B[:, 1]
+    if np.any(successor[B[:, 1]] < 0):             # an edge into a vertex with none out of it
+        check_oriented(F, what)
+    loops, seen = [], np.zeros(n, dtype=bool)
+    for start in np.sort(B[:, 0]):
+        if seen[start]:
+            continue
+        loop = [start]
+        seen[start] = True
+        v = successor[start]
+        while v != start:
+            if v < 0 or seen[v]:
+                check_oriented(F, what)
+                raise MeshError(f"{what}: the boundary through vertex {start} does not close", hint="orient the "
+                                "triangles consistently and repair the mesh so that each boundary is a simple loop")
+            seen[v] = True
+            loop.append(v)
+            v = successor[v]
+        loops.append(np.asarray(loop, dtype=np.int64))
+    return loops
+
+
+def euler_characteristic(F, n, boundary_edge_count):
+    """``V - E + F`` of the manifold ``F`` with ``n`` vertices (every interior edge is two of the 3m
+    half-edges, every boundary edge one)."""
+    return n - (3 * F.shape[0] + boundary_edge_count) // 2 + F.shape[0]
 
 
 def _refuse(problem, advice):
@@ -224,12 +302,20 @@ TARGET_BOUNDARY_TOLERANCE = 1e-6
 
 
 def check_target_boundary(P, X, d, advice):
-    """RemeshError unless every target boundary vertex ``X`` lies on the source boundary
-    polyline ``P`` within ``TARGET_BOUNDARY_TOLERANCE`` times the larger of the diagonal ``d``
+    """RemeshError unless every target boundary vertex ``X`` lies on a source boundary
+    polyline (``P``: one loop's points, or a list of loops) within
+    ``TARGET_BOUNDARY_TOLERANCE`` times the larger of the diagonal ``d``
     and the largest coordinate (float32 files far from the origin round by more than 1e-6 of a
     small diagonal); ``advice``: the sentence that ends the message (what to pass instead)."""
-    scale = max(d, float(np.abs(P).max()), float(np.abs(X).max()))
-    dist = Polyline(P).project(X)[2] / scale              # exact: every segment where it must be
+    loops = P if isinstance(P, list) else [P]
+    if not loops or X.shape[0] == 0:
+        if len(loops) or X.shape[0]:
+            raise RemeshError(f"the target has {X.shape[0]} boundary vertices and the source {len(loops)} "
+                              f"boundary loops: the target must be a retriangulation of the source. {advice}")
+        return
+    scale = max(d, max(float(np.abs(p).max()) for p in loops), float(np.abs(X).max()))
+    # exact: every segment where it must be
+    dist = np.min([Polyline(p).project(X)[2] for p in loops], axis=0) / scale
     off = np.flatnonzero(dist > TARGET_BOUNDARY_TOLERANCE)
     if off.size:
         raise RemeshError(

@@ -4,14 +4,16 @@ import time
 
 import numpy as np
 
-from ..curvature.errors import warn
+from ..curvature.errors import MeshError, warn
 
-from ..curvature.checks import check_bool, check_choice
+from ..curvature.checks import as_count, check_bool, check_choice
 from ..curvature.geometry import bbox_diagonal
-from ..curvature.boundary_editing import boundary_loop
+from ..curvature.anchors import anchor_vertices
+from ..curvature.topology import boundary_vertices
 from ..curvature.reconstruct import ROW_MODES, Reconstructor
 from ..curvature.sparse_solver import resolve_backend
-from ._disk import TARGET_BOUNDARY_TOLERANCE, RemeshError, check_disk, check_target_boundary  # noqa: F401 (its home before)
+from ._disk import TARGET_BOUNDARY_TOLERANCE, RemeshError  # noqa: F401 (their home before)
+from ._disk import check_disk, check_surface, check_target_boundary
 from .evaluate import hausdorff, vertex_distance
 from .parameterize import METHODS as PARAMETERIZATIONS
 from .parameterize import parameterize
@@ -77,7 +79,7 @@ def worse_than_zero_detail(report, cli=False):
     zero-detail surface (RMS), lies on the source to rounding (RMS below its engine's
     ``ROUNDING_RMS``) or was not measured. ``cli``: naming the options of ``curvdetail remesh``
     instead of the function's parameters."""
-    if "error" not in report or "baseline_zero_detail" not in report:
+    if "error" not in report or not report.get("baseline_zero_detail"):
         return None
     rms, zero = report["error"][RMS], report["baseline_zero_detail"][RMS]
     if not (rms > zero and rms >= ROUNDING_RMS[report["error"].get("engine", "exact")]):
@@ -105,13 +107,15 @@ def worse_than_zero_detail(report, cli=False):
 
 def remesh_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="conservative", rows="free",
                       location="closest", parameterization=None, backend="auto", evaluate=True,
-                      source_path=None, progress=None, target=None, surface_check=True):
-    """Retriangulate a disk patch, carry its curvature detail over, rebuild it, and measure.
+                      source_path=None, progress=None, target=None, surface_check=True, anchors=1):
+    """Retriangulate a surface, carry its curvature detail over, rebuild it, and measure.
 
     Stages (timed): retriangulate (:func:`retriangulate`), parameterize (only for
     ``location="uv"``: :func:`parameterize`), transfer (:func:`transfer_curvature`, location
     included), reconstruct (target positions from the transferred detail with the target's
-    boundary fixed: one :class:`~curvdetail.Reconstructor` factorization, solved for the detail
+    boundary loops fixed and ``anchors`` vertices on each closed piece, see
+    :func:`~curvdetail.anchor_vertices`: one :class:`~curvdetail.Reconstructor` factorization,
+    solved for the detail
     and for the zero-detail baseline, the harmonic surface ``(L Z)_free = 0``: with
     ``rows="all"`` a second, free-row factorization gives it), evaluate (:func:`hausdorff` for
     the rebuilt mesh, the zero-detail baseline and the retriangulated surface itself, the
@@ -119,14 +123,16 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="c
 
     Parameters
     ----------
-    V : (n, 3) float array, F : (m, 3) int array   the source, a disk-topology patch
+    V : (n, 3) float array, F : (m, 3) int array   the source: a manifold, consistently oriented
+                                               surface (closed, holes, pieces, handles; a disk for
+                                               ``location="uv"``)
     method : {"isotropic", "decimate"}         retriangulation
     target_edge : float or str                 target edge length: model units, or a percentage of
                                                the bbox diagonal ("1%", PercentageValue(1); see
                                                :func:`~.units.as_length`)
     transfer : {"conservative", "pointwise"}   how detail is carried over (conservative: measured better)
     rows : {"free", "all"}                     residual rows of the reconstruction energy
-    location : {"closest", "uv"}               3D closest point, or a shared planar domain
+    location : {"closest", "uv"}               3D closest point, or a shared planar domain (disks only)
     parameterization : {"harmonic", "meshlab_harmonic", "lscm"} or None   the planar domain of
                                                ``location="uv"`` (None: "harmonic"); refused with
                                                ``location="closest"``, which uses no planar map
@@ -159,18 +165,24 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="c
                                                at 100k targets 26.1 s -> 19.9 s) and may change the
                                                retriangulation; recorded in ``options.surface_check``
                                                (None for a given ``target`` or ``"decimate"``)
+    anchors : int                              fixed vertices on each closed piece of the target
+                                               (farthest-point sampled from its flattest vertex)
 
     Returns
     -------
     mesh : tuple ``(X, Ft)``   the rebuilt target: (p, 3) positions and (q, 3) triangles
     report : dict              JSON-ready: ``source.{path, vertices, faces, bbox_diagonal}``,
-        ``target.{vertices, faces, boundary_vertices}``, ``options``, ``error``,
+        ``target.{vertices, faces, boundary_vertices, boundary_loops}``, ``anchors`` (fixed
+        vertices on closed pieces), ``options``, ``error``,
         ``baseline_zero_detail`` and ``floor_retriangulated`` (each
         ``{hausdorff_max_percent_of_diagonal, hausdorff_rms_percent_of_diagonal}``, % of the
         source bbox diagonal; ``error`` also has ``vertex_max_percent_of_diagonal``, the largest
         distance of a rebuilt vertex to the source, exact),
         ``improvement_over_zero_detail`` (zero-detail RMS / error RMS) and ``ratio_to_floor``
-        (error RMS / floor RMS), each None where one of its two RMS values is rounding, not a
+        (error RMS / floor RMS). Where the target has a closed piece there is no zero-detail
+        surface (it collapses onto the anchors): ``baseline_zero_detail`` and the improvement are
+        None, with the reason in ``ratio_notes``. Each ratio is None where one of its two RMS
+        values is rounding, not a
         measurement (below ``ROUNDING_RMS``: 1e-5 % of the diagonal as pymeshlab's single-precision
         engine measures, 1e-10 % as the exact engine does; e.g. every surface of a flat patch, or
         a target equal to the source), with the reason under ``ratio_notes``
@@ -183,7 +195,8 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="c
 
     Raises
     ------
-    MeshError, NotADiskError   malformed source or not a disk (says what was found)
+    MeshError                  malformed or non-manifold source (names the edges)
+    NotADiskError              (a MeshError) ``location="uv"`` with a source that is not a disk
     CurvdetailError            ``target_edge`` not a positive length (even with a ``target``)
     RemeshError                absurd target edge (with the numbers), a failed retriangulation, or a ``target`` with
                                boundary vertices off the source's boundary polyline (by more than
@@ -213,7 +226,7 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="c
     result = run_experiment(V, F, method=method, target_edge=target_edge, transfer=transfer, rows=rows,
                             location=location, parameterization=parameterization, backend=backend,
                             evaluate=evaluate, source_path=source_path, progress=progress, target=target,
-                            surface_check=surface_check)
+                            surface_check=surface_check, anchors=anchors)
     return (result["X"], result["Ft"]), result["report"]
 
 
@@ -233,6 +246,8 @@ def _ratios(report, engines):
     None where one of its RMS figures is below the ``ROUNDING_RMS`` of the engine that measured
     it (``engines``: figure key -> engine), and ``ratio_notes`` saying why, where one is None."""
     def rounding(key, what, then):
+        if report[key] is None:                     # not measured: engines[key] says why
+            return engines[key]
         rms = report[key][RMS]
         floor = ROUNDING_RMS[engines[key]]
         if rms >= floor:
@@ -270,9 +285,10 @@ def _check_choice(name, value, choices):
 
 def run_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="conservative", rows="free",
                    location="closest", parameterization=None, backend="auto", evaluate=True,
-                   source_path=None, progress=None, target=None, surface_check=True):
+                   source_path=None, progress=None, target=None, surface_check=True, anchors=1):
     """:func:`remesh_experiment` returning everything as a dict: ``X``, ``Ft``, ``Vt`` (the
-    retriangulated surface), ``Z`` (zero-detail baseline), ``Dt``, ``distance`` and
+    retriangulated surface), ``Z`` (zero-detail baseline; None where the target has a closed
+    piece), ``Dt``, ``distance`` and
     ``zero_distance`` (the exact distance of each vertex of ``X``, of ``Z``, to the source: the
     ones the Hausdorff maxima are taken over; None when ``evaluate=False``) and ``report``."""
     method = _check_choice("method", method, RETRIANGULATIONS)
@@ -299,7 +315,10 @@ def run_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="cons
     if progress is not None and not callable(progress):
         raise ValueError(f"progress must be callable (called with each stage name) or None; got "
                          f"{type(progress).__name__}.")
-    V, F, loop_s = check_disk(V, F, "the source")
+    anchors = as_count(anchors, "anchors")
+    if location == "uv":
+        check_disk(V, F, "the source")          # the planar map needs a disk: said before any work
+    V, F, loops_s = check_surface(V, F, "the source")
     d = bbox_diagonal(V)
     seconds = dict.fromkeys(STAGES, 0.0)
     t_all = time.perf_counter()
@@ -318,8 +337,9 @@ def run_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="cons
         Vt, Ft = retriangulate(V, F, method=method, target_edge=length, surface_check=surface_check)
         seconds["retriangulate"] = time.perf_counter() - t
     else:
-        Vt, Ft, loop_given = check_disk(*target, "the target")
-        check_target_boundary(V[loop_s], Vt[loop_given], d, "Pass one made by "
+        Vt, Ft, loops_given = check_surface(*target, "the target")
+        given = np.concatenate(loops_given) if loops_given else np.zeros(0, dtype=np.int64)
+        check_target_boundary([V[loop] for loop in loops_s], Vt[given], d, "Pass one made by "
                               "curvdetail.remesh.retriangulate, or target=None to make it here.")
 
     uv, param_info = None, None
@@ -336,23 +356,29 @@ def run_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="cons
     seconds["transfer"] = time.perf_counter() - t
 
     t = stage("reconstruct")
-    loop_t = boundary_loop(Ft)
-    rec = Reconstructor(Vt, Ft, loop_t, rows=rows, backend=backend)
-    X = rec.solve(Dt, Vt[loop_t])
+    boundary_t = boundary_vertices(Ft)
+    fixed = anchor_vertices(Vt, Ft, k=anchors, detail=Dt)
+    rec = Reconstructor(Vt, Ft, fixed, rows=rows, backend=backend)
+    X = rec.solve(Dt, Vt[fixed])
     # the baseline is the harmonic surface (L Z)_free = 0 whatever the rows: with rows="all",
     # D = 0 would give the least-squares argmin |L Z|^2 instead, another surface (nose: 9.1 %
-    # RMS against the harmonic 10.3 %), and the baseline would change with the option
-    harmonic = rec if rows == "free" else Reconstructor(Vt, Ft, loop_t, rows="free", backend=backend)
-    Z = harmonic.solve(np.zeros_like(Dt), Vt[loop_t])
+    # RMS against the harmonic 10.3 %), and the baseline would change with the option. A closed
+    # piece has none: with zero detail it collapses onto its anchors.
+    Z = None
+    if fixed.size == boundary_t.size:
+        harmonic = rec if rows == "free" else Reconstructor(Vt, Ft, fixed, rows="free", backend=backend)
+        Z = harmonic.solve(np.zeros_like(Dt), Vt[fixed])
+        del harmonic
     seconds["reconstruct"] = time.perf_counter() - t
     solver = rec.backend
-    del rec, harmonic           # their factors (~290 MB at 400k vertices) are not needed to evaluate
+    del rec                     # its factors (~290 MB at 400k vertices) are not needed to evaluate
 
     report = {
         "source": {"path": None if source_path is None else str(source_path), "vertices": int(V.shape[0]),
                    "faces": int(F.shape[0]), "bbox_diagonal": d},
         "target": {"vertices": int(Vt.shape[0]), "faces": int(Ft.shape[0]),
-                   "boundary_vertices": int(loop_t.size)},
+                   "boundary_vertices": int(boundary_t.size), "boundary_loops": len(loops_s)},
+        "anchors": int(fixed.size - boundary_t.size),
         "options": {"method": "given" if target is not None else method,
                     **(length_figures(length, d, "target_edge") if target is None else
                        dict.fromkeys(("target_edge_model_units", "target_edge_percent_of_diagonal"))),
@@ -372,7 +398,7 @@ def run_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="cons
         # its figures are those it would measure itself
         out["distance"] = vertex_distance(X, V, F)
         measured(1)
-        out["zero_distance"] = vertex_distance(Z, V, F)
+        out["zero_distance"] = None if Z is None else vertex_distance(Z, V, F)
         measured(2)
         # pymeshlab's grid search slows down with the cube of the distance: surfaces that are
         # far apart (a failed rebuild, the zero-detail baseline) use the exact engine.
@@ -382,9 +408,21 @@ def run_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="cons
                 ("error", X, out["distance"], None, "exact" if far else "meshlab"),
                 ("baseline_zero_detail", Z, out["zero_distance"], BASELINE_SAMPLES, "exact"),
                 ("floor_retriangulated", Vt, vertex_distance(Vt, V, F), None, "meshlab")):
-            h = hausdorff(P, Ft, V, F, samples=n, engine=engine, a_vertex_distance=dist)
-            report[key] = {MAX: 100 * h["max"] / d, RMS: 100 * h["rms"] / d}
-            engines[key] = h["engine"]
+            try:
+                if P is None:
+                    raise MeshError("the target has a closed piece, which with zero detail collapses onto its "
+                                    "anchors: there is no zero-detail surface to compare with")
+                h = hausdorff(P, Ft, V, F, samples=n, engine=engine, a_vertex_distance=dist)
+            except MeshError as exc:
+                if Z is not None and key != "baseline_zero_detail":
+                    raise
+                # a harmonic surface spanning several small loops degenerates (zero-area triangles)
+                report[key] = None
+                engines[key] = exc.problem if P is None else ("the zero-detail surface is degenerate (zero-area "
+                                                              "triangles): there is no baseline to compare with")
+            else:
+                report[key] = {MAX: 100 * h["max"] / d, RMS: 100 * h["rms"] / d}
+                engines[key] = h["engine"]
             measured(2 + len(engines))
         report["error"]["engine"] = engines["error"]            # the engine that ran (hausdorff may switch)
         report["error"]["vertex_max_percent_of_diagonal"] = float(100 * out["distance"].max() / d)

@@ -1,4 +1,4 @@
-"""Retriangulate a disk-topology patch, keeping its boundary curve (paper Fig. 3, step 1)."""
+"""Retriangulate a surface, keeping its boundary curves (paper Fig. 3, step 1)."""
 
 import math
 
@@ -7,8 +7,9 @@ import numpy as np
 from ..curvature.checks import as_count, as_float, check_bool, check_choice
 from ..curvature.geometry import bbox_diagonal, face_double_areas
 from ..curvature.topology import boundary_edges
-from ..curvature.errors import counted
-from ._disk import NotADiskError, Polyline, RemeshError, check_disk
+from ..curvature.errors import MeshError, counted
+from ..curvature.topology import vertex_components
+from ._disk import Polyline, RemeshError, check_surface, euler_characteristic
 from .units import as_bbox_length
 
 METHODS = ("isotropic", "decimate")
@@ -177,13 +178,13 @@ def _as(check, value, name, requirement):
 
 def retriangulate(V, F, *, method="isotropic", target_edge="1%", iterations=10, max_surface_distance=None,
                   aggressiveness=7.0, surface_check=True):
-    """Retriangulate a disk-topology patch; every boundary vertex of the result stays on the
-    source's boundary polyline.
+    """Retriangulate a surface (closed, with holes, several pieces or handles); every boundary
+    vertex of the result stays on its source boundary loop, and the topology is kept.
 
     Parameters
     ----------
     V : (n, 3) float array     source vertex positions
-    F : (m, 3) int array       source triangles (a disk: one piece, one boundary loop, no handles)
+    F : (m, 3) int array       source triangles (a manifold, consistently oriented surface)
     method : {"isotropic", "decimate"}
         ``"isotropic"``: pymeshlab ``meshing_isotropic_explicit_remeshing`` (split, collapse,
         flip, smooth, reproject) at the target edge length, every parameter passed explicitly.
@@ -218,12 +219,13 @@ def retriangulate(V, F, *, method="isotropic", target_edge="1%", iterations=10, 
     Returns
     -------
     Vt : (p, 3) float array    target vertex positions; boundary vertices lie on the source's
-                               boundary polyline (projected onto it, within 1e-12 of the bbox diagonal)
-    Ft : (q, 3) int array      target triangles, a disk, oriented as the source
+                               boundary polylines (projected onto them, within 1e-12 of the bbox diagonal)
+    Ft : (q, 3) int array      target triangles, oriented as the source, with its pieces, boundary
+                               loops and Euler characteristic
 
     Raises
     ------
-    MeshError, NotADiskError   the source is malformed or not a disk (says what was found)
+    MeshError                  the source is malformed or not manifold (names the edges)
     CurvdetailError            a ``target_edge`` or ``max_surface_distance`` that is not a positive
                                length (``parameter`` names it)
     RemeshError                unknown method, ``iterations`` not a whole number from 1 to 1,000,
@@ -235,7 +237,7 @@ def retriangulate(V, F, *, method="isotropic", target_edge="1%", iterations=10, 
                                decimation asked to refine, or for fewer than 1.25 x the b - 2
                                triangles its b boundary vertices (which it keeps) need, or that
                                stops at more than 1.25 x the triangles asked for, or a remesher
-                               result that is not a disk or moved the boundary
+                               result that changed the topology or moved the boundary
 
     Examples
     --------
@@ -247,7 +249,8 @@ def retriangulate(V, F, *, method="isotropic", target_edge="1%", iterations=10, 
     """
     method = check_choice(method, "method", METHODS, " is not a retriangulation method; use 'isotropic' or "
                           "'decimate'.", RemeshError)
-    V, F, loop = check_disk(V, F, "the source")
+    V, F, loops = check_surface(V, F, "the source")
+    topology = _topology(F, V.shape[0], loops)
     d = bbox_diagonal(V)
     target_edge = as_bbox_length(target_edge, "target_edge").fraction(d)
     iterations = _as(as_count, iterations, "iterations",
@@ -277,16 +280,34 @@ def retriangulate(V, F, *, method="isotropic", target_edge="1%", iterations=10, 
         surf = target_edge if max_surface_distance is None else max_surface_distance
         Ut, Ft = _isotropic(unit, F, target_edge, iterations, surf, surface_check)
         try:
-            Ut, Ft, loop_t = check_disk(Ut, Ft, "the isotropic remesher's result")
-        except NotADiskError as exc:
-            # what was found, not the advice to the owner of a mesh (repair it, cut a disk out)
-            raise RemeshError(f"{getattr(exc, 'problem', exc)}; try another target edge.") from None
+            Ut, Ft, loops_t = _same_topology(Ut, Ft, topology, "the isotropic remesher's result")
+        except MeshError as exc:
+            # what was found, not the advice to the owner of a mesh (repair it)
+            raise RemeshError(f"{exc.problem}; try another target edge.") from None
     else:
-        Ut, Ft, loop_t = _decimate(unit, F, target_edge, aggressiveness, loop.size)
+        Ut, Ft, loops_t = _decimate(unit, F, target_edge, aggressiveness, sum(map(len, loops)), topology)
     Vt = Ut * d + center
     if method == "decimate":
         Vt = _restore_kept_vertices(V, Vt, d)
-    return _snap_boundary(V, loop, Vt, Ft, loop_t, d, h)
+    for loop_t in loops_t:
+        Vt = _snap_boundary(V, loops, Vt, loop_t, d, h)
+    return Vt, Ft
+
+
+def _topology(F, n, loops):
+    """``(pieces, boundary loops, Euler characteristic)`` of the checked surface ``F``."""
+    return vertex_components(F, n)[1], len(loops), euler_characteristic(F, n, sum(map(len, loops)))
+
+
+def _same_topology(V, F, topology, what):
+    """``check_surface(V, F, what)``, or MeshError where the pieces, boundary loops or Euler
+    characteristic differ from ``topology`` (the source's)."""
+    V, F, loops = check_surface(V, F, what)
+    found = _topology(F, V.shape[0], loops)
+    if found != topology:
+        raise MeshError(f"{what} has {found[0]} pieces, {found[1]} boundary loops and Euler characteristic "
+                        f"{found[2]} where the source has {topology[0]}, {topology[1]} and {topology[2]}")
+    return V, F, loops
 
 
 def _restore_kept_vertices(V, Vt, d):
@@ -314,7 +335,7 @@ def _isotropic(V, F, h, iterations, max_dist, surface_check=True):
     import pymeshlab
 
     ms = pymeshlab.MeshSet()
-    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=V, face_matrix=F.astype(np.int32)))
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=_apart(V, F), face_matrix=F.astype(np.int32)))
     # Every parameter explicitly: pymeshlab keeps values from earlier calls in one process.
     ms.meshing_isotropic_explicit_remeshing(
         iterations=iterations, adaptive=False, selectedonly=False, targetlen=pymeshlab.PureValue(h),
@@ -323,6 +344,32 @@ def _isotropic(V, F, h, iterations, max_dist, surface_check=True):
     ms.meshing_remove_unreferenced_vertices()
     m = ms.current_mesh()
     return np.array(m.vertex_matrix(), dtype=np.float64), np.array(m.face_matrix(), dtype=np.int64)
+
+
+#: How far (a fraction of the way to the centroid of its neighbours) a vertex that shares its
+#: position with another is moved before the isotropic remeshing, which merges such vertices
+#: (cow.off has two where its surface touches itself: the remesher glued the two sheets into a
+#: non-manifold edge at any target edge).
+APART = 1e-6
+
+
+def _apart(V, F):
+    """``V`` with every vertex at the position of an earlier one moved ``APART`` of the way to
+    the centroid of its neighbours (into its own sheet of the surface)."""
+    order = np.lexsort(V.T[::-1])
+    moved = order[1:][np.all(V[order[1:]] == V[order[:-1]], axis=1)]
+    if moved.size == 0:
+        return V
+    is_moved = np.zeros(V.shape[0], dtype=bool)
+    is_moved[moved] = True
+    total, count = np.zeros_like(V), np.zeros(V.shape[0])
+    for k in range(3):
+        rows = F[is_moved[F[:, k]]]
+        np.add.at(total, rows[:, k], V[rows[:, (k + 1) % 3]] + V[rows[:, (k + 2) % 3]])
+        np.add.at(count, rows[:, k], 2.0)
+    V = V.copy()
+    V[moved] += APART * (total[moved] / count[moved, None] - V[moved])
+    return V
 
 
 # shown by retriangulate, the generate_curvature_remeshing filter and `curvdetail remesh` alike,
@@ -354,9 +401,10 @@ def _decimation_scale(agg):
 DECIMATION_SHORTFALL = 1.25
 
 
-def _decimate(V, F, h, agg, boundary):
-    """Decimate the unit-frame patch ``V`` to an equilateral target edge ``h`` (``boundary``: the
-    number of its boundary vertices, which the decimation keeps)."""
+def _decimate(V, F, h, agg, boundary, topology):
+    """Decimate the unit-frame surface ``V`` to an equilateral target edge ``h`` (``boundary``: the
+    number of its boundary vertices, which the decimation keeps; ``topology``: what the result
+    must keep, see :func:`_topology`)."""
     import fast_simplification
 
     area = 0.5 * face_double_areas(V, F).sum()
@@ -385,7 +433,7 @@ def _decimate(V, F, h, agg, boundary):
         remap = np.cumsum(used) - 1
         P, T = P[used], remap[T]
         try:
-            P, T, loop = check_disk(P, T, "the decimated mesh")
+            P, T, loops = _same_topology(P, T, topology, "the decimated mesh")
         except ValueError as exc:  # a non-manifold edge or a zero-area triangle at high agg
             last = exc
             continue
@@ -393,13 +441,23 @@ def _decimate(V, F, h, agg, boundary):
             raise RemeshError(f"the decimation stopped at {T.shape[0]:,} triangles, more than {DECIMATION_SHORTFALL:g} x "
                               f"the {target_faces:,} the target edge asks for (fast-simplification found no more "
                               f"collapses that keep the boundary); choose a shorter target edge or {_USE_ISOTROPIC}.")
-        return P, T, loop
+        return P, T, loops
     raise RemeshError(f"{getattr(last, 'problem', last)} (decimation with agg={agg}, 3 and 1); {_USE_ISOTROPIC}.")
 
 
-def _snap_boundary(V, loop, Vt, Ft, loop_t, d, h):
-    poly = Polyline(V[loop])
-    Y, _, dist = poly.project(Vt[loop_t])
+def _snap_boundary(V, loops, Vt, loop_t, d, h):
+    """``Vt`` with the target loop ``loop_t`` projected onto the source loop (of ``loops``) nearest
+    it, or RemeshError where a vertex is further than ``BOUNDARY_SNAP * h`` from it or the loop
+    does not run once around it in order."""
+    best = None
+    for loop in loops:
+        poly = Polyline(V[loop])
+        Y, _, dist = poly.project(Vt[loop_t])
+        if best is None or dist.max() < best[2].max():
+            best = poly, Y, dist
+    if best is None:
+        raise RemeshError("the remesher opened a boundary in a closed surface; try another target edge.")
+    poly, Y, dist = best
     far = np.flatnonzero(dist > BOUNDARY_SNAP * h)
     if far.size:
         raise RemeshError(
@@ -413,4 +471,4 @@ def _snap_boundary(V, loop, Vt, Ft, loop_t, d, h):
                           "(it folds back); try another target edge.")
     Vt = Vt.copy()
     Vt[loop_t] = Y
-    return Vt, Ft
+    return Vt

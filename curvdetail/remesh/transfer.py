@@ -11,6 +11,7 @@ from ..curvature.mean_curvature_normal import mean_curvature_normal
 from ..curvature.mixed_voronoi_area import mixed_voronoi_area
 from ..curvature.sparse_solver import factorize
 from .closest_point import as_coordinates, check_points_and_mesh, unit_frame
+from .closest_point import _barycentric
 from .locate import _locate, interpolate, spread
 
 METHODS = ("conservative", "pointwise")
@@ -57,7 +58,8 @@ def edge_curvature_measure(V, F):
     return _edge_curvature_measure(V, F)
 
 
-def _edge_curvature_measure(V, F):
+def _edge_curvature_measure(V, F, normals=False):
+    """``(E, c)``, and with ``normals`` also each edge's normal: the sum of its triangles' unit normals."""
     a, b, c = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
     n = np.cross(b - a, c - a)
     n /= np.linalg.norm(n, axis=1, keepdims=True)
@@ -71,7 +73,10 @@ def _edge_curvature_measure(V, F):
     E = np.sort(ends[first], axis=1)
     inverse = inverse.reshape(-1)
     meas = np.column_stack([np.bincount(inverse, weights=g[:, j], minlength=keys.size) for j in range(3)])
-    return E, meas
+    if not normals:
+        return E, meas
+    n3 = np.repeat(n, 3, axis=0)
+    return E, meas, np.column_stack([np.bincount(inverse, weights=n3[:, j], minlength=keys.size) for j in range(3)])
 
 
 def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="closest", uv=None,
@@ -98,7 +103,9 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     triangles, well conditioned, so the correction stays near the vertices it belongs to).
 
     Location: ``"closest"`` = the closest point on the other surface in space (the meshes are
-    two triangulations of one surface); ``"uv"`` = point location in a shared planar domain
+    two triangulations of one surface; a conservative sample whose closest target triangle
+    faces away from its source edge, the other sheet where two lie close, is put on the nearest
+    one that faces its way); ``"uv"`` = point location in a shared planar domain
     given as ``uv=(UVs, UVt)`` (see :func:`parameterize`).
 
     Parameters
@@ -172,7 +179,7 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
         face, bary, dist = _locate(*check_points_and_mesh(tgt_dom, src_dom, Fs, names=(names[1], names[0], "Fs")))
         _check_same_surface(dist, Vs, location)
         return interpolate(K, Fs, face, bary) * mixed_voronoi_area(Vt, Ft)[:, None]
-    E, c = _edge_curvature_measure(Vs, Fs)
+    E, c, normal = _edge_curvature_measure(Vs, Fs, normals=True)
     if detail is not None:
         c = _carrying(E, c, detail)
     q = _samples_per_edge(Vs, E, Vt, Ft, samples_per_edge)
@@ -182,7 +189,42 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     pts = (1 - t)[:, None] * src_dom[E[edge, 0]] + t[:, None] * src_dom[E[edge, 1]]
     face, bary, dist = _locate(*check_points_and_mesh(pts, tgt_dom, Ft, names=("edge samples", names[1], "Ft")))
     _check_same_surface(dist, Vs, location)
+    if location == "closest":
+        _facing_side(pts, normal[edge], Vt, Ft, face, bary, dist)
     return spread(c[edge] / q[edge, None], Ft, face, bary, Vt.shape[0])
+
+
+#: Most samples :func:`_facing_side` relocates one by one; more (a target wound against the
+#: source) are left where they are.
+MAX_RELOCATED = 10_000
+
+
+def _facing_side(P, normal, Vt, Ft, face, bary, dist):
+    """Relocate, in place, the samples ``P`` whose closest target triangle faces away from their
+    source edge (``normal``: the sum of its triangles' normals; a negative dot product) onto the
+    nearest target triangle that faces their way, among those with a centroid within
+    max(4 x the sample's distance, 3 x the mean target edge). Where two sheets of a surface lie
+    closer than the retriangulation's error (cow.off: its tail along its rear) the closest point
+    can be on the other sheet, and the detail moved there bent the tail by 1.5 % of the diagonal."""
+    import igl
+    from scipy.spatial import cKDTree
+
+    Nt = np.cross(Vt[Ft[:, 1]] - Vt[Ft[:, 0]], Vt[Ft[:, 2]] - Vt[Ft[:, 0]])
+    bad = np.flatnonzero((normal * Nt[face]).sum(1) < 0)
+    if bad.size == 0 or bad.size > MAX_RELOCATED:
+        return
+    centroids = Vt[Ft].mean(axis=1)
+    reach = 3.0 * np.linalg.norm(Vt[Ft[:, 1]] - Vt[Ft[:, 0]], axis=1).mean()
+    tree = cKDTree(centroids)
+    for i in bad:
+        near = np.asarray(tree.query_ball_point(P[i], max(4.0 * dist[i], reach)), dtype=np.int64)
+        near = near[Nt[near] @ normal[i] > 0]
+        if near.size == 0:
+            continue
+        sq, at, C = igl.point_mesh_squared_distance(P[i:i + 1], Vt, Ft[near])
+        face[i] = near[at[0]]
+        bary[i] = _barycentric(C, Vt[Ft[face[i:i + 1]]])[0]
+        dist[i] = np.sqrt(sq[0])
 
 
 def _carrying(E, c, detail):
