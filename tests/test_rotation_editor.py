@@ -135,3 +135,19 @@ def test_no_fold_on_the_benchmark_cases_at_their_files_transforms(name):
     X, ed = edit_with_selection(V, F, status, T, return_editor=True)
     assert ed.converged
     assert folded_triangles(V, F, X, T[:3, :3]).size == 0
+
+
+def test_the_local_fit_is_the_svd_s_nearest_rotation():
+    # the Newton polar factor of C + cof(C) (with the eigen fallback) against numpy's SVD:
+    # random, flat (rank 2: a planar one-ring) and near-reflection covariances, to rounding
+    from curvdetail.curvature.rotation_editor import _closest_rotations
+
+    rng = np.random.default_rng(7)
+    Q = np.linalg.qr(rng.normal(size=(3000, 3, 3)))[0]
+    C = np.concatenate([rng.normal(size=(3000, 3, 3)), Q @ np.diag([1.0, 0.6, 0.0]) @ Q[::-1],
+                        0.5 * Q @ np.diag([1.0, 1.0, -1.0]) + 1e-3 * rng.normal(size=(3000, 3, 3))])
+    U, _, Wt = np.linalg.svd(C)
+    U[:, :, 2] *= np.sign(np.linalg.det(U) * np.linalg.det(Wt))[:, None]
+    R = _closest_rotations(C)
+    assert np.abs(R - U @ Wt).max() < 1e-9
+    assert np.abs(np.linalg.det(R) - 1).max() < 1e-12

@@ -276,10 +276,38 @@ def _anderson(history):
     return G[:, -1] - dG @ gamma
 
 
-def _closest_rotations(C):
-    """The rotations ``R_k`` maximizing ``trace(R_k^T C_k)`` for (k, 3, 3) ``C`` (the SVD
-    solution ``U diag(1, 1, det(U W^T)) W^T``), from the eigenvectors of ``C^T C``; rank-2
-    matrices (a flat one-ring) included."""
+def _closest_rotations(C, steps=8):
+    """The rotations ``R_k`` maximizing ``trace(R_k^T C_k)`` for (k, 3, 3) ``C``: the SVD
+    solution ``U diag(1, 1, d) W^T``, ``d = det(U) det(W)``.
+
+    ``C + cof(C)`` (``C`` scaled to unit Frobenius norm) is ``U diag(s1 + d s2 s3, s2 + d s1 s3,
+    s3 + d s1 s2) W^T``: where its first two entries are positive and the third has the sign of
+    ``d`` (always for ``d = 1``, rank 2 included), its orthogonal polar factor is the answer,
+    found by ``steps`` scaled Newton steps ``X <- (g X + X^-T / g) / 2``. The rest (a factor
+    that is no rotation to 1e-12) goes through :func:`_closest_rotations_eigh`."""
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        X = C / np.sqrt(np.einsum("kij,kij->k", C, C))[:, None, None]
+        X = X + _cofactor(X)
+        for _ in range(steps):
+            inv_t = _cofactor(X)
+            inv_t /= np.einsum("ki,ki->k", X[..., 0], inv_t[..., 0])[:, None, None]       # X^-T
+            g = (np.einsum("kij,kij->k", inv_t, inv_t) / np.einsum("kij,kij->k", X, X)) ** 0.25
+            X = 0.5 * (g[:, None, None] * X + inv_t / g[:, None, None])
+        error = np.abs(np.swapaxes(X, 1, 2) @ X - np.eye(3)).max(axis=(1, 2))
+        bad = ~((error < 1e-12) & (np.einsum("ki,ki->k", X[..., 0], np.cross(X[..., 1], X[..., 2])) > 0))
+    if bad.any():
+        X[bad] = _closest_rotations_eigh(C[bad])
+    return X
+
+
+def _cofactor(A):
+    """Cofactor matrices ``det(A) A^-T`` of (k, 3, 3) ``A``: columns ``a1 x a2, a2 x a0, a0 x a1``."""
+    a0, a1, a2 = A[..., 0], A[..., 1], A[..., 2]
+    return np.stack([np.cross(a1, a2), np.cross(a2, a0), np.cross(a0, a1)], axis=2)
+
+
+def _closest_rotations_eigh(C):
+    """:func:`_closest_rotations` from the eigenvectors of ``C^T C`` (rank 2 included)."""
     _, W = np.linalg.eigh(np.swapaxes(C, 1, 2) @ C)          # ascending: W[..., 2] the largest
     w1, w2 = W[..., 2], W[..., 1]
     u1 = np.einsum("kij,kj->ki", C, w1)
