@@ -214,7 +214,9 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="c
 
     Raises
     ------
-    MeshError                  malformed or non-manifold source (names the edges)
+    MeshError                  malformed or non-manifold source (names the edges); zero-area
+                               source triangles with ``laplacian="cotan"``, or ones no flip removes
+                               (a needle: two vertices at one point) with the others
     NotADiskError              (a MeshError) ``location="uv"`` with a source that is not a disk
     CurvdetailError            ``target_edge`` not a positive length (even with a ``target``)
     RemeshError                absurd target edge (with the numbers), a failed retriangulation, or a ``target`` with
