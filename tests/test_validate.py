@@ -1,6 +1,8 @@
 """Input checks (checks, topology): every bad-input class gets its error class and a message that names
 the count and the first offending indices; good input comes back as float64 / int64."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -9,6 +11,8 @@ from curvdetail import (ConstraintError, CurvatureEditor, MeshError, check_mesh,
                         minimal_surface, mixed_voronoi_area, reconstruct, sine_displacement)
 from curvdetail.curvature import boundary_edges, boundary_vertices
 from curvdetail.curvature.checks import as_index_set, as_values
+from curvdetail.curvature.errors import CurvdetailError
+
 from curvdetail.curvature.topology import vertex_components
 from curvdetail.curvature.testing import grid, icosphere
 
@@ -22,45 +26,52 @@ def _square():
 
 @pytest.mark.parametrize("op", OPERATORS)
 def test_empty_vertices_are_refused(op):
-    with pytest.raises(MeshError, match=r"V is empty \(0 vertices\)"):
+    with pytest.raises(MeshError) as e:
         op(np.zeros((0, 3)), np.zeros((0, 3), dtype=int))
+    assert (e.value.parameter, e.value.count) == ("V", 0)
 
 
 def test_empty_faces_are_refused():
     V, _ = _square()
-    with pytest.raises(MeshError, match=r"F is empty \(0 triangles\)"):
+    with pytest.raises(MeshError, match=r"\(0 triangles\)") as e:
         cotan_laplacian(V, np.zeros((0, 3), dtype=int))
+    assert e.value.parameter == "F"
 
 
 @pytest.mark.parametrize("shape", [(9, 2), (9,), (9, 3, 1)])
 def test_vertex_array_of_the_wrong_shape_is_refused(shape):
     _, F = _square()
-    with pytest.raises(MeshError, match=r"V has shape .*; vertex positions must be an \(n, 3\) array"):
+    with pytest.raises(MeshError, match=re.escape(str(shape))) as e:
         cotan_laplacian(np.zeros(shape), F)
+    assert e.value.parameter == "V"
 
 
 def test_quad_faces_are_refused():
     V, _ = _square()
-    with pytest.raises(MeshError, match=r"F has shape \(1, 4\); triangles must be an \(m, 3\)"):
+    with pytest.raises(MeshError, match=r"\(1, 4\)") as e:
         cotan_laplacian(V, np.array([[0, 1, 4, 3]]))
+    assert e.value.parameter == "F"
 
 
 @pytest.mark.parametrize("bad", [np.array([["a", "b", "c"]] * 9), np.ones((9, 3), dtype=complex)])
 def test_non_real_vertices_are_refused(bad):
     _, F = _square()
-    with pytest.raises(MeshError, match="dtype"):
+    with pytest.raises(MeshError, match=str(bad.dtype)) as e:
         cotan_laplacian(bad, F)
+    assert e.value.parameter == "V"
 
 
 def test_ragged_input_is_refused():
-    with pytest.raises(MeshError, match="could not be read as an array"):
+    with pytest.raises(MeshError) as e:
         cotan_laplacian([[0, 0, 0], [1, 0]], [[0, 1, 2]])
+    assert e.value.parameter == "V"
 
 
 def test_fractional_face_indices_are_refused():
     V, F = _square()
-    with pytest.raises(MeshError, match="non-integer entries"):
+    with pytest.raises(MeshError) as e:
         cotan_laplacian(V, F + 0.5)
+    assert (e.value.parameter, e.value.count, e.value.first) == ("F", 8, [0, 1, 2])
 
 
 def test_integral_float_faces_and_integer_vertices_are_accepted():
@@ -73,23 +84,26 @@ def test_integral_float_faces_and_integer_vertices_are_accepted():
 def test_non_finite_coordinates_are_refused_with_the_vertices(value):
     V, F = _square()
     V[[2, 7], 1] = value
-    with pytest.raises(MeshError, match=r"2 vertices have NaN or infinite coordinates \(first: 2, 7\)"):
+    with pytest.raises(MeshError) as e:
         mean_curvature_normal(V, F)
+    assert (e.value.parameter, e.value.count, e.value.first) == ("V", 2, [2, 7])
 
 
 def test_out_of_range_face_indices_are_refused_with_the_faces():
     V, F = _square()
     F[5, 0] = 9
     F[6, 2] = -1
-    with pytest.raises(MeshError, match=r"2 triangles have vertex indices outside \[0, 9\) \(first: 5, 6\)"):
+    with pytest.raises(MeshError, match=r"\[0, 9\)") as e:
         cotan_laplacian(V, F)
+    assert (e.value.parameter, e.value.count, e.value.first) == ("F", 2, [5, 6])
 
 
 def test_repeated_index_in_a_face_is_refused_with_the_face():
     V, F = _square()
     F[4] = [3, 4, 3]
-    with pytest.raises(MeshError, match=r"F: 1 triangle repeats a vertex index \(first: 4\); remove it, "):
+    with pytest.raises(MeshError) as e:
         mixed_voronoi_area(V, F)
+    assert (e.value.parameter, e.value.count, e.value.first) == ("F", 1, [4])
 
 
 def test_the_advice_for_flat_slivers_works_where_removing_them_would_leave_slits():
@@ -102,8 +116,9 @@ def test_the_advice_for_flat_slivers_works_where_removing_them_would_leave_slits
     for f in (17, 402, 931):                       # third corner onto the middle of the first edge
         a, b, c = F[f]
         V[c] = (V[a] + V[b]) / 2
-    with pytest.raises(MeshError, match=r"3 triangles have zero area .*meshing_remove_t_vertices\(method=1\)"):
+    with pytest.raises(MeshError, match=r"meshing_remove_t_vertices\(method=1") as e:   # the advice's filter
         mean_curvature_normal(V, F)
+    assert (e.value.parameter, e.value.count, e.value.first) == ("F", 3, [17, 402, 931])
     ms = pymeshlab.MeshSet()
     ms.add_mesh(pymeshlab.Mesh(V, F))
     ms.meshing_remove_t_vertices(method=1, threshold=40, repeat=True)     # flips the slivers away
@@ -117,17 +132,19 @@ def test_zero_area_faces_are_refused_with_the_faces():
     V, F = _square()
     V[4] = V[0] + 0.5 * (V[1] - V[0])         # centre vertex onto the bottom edge, between 0 and 1
     bad = np.flatnonzero(np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1) == 0)
-    assert bad.size == 1                        # one: the message says "1 triangle has", not "1 triangles have"
-    with pytest.raises(MeshError, match=rf"^1 triangle has zero area \(first: {bad[0]}.*; flip or collapse it away"):
+    assert bad.size == 1
+    with pytest.raises(MeshError) as e:
         cotan_laplacian(V, F)
+    assert (e.value.parameter, e.value.count, e.value.first) == ("F", 1, [bad[0]])
 
 
 def test_non_manifold_edge_is_refused_with_the_edge():
     V, F = _square()
     V = np.vstack([V, [0.25, 0.25, 1.0]])     # a fin on the interior diagonal (0, 4)
     F = np.vstack([F, [0, 4, 9]])
-    with pytest.raises(MeshError, match=r"^1 edge is shared by more than two triangles \(first: \(0, 4\)\)"):
+    with pytest.raises(MeshError) as e:
         cotan_laplacian(V, F)
+    assert (e.value.parameter, e.value.count, e.value.first) == ("F", 1, [(0, 4)])
 
 
 @pytest.mark.parametrize("entry", [check_mesh, cotan_laplacian, curvature_detail, mixed_voronoi_area,
@@ -138,9 +155,9 @@ def test_non_manifold_edges_are_counted_and_listed_in_order_by_every_entry_point
     V, F = _square()
     V = np.vstack([V, [[0.25, 0.25, 1.0], [0.75, 0.75, 1.0], [0.5, 0.0, 1.0]]])
     F = np.vstack([F, [[0, 4, 9], [4, 8, 10], [1, 4, 11]]])   # fins on (0, 4), (4, 8), (1, 4)
-    with pytest.raises(MeshError, match=r"3 edges are shared by more than two triangles "
-                                        r"\(first: \(0, 4\), \(1, 4\), \(4, 8\)\)"):
+    with pytest.raises(MeshError, match=r"\(0, 4\), \(1, 4\), \(4, 8\)") as e:
         entry(V, F)
+    assert (e.value.parameter, e.value.count, e.value.first) == ("F", 3, [(0, 4), (1, 4), (4, 8)])
 
 
 @pytest.mark.parametrize("op", OPERATORS + [check_mesh])
@@ -149,11 +166,9 @@ def test_an_isolated_pair_of_duplicate_triangles_is_refused(op, second):
     # same order, reversed, rotated: accepted before, with twice the area (each edge on exactly two
     # triangles passes the non-manifold check)
     V = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
-    with pytest.raises(MeshError, match=r"^F: 1 triangle repeats the three vertices of an earlier one \(first "
-                                        r"pairs: \(0, 1\)\): a repeated triangle counts its area and curvature "
-                                        r"twice\. Remove the duplicates, e\.g\. with pymeshlab's "
-                                        r"meshing_remove_duplicate_faces\.$"):
+    with pytest.raises(MeshError, match=r"\(0, 1\).*meshing_remove_duplicate_faces") as e:
         op(V, [[0, 1, 2], second])
+    assert (e.value.parameter, e.value.count, e.value.first) == ("F", 1, [1])
 
 
 @pytest.mark.parametrize("entry", [check_mesh, cotan_laplacian, curvature_detail, mixed_voronoi_area,
@@ -163,10 +178,9 @@ def test_duplicates_inside_a_mesh_are_named_as_such_not_as_non_manifold_edges(en
     # the non-manifold edges" was the message
     V, F = grid(5, 5)
     F = np.vstack([F, F[[7]][:, ::-1], F[[3]], F[[7]][:, [1, 2, 0]]])     # 32 triangles before
-    with pytest.raises(MeshError, match=r"^F: 3 triangles repeat the three vertices of an earlier one \(first "
-                                        r"pairs: \(7, 32\), \(3, 33\), \(7, 34\)\): .* "
-                                        r"meshing_remove_duplicate_faces"):
+    with pytest.raises(MeshError, match=r"\(7, 32\), \(3, 33\), \(7, 34\).*meshing_remove_duplicate_faces") as e:
         entry(V, F)
+    assert (e.value.parameter, e.value.count, e.value.first) == ("F", 3, [32, 33, 34])
 
 
 def test_repeated_triangles_finds_every_repeat_also_for_vertex_counts_beyond_its_key():
@@ -187,23 +201,12 @@ def test_repeated_triangles_finds_every_repeat_also_for_vertex_counts_beyond_its
 def test_unreferenced_vertices_are_refused_with_the_vertices():
     V, F = _square()
     V = np.vstack([V, [[5.0, 5, 5], [6.0, 6, 6]]])
-    with pytest.raises(MeshError, match=r"2 vertices are not used by any triangle \(first: 9, 10\); remove them"):
+    with pytest.raises(MeshError, match="meshing_remove_unreferenced_vertices") as e:
         curvature_detail(V, F)
-    # one is one: "1 vertices are not used" before
-    with pytest.raises(MeshError, match=r"^1 vertex is not used by any triangle \(first: 9\); remove it, e\.g\."):
+    assert (e.value.parameter, e.value.count, e.value.first) == ("V", 2, [9, 10])
+    with pytest.raises(MeshError) as e:
         curvature_detail(V[:10], F)
-
-
-def test_one_bad_vertex_is_named_in_the_singular():
-    V, F = _square()
-    V[2, 1] = np.nan
-    with pytest.raises(MeshError, match=r"^V: 1 vertex has NaN or infinite coordinates \(first: 2\); remove or "
-                                        r"repair it before"):
-        check_mesh(V, F)
-    V[3, 0] = np.inf
-    with pytest.raises(MeshError, match=r"^V: 2 vertices have NaN or infinite coordinates \(first: 2, 3\); remove "
-                                        r"or repair them before"):
-        check_mesh(V, F)
+    assert (e.value.count, e.value.first) == (1, [9])
 
 
 @pytest.mark.parametrize("count, words", [(0, "0 edges are"), (1, "1 edge is"), (2, "2 edges are")])
@@ -220,20 +223,25 @@ def test_component_without_fixed_vertex_is_refused():
     V, F = _square()
     V2 = np.vstack([V, V + [3.0, 0, 0]])
     F2 = np.vstack([F, F + 9])
-    with pytest.raises(ConstraintError, match=r"1 of 2 connected components have no fixed vertex .*vertex 9"):
+    with pytest.raises(ConstraintError) as e:
         reconstruct(V2, F2, np.zeros_like(V2), [0], V2[[0]])
-    with pytest.raises(ConstraintError, match=r"vertex 9"):
+    assert (e.value.parameter, e.value.count, e.value.first) == ("fixed", 1, [9])
+    with pytest.raises(ConstraintError) as e:
         minimal_surface(V2, F2, [0, 1, 2])
+    assert (e.value.count, e.value.first) == (1, [9])
 
 
 def test_fixed_indices_out_of_range_and_repeated_are_named():
-    with pytest.raises(ConstraintError, match=r"2 indices are outside \[0, 9\) \(first: 9, -3\)"):
+    with pytest.raises(ConstraintError, match=r"\[0, 9\)") as e:
         as_index_set([0, 9, -3], 9, "fixed")
-    with pytest.raises(ConstraintError, match=r"1 index is repeated \(first: 4\)"):
+    assert (e.value.parameter, e.value.count, e.value.first) == ("fixed", 2, [9, -3])
+    with pytest.raises(ConstraintError) as e:
         as_index_set([4, 1, 4], 9, "fixed")
-    # a non-whole value is named with its position, as the editing filter names it
-    with pytest.raises(ConstraintError, match=r"fixed: 2 values are not whole numbers \(first: 0\.5, at position 1\)"):
+    assert (e.value.parameter, e.value.count, e.value.first) == ("fixed", 1, [4])
+    # a non-whole value is named by its position, as the editing filter names it
+    with pytest.raises(ConstraintError, match=r"0\.5") as e:
         as_index_set([3, 0.5, np.inf], 9, "fixed")
+    assert (e.value.parameter, e.value.count, e.value.first) == ("fixed", 2, [1, 2])
     assert as_index_set([3.0, 0.0], 9, "fixed").tolist() == [3, 0]
 
 
@@ -245,12 +253,14 @@ def test_index_set_keeps_the_callers_order_and_reads_masks():
 
 
 def test_values_of_the_wrong_shape_or_non_finite_are_named():
-    with pytest.raises(ConstraintError, match=r"detail has shape \(4, 2\); expected \(4, 3\)"):
+    with pytest.raises(ConstraintError, match=r"\(4, 2\).*\(4, 3\)") as e:
         as_values(np.zeros((4, 2)), 4, "detail")
+    assert e.value.parameter == "detail"
     bad = np.zeros((4, 3))
     bad[3, 0] = np.nan
-    with pytest.raises(ConstraintError, match=r"1 row is NaN or infinite \(first: 3\)"):
+    with pytest.raises(ConstraintError) as e:
         as_values(bad, 4, "detail")
+    assert (e.value.parameter, e.value.count, e.value.first) == ("detail", 1, [3])
 
 
 def test_errors_are_value_errors():
@@ -288,15 +298,16 @@ def test_components_are_labelled():
     assert count == 2 and len(set(labels[:9])) == 1 and labels[0] != labels[9]
 
 
-@pytest.mark.parametrize("F, message", [
-    ([[0, 1]], r"shape \(1, 2\)"), (None, r"shape \(\)"), (np.zeros((0, 3), int), "is empty"),
-    ([[0, 1, -2]], "1 triangle has negative vertex indices"), ([[0, 1, 1]], "1 triangle repeats a vertex index"),
-    ([[0, 1, 2.5]], "non-integer"), (np.ones((1, 3), bool), "dtype bool"),
+@pytest.mark.parametrize("F, message, count", [
+    ([[0, 1]], r"\(1, 2\)", None), (None, r"\(\)", None), (np.zeros((0, 3), int), r"\(0, 3\)|0 triangles", None),
+    ([[0, 1, -2]], None, 1), ([[0, 1, 1]], None, 1), ([[0, 1, 2.5]], None, 1), (np.ones((1, 3), bool), "bool", None),
 ])
-def test_boundary_functions_check_their_triangles(F, message):
+def test_boundary_functions_check_their_triangles(F, message, count):
     for function in (boundary_edges, boundary_vertices):
-        with pytest.raises(MeshError, match=message):
+        with pytest.raises(MeshError, match=message) as e:
             function(F)
+        assert (e.value.parameter, e.value.count) == ("F", count)
+        assert e.value.first == (None if count is None else [0])
 
 
 def test_indices_out_of_range_are_counted_by_position_not_wrapped():
@@ -315,8 +326,9 @@ def test_indices_out_of_range_are_counted_by_position_not_wrapped():
 @pytest.mark.parametrize("values", [np.ones((2, 3)) + 1j, np.ones((2, 3), bool), np.full((2, 3), "1")])
 def test_values_must_be_real_numbers(values):
     # complex would silently lose its imaginary part, bool would mean 0/1
-    with pytest.raises(ConstraintError, match=f"has dtype {values.dtype}; pass a \\(2, 3\\) array of real"):
+    with pytest.raises(ConstraintError, match=str(values.dtype)) as e:
         as_values(values, 2, "detail")
+    assert e.value.parameter == "detail"
     assert as_values(np.ones((2, 3), np.int32), 2, "detail").dtype == np.float64
 
 
@@ -325,13 +337,15 @@ def test_coordinates_whose_products_overflow_are_named(scale):
     # before: "16 triangles have zero area" at 1e155, and at 1e80 mean_curvature_normal returned
     # inf / NaN without a word (the areas square the cross products)
     V, F = grid(3, 3)
-    with pytest.raises(MeshError, match=rf"V: 8 rows reach {scale:.0e}".replace("+", r"\+") +
-                       r" .* the geometry overflows double precision: scale the mesh down"):
+    with pytest.raises(MeshError, match=re.escape(f"{scale:.0e}")) as e:       # the largest coordinate
         check_mesh(V * scale, F)
-    with pytest.raises(MeshError, match="overflows double precision"):
+    assert (e.value.parameter, e.value.count, e.value.first) == ("V", 8, [1, 2, 3])
+    with pytest.raises(MeshError) as e:
         mean_curvature_normal(V * scale, F)
-    with pytest.raises(ConstraintError, match=r"positions: 1 row reaches 1e\+200"):
+    assert (e.value.parameter, e.value.count) == ("V", 8)
+    with pytest.raises(ConstraintError, match=r"1e\+200") as e:
         as_values([[1e200, 0, 0]], 1, "positions")
+    assert (e.value.parameter, e.value.count, e.value.first) == ("positions", 1, [0])
 
 
 def test_a_mesh_too_small_for_its_areas_is_named_by_its_size():
@@ -339,11 +353,12 @@ def test_a_mesh_too_small_for_its_areas_is_named_by_its_size():
     V[:, 2] = V[:, 0] ** 2                                    # 1.73 across
     check_mesh(V * 1e-60, F)                                  # still fine
     for scale in (1e-61, 1e-100, 1e-200):                    # 1e-200: its squared extent underflows
-        with pytest.raises(MeshError, match=rf"the mesh is 1.73e-{-np.log10(scale):.0f} across \(bbox "
-                                            r"diagonal\), below 1e-60: .* scale it up, e\.g\. to unit size"):
+        with pytest.raises(MeshError, match=rf"1.73e-{-np.log10(scale):.0f}.*1e-60") as e:   # size, limit
             check_mesh(V * scale, F)
-    with pytest.raises(MeshError, match="the mesh is 0 across .* all 9 vertices lie at one point"):
+        assert e.value.parameter == "V" and e.value.value == pytest.approx(1.73 * scale, rel=1e-2)
+    with pytest.raises(MeshError) as e:
         check_mesh(V * 0.0, F)
+    assert (e.value.parameter, e.value.value) == ("V", 0.0)
 
 
 @pytest.mark.parametrize("op", OPERATORS)
@@ -355,8 +370,9 @@ def test_a_mesh_whose_areas_lose_digits_to_subnormals_is_refused_not_answered_in
     exact = op(V, F)
     exact = exact[0] if isinstance(exact, tuple) else exact
     for scale in (1e-75, 1e-78):
-        with np.errstate(all="raise"), pytest.raises(MeshError, match=r"the mesh is 9.08e-\d+ across"):
+        with np.errstate(all="raise"), pytest.raises(MeshError, match=r"9.08e-\d+") as e:
             op(V * scale, F)
+        assert e.value.parameter == "V"
     # just above the limit the answer is exact: K scales as 1 / length, A as length^2, L as 1
     scaled = op(V * 1e-59, F)
     scaled = scaled[0] if isinstance(scaled, tuple) else scaled
@@ -436,10 +452,12 @@ def test_counts_and_positive_numbers_take_what_numpy_hands_out():
         assert as_count(3.0, "n") == 3 and as_count(np.array(2000), "n") == 2000
         assert as_count(np.uint8(7), "n") == 7 and as_count(2 ** 70, "n") == 2 ** 70
     for bad in (True, np.True_, 2.5, "5", None, float("nan"), np.array([1, 2])):
-        with pytest.raises(ValueError, match="must be a whole number >= 1"):
+        with pytest.raises(CurvdetailError, match=">= 1") as e:
             as_count(bad, "n")
-    with pytest.raises(ValueError, match="must be a positive number"):       # inf, not an OverflowError
+        assert e.value.parameter == "n"
+    with pytest.raises(CurvdetailError) as e:       # inf, not an OverflowError
         as_positive_number(10 ** 400, "tol")
+    assert e.value.parameter == "tol"
 
 
 def test_docstring_examples_run():
@@ -493,14 +511,16 @@ def test_check_choice_takes_one_str_of_the_choices_and_names_anything_else():
 
     assert check_choice("free", "rows", ("all", "free"), "; use 'all' or 'free'.") == "free"
     assert type(check_choice(np.str_("all"), "rows", ("all", "free"), ".")) is str
-    with pytest.raises(ValueError, match=r"^rows='some'; use 'all' or 'free'\.$"):
+    with pytest.raises(CurvdetailError, match="'some'") as e:
         check_choice("some", "rows", ("all", "free"), "; use 'all' or 'free'.")
+    assert (e.value.parameter, e.value.value) == ("rows", "some")
     # ``value in choices`` compares an array element-wise: one entry passed, two raised numpy's
     # "truth value ... is ambiguous"; neither is an option value
     for value, kind in ((np.array(["all"]), "ndarray"), (np.array(["all", "free"]), "ndarray"),
                         (["all"], "list"), (None, "NoneType")):
-        with pytest.raises(ConstraintError, match=rf"^rows=.* \({kind}, not a single str\); use"):
+        with pytest.raises(ConstraintError, match=kind) as e:
             check_choice(value, "rows", ("all", "free"), "; use 'all' or 'free'.", ConstraintError)
+        assert e.value.parameter == "rows"
 
 
 def test_index_values_that_are_not_whole_numbers_are_named_with_the_first_and_its_position():

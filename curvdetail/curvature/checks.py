@@ -178,11 +178,12 @@ def check_referenced(n, F, name=None):
 
 def non_manifold_error(count, first):
     """The MeshError for ``count`` edges on three or more triangles, ``first``: a few (a, b)."""
+    first = [(int(a), int(b)) for a, b in first]           # an iterator too: read it once
     pairs = ", ".join(f"({a}, {b})" for a, b in first)
     return MeshError(
         f"{counted(count, 'edge', verb='are')} shared by more than two triangles (first: {pairs}); "
         "the mesh is not manifold. Repair it, e.g. with pymeshlab's meshing_repair_non_manifold_edges.",
-        parameter="F", count=int(count), first=[tuple(int(v) for v in e) for e in first])
+        parameter="F", count=int(count), first=first)
 
 
 def as_index_set(indices, n, name):
@@ -328,7 +329,7 @@ def check_choice(value, name, choices, advice, error=None):
     shown = repr(value) if isinstance(value, str) else f"{value!r} ({type(value).__name__}, not a single str)"
     if error is None:
         raise CurvdetailError(f"{name}={shown}{advice}", parameter=name, value=value)
-    raise error(f"{name}={shown}{advice}")
+    raise error(f"{name}={shown}{advice}", parameter=name, value=value)
 
 
 def real_word(word):
