@@ -34,51 +34,50 @@ def test_formatted_values_parse_back_exactly():
         assert p.parse(p.format(v)) == v
 
 
+def _refused(p, value, parse=False):
+    """The FilterParameterError of ``p.check(value)`` (``p.parse`` with ``parse``), which names ``p``."""
+    with pytest.raises(FilterParameterError) as e:
+        (p.parse if parse else p.check)(value)
+    assert e.value.parameter == p.name
+    return e.value
+
+
 def test_wrong_type_error_names_parameter_and_expected_type():
     p = Parameter("max_iterations", "int", 200, "steps")
-    with pytest.raises(FilterParameterError, match=r"'max_iterations' expects an int.*str"):
-        p.check("200")
-    with pytest.raises(FilterParameterError, match=r"'max_iterations' expects an int"):
-        p.check(2.5)
+    assert "'200' (str)" in str(_refused(p, "200"))
+    assert "2.5 (float)" in str(_refused(p, 2.5))
 
 
 def test_bool_is_not_accepted_as_a_number():
-    with pytest.raises(FilterParameterError, match="'tol' expects a float"):
-        Parameter("tol", "float", 1e-6, "tolerance").check(True)
+    assert "True (bool)" in str(_refused(Parameter("tol", "float", 1e-6, "tolerance"), True))
 
 
 def test_numpy_scalars_are_accepted():
     assert Parameter("n", "int", 1, "d").check(np.int32(4)) == 4
     assert Parameter("x", "float", 1.0, "d").check(np.float32(0.5)) == 0.5
     assert Parameter("b", "bool", False, "d").check(np.True_) is True        # numpy 2's bool
-    with pytest.raises(FilterParameterError, match="expects an int"):
-        Parameter("n", "int", 1, "d").check(np.False_)
+    _refused(Parameter("n", "int", 1, "d"), np.False_)
 
 
 @pytest.mark.parametrize("kind, value, message", [
-    ("mesh", 2 ** 31, "2147483648; it must lie within"), ("int", -(2 ** 40), "must lie within"),
-    ("float", 10 ** 400, "is inf; it must be a finite number"),
+    ("mesh", 2 ** 31, "2147483648"), ("int", -(2 ** 40), "-1099511627776"), ("float", 10 ** 400, "inf"),
 ])
 def test_numbers_beyond_what_pymeshlab_takes_are_refused(kind, value, message):
     # they reached pybind11 (TypeError) or float() (OverflowError) before
     p = Parameter("p", kind, None if kind == "mesh" else 1, "d")
-    with pytest.raises(FilterParameterError, match=message):
-        p.check(value)
-    with pytest.raises(FilterParameterError, match="must"):
-        p.parse(str(value))
+    assert message in str(_refused(p, value))
+    _refused(p, str(value), parse=True)
 
 
 def test_an_enum_index_in_other_digits_is_named_not_a_key_error():
     p = Parameter("rows", "str", "all", "rows", choices=("all", "free"))
-    with pytest.raises(FilterParameterError, match="one of all, free"):
-        p.parse("\u00b2")
+    assert "all, free" in str(_refused(p, "\u00b2", parse=True))       # the choices
 
 
 def test_choice_is_case_insensitive_and_canonical():
     p = Parameter("rows", "str", "all", "rows", choices=("all", "free"))
     assert p.check("FREE") == "free"
-    with pytest.raises(FilterParameterError, match="one of all, free"):
-        p.check("some")
+    assert "all, free" in str(_refused(p, "some"))
 
 
 def test_enum_index_parses_as_meshlab_writes_it():
@@ -88,15 +87,13 @@ def test_enum_index_parses_as_meshlab_writes_it():
 
 def test_range_is_enforced():
     p = Parameter("max_iterations", "int", 200, "steps", min=1)
-    with pytest.raises(FilterParameterError, match="at least 1"):
-        p.check(0)
+    assert "at least 1" in str(_refused(p, 0))       # the bound
 
 
 @pytest.mark.parametrize("value", [0.0, -1e-9, pymeshlab.PercentageValue(0.0)])
 def test_positive_parameters_refuse_zero_and_below(value):
     p = Parameter("target_edge", "PercentageValue", BBoxLength(1.0, True), "edge", positive=True)
-    with pytest.raises(FilterParameterError, match="'target_edge' is .*; it must be greater than 0"):
-        p.check(value)
+    assert "greater than 0" in str(_refused(p, value))       # the bound
     assert p.check(pymeshlab.PercentageValue(0.5)) == BBoxLength(0.5, True)
 
 
@@ -112,18 +109,15 @@ def test_filters_declare_the_strictly_positive_ranges_their_code_demands(name, p
     assert p.positive
     line = next(text for text in describe_filter(spec).splitlines() if text.strip().startswith(parameter))
     assert "> 0" in line and ">= 0" not in line
-    with pytest.raises(FilterParameterError, match="greater than 0"):
-        p.parse("0")
+    _refused(p, "0", parse=True)
 
 
 def test_non_finite_float_is_refused():
-    with pytest.raises(FilterParameterError, match="finite"):
-        Parameter("tol", "float", 1e-6, "tolerance").parse("nan")
+    assert "nan" in str(_refused(Parameter("tol", "float", 1e-6, "tolerance"), "nan", parse=True))
 
 
 def test_unparsable_text_names_parameter():
-    with pytest.raises(FilterParameterError, match="'fix_boundary' expects true or false"):
-        Parameter("fix_boundary", "bool", True, "d").parse("maybe")
+    assert "'maybe'" in str(_refused(Parameter("fix_boundary", "bool", True, "d"), "maybe", parse=True))
 
 
 def test_mesh_parameter_defaults_to_current_mesh():
@@ -132,14 +126,13 @@ def test_mesh_parameter_defaults_to_current_mesh():
 
 
 def test_negative_layer_id_is_refused():
-    with pytest.raises(FilterParameterError, match="'targetmesh' is -1; a layer id is 0 or more"):
-        Parameter("targetmesh", "mesh", 0, "target layer").check(-1)
+    assert "-1" in str(_refused(Parameter("targetmesh", "mesh", 0, "target layer"), -1))
 
 
 def test_declaration_needs_known_type_and_description():
-    with pytest.raises(TypeError, match="not one of"):
+    with pytest.raises(TypeError, match="'double'"):
         Parameter("x", "double", 1.0, "d")
-    with pytest.raises(TypeError, match="description"):
+    with pytest.raises(TypeError, match="'x'"):
         Parameter("x", "float", 1.0, " ")
 
 
@@ -147,8 +140,7 @@ def test_enum_takes_its_index_from_python_as_pymeshlab_does():
     p = Parameter("rows", "str", "all", "rows", choices=("all", "free"))
     assert p.check(1) == "free" and p.check(np.int64(0)) == "all"
     for bad in (2, -1, True):
-        with pytest.raises(FilterParameterError, match=r"'rows'.*one of all, free, or its index"):
-            p.check(bad)
+        assert "all, free" in str(_refused(p, bad))
 
 
 def test_text_parameter_takes_a_sequence_of_numbers_digit_for_digit():
@@ -160,12 +152,10 @@ def test_text_parameter_takes_a_sequence_of_numbers_digit_for_digit():
     assert p.check(list(np.eye(2).ravel())) == "1.0 0.0 0.0 1.0"
     assert p.check([np.int64(3), np.int32(4), np.float32(0.5)]) == "3 4 0.5"
     for bad in ([[1, 2], [3]], ["1", 2], object()):
-        with pytest.raises(FilterParameterError, match="'transform' expects a str"):
-            p.check(bad)
-    # True/False among numbers are named (the generic message called the list a list it takes)
-    for bad in ([True, 2], (2, np.True_)):
-        with pytest.raises(FilterParameterError, match=r"'transform' has True/False among its numbers \(first at position"):
-            p.check(bad)
+        _refused(p, bad)
+    # True/False among numbers are named with the position of the first
+    assert "position 0" in str(_refused(p, [True, 2]))
+    assert "position 1" in str(_refused(p, (2, np.True_)))
 
 
 @pytest.mark.parametrize("shape", [(2, 8), (16, 1), (1, 16), (4, 4, 1)])
@@ -173,15 +163,14 @@ def test_a_matrix_parameter_refuses_arrays_of_another_shape(shape):
     # every array was flattened: a 2x8 array passed and was read row by row as a 4x4 matrix
     p = Parameter("transform", "str", "", "4x4 matrix", shape=(4, 4))
     dims = "x".join(map(str, shape))
-    with pytest.raises(FilterParameterError, match=rf"'transform' is a {dims} array; it must be a 4x4 matrix"):
-        p.check(np.arange(16.0).reshape(shape))
+    assert f"a {dims} array" in str(_refused(p, np.arange(16.0).reshape(shape)))
     text = " ".join(repr(float(x)) for x in range(16))
     for good in (np.arange(16.0).reshape(4, 4), np.arange(16.0), np.arange(16.0).reshape(4, 4).tolist()):
         assert p.check(good) == text                  # the matrix, or its 16 numbers row by row
 
 
 def test_a_shape_is_declared_for_a_str_of_numbers_only():
-    with pytest.raises(TypeError, match="a shape applies to a str of numbers only"):
+    with pytest.raises(TypeError, match="'rows'"):
         Parameter("rows", "str", "all", "d", choices=("all", "free"), shape=(2,))
 
 
@@ -199,14 +188,12 @@ def test_an_index_parameter_takes_a_single_number_a_range_and_a_set(value, text)
     assert Parameter("handles", "str", "", "indices").check(value) == text
 
 
-@pytest.mark.parametrize("value, what", [(3, r"a single number \(3\)"),
-                                         (set(range(16)), "a set of 16 values, which has no order")])
+@pytest.mark.parametrize("value, what", [(3, "(3)"), (set(range(16)), "set of 16")])
 def test_a_matrix_parameter_refuses_a_single_number_and_a_set_with_the_fix(value, what):
     # a matrix is read row by row: one number is no matrix, and a set has no order to read
     p = Parameter("transform", "str", "", "4x4 matrix", shape=(4, 4))
-    with pytest.raises(FilterParameterError, match=rf"parameter 'transform' is {what}; it must be a 4x4 matrix: "
-                                                   r"a \(4, 4\) array, or its 16 numbers row by row"):
-        p.check(value)
+    message = str(_refused(p, value))
+    assert what in message and "(4, 4)" in message
     assert p.check(range(16)) == " ".join(map(str, range(16)))      # a range has an order
 
 
@@ -220,16 +207,13 @@ def test_an_empty_sequence_of_numbers_is_the_empty_text(empty):
 def test_a_boolean_mask_is_refused_with_the_indices_it_means(mask):
     # it was "expects a str; got array([False, True, ...]) (ndarray)", about the type
     p = Parameter("handles", "str", "", "indices")
-    with pytest.raises(FilterParameterError, match=r"'handles' is a boolean mask \(4 True/False values\); it "
-                                                   r"takes numbers, not a mask: .*np\.flatnonzero\(mask\)"):
-        p.check(mask)
+    assert "np.flatnonzero(mask)" in str(_refused(p, mask))        # the fix
 
 
 def test_masked_entries_are_refused_not_read_as_numbers():
     # np.ma.array([1, 2], mask=[0, 1]) was read as "1 2", the masked entry included
     p = Parameter("handles", "str", "", "indices")
-    with pytest.raises(FilterParameterError, match="'handles' has 1 masked entries"):
-        p.check(np.ma.array([1, 2], mask=[False, True]))
+    _refused(p, np.ma.array([1, 2], mask=[False, True]))
     assert p.check(np.ma.array([1, 2], mask=[False, False])) == "1 2"
 
 
@@ -238,9 +222,7 @@ def test_masked_entries_are_refused_not_read_as_numbers():
 def test_an_enum_given_as_an_array_or_a_list_names_the_parameter_and_the_choices(value):
     # not numpy's "truth value of an array ... is ambiguous", and not the first element taken
     p = Parameter("rows", "str", "all", "rows", choices=("all", "free"))
-    with pytest.raises(FilterParameterError, match=r"'rows' expects a str \(one of all, free, or its index\); "
-                                                   r"got .*(all|free)"):      # (grouped: 'free' alone matched any such message)
-        p.check(value)
+    assert "all, free" in str(_refused(p, value))
 
 
 def test_an_enum_index_outside_the_choices_says_the_range_of_indices():
@@ -248,9 +230,7 @@ def test_an_enum_index_outside_the_choices_says_the_range_of_indices():
     # the index was not (pymeshlab: "Enum 2 not valid. Must be a value between 0 and 1")
     p = Parameter("rows", "str", "all", "rows", choices=("all", "free"))
     for bad in (2, np.int64(-1)):
-        with pytest.raises(FilterParameterError, match=r"'rows' is .*; it must be one of all, free, or its "
-                                                       r"index, 0 to 1\."):
-            p.check(bad)
+        assert "0 to 1" in str(_refused(p, bad))
 
 
 @pytest.mark.parametrize("kind, value, expected", [
@@ -280,8 +260,8 @@ def test_an_enum_index_given_as_a_zero_dimensional_array_is_taken(value, expecte
     p = Parameter("rows", "str", "all", "rows", choices=("all", "free"))
     out = p.check(value)
     assert out == expected and type(out) is str
-    with pytest.raises(FilterParameterError, match=r"'rows' is .*; it must be one of all, free, or its index, 0 to 1\."):
-        p.check(np.array(2))
+    assert "0 to 1" in str(_refused(p, np.array(2)))
+
 
 
 def test_curvdetail_list_says_which_parameters_are_required():

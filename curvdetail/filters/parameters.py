@@ -138,7 +138,7 @@ class Parameter:
 
     def _fail(self, value, expected):
         return FilterParameterError(
-            f"parameter {self.name!r} expects {expected}; got {value!r} ({type(value).__name__})."
+            f"parameter {self.name!r} expects {expected}; got {value!r} ({type(value).__name__}).", parameter=self.name
         )
 
     def check(self, value):
@@ -166,10 +166,10 @@ class Parameter:
             if isinstance(value, numbers.Integral) and not isinstance(value, (bool, np.bool_)):
                 if t == "mesh" and value < 0:
                     raise FilterParameterError(f"parameter {self.name!r} is {value}; a layer id is "
-                                               "0 or more.")
+                                               "0 or more.", parameter=self.name)
                 if abs(value) > INT_MAX:              # pymeshlab's C++ ints
                     raise FilterParameterError(f"parameter {self.name!r} is {value}; it must lie within "
-                                               f"+-{INT_MAX}.")
+                                               f"+-{INT_MAX}.", parameter=self.name)
                 return self._range(int(value))
             raise self._fail(value, "an int" if t == "int" else "a layer id (int) of the MeshSet")
         if t == "float":
@@ -184,7 +184,7 @@ class Parameter:
                     and not isinstance(value, (bool, np.bool_)):
                 raise FilterParameterError(
                     f"parameter {self.name!r} is {value!r}; it must be one of {', '.join(self.choices)}, "
-                    f"or its index, 0 to {len(self.choices) - 1}.")
+                    f"or its index, 0 to {len(self.choices) - 1}.", parameter=self.name)
             if self.choices is None:
                 value = _numbers_as_text(self._check_numbers(self._as_sequence(value)))
             if not isinstance(value, str):
@@ -196,7 +196,7 @@ class Parameter:
                         return c
                 raise FilterParameterError(
                     f"parameter {self.name!r} is {value!r}; it must be one of {', '.join(self.choices)} "
-                    f"(or its index, 0 to {len(self.choices) - 1})."
+                    f"(or its index, 0 to {len(self.choices) - 1}).", parameter=self.name
                 )
             return value
         # PercentageValue
@@ -231,7 +231,7 @@ class Parameter:
                     f"a {type(value).__name__} of {len(value)} values, which has no order")
             raise FilterParameterError(
                 f"parameter {self.name!r} is {what}; it must be a {dims} matrix: a {self.shape} array, or "
-                f"its {count} numbers row by row as a list or as text.")
+                f"its {count} numbers row by row as a list or as text.", parameter=self.name)
         if single:
             return [value]
         try:
@@ -253,37 +253,42 @@ class Parameter:
             fix = (f"pass a {self.shape} array of numbers" if self.shape is not None else
                    "pass the indices where the mask is true, np.flatnonzero(mask)")
             raise FilterParameterError(f"parameter {self.name!r} is a boolean mask ({arr.size} True/False "
-                                       f"values); it takes numbers, not a mask: {fix}.")
+                                       f"values); it takes numbers, not a mask: {fix}.", parameter=self.name)
         flags = [isinstance(x, (bool, np.bool_)) for x in items]
         if any(flags):                  # True/False among numbers: read as 1/0 otherwise
             raise FilterParameterError(
                 f"parameter {self.name!r} has True/False among its numbers (first at position "
-                f"{flags.index(True)}); pass numbers only (or, for indices, np.flatnonzero(mask) of a mask).")
+                f"{flags.index(True)}); pass numbers only (or, for indices, np.flatnonzero(mask) of a mask).",
+                parameter=self.name)
         if np.ma.isMaskedArray(value) and np.ma.getmaskarray(value).any():
             raise FilterParameterError(
                 f"parameter {self.name!r} has {int(np.ma.getmaskarray(value).sum())} masked entries, which "
-                "would be read as numbers; pass the entries you mean, e.g. value.compressed().")
+                "would be read as numbers; pass the entries you mean, e.g. value.compressed().", parameter=self.name)
         if self.shape is not None and arr.ndim > 1 and arr.shape != self.shape and \
                 all(isinstance(x, numbers.Real) for x in items):
             dims = "x".join(map(str, self.shape))
             raise FilterParameterError(
                 f"parameter {self.name!r} is a {'x'.join(map(str, arr.shape))} array; it must be a {dims} "
                 f"matrix: a {self.shape} array, or its {math.prod(self.shape)} numbers row by row as a "
-                "flat list or as text.")
+                "flat list or as text.", parameter=self.name)
         return value
 
     def _finite(self, x):
         if not math.isfinite(x):
-            raise FilterParameterError(f"parameter {self.name!r} is {x}; it must be a finite number.")
+            raise FilterParameterError(f"parameter {self.name!r} is {x}; it must be a finite number.",
+                                       parameter=self.name)
         return x
 
     def _range(self, x):
         if self.positive and not x > 0:
-            raise FilterParameterError(f"parameter {self.name!r} is {x}; it must be greater than 0.")
+            raise FilterParameterError(f"parameter {self.name!r} is {x}; it must be greater than 0.",
+                                       parameter=self.name)
         if self.min is not None and x < self.min:
-            raise FilterParameterError(f"parameter {self.name!r} is {x}; it must be at least {self.min}.")
+            raise FilterParameterError(f"parameter {self.name!r} is {x}; it must be at least {self.min}.",
+                                       parameter=self.name)
         if self.max is not None and x > self.max:
-            raise FilterParameterError(f"parameter {self.name!r} is {x}; it must be at most {self.max}.")
+            raise FilterParameterError(f"parameter {self.name!r} is {x}; it must be at most {self.max}.",
+                                       parameter=self.name)
         return x
 
     # -- parsing text (command line, .mlx) ------------------------------------------------------
@@ -327,7 +332,8 @@ class Parameter:
                         "float": "a number", "str": "text",
                         "PercentageValue": "a number (absolute) or a percentage of the bbox "
                                            "diagonal such as 1%"}[t]
-            raise FilterParameterError(f"parameter {self.name!r} expects {expected}; got {s!r}.") from None
+            raise FilterParameterError(f"parameter {self.name!r} expects {expected}; got {s!r}.",
+                                       parameter=self.name) from None
 
     def format(self, value):
         """``value`` as text that :meth:`parse` reads back exactly."""
