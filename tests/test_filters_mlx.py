@@ -1,6 +1,8 @@
 """MeshLab filter scripts: save/run round trip, native pymeshlab steps mixed in, defaults, errors."""
 
 import os
+import re
+
 
 import numpy as np
 import pymeshlab
@@ -109,40 +111,31 @@ def test_enum_index_is_read_through_the_script_s_own_values(tmp_path, enum_value
 def test_unknown_parameter_in_script_names_step_and_close_match(tmp_path):
     path = write(tmp_path, '<filter name="generate_minimal_surface"><Param name="max_iteration" '
                            'value="3"/></filter>')
-    with pytest.raises(ScriptError, match=r"s.mlx step 1 \(generate_minimal_surface\).*did you mean "
-                                          "max_iterations"):
+    with pytest.raises(ScriptError, match=r"s\.mlx step 1 .*max_iterations") as e:     # the close match
         run_script(meshset(), path)
+    assert e.value.parameter is None           # no such parameter
 
 
 def test_bad_value_in_script_names_step_and_parameter(tmp_path):
     path = write(tmp_path, NATIVE_BORDER + '\n <filter name="generate_minimal_surface">'
                                            '<Param name="tol" value="small"/></filter>')
-    with pytest.raises(ScriptError,
-                       match=r"step 2 \(generate_minimal_surface\): parameter 'tol' expects a number"):
+    with pytest.raises(ScriptError, match=r"s\.mlx step 2 \(generate_minimal_surface\)") as e:
         run_script(meshset(), path)
+    assert e.value.parameter == "tol"
 
 
 def test_failing_native_step_names_the_step(tmp_path):
     path = write(tmp_path, '<filter name="No Such MeshLab Filter"/>')
-    with pytest.raises(ScriptError, match=r"step 1 \(No Such MeshLab Filter\): pymeshlab failed without a "
-                                          r"reason .*usual cause is a filter name MeshLab does not know"):
+    with pytest.raises(ScriptError, match=r"s\.mlx step 1 \(No Such MeshLab Filter\)"):
         run_script(meshset(), path)
 
 
-@pytest.mark.parametrize("name, words", [
+@pytest.mark.parametrize("name", ["meshing_remove_duplicate_vertices", "remove duplicate vertices",
+                                  "Remove Duplicated Vertex"])
+def test_misnamed_meshlab_step_says_what_meshlab_calls_it(tmp_path, name):
     # pymeshlab answers each with "Something really bad happened. Please report this issue"
-    ("meshing_remove_duplicate_vertices",
-     r"'meshing_remove_duplicate_vertices' is pymeshlab's Python name, not MeshLab's \(its words, in lower "
-     r"case and without punctuation: 'remove duplicate vertices'"),
-    ("remove duplicate vertices",
-     r"MeshLab's name for this filter \(pymeshlab's meshing_remove_duplicate_vertices\) has these words, "
-     r"'remove duplicate vertices', with other capitals or punctuation"),
-    ("Remove Duplicated Vertex", r"no filter called 'Remove Duplicated Vertex'; did you mean 'remove duplicate "
-                                 r"vertices'.* \(their words, in lower case and without punctuation\)"),
-])
-def test_misnamed_meshlab_step_says_what_meshlab_calls_it(tmp_path, name, words):
     path = write(tmp_path, f'<filter name="{name}"/>')
-    with pytest.raises(ScriptError, match=words + r".*as MeshLab writes it \(Filters > Show current filter script\)"):
+    with pytest.raises(ScriptError, match=r"s\.mlx step 1 .*'remove duplicate vertices'"):    # its words
         run_script(meshset(), path)
     # the name MeshLab writes runs, and does what it says: a grid whose vertex 5 is also stored
     # as vertex 16 (used by one triangle) gets its 16 distinct vertices back
@@ -189,8 +182,7 @@ def test_a_mesh_creating_native_step_runs_on_an_empty_meshset(tmp_path):
 
 def test_a_typo_of_one_of_our_filters_gets_the_close_match(tmp_path):
     path = write(tmp_path, '<filter name="compute_curvature_detial"/>')
-    with pytest.raises(ScriptError, match="no filter is called 'compute_curvature_detial'; did you mean "
-                                          "compute_curvature_detail"):
+    with pytest.raises(ScriptError, match=r"s\.mlx step 1 .*\bcompute_curvature_detail\b"):
         run_script(meshset(), path)
 
 
@@ -198,12 +190,12 @@ def test_a_parameter_given_twice_is_refused(tmp_path):
     path = write(tmp_path, '<filter name="compute_curvature_detail"/>\n <filter name='
                            '"apply_curvature_reconstruction"><Param name="rows" value="all"/>'
                            '<Param name="rows" value="free"/></filter>')
-    with pytest.raises(ScriptError, match="parameter 'rows' is given twice"):
+    with pytest.raises(ScriptError, match=r"s\.mlx step 2") as e:
         run_script(meshset(), path)
+    assert e.value.parameter == "rows"
 
 
-@pytest.mark.parametrize("ms, progress, message", [(None, None, "needs a pymeshlab.MeshSet, got NoneType"),
-                                                   ("meshset", 3, "progress=3 is not callable")])
+@pytest.mark.parametrize("ms, progress, message", [(None, None, "NoneType"), ("meshset", 3, "progress=3")])
 def test_run_script_checks_its_arguments(tmp_path, ms, progress, message):
     path = write(tmp_path, '<filter name="compute_curvature_detail"/>')
     with pytest.raises(ScriptError, match=message):
@@ -213,45 +205,45 @@ def test_run_script_checks_its_arguments(tmp_path, ms, progress, message):
 def test_an_unknown_encoding_is_a_script_error(tmp_path):
     path = tmp_path / "enc.mlx"
     path.write_text('<?xml version="1.0" encoding="foo"?>\n<FilterScript/>\n')
-    with pytest.raises(ScriptError, match="not a MeshLab filter script"):
+    with pytest.raises(ScriptError, match=r"enc\.mlx"):
         run_script(meshset(), path)
 
 
 def test_malformed_xml_is_refused(tmp_path):
     path = tmp_path / "bad.mlx"
     path.write_text("<FilterScript><filter name='x'>")
-    with pytest.raises(ScriptError, match="not a MeshLab filter script"):
+    with pytest.raises(ScriptError, match=r"bad\.mlx"):
         run_script(meshset(), path)
 
 
 def test_wrong_root_element_is_refused(tmp_path):
     path = tmp_path / "bad.mlx"
     path.write_text("<Script/>")
-    with pytest.raises(ScriptError, match="root element is <Script>"):
+    with pytest.raises(ScriptError, match=r"bad\.mlx.*<Script>"):
         run_script(meshset(), path)
 
 
 def test_missing_script_is_file_not_found(tmp_path):
-    with pytest.raises(FileNotFoundError, match="filter script not found"):
+    with pytest.raises(FileNotFoundError, match=r"none\.mlx"):
         run_script(meshset(), tmp_path / "none.mlx")
 
 
 @pytest.mark.parametrize("path, kind", [(None, "NoneType"), (3, "int")])
 def test_a_script_path_that_is_not_a_path_is_a_script_error(path, kind):
     # os.fspath raised a TypeError
-    with pytest.raises(ScriptError, match=f"a filter script path is needed .*; got {kind}"):
+    with pytest.raises(ScriptError, match=kind):
         run_script(meshset(), path)
 
 
 def test_a_folder_is_named_as_a_folder_not_as_missing(tmp_path):
     # it was "filter script not found" for a folder that exists
-    with pytest.raises(ScriptError, match=r"is a folder; pass the path of a \.mlx filter script"):
+    with pytest.raises(ScriptError, match=re.escape(str(tmp_path))):
         run_script(meshset(), tmp_path)
 
 
 @pytest.mark.parametrize("steps, message", [
-    (None, "got NoneType"), ("compute_curvature_detail", "got str"),
-    ([("compute_curvature_detail",)], r"step 1 is \('compute_curvature_detail',\); give a filter name"),
+    (None, "NoneType"), ("compute_curvature_detail", r"\bstr\b"),
+    ([("compute_curvature_detail",)], r"step 1 is \('compute_curvature_detail',\)"),
 ])
 def test_save_refuses_malformed_steps(tmp_path, steps, message):
     with pytest.raises(ScriptError, match=message):
@@ -280,21 +272,22 @@ def test_progress_is_called_before_each_step(tmp_path):
 
 # MeshLab misreads these without a word (measured): a bool other than "false" is true, an int
 # that does not parse is 0, a RichAbsPerc without min and max is ignored, an unknown name too
-@pytest.mark.parametrize("param, words", [
-    ('name="Boundary" value="0" type="RichBool"', r"'Boundary' \(RichBool\) has value '0'; write 'true' or 'false'"),
-    ('name="Boundary" value="False" type="RichBool"', r"has value 'False'; write 'true' or 'false'"),
-    ('name="Boundary" value="no" type="RichBool"', r"has value 'no'; write 'true' or 'false'"),
-    ('name="stepSmoothNum" value="3.7" type="RichInt"', r"'stepSmoothNum' \(RichInt\) has value '3.7'; write a whole"),
-    ('name="stepSmoothNum" value="abc" type="RichInt"', r"has value 'abc'"),
-    ('name="stepSmoothNum" type="RichInt"', r"has value None"),
-    ('name="Smoothing steps" value="2" type="RichInt"', r"no parameter 'Smoothing steps' .*stepsmoothnum"),
+@pytest.mark.parametrize("param, name, words", [
+    ('name="Boundary" value="0" type="RichBool"', "Boundary", "'0'"),
+    ('name="Boundary" value="False" type="RichBool"', "Boundary", "'False'"),
+    ('name="Boundary" value="no" type="RichBool"', "Boundary", "'no'"),
+    ('name="stepSmoothNum" value="3.7" type="RichInt"', "stepSmoothNum", r"'3\.7'"),
+    ('name="stepSmoothNum" value="abc" type="RichInt"', "stepSmoothNum", "'abc'"),
+    ('name="stepSmoothNum" type="RichInt"', "stepSmoothNum", "None"),
+    ('name="Smoothing steps" value="2" type="RichInt"', "Smoothing steps", "stepsmoothnum"),   # the real names
 ])
-def test_native_parameters_meshlab_would_misread_are_refused_before_any_step(tmp_path, param, words):
+def test_native_parameters_meshlab_would_misread_are_refused_before_any_step(tmp_path, param, name, words):
     body = NATIVE_SMOOTH + f'\n <filter name="Laplacian Smooth"><Param {param}/></filter>'
     ms = meshset()
     V0 = ms.current_mesh().vertex_matrix().copy()
-    with pytest.raises(ScriptError, match=r"step 2 \(Laplacian Smooth\): .*" + words):
+    with pytest.raises(ScriptError, match=r"s\.mlx step 2 \(Laplacian Smooth\): .*" + words) as e:
         run_script(ms, write(tmp_path, body))
+    assert e.value.parameter == name
     assert np.array_equal(ms.current_mesh().vertex_matrix(), V0)     # step 1 did not run either
 
 
@@ -302,8 +295,9 @@ def test_native_parameters_meshlab_would_misread_are_refused_before_any_step(tmp
 def test_a_native_absolute_or_percentage_value_without_min_and_max_is_refused(tmp_path, attrs):
     body = ('<filter name="Remeshing: Isotropic Explicit Remeshing"><Param name="TargetLen" value="0.05" '
             'type="RichAbsPerc" {}/></filter>')
-    with pytest.raises(ScriptError, match="needs min and max attributes"):
+    with pytest.raises(ScriptError, match=r"\bmin\b.*\bmax\b") as e:
         run_script(meshset(), write(tmp_path, body.format(attrs)))
+    assert e.value.parameter == "TargetLen"
     # with them (their values do not matter to MeshLab) the value is used: a coarser mesh
     ms = meshset()
     run_script(ms, write(tmp_path, body.format('min="0" max="1"')))
@@ -313,7 +307,7 @@ def test_a_native_absolute_or_percentage_value_without_min_and_max_is_refused(tm
 def test_a_native_parameter_name_with_other_capitals_is_reported_after_its_step(tmp_path):
     # MeshLab's own name check is case-sensitive; the step has run without the parameter
     body = '<filter name="Laplacian Smooth"><Param name="stepsmoothnum" value="2" type="RichInt"/></filter>'
-    with pytest.raises(ScriptError, match=r"ran this step without parameter\(s\) 'stepsmoothnum'"):
+    with pytest.raises(ScriptError, match=r"s\.mlx step 1 .*'stepsmoothnum'"):
         run_script(meshset(), write(tmp_path, body))
 
 
@@ -346,36 +340,36 @@ def test_native_bools_meshlab_reads_as_written_pass(tmp_path, value):
 def test_a_native_float_with_an_underscore_is_refused(tmp_path):
     # Python reads 3_0 as 30, MeshLab as 0
     body = '<filter name="Taubin Smooth"><Param name="lambda" value="0_5" type="RichFloat"/></filter>'
-    with pytest.raises(ScriptError, match=r"'lambda' \(RichFloat\) has value '0_5'"):
+    with pytest.raises(ScriptError, match="'0_5'") as e:
         run_script(meshset(), write(tmp_path, body))
+    assert e.value.parameter == "lambda"
 
 
 DUPLICATE = '<filter name="Duplicate Current layer"/>'
 
 
-@pytest.mark.parametrize("step, message", [
-    ('<filter name="generate_minimal_surface"><Param name="tol" value="small"/></filter>',
-     r"step 2 \(generate_minimal_surface\): parameter 'tol' expects a number"),
-    ('<filter name="generate_minimal_surface"><Param name="max_iteration" value="3"/></filter>',
-     r"step 2 \(generate_minimal_surface\): .*did you mean max_iterations"),
+@pytest.mark.parametrize("step, parameter, message", [
+    ('<filter name="generate_minimal_surface"><Param name="tol" value="small"/></filter>', "tol", "'small'"),
+    ('<filter name="generate_minimal_surface"><Param name="max_iteration" value="3"/></filter>', None,
+     r"\bmax_iterations\b"),
     ('<filter name="generate_minimal_surface"><Param name="max_iterations" value="0"/></filter>',
-     r"step 2 \(generate_minimal_surface\): parameter 'max_iterations' is 0; it must be at least 1"),
-    ('<filter name="generate_minimal_surfaces"/>', r"step 2 .*did you mean generate_minimal_surface"),
+     "max_iterations", r"\b1\b"),
+    ('<filter name="generate_minimal_surfaces"/>', None, r"\bgenerate_minimal_surface\b"),
 ])
-def test_a_bad_later_step_of_ours_is_refused_before_the_first_step_runs(tmp_path, step, message):
+def test_a_bad_later_step_of_ours_is_refused_before_the_first_step_runs(tmp_path, step, parameter, message):
     # it was found only when its turn came, after the steps before it (minutes of remeshing)
     # had changed the MeshSet: here the duplicate layer of step 1
     ms = meshset()
-    with pytest.raises(ScriptError, match=message):
+    with pytest.raises(ScriptError, match=r"s\.mlx step 2 .*" + message) as e:
         run_script(ms, write(tmp_path, DUPLICATE + "\n " + step))
+    assert e.value.parameter == parameter
     assert ms.mesh_number() == 1
 
 
 def test_a_step_with_another_tag_is_named_by_its_tag_not_as_nameless(tmp_path):
     # "<Filter name='x'>" was called "without a name"
     path = write(tmp_path, '<Filter name="Select Border"/>')
-    with pytest.raises(ScriptError, match=r"step 1 is <Filter name='Select Border'>; a step is "
-                                          r"<filter name=\"\.\.\.\"> \(the tag in lower case"):
+    with pytest.raises(ScriptError, match=r"s\.mlx: step 1 is <Filter name='Select Border'>"):
         run_script(meshset(), path)
 
 
@@ -396,13 +390,13 @@ def test_a_layer_set_to_the_current_mesh_is_saved_as_such_not_as_its_default(tmp
 
 
 @pytest.mark.parametrize("param, value, message", [
-    ("transform", "1 0 0 0 0 1 0 0 0 0 1 0", r"'transform' has 12 numbers; it must be 16 finite numbers"),
-    ("transform", "1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 nan", r"'transform' has NaN or infinite numbers"),
-    ("transform", "1 0 0 0 0 1 0 0 0 0 1 0 1 0 0 1", r"'transform': the last row is \[1.0, 0.0, 0.0, 1.0\]"),
-    ("handles", "5 x", r"'handles' must be vertex indices"),
-    ("handles", "5 5", r"'handles': 1 index is repeated \(first: 5\)"),
-    ("handles", "2.5", r"'handles': 1 value is not a whole number"),
-    ("handles", "3 -1", r"'handles': 1 index is negative \(first: -1\)"),
+    ("transform", "1 0 0 0 0 1 0 0 0 0 1 0", r"\b12\b"),
+    ("transform", "1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 nan", "NaN"),
+    ("transform", "1 0 0 0 0 1 0 0 0 0 1 0 1 0 0 1", r"\[1.0, 0.0, 0.0, 1.0\]"),      # the last row
+    ("handles", "5 x", "'5 x'"),
+    ("handles", "5 5", r"\b5\b"),
+    ("handles", "2.5", r"2\.5"),
+    ("handles", "3 -1", "-1"),
 ])
 def test_a_malformed_edit_is_refused_before_the_first_step_runs(tmp_path, param, value, message):
     # a transform of 12 numbers or repeated handles were found only when the editing step ran,
@@ -410,11 +404,13 @@ def test_a_malformed_edit_is_refused_before_the_first_step_runs(tmp_path, param,
     path = write(tmp_path, '<filter name="compute_curvature_detail"/>\n <filter name="apply_curvature_editing">'
                            f'<Param name="{param}" value="{value}"/></filter>')
     ms = meshset()
-    with pytest.raises(ScriptError, match=r"s.mlx step 2 \(apply_curvature_editing\): parameter " + message):
+    with pytest.raises(ScriptError, match=r"s\.mlx step 2 \(apply_curvature_editing\): .*" + message) as e:
         run_script(ms, path)
+    assert e.value.parameter == param
     assert vertex_attribute(ms, 0, "curvature_detail", "point") is None
-    with pytest.raises(FilterParameterError, match=message):          # and save_script writes no such step
+    with pytest.raises(FilterParameterError, match=message) as e:          # and save_script writes no such step
         save_script(tmp_path / "other.mlx", [("apply_curvature_editing", {param: value})])
+    assert e.value.parameter == param
 
 
 def test_a_step_that_leaves_out_a_required_parameter_is_refused_before_the_first_step_runs(tmp_path):
@@ -423,18 +419,19 @@ def test_a_step_that_leaves_out_a_required_parameter_is_refused_before_the_first
     path = write(tmp_path, '<filter name="compute_curvature_detail"/>\n <filter name="apply_curvature_editing">'
                            '<Param name="region_radius" value="10%"/></filter>')
     ms = meshset()
-    with pytest.raises(ScriptError, match=r"s.mlx step 2 \(apply_curvature_editing\): filter "
-                                          r"'apply_curvature_editing' needs parameter 'handles': handle vertex "
-                                          r"indices, .*; it has no default that works$"):
+    with pytest.raises(ScriptError, match=r"s\.mlx step 2 \(apply_curvature_editing\)") as e:
         run_script(ms, path)
+    assert e.value.parameter == "handles"
     assert vertex_attribute(ms, 0, "curvature_detail", "point") is None
-    with pytest.raises(FilterParameterError, match="needs parameter 'handles'"):
+    with pytest.raises(FilterParameterError) as e:
         save_script(tmp_path / "other.mlx", ["apply_curvature_editing"])
+    assert e.value.parameter == "handles"
     assert not (tmp_path / "other.mlx").exists()
     # and apply, before the mesh is read; given, the step runs
     V = ms.current_mesh().vertex_matrix().copy()
-    with pytest.raises(FilterParameterError, match="needs parameter 'handles'"):
+    with pytest.raises(FilterParameterError) as e:
         apply(ms, "apply_curvature_editing", region_radius=pymeshlab.PercentageValue(10.0))
+    assert e.value.parameter == "handles"
     assert np.array_equal(ms.current_mesh().vertex_matrix(), V)
     apply(ms, "apply_curvature_editing", handles="0 1 2", region_radius=pymeshlab.PercentageValue(10.0))
     from curvdetail.filters import get_filter

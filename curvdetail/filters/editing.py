@@ -53,11 +53,12 @@ def _indices(text, n):
                 values.append(real_word(t))
             except ValueError:
                 raise FilterParameterError(f"parameter 'handles' must be vertex indices separated by spaces "
-                                           f"or commas; got {str(text)[:40]!r}.") from None
+                                           f"or commas; got {str(text)[:40]!r}.", parameter="handles") from None
     # the ints stand in as 0.0 (whole), keeping the positions: one beyond a double would overflow
     error = non_whole_index_error([v if isinstance(v, float) else 0.0 for v in values], "parameter 'handles'",
                                   FilterParameterError)
     if error is not None:
+        error.parameter = "handles"                 # the message says "parameter 'handles'"
         raise error
     values = [int(v) for v in values]
     # before the int64 cast, which overflows; without a mesh (n None) the negative ones only
@@ -66,18 +67,20 @@ def _indices(text, n):
         where = "negative" if n is None else f"outside [0, {n})"
         raise FilterParameterError(f"parameter 'handles': {counted(len(beyond), 'index', 'indices', verb='are')} "
                                    f"{where} (first: {tokens[beyond[0]]}); indices are 0-based into "
-                                   "the mesh's vertices.")
+                                   "the mesh's vertices.", parameter="handles", count=len(beyond),
+                                   first=[values[k] for k in beyond[:3]])
     if n is None and values and max(values) > np.iinfo(np.int64).max:
         return None                 # outside any mesh: named with the mesh's size when the filter runs
     idx = np.asarray(values, dtype=np.int64)
     if idx.size == 0:
         raise FilterParameterError("parameter 'handles' is empty; name the handle vertices, e.g. "
-                                   "handles='12 40 41'.")
+                                   "handles='12 40 41'.", parameter="handles", count=0)
     uniq, counts = np.unique(idx, return_counts=True)
     if uniq.size != idx.size:
         repeated = counted(idx.size - uniq.size, 'index', 'indices', verb='are')
         raise FilterParameterError(f"parameter 'handles': {repeated} repeated (first: "
-                                   f"{first_indices(uniq[counts > 1])}); list each vertex once.")
+                                   f"{first_indices(uniq[counts > 1])}); list each vertex once.", parameter="handles",
+                                   count=int(idx.size - uniq.size), first=uniq[counts > 1][:3].tolist())
     return idx
 
 
@@ -95,15 +98,15 @@ def _matrix(text):
         values = [real_word(t) for t in str(text).replace(",", " ").split()]
     except ValueError:
         raise FilterParameterError(f"parameter 'transform' must be 16 numbers (a 4x4 matrix, row by "
-                                   f"row); got {str(text)[:40]!r}.") from None
+                                   f"row); got {str(text)[:40]!r}.", parameter="transform") from None
     if len(values) != 16 or not np.all(np.isfinite(values)):
         what = f"{len(values)} numbers" if len(values) != 16 else "NaN or infinite numbers"
         raise FilterParameterError(f"parameter 'transform' has {what}; it must be 16 finite numbers, a "
-                                   "4x4 matrix row by row.")
+                                   "4x4 matrix row by row.", parameter="transform", count=len(values))
     T = np.asarray(values).reshape(4, 4)
     problem = affine_transform_problem(T)
     if problem:
-        raise FilterParameterError(f"parameter 'transform': {problem}.")
+        raise FilterParameterError(f"parameter 'transform': {problem}.", parameter="transform")
     return T
 
 

@@ -80,7 +80,8 @@ def _our_parameters(spec, element, where):
         if name is None or value is None:
             raise ScriptError(f"{where}: a <{child.tag}> lacks a name or a value.")
         if name in params:
-            raise ScriptError(f"{where}: parameter {name!r} is given twice; keep one <Param name={name!r}>.")
+            raise ScriptError(f"{where}: parameter {name!r} is given twice; keep one <Param name={name!r}>.",
+                              parameter=name)
         # an enum index means the script's own enum_val<i> where it lists them (MeshLab writes
         # both), so a script whose list is in another order still means what it says
         value = child.get(f"enum_val{value.strip()}", value) if child.get("type") == "RichEnum" else value
@@ -89,7 +90,7 @@ def _our_parameters(spec, element, where):
         except KeyError:
             params[name] = value          # let apply() report it with the close matches
         except FilterError as exc:
-            raise ScriptError(f"{where}: {exc}") from None
+            raise ScriptError(f"{where}: {exc}", parameter=getattr(exc, "parameter", None)) from None
     return params
 
 
@@ -161,7 +162,7 @@ def run_script(ms, path, *, progress=None):
             try:
                 figures = apply(ms, name, **params)
             except ValueError as exc:
-                raise ScriptError(f"{where}: {exc}") from None
+                raise ScriptError(f"{where}: {exc}", parameter=getattr(exc, "parameter", None)) from None
         else:
             run_native(ms, element, where)
             figures = {}
@@ -211,7 +212,7 @@ def check_script(path):
             try:
                 complete_parameters(_REGISTRY[name], params)
             except ValueError as exc:
-                raise ScriptError(f"{where}: {exc}") from None
+                raise ScriptError(f"{where}: {exc}", parameter=getattr(exc, "parameter", None)) from None
         else:
             _refuse_a_near_miss(name, where)
             if element.tag == "filter":

@@ -118,19 +118,21 @@ def check_native_parameters(element, where):
         if name is None:
             raise ScriptError(f"{where}: a <Param> lacks a name.")
         if name in seen:
-            raise ScriptError(f"{where}: parameter {name!r} is given twice; keep one <Param name={name!r}>.")
+            raise ScriptError(f"{where}: parameter {name!r} is given twice; keep one <Param name={name!r}>.",
+                              parameter=name)
         seen.add(name)
         if keys is not None and name_key(name) not in keys:
             raise ScriptError(f"{where}: this MeshLab filter has no parameter {name!r} (pymeshlab ignores it "
                               f"without a word); its parameters, in pymeshlab's lower case: "
-                              f"{', '.join(sorted(names))}.")
+                              f"{', '.join(sorted(names))}.", parameter=name)
         check, meaning = _NATIVE_CHECKS.get(kind, (None, None))
         if check is not None and (value is None or not check(value if kind == "RichBool" else value.strip())):
-            raise ScriptError(f"{where}: parameter {name!r} ({kind}) has value {value!r}; write {meaning}.")
+            raise ScriptError(f"{where}: parameter {name!r} ({kind}) has value {value!r}; write {meaning}.",
+                              parameter=name)
         if kind == "RichAbsPerc" and (child.get("min") is None or child.get("max") is None):
             raise ScriptError(f"{where}: parameter {name!r} (RichAbsPerc) needs min and max attributes, "
                               "as MeshLab writes them (e.g. min=\"0\" max=\"1\"); without them MeshLab "
-                              "ignores its value.")
+                              "ignores its value.", parameter=name)
 
 
 _IGNORED_PARAMETER = re.compile(r"Warning: parameter (\S*) not required by filter")
