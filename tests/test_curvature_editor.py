@@ -1,11 +1,13 @@
 """CurvatureEditor: two-stage editing, exact constraints, similarity covariance, no re-factoring."""
 
+import re
+
 import numpy as np
 import pytest
 
 from curvdetail import CurvatureEditor, boundary_vertices, curvature_detail, reconstruct
 from curvdetail.curvature import sparse_solver
-from curvdetail.curvature.errors import ConstraintError, UndeterminedEditError
+from curvdetail.curvature.errors import ConstraintError, CurvdetailError, UndeterminedEditError
 from curvdetail.curvature.testing import grid
 
 from conftest import InexactSolves
@@ -165,20 +167,22 @@ def test_translated_frame_translates_a_rank_deficient_plane(plane_grid):
     assert np.abs(X - (V + [0.2, -0.1, 0.4])).max() < 1e-10
 
 
-@pytest.mark.parametrize("kwargs, message", [
-    (dict(position_constrained=[0, 10**6], detail_constrained=[0]), "outside"),
-    (dict(position_constrained=[3, 3], detail_constrained=[3]), "repeated"),
-    (dict(position_constrained=[], detail_constrained=[0, 1, 2]), "position_constrained is empty"),
-    (dict(position_constrained=[0], detail_constrained=[]), "detail_constrained is empty"),
-    (dict(position_constrained=[0], detail_constrained=[0, 1]), "has only 2 vertices"),
-    (dict(position_constrained=[0], detail_constrained=[0], roi=[]), "roi is empty"),
-    (dict(position_constrained=[0, 1], detail_constrained=[1], roi=np.arange(1, 100)), "outside the roi"),
-    (dict(position_constrained=[0], detail_constrained=[0], roi=np.arange(1, 100)), "1 vertex lies outside the roi"),
+@pytest.mark.parametrize("kwargs, fields", [
+    (dict(position_constrained=[0, 10**6], detail_constrained=[0]), ("position_constrained", 1, [10**6])),
+    (dict(position_constrained=[3, 3], detail_constrained=[3]), ("position_constrained", 1, [3])),
+    (dict(position_constrained=[], detail_constrained=[0, 1, 2]), ("position_constrained", 0, None)),
+    (dict(position_constrained=[0], detail_constrained=[]), ("detail_constrained", 0, None)),
+    (dict(position_constrained=[0], detail_constrained=[0, 1]), ("detail_constrained", 2, None)),
+    (dict(position_constrained=[0], detail_constrained=[0], roi=[]), ("roi", 0, None)),
+    (dict(position_constrained=[0, 1], detail_constrained=[1], roi=np.arange(1, 100)),
+     ("position_constrained", 1, [0])),
+    (dict(position_constrained=[0], detail_constrained=[0], roi=np.arange(1, 100)), ("position_constrained", 1, [0])),
 ])
-def test_bad_constraint_sets_are_refused(plane_grid, kwargs, message):
+def test_bad_constraint_sets_are_refused(plane_grid, kwargs, fields):
     V, F = plane_grid
-    with pytest.raises(ConstraintError, match=message):
+    with pytest.raises(ConstraintError) as e:
         CurvatureEditor(V, F, **kwargs)
+    assert (e.value.parameter, e.value.count, e.value.first) == fields
 
 
 def test_a_free_piece_without_any_constraint_is_refused(plane_grid):
@@ -187,11 +191,15 @@ def test_a_free_piece_without_any_constraint_is_refused(plane_grid):
     F2 = np.vstack([F, F + V.shape[0]])
     b = boundary_vertices(F)                               # constraints on the first piece only
     # an UndeterminedEditError (a ConstraintError), whose advice callers word in their own terms
-    with pytest.raises(UndeterminedEditError, match="1 connected free region touches no position constraint"):
+    n = V.shape[0]                                         # the second piece's first vertex
+    with pytest.raises(UndeterminedEditError) as error:
         CurvatureEditor(V2, F2, b, np.arange(V2.shape[0]))
-    with pytest.raises(UndeterminedEditError, match="touches no detail constraint") as error:
+    assert (error.value.parameter, error.value.count, error.value.first) == ("position_constrained", 1, [n])
+    with pytest.raises(UndeterminedEditError) as error:
         CurvatureEditor(V2, F2, np.arange(V2.shape[0]), b)
-    assert error.value.advice.startswith("Add a vertex of each region to detail_constrained")
+    assert (error.value.parameter, error.value.count, error.value.first) [:2] == ("detail_constrained", 1)
+    assert error.value.first[0] >= n
+    assert "detail_constrained" in error.value.advice
 
 
 @pytest.mark.parametrize("given", [1, 2])
@@ -206,12 +214,13 @@ def test_a_piece_inside_the_roi_with_one_or_two_detail_constraints_is_refused(lo
     V2, F2 = np.vstack([V, V + [3 * _diag(V), 0.0, 0.0]]), np.vstack([F, F + n])
     b = boundary_vertices(F)
     pc = np.concatenate([b, b + n])
-    with pytest.raises(UndeterminedEditError, match=f"wholly inside the edited region with only {given} detail") as error:
+    with pytest.raises(UndeterminedEditError, match=rf"\b{given} detail") as error:     # how many it has
         CurvatureEditor(V2, F2, pc, np.concatenate([b, n + b[:given]]))
-    assert error.value.advice.startswith("Constrain the details of at least three vertices of each such piece")
+    assert (error.value.parameter, error.value.count, error.value.first) == ("detail_constrained", 1, [n])
     # the same piece as the whole roi of a smaller edit
-    with pytest.raises(UndeterminedEditError, match="wholly inside the edited region"):
+    with pytest.raises(UndeterminedEditError) as error:
         CurvatureEditor(V2, F2, n + b, n + b[:given], roi=n + np.arange(n))
+    assert (error.value.parameter, error.value.first) == ("detail_constrained", [n])
     X = CurvatureEditor(V2, F2, pc, np.concatenate([b, n + b[::10]])).solve()
     assert np.abs(X - V2).max() < 1e-8 * _diag(V)
 
@@ -219,10 +228,12 @@ def test_a_piece_inside_the_roi_with_one_or_two_detail_constraints_is_refused(lo
 def test_unknown_row_mode_or_relations_are_refused(plane_grid):
     V, F = plane_grid
     b = boundary_vertices(F)
-    with pytest.raises(ValueError, match="row mode"):
+    with pytest.raises(CurvdetailError) as e:
         CurvatureEditor(V, F, b, b, rows="some")
-    with pytest.raises(ValueError, match="relations"):
+    assert (e.value.parameter, e.value.value) == ("rows", "some")
+    with pytest.raises(CurvdetailError) as e:
         CurvatureEditor(V, F, b, b, relations="three-ring")
+    assert (e.value.parameter, e.value.value) == ("relations", "three-ring")
 
 
 @pytest.mark.parametrize("rcond", [float("nan"), -1.0, 0.0, 1.0, "tiny"])
@@ -231,16 +242,18 @@ def test_rcond_outside_zero_one_is_refused_like_curvature_coefficients(plane_gri
     # singular-factor SolverError
     V, F = plane_grid
     b = boundary_vertices(F)
-    with pytest.raises(ValueError, match="rcond="):
+    with pytest.raises(CurvdetailError) as e:
         CurvatureEditor(V, F, b, b, rcond=rcond)
+    assert e.value.parameter == "rcond"
 
 
 def test_rcond_as_a_string_is_refused_by_the_editor(plane_grid):
     # "1e-6" was converted by float() and taken
     V, F = plane_grid
     b = boundary_vertices(F)
-    with pytest.raises(ValueError, match=r"rcond='1e-6' is not a number"):
+    with pytest.raises(CurvdetailError) as e:
         CurvatureEditor(V, F, b, b, rcond="1e-6")
+    assert (e.value.parameter, e.value.value) == ("rcond", "1e-6")
 
 
 def test_stacked_relations_solve_the_least_squares_problem_of_both_coefficient_sets(load_mesh, rng):
@@ -262,12 +275,14 @@ def test_solve_refuses_values_of_the_wrong_shape(plane_grid):
     V, F = plane_grid
     b = boundary_vertices(F)
     ed = CurvatureEditor(V, F, b, b)
-    with pytest.raises(ConstraintError, match="positions has shape"):
+    with pytest.raises(ConstraintError, match=re.escape(str(V[b][:-1].shape))) as e:
         ed.solve(positions=V[b][:-1])
+    assert e.value.parameter == "positions"
     bad = ed.detail[b].copy()
     bad[2, 0] = np.nan
-    with pytest.raises(ConstraintError, match="NaN"):
+    with pytest.raises(ConstraintError) as e:
         ed.solve(details=bad)
+    assert (e.value.parameter, e.value.count, e.value.first) == ("details", 1, [2])
 
 
 def test_twisting_a_rank_deficient_cylinder_stays_finite_and_exact(open_cylinder):
@@ -318,8 +333,9 @@ def test_precompute_refuses_unconstrained_handles(plane_grid):
     b = boundary_vertices(F)
     ed = CurvatureEditor(V, F, b, b)
     inner = np.setdiff1d(np.arange(V.shape[0]), b)[:2]
-    with pytest.raises(ConstraintError, match="neither position- nor detail-constrained"):
+    with pytest.raises(ConstraintError) as e:
         ed.precompute_handles(inner)
+    assert (e.value.parameter, e.value.count, e.value.first) == ("handles", 2, inner.tolist())
 
 
 def test_unknown_backend_is_refused_before_computing_coefficients(plane_grid, monkeypatch):
@@ -329,8 +345,9 @@ def test_unknown_backend_is_refused_before_computing_coefficients(plane_grid, mo
     monkeypatch.setattr(module, "_coefficients", lambda *a, **k: pytest.fail("coefficients computed"))
     V, F = plane_grid
     b = boundary_vertices(F)
-    with pytest.raises(SolverError, match="unknown solver backend 'umfpack'"):
+    with pytest.raises(SolverError) as e:
         CurvatureEditor(V, F, b, b, backend="umfpack")
+    assert (e.value.parameter, e.value.value) == ("backend", "umfpack")
 
 
 @pytest.mark.skipif("pardiso" not in sparse_solver.available_backends(),
@@ -394,8 +411,9 @@ def test_the_embedding_refuses_normal_equations_it_cannot_refine(wavy_grid_with_
         b = boundary_vertices(F)
         ed = CurvatureEditor(V, F, b, np.arange(V.shape[0]), backend="splu")
         if fails:
-            with pytest.raises(SolverError, match="too ill-conditioned"):
+            with pytest.raises(SolverError) as e:
                 ed.solve()
+            assert e.value.parameter == "rows"       # the fix: rows='free'
         else:
             assert np.abs(ed.solve() - V).max() < 1e-9 * _diag(V)
 
@@ -418,8 +436,9 @@ def test_constraints_that_do_not_determine_the_edit_are_refused():
     b = boundary_vertices(F)
     from curvdetail.curvature.errors import UndeterminedEditError
 
-    with pytest.raises(UndeterminedEditError, match="do not determine the edit.*of the bbox diagonal off"):
+    with pytest.raises(UndeterminedEditError) as e:
         CurvatureEditor(V, F, b, [450, 451, 480])
+    assert e.value.parameter == "detail_constrained"
     # the same grid with its boundary details constrained is determined: the rest shape exactly
     assert CurvatureEditor(V, F, b, b).rest_error < 1e-14
 
@@ -433,8 +452,9 @@ def test_undetermined_details_are_refused_where_every_position_is_given(load_mes
     everything = np.arange(V.shape[0])
     ed = CurvatureEditor(V, F, everything, [450, 451, 480])
     for call in (ed.solve_details, lambda: ed.solve(return_details=True)):
-        with pytest.raises(UndeterminedEditError, match="do not determine the details: every position in the roi is given"):
+        with pytest.raises(UndeterminedEditError) as e:
             call()
+        assert e.value.parameter == "detail_constrained"
     # the positions are given, so the shape is determined: solve() answers
     P = V.copy()
     P[7] += [0.0, 0.0, 0.1]
@@ -518,26 +538,25 @@ def test_a_curvature_stage_that_cannot_be_factored_is_an_undetermined_edit(monke
     V[:, 2] = 0.1 * np.sin(3 * V[:, 0])
     b = boundary_vertices(F)
     monkeypatch.setattr(curvature_editor, "factorize", failing)
-    with pytest.raises(UndeterminedEditError, match="curvature stage could not be factored.*error -4") as exc:
+    with pytest.raises(UndeterminedEditError, match="error -4") as exc:        # the solver's own code
         CurvatureEditor(V, F, b, b[:5], relations="one+two-ring")
+    assert exc.value.parameter == "detail_constrained"
     assert "relations='one-ring'" in exc.value.advice
 
 
-@pytest.mark.parametrize("kwargs, error, message", [
+@pytest.mark.parametrize("kwargs, error, parameter", [
     # np.array(["all"]) passed `in ("all", "free")` element-wise and was kept as the row mode
-    (dict(rows=np.array(["all"])), ValueError, r"rows=array\(\['all'\].*\(ndarray, not a single str\) is not a "
-                                               r"row mode; use 'all'"),
+    (dict(rows=np.array(["all"])), CurvdetailError, "rows"),
     # two elements: numpy's "truth value of an array ... is ambiguous"
-    (dict(relations=np.array(["one-ring", "one+two-ring"])), ValueError,
-     r"relations=array\(.*\(ndarray, not a single str\); use 'one-ring' .* or 'one\+two-ring'"),
-    (dict(backend=np.array(["auto", "splu"])), sparse_solver.SolverError,
-     r"backend=array\(.*\(ndarray, not a single str\) is not a solver backend; choose one of .*splu.* or 'auto'"),
+    (dict(relations=np.array(["one-ring", "one+two-ring"])), CurvdetailError, "relations"),
+    (dict(backend=np.array(["auto", "splu"])), sparse_solver.SolverError, "backend"),
 ])
-def test_options_given_as_arrays_or_lists_are_refused_naming_the_option(plane_grid, kwargs, error, message):
+def test_options_given_as_arrays_or_lists_are_refused_naming_the_option(plane_grid, kwargs, error, parameter):
     V, F = plane_grid
     b = boundary_vertices(F)
-    with pytest.raises(error, match=message):
+    with pytest.raises(error, match="ndarray") as e:
         CurvatureEditor(V, F, b, b, **kwargs)
+    assert e.value.parameter == parameter
 
 
 @pytest.mark.parametrize("flag", ["no", 0, np.array([True, False])])
@@ -546,23 +565,22 @@ def test_return_details_must_be_a_bool(plane_grid, flag):
     V, F = plane_grid
     b = boundary_vertices(F)
     ed = CurvatureEditor(V, F, b, b)
-    with pytest.raises(ValueError, match=r"return_details=.* must be True or False"):
+    with pytest.raises(CurvdetailError) as e:
         ed.solve(return_details=flag)
+    assert e.value.parameter == "return_details"
     assert isinstance(ed.solve(return_details=np.False_), np.ndarray)
 
 
-@pytest.mark.parametrize("kwargs, message", [
-    (dict(position_constrained=None, detail_constrained=[0, 1, 2]),
-     r"position_constrained is None; pass vertex indices \(\[\] for none\) or an \(441,\) boolean mask"),
-    (dict(position_constrained=[0, 1, 2], detail_constrained={0, 1, 2}),
-     r"detail_constrained is a set, which has no order; pass a list or array of vertex indices \(row r of the "
-     r"details belongs to detail_constrained\[r\]\)"),
+@pytest.mark.parametrize("kwargs, parameter, message", [
+    (dict(position_constrained=None, detail_constrained=[0, 1, 2]), "position_constrained", "None"),
+    (dict(position_constrained=[0, 1, 2], detail_constrained={0, 1, 2}), "detail_constrained", r"\bset\b"),
 ])
-def test_constraint_sets_given_as_none_or_a_set_are_named_as_such(plane_grid, kwargs, message):
+def test_constraint_sets_given_as_none_or_a_set_are_named_as_such(plane_grid, kwargs, parameter, message):
     # both were "has dtype object; pass integer vertex indices", about the type
     V, F = plane_grid
-    with pytest.raises(ConstraintError, match=message):
+    with pytest.raises(ConstraintError, match=message) as e:
         CurvatureEditor(V, F, **kwargs)
+    assert e.value.parameter == parameter
 
 
 def test_a_region_and_precomputed_handles_given_as_sets_are_taken(plane_grid):
@@ -590,26 +608,24 @@ def test_index_arguments_take_whole_floats_ranges_and_columns(plane_grid, given)
     assert CurvatureEditor(V, F, 60, 60, roi=np.arange(40, 120)).position_constrained.tolist() == [60]
 
 
-@pytest.mark.parametrize("given, how_many", [
-    ([60, 61.5, 62], r"1 value is not a whole number \(first: 61\.5, at position 1\)"),
-    (np.array([60.25, np.nan, 62.0]), r"2 values are not whole numbers \(first: 60\.25, at position 0\)"),
-    (np.array([60.0, np.inf]), r"1 value is not a whole number \(first: inf, at position 1\)"),
+@pytest.mark.parametrize("given, value, count, first", [
+    ([60, 61.5, 62], r"61\.5", 1, [1]), (np.array([60.25, np.nan, 62.0]), r"60\.25", 2, [0, 1]),
+    (np.array([60.0, np.inf]), "inf", 1, [1]),
 ])
-def test_indices_that_are_not_whole_numbers_are_refused_naming_the_first(plane_grid, given, how_many):
+def test_indices_that_are_not_whole_numbers_are_refused_naming_the_first(plane_grid, given, value, count, first):
     # it was "position_constrained has dtype float64; pass integer vertex indices": no value, no place
     V, F = plane_grid
-    with pytest.raises(ConstraintError, match=rf"position_constrained: {how_many}; vertex indices are whole "
-                                              r"numbers: pass integers \(or whole floats such as 3\.0\)"):
+    with pytest.raises(ConstraintError, match=value) as e:       # the first such value, by its position
         CurvatureEditor(V, F, given, [60, 61, 62], roi=np.arange(40, 120))
+    assert (e.value.parameter, e.value.count, e.value.first) == ("position_constrained", count, first)
 
 
 def test_true_or_false_among_indices_is_refused(plane_grid):
     # numpy reads [True, 61] as [1, 61]: vertex 1 was constrained without a word
     V, F = plane_grid
-    with pytest.raises(ConstraintError, match=r"detail_constrained has True/False among its vertex indices "
-                                              r"\(first at position 0\); pass indices only, or an \(441,\) "
-                                              "boolean mask"):
+    with pytest.raises(ConstraintError) as e:
         CurvatureEditor(V, F, [60, 61], [True, 61], roi=np.arange(40, 120))
+    assert (e.value.parameter, e.value.first) == ("detail_constrained", [0])
 
 
 def test_max_ring_1_keeps_the_papers_one_ring_relations(load_mesh):
@@ -627,8 +643,10 @@ def test_max_ring_1_keeps_the_papers_one_ring_relations(load_mesh):
         curvature_coefficients(V, F, return_info=True)[1].widened_vertices.tolist()
     assert abs(narrow.coefficients - curvature_coefficients(V, F, max_ring=1)).max() == 0
     assert np.abs(narrow.solve() - V).max() < 1e-8 * _diag(V)
-    with pytest.raises(ValueError, match="max_ring"):
+    with pytest.raises(CurvdetailError) as e:
         CurvatureEditor(V, F, handles, handles, max_ring=0)
+    assert e.value.parameter == "max_ring"
+
 
 
 _SHARED_EDITOR_SCRIPT = """

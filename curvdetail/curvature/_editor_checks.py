@@ -39,13 +39,15 @@ def _check_whole_mesh_constraints(pc, dc):
     if pc.size == 0:
         raise ConstraintError("position_constrained is empty and the roi is the whole mesh: the "
                               "result is only determined up to a translation. Constrain at least "
-                              "one vertex per connected piece, or pass a smaller roi.")
+                              "one vertex per connected piece, or pass a smaller roi.",
+                              parameter="position_constrained", count=0)
     if dc.size < 3:
         state = "is empty" if dc.size == 0 else f"has only {counted(dc.size, 'vertex', 'vertices')}"
         raise ConstraintError(f"detail_constrained {state} and the roi is the whole mesh: the "
                               "curvature stage is only determined up to a linear map (9 unknowns, "
                               "3 per constrained detail). Constrain the details of at least three "
-                              "vertices (e.g. the handles), or pass a smaller roi.")
+                              "vertices (e.g. the handles), or pass a smaller roi.",
+                              parameter="detail_constrained", count=int(dc.size))
 
 
 def _check_relations(relations):
@@ -61,12 +63,13 @@ def _index_set(indices, n, name, values=None):
     ``values`` given to solve belongs to ``name[r]`` it is refused, elsewhere (``values`` None:
     a region, the handles of precompute_handles) it is taken."""
     if indices is None:
-        raise ConstraintError(f"{name} is None; pass vertex indices ([] for none) or an ({n},) boolean mask.")
+        raise ConstraintError(f"{name} is None; pass vertex indices ([] for none) or an ({n},) boolean mask.",
+                              parameter=name)
     if isinstance(indices, (set, frozenset)):
         if values is not None:
             raise ConstraintError(f"{name} is a {type(indices).__name__}, which has no order; pass a list or "
                                   f"array of vertex indices (row r of the {values} belongs to {name}[r]), e.g. "
-                                  f"sorted({name}).")
+                                  f"sorted({name}).", parameter=name)
         try:
             indices = sorted(indices)
         except TypeError:               # values that do not compare: as_index_set names them
@@ -75,7 +78,8 @@ def _index_set(indices, n, name, values=None):
         flags = [isinstance(i, (bool, np.bool_)) for i in indices]
         if any(flags) and not all(flags):       # numpy reads [True, 3] as vertices 1 and 3
             raise ConstraintError(f"{name} has True/False among its vertex indices (first at position "
-                                  f"{flags.index(True)}); pass indices only, or an ({n},) boolean mask.")
+                                  f"{flags.index(True)}); pass indices only, or an ({n},) boolean mask.",
+                                  parameter=name, first=[flags.index(True)])
     return as_index_set(indices, n, name)             # names non-whole values too
 
 
@@ -148,7 +152,7 @@ def _check_pieces_detail_constrained(F, in_roi, dc):
         f"the piece containing vertex {first}): its details are determined only up to a linear map "
         "(9 unknowns, 3 per constrained detail).",
         "Constrain the details of at least three vertices of each such piece (e.g. its handles), or leave "
-        "part of it outside the roi.")
+        "part of it outside the roi.", parameter="detail_constrained", count=int(short.size), first=[first])
 
 
 def _check_reached(rows, cols, free, n, what, name):
@@ -167,7 +171,8 @@ def _check_reached(rows, cols, free, n, what, name):
             f"{regions.size} connected free {'region touches' if regions.size == 1 else 'regions touch'} no "
             f"{what} constraint (e.g. the {'region' if regions.size == 1 else 'regions'} containing vertex "
             f"{', '.join(map(str, example))}); their {what}s are undetermined.",
-            f"Add a vertex of each region to {name}, or shrink the roi.")
+            f"Add a vertex of each region to {name}, or shrink the roi.", parameter=name,
+            count=int(regions.size), first=example)
 
 
 def square_curvature_system(D, in_roi, free_d, fd, dc, at_fd, at_dc, rows, cols, cvals):

@@ -228,7 +228,7 @@ class CurvatureEditor:
                 f"the constraints do not determine the edit: solved with their rest values they give "
                 f"back a shape {error:.2g} of the bbox diagonal off the rest shape (the curvature stage "
                 f"is singular to working precision with these {self._user_dc} detail constraints: "
-                "groups of rings can turn together).", self._undetermined_advice())
+                "groups of rings can turn together).", self._undetermined_advice(), parameter="detail_constrained")
         return error
 
     def _check_rest_details(self):
@@ -247,7 +247,8 @@ class CurvatureEditor:
 
     def _refuse_undetermined_details(self):
         if self._undetermined_details is not None:
-            raise UndeterminedEditError(self._undetermined_details, self._undetermined_advice())
+            raise UndeterminedEditError(self._undetermined_details, self._undetermined_advice(),
+                                        parameter="detail_constrained")
 
     def _undetermined_advice(self):
         # on flat and near-flat regions the stacked relations are singular where the square
@@ -263,7 +264,8 @@ class CurvatureEditor:
         except SolverError as exc:
             raise UndeterminedEditError(f"the constraints do not determine the edit: the curvature stage "
                                         f"could not be factored with these {self._user_dc} detail "
-                                        f"constraints ({exc})", self._undetermined_advice()) from None
+                                        f"constraints ({exc})", self._undetermined_advice(),
+                                        parameter="detail_constrained") from None
 
     def _square_system(self, D, in_roi, free_d, fd, dc, at_fd, at_dc, rows, cols, cvals, curv_backend):
         """The paper's linear-system form (see :func:`square_curvature_system`)."""
@@ -444,7 +446,8 @@ class CurvatureEditor:
         if stray.size:
             raise ConstraintError(f"handles: {counted(stray.size, 'vertex', 'vertices', verb='are')} neither position- nor detail-"
                                   f"constrained (first: {first_indices(stray)}); only constrained "
-                                  "values can change between solves.")
+                                  "values can change between solves.", parameter="handles",
+                                  count=int(stray.size), first=stray[:3].tolist())
         Xk, Dk = self._positions(positions), self._details(details)
         base = self._solve(Xk, Dk, fast_path=False)     # not another thread's response
         jp = np.flatnonzero(np.isin(self._pc, h))              # rows of positions that may change

@@ -30,8 +30,8 @@ class UndeterminedEditError(ConstraintError):
     """An edit's constraints leave part of it undetermined; ``problem`` is what was found and
     ``advice`` what to change in the editor's terms (front ends give their own)."""
 
-    def __init__(self, problem, advice):
-        super().__init__(f"{problem} {advice}")
+    def __init__(self, problem, advice, **fields):
+        super().__init__(f"{problem} {advice}", **fields)
         self.problem, self.advice = problem, advice
 
 

@@ -233,7 +233,7 @@ def refine_least_squares(X, correction, min_steps, *, stall="raise"):
         f"rows='all': the normal equations are too ill-conditioned to solve accurately (the "
         f"refinement stalled at a correction of {relative:.1e} of the solution), most likely from "
         "needle or sliver triangles. Use rows='free', or remesh the near-degenerate triangles away "
-        "(e.g. pymeshlab's meshing_isotropic_explicit_remeshing).")
+        "(e.g. pymeshlab's meshing_isotropic_explicit_remeshing).", parameter="rows", value=relative)
 
 
 #: ``rows="all"``: refinement continues while the estimated error left is above this fraction of
