@@ -70,8 +70,9 @@ def test_the_default_rotation_aware_edit_turns_the_region_without_warning():
 @pytest.mark.parametrize("params", [dict(detail_scale=0.5), dict(move_handles=False)])
 def test_paper_only_parameters_are_refused_with_the_rotation_aware_method(params):
     ms, V, d, handles = _meshset_with_roi()
-    with pytest.raises(FilterParameterError, match="method='paper'"):
+    with pytest.raises(FilterParameterError, match="method='paper'") as e:      # the value that takes them
         apply(ms, "apply_curvature_editing", handles=handles, **params)
+    assert e.value.parameter == "method"
     assert np.array_equal(ms.current_mesh().vertex_matrix(), V)
 
 
@@ -116,10 +117,7 @@ def test_a_detail_edit_that_folds_triangles_warns_with_the_count_and_what_to_try
     # triangles; the filter said nothing (amplification None, "the handles do not move")
     ms, V, d, handles = _meshset_with_roi()
     F = ms.current_mesh().face_matrix()
-    with pytest.warns(FoldedTrianglesWarning, match=r"apply_curvature_editing with relations='one-ring': "
-                                                    r"\d+ triangles of 2403 folded over .*first: \d+, \d+, \d+\).*"
-                                                    r"try relations='one\+two-ring', more handles, a "
-                                                    r"detail_scale closer to 1 or a larger region") as record:
+    with pytest.warns(FoldedTrianglesWarning, match=r"relations='one-ring'.* 2403\b.*relations='one\+two-ring'") as record:
         figures = apply(ms, "apply_curvature_editing", method="paper", handles=handles, detail_scale=2.0)
     X = ms.current_mesh().vertex_matrix()
     assert figures["folded_triangles"] == _folded(V, X, F) > 100
@@ -168,9 +166,7 @@ def test_a_detail_edit_amplified_without_folds_warns_with_the_ratio():
     # (6.0 % against 0.58 % of the diagonal), without a fold; nothing was said
     ms, V, handles = _terrain_handles()
     edit = dict(handles=handles, region_radius=pymeshlab.PercentageValue(10.0), detail_scale=1.2)
-    with pytest.warns(AmplifiedEditWarning, match=r"the details changed up to \d+\.\d times as much as the "
-                                                  r"edit asks of the region \(vertex \d+\).*amplified.*try "
-                                                  r"relations='one\+two-ring'"):
+    with pytest.warns(AmplifiedEditWarning, match=r"\b\d+\.\d times.*\(vertex \d+\).*relations='one\+two-ring'"):
         amplified = apply(ms, "apply_curvature_editing", method="paper", **edit)
     assert amplified["folded_triangles"] == 0 and amplified["amplification"] is None
     assert amplified["detail_amplification"] > 3.0 * AMPLIFICATION_LIMIT          # 14.2
@@ -324,28 +320,28 @@ def test_filter_is_declared_with_its_parameters():
     assert expected <= set(spec.parameter_names)
 
 
-@pytest.mark.parametrize("params, error, message", [
-    (dict(handles=""), FilterParameterError, "empty"),
-    (dict(handles="1 2 999999"), FilterParameterError, "outside"),
-    (dict(handles="1 99999999999999999999999"), FilterParameterError, r"1 index is outside \[0, \d+\) "
-                                                                        r"\(first: 99999999999999999999999\)"),
-    (dict(handles="1 2 2"), FilterParameterError, r"1 index is repeated \(first: 2\); list each vertex once"),
-    (dict(handles="1 2", transform="1 0 0"), FilterParameterError, "16 finite numbers"),
-    (dict(handles="1 2", detail_scale=-1.0), FilterParameterError, "greater than 0"),
+@pytest.mark.parametrize("params, fields", [
+    (dict(handles=""), ("handles", 0, None)),
+    (dict(handles="1 2 999999"), ("handles", 1, [999999])),
+    (dict(handles="1 99999999999999999999999"), ("handles", 1, [99999999999999999999999])),
+    (dict(handles="1 2 2"), ("handles", 1, [2])),
+    (dict(handles="1 2", transform="1 0 0"), ("transform", 3, None)),
+    (dict(handles="1 2", detail_scale=-1.0), ("detail_scale", None, None)),
     # transforms that collapse the handles: refused here as curvdetail edit's .def files are
-    (dict(handles="1 2", transform="0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 1"), FilterParameterError, "singular"),
-    (dict(handles="1 2", transform="1 0 0 0 0 1 0 0 0 0 0 0 0 0 0 1"), FilterParameterError, "singular"),
-    (dict(handles="1 2", transform="1 0 0 1_0 0 1 0 0 0 0 1 0 0 0 0 1"), FilterParameterError, "16 numbers"),
+    (dict(handles="1 2", transform="0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 1"), ("transform", None, None)),
+    (dict(handles="1 2", transform="1 0 0 0 0 1 0 0 0 0 0 0 0 0 0 1"), ("transform", None, None)),
+    (dict(handles="1 2", transform="1 0 0 1_0 0 1 0 0 0 0 1 0 0 0 0 1"), ("transform", None, None)),
 ])
-def test_bad_parameters_are_refused(params, error, message):
+def test_bad_parameters_are_refused(params, fields):
     ms, V, d, handles = _meshset_with_roi()
-    with pytest.raises(error, match=message):
+    with pytest.raises(FilterParameterError) as e:
         apply(ms, "apply_curvature_editing", **params)
+    assert (e.value.parameter, e.value.count, e.value.first) == fields
 
 
 @pytest.mark.parametrize("params, message", [
-    (dict(detail_scale=1e300), "transform with detail_scale gives the handles values of"),
-    (dict(transform="1e300 0 0 0 0 1e300 0 0 0 0 1e300 0 0 0 0 1"), "the transform gives the handles values of"),
+    (dict(detail_scale=1e300), r"detail_scale .*e\+29\d.*\b1e\+75"),          # the value, the limit
+    (dict(transform="1e300 0 0 0 0 1e300 0 0 0 0 1e300 0 0 0 0 1"), r"e\+29\d.*\b1e\+75"),
 ])
 def test_an_overflowing_edit_is_refused_before_the_mesh_is_touched(params, message):
     # before, the positions were written and only then the quality's infinities refused
@@ -377,8 +373,9 @@ def test_region_radius_makes_the_region_without_a_selection():
 def test_no_selection_is_refused():
     ms = pymeshlab.MeshSet()
     ms.load_new_mesh(os.path.join(DATA, "mannequin_ear.obj"))
-    with pytest.raises(ConstraintError, match="no selected vertices"):
+    with pytest.raises(ConstraintError, match=r"layer 0 \('mannequin_ear\.obj'\)") as e:
         apply(ms, "apply_curvature_editing", handles="1 2 3")
+    assert (e.value.parameter, e.value.value) == ("region_radius", 0.0)
 
 
 def test_an_edit_the_handles_do_not_determine_is_refused_with_the_filter_s_options():
@@ -392,7 +389,7 @@ def test_an_edit_the_handles_do_not_determine_is_refused_with_the_filter_s_optio
     ms = pymeshlab.MeshSet()
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=V, face_matrix=F))
     # free handle details on a flat grid: nothing ties the in-plane rings of the region down
-    with pytest.raises(UndeterminedEditError, match="do not determine the edit.*more handles, handle_detail") as exc:
+    with pytest.raises(UndeterminedEditError, match="handle_detail='transform'") as exc:      # the advice
         apply(ms, "apply_curvature_editing", method="paper", handles="450 451 480", handle_detail="free",
               region_radius=pymeshlab.PercentageValue(45.0))
     assert "roi" not in str(exc.value)              # the filter's terms, not the library's
@@ -419,9 +416,9 @@ def test_a_selected_piece_with_one_handle_is_refused_in_the_filter_s_terms():
     _select(ms, np.arange(2 * n) >= n)
     T = np.eye(4)
     T[2, 3] = 1.0
-    with pytest.raises(UndeterminedEditError, match="wholly inside the edited region with only 1 detail "
-                                                    "constraint.*Use more handles") as exc:
+    with pytest.raises(UndeterminedEditError, match=r"\b1 detail") as exc:
         apply(ms, "apply_curvature_editing", method="paper", handles=[n + 5], transform=T)
+    assert (exc.value.count, exc.value.first) == (1, [n])
     assert "roi" not in str(exc.value)
     assert np.array_equal(ms.current_mesh().vertex_matrix(), V2)      # untouched
     # three handles determine it: the translation moves the piece as a whole
@@ -438,9 +435,9 @@ def test_a_transform_array_of_another_shape_than_4x4_is_refused(shape):
     T = np.eye(4)
     T[:3, 3] = [0.0, 0.0, 0.02]
     dims = "x".join(map(str, shape))
-    with pytest.raises(FilterParameterError, match=rf"parameter 'transform' is a {dims} array; it must be a "
-                                                   r"4x4 matrix"):
+    with pytest.raises(FilterParameterError, match=rf"\b{dims}\b") as e:
         apply(ms, "apply_curvature_editing", handles=handles, transform=T.reshape(shape))
+    assert e.value.parameter == "transform"
     assert np.array_equal(ms.current_mesh().vertex_matrix(), V)
     # the documented forms stay: 16 numbers as a flat list, as in the text
     apply(ms, "apply_curvature_editing", handles=handles, transform=T.ravel().tolist())
@@ -451,17 +448,18 @@ def test_a_transform_array_of_another_shape_than_4x4_is_refused(shape):
 def test_handles_given_as_an_empty_list_are_named_as_no_handle(handles):
     # it was "parameter 'handles' expects a str; got [] (list)", about the type
     ms, *_ = _meshset_with_roi()
-    with pytest.raises(FilterParameterError, match=r"parameter 'handles' is empty; name the handle vertices"):
+    with pytest.raises(FilterParameterError) as e:
         apply(ms, "apply_curvature_editing", handles=handles)
+    assert (e.value.parameter, e.value.count) == ("handles", 0)
 
 
 def test_handles_given_as_a_boolean_mask_are_refused_with_the_conversion():
     ms, V, d, handles = _meshset_with_roi()
     mask = np.zeros(V.shape[0], dtype=bool)
     mask[handles] = True
-    with pytest.raises(FilterParameterError, match=rf"parameter 'handles' is a boolean mask \({V.shape[0]} "
-                                                   r"True/False values\); .*np\.flatnonzero\(mask\)"):
+    with pytest.raises(FilterParameterError, match=r"np\.flatnonzero\(mask\)") as e:     # the fix
         apply(ms, "apply_curvature_editing", handles=mask)
+    assert e.value.parameter == "handles"
     apply(ms, "apply_curvature_editing", handles=np.flatnonzero(mask))      # the conversion it names
 
 
@@ -475,14 +473,14 @@ def test_a_positive_region_radius_that_reaches_no_vertex_is_named_as_given(radiu
     ms = pymeshlab.MeshSet()
     ms.load_new_mesh(os.path.join(DATA, "mannequin_ear.obj"))
     V = ms.current_mesh().vertex_matrix().copy()
-    with pytest.raises(ConstraintError, match=r"no selected vertices and no vertex but the handles lies within "
-                                              + given) as error:
+    with pytest.raises(ConstraintError, match=given) as error:
         apply(ms, "apply_curvature_editing", handles="1 2 3", region_radius=radius,
               transform="1 0 0 0 0 1 0 0 0 0 1 0.01 0 0 0 1")
-    assert "is 0" not in str(error.value)
+    assert error.value.parameter == "region_radius" and error.value.value > 0
     assert np.array_equal(ms.current_mesh().vertex_matrix(), V)
-    with pytest.raises(ConstraintError, match="no selected vertices and region_radius is 0: the region"):
+    with pytest.raises(ConstraintError) as error:
         apply(ms, "apply_curvature_editing", handles="1 2 3", region_radius=0.0)
+    assert (error.value.parameter, error.value.value) == ("region_radius", 0.0)
 
 
 def _edited(handles, transform="1 0 0 0 0 1 0 0 0 0 1 0.02 0 0 0 1"):
@@ -501,18 +499,16 @@ def test_handles_given_as_whole_number_floats_make_the_edit_of_the_ints(as_float
     assert np.array_equal(_edited(as_floats(handles)), _edited(handles))       # the same path: bit for bit
 
 
-@pytest.mark.parametrize("handles, how_many", [
-    ([3.5, 7.0], r"1 value is not a whole number \(first: 3\.5, at position 0\)"),
-    (np.array([3.0, 7.25, 9.5]), r"2 values are not whole numbers \(first: 7\.25, at position 1\)"),
-    ("3 7.5", r"1 value is not a whole number \(first: 7\.5, at position 1\)"),
-    ([2, np.nan], r"1 value is not a whole number \(first: nan, at position 1\)"),
+@pytest.mark.parametrize("handles, value, count, first", [
+    ([3.5, 7.0], r"3\.5", 1, [0]), (np.array([3.0, 7.25, 9.5]), r"7\.25", 2, [1, 2]), ("3 7.5", r"7\.5", 1, [1]),
+    ([2, np.nan], "nan", 1, [1]),
 ])
-def test_handles_that_are_not_whole_numbers_are_refused_naming_the_first(handles, how_many):
+def test_handles_that_are_not_whole_numbers_are_refused_naming_the_first(handles, value, count, first):
     # [3.5, 7.0] was "must be vertex indices separated by spaces or commas; got '3.5 7.0'", naming no value
     ms, V, d, _ = _meshset_with_roi()
-    with pytest.raises(FilterParameterError, match=rf"parameter 'handles': {how_many}; vertex indices are whole "
-                                                   r"numbers: pass integers \(or whole floats such as 3\.0\)"):
+    with pytest.raises(FilterParameterError, match=value) as e:
         apply(ms, "apply_curvature_editing", handles=handles, transform="1 0 0 0 0 1 0 0 0 0 1 0.02 0 0 0 1")
+    assert (e.value.parameter, e.value.count, e.value.first) == ("handles", count, first)
     assert np.array_equal(ms.current_mesh().vertex_matrix(), V)
 
 
@@ -544,9 +540,10 @@ def test_a_translation_with_move_handles_false_is_refused_as_doing_nothing():
     # mesh came back unchanged, without a word
     ms, V, d, handles = _meshset_with_roi()
     shift = "1 0 0 0.1 0 1 0 0 0 0 1 0 0 0 0 1"
-    with pytest.raises(FilterParameterError, match="only translates, and move_handles=false .* nothing would move"):
+    with pytest.raises(FilterParameterError) as e:
         apply(ms, "apply_curvature_editing", method="paper", handles=" ".join(map(str, handles)), transform=shift,
               move_handles=False)
+    assert e.value.parameter == "move_handles"
     assert np.array_equal(ms.current_mesh().vertex_matrix(), V)
     # what the advice names works: the handles move by the translation
     apply(ms, "apply_curvature_editing", method="paper", handles=" ".join(map(str, handles)), transform=shift,
@@ -564,14 +561,13 @@ def test_a_region_of_every_vertex_is_refused_naming_what_made_it():
     # a region_radius beyond the mesh took in every vertex, and the refusal named only the selection
     ms, V, d, handles = _meshset_with_roi()
     h = " ".join(map(str, handles))
-    with pytest.raises(ConstraintError, match=r"^every vertex is in the region of interest \(selection plus handles "
-                                              r"plus every vertex within region_radius=1000(\.0)? of a handle\), so "
-                                              r"nothing stays fixed; leave part of the mesh unselected, or a smaller "
-                                              r"region_radius\.$"):
+    with pytest.raises(ConstraintError, match=r"region_radius=1000") as e:       # what made it
         apply(ms, "apply_curvature_editing", handles=h, region_radius=1000.0)
+    assert (e.value.parameter, e.value.value, e.value.count) == ("region_radius", 1000.0, V.shape[0])
+
     assert np.array_equal(ms.current_mesh().vertex_matrix(), V)
     _select(ms, np.ones(V.shape[0]))
-    with pytest.raises(ConstraintError, match=r"^every vertex is in the region of interest \(selection plus "
-                                              r"handles\), so nothing stays fixed; leave part of the mesh "
-                                              r"unselected\.$"):
+    with pytest.raises(ConstraintError) as e:                                    # the selection alone
         apply(ms, "apply_curvature_editing", handles=h, region_radius=pymeshlab.PercentageValue(0.0))
+    assert (e.value.value, e.value.count) == (0.0, V.shape[0]) and "region_radius=" not in str(e.value)
+

@@ -176,16 +176,17 @@ def apply_curvature_editing(ms, *, handles, region_radius, transform, method, de
     T = _matrix(transform)
     if method == "rotation" and (detail_scale != 1.0 or not move_handles):
         raise FilterParameterError("method='rotation' moves the handles and keeps their details' size; "
-                                   "detail_scale and move_handles=false need method='paper'.")
+                                   "detail_scale and move_handles=false need method='paper'.", parameter="method")
     if not move_handles and handle_detail == "free":
         raise FilterParameterError("move_handles=false with handle_detail='free' leaves the handles "
-                                   "unconstrained; set one of them.")
+                                   "unconstrained; set one of them.", parameter="handle_detail")
     if not move_handles and detail_scale == 1.0 and np.array_equal(T[:3, :3], np.eye(3)) and T[:3, 3].any():
         # the details take the linear part alone: the translation would be dropped without a word
         raise FilterParameterError("the transform only translates, and move_handles=false keeps the handles' "
                                    "curvature normals alone, which a translation does not change: nothing "
                                    "would move. Set move_handles=true to move the handles, or give a "
-                                   "rotation, scale or detail_scale to change their details.")
+                                   "rotation, scale or detail_scale to change their details.",
+                                   parameter="move_handles")
     selected = selected_vertices(ms, mid)
     radius = region_radius.resolve(bbox_diagonal(V))
     if radius > 0:
@@ -203,13 +204,15 @@ def apply_curvature_editing(ms, *, handles, region_radius, transform, method, de
         raise ConstraintError(
             f"layer {mid} ({get_mesh(ms, mid).label()!r}) has no selected vertices and {within}: the "
             "region of interest to rebuild is empty. Select it first (e.g. with "
-            "compute_selection_by_condition_per_vertex) or set a larger region_radius (e.g. 20%).")
+            "compute_selection_by_condition_per_vertex) or set a larger region_radius (e.g. 20%).",
+            parameter="region_radius", value=radius)
     roi = np.union1d(selected, h)
     if roi.size == V.shape[0]:
         reach = (f" plus every vertex within region_radius={region_radius} of a handle" if radius > 0 else "")
         smaller = ", or a smaller region_radius" if radius > 0 else ""
         raise ConstraintError(f"every vertex is in the region of interest (selection plus handles{reach}), so "
-                              f"nothing stays fixed; leave part of the mesh unselected{smaller}.")
+                              f"nothing stays fixed; leave part of the mesh unselected{smaller}.",
+                              parameter="region_radius", value=radius, count=int(roi.size))
     t = time.perf_counter()
     if method == "rotation":
         return _rotation_edit(ms, mid, V, F, h, roi, T, backend, t)
@@ -221,7 +224,8 @@ def apply_curvature_editing(ms, *, handles, region_radius, transform, method, de
         other = ("relations='one-ring', " if relations == "one+two-ring" else
                  "handle_detail='transform' (the handles' details given), " if handle_detail == "free" else "")
         raise UndeterminedEditError(exc.problem, f"Use more handles, {other}or a smaller region "
-                                                 "(selection, region_radius).") from None
+                                                 "(selection, region_radius).", parameter=exc.parameter,
+                                    count=exc.count, first=exc.first) from None
     with np.errstate(over="ignore", invalid="ignore"):      # named below instead
         details = detail_scale * (editor.detail[dc] @ T[:3, :3].T) if dc.size else None
         positions = V[pc] @ T[:3, :3].T + T[:3, 3] if pc.size else None
