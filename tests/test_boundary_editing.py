@@ -7,7 +7,7 @@ import pytest
 
 from curvdetail import edit_boundary, sine_displacement
 from curvdetail.curvature.boundary_editing import boundary_loop, loop_of_boundary_edges
-from curvdetail.curvature.errors import ConstraintError, FoldedTrianglesWarning, MeshError
+from curvdetail.curvature.errors import ConstraintError, CurvdetailError, FoldedTrianglesWarning, MeshError
 from curvdetail.curvature.testing import cylinder, grid
 
 
@@ -70,22 +70,23 @@ def test_the_loop_of_a_long_strip_is_every_vertex_in_order():
     assert np.array_equal(loop_of_boundary_edges(edges[np.random.default_rng(0).permutation(loop.size)]), loop)
 
 
-@pytest.mark.parametrize("edges, message", [
-    ([[0, 1], [1, 2], [2, 1]], r"the boundary walk from vertex 0 runs into vertex 1, which ends two boundary edges: "
-                               r"the boundary touches itself"),
-    ([[0, 1], [1, 0], [0, 2]], r"1 boundary vertex is on more than one boundary edge pair \(first: 0\)"),
-    ([[0, 1], [1, 2]], r"the boundary does not close: its edge into vertex 2 has no edge out of it"),
-    ([[0, 1], [1, 2], [2, 0], [3, 4], [4, 3]], r"the boundary has 5 edges but the loop through vertex 0 has 3"),
+@pytest.mark.parametrize("edges, count, first", [
+    ([[0, 1], [1, 2], [2, 1]], None, [0, 1]),           # the walk from 0 runs into 1, which ends two edges
+    ([[0, 1], [1, 0], [0, 2]], 1, [0]),                 # vertex 0 starts two edges
+    ([[0, 1], [1, 2]], None, [2]),                      # nothing leaves vertex 2
+    ([[0, 1], [1, 2], [2, 0], [3, 4], [4, 3]], 5, [0]),  # 5 edges, the loop through 0 has 3
 ])
-def test_boundary_edges_that_make_no_simple_loop_are_named(edges, message):
-    with pytest.raises(MeshError, match=message):
+def test_boundary_edges_that_make_no_simple_loop_are_named(edges, count, first):
+    with pytest.raises(MeshError) as e:
         loop_of_boundary_edges(np.array(edges))
+    assert (e.value.parameter, e.value.count, e.value.first) == ("F", count, first)
 
 
 def test_a_mesh_with_two_boundary_loops_is_refused():
     V, F = cylinder(n_around=16, n_along=5)
-    with pytest.raises(MeshError, match="several boundary loops"):
+    with pytest.raises(MeshError) as e:
         edit_boundary(V, F, sine_displacement(0.1))
+    assert (e.value.parameter, e.value.count) == ("F", 32)      # 32 boundary edges, 16 in the loop
 
 
 def test_displacement_array_of_the_wrong_shape_is_refused(load_mesh):
@@ -125,8 +126,9 @@ def test_the_sine_runs_along_the_arc_length_of_an_uneven_boundary():
 
 def test_unknown_boundary_detail_mode_is_refused(load_mesh):
     V, F = load_mesh("terrainA_1k.obj")
-    with pytest.raises(ValueError, match="boundary_detail"):
+    with pytest.raises(CurvdetailError) as e:
         edit_boundary(V, F, sine_displacement(0.1), boundary_detail="rotate")
+    assert (e.value.parameter, e.value.value) == ("boundary_detail", "rotate")
 
 
 def test_stacked_relations_keep_a_large_boundary_sine_free_of_folds(load_mesh):
@@ -166,16 +168,17 @@ def test_the_mesh_is_checked_and_its_laplacian_assembled_once(monkeypatch):
     assert (info["editor"].laplacian != cotan_laplacian(V, F)).nnz == 0
 
 
-@pytest.mark.parametrize("damage, message", [
-    (lambda V, F: (V, np.vstack([F, F[:1]])), "repeats the three vertices of an earlier one"),  # a doubled triangle
+@pytest.mark.parametrize("damage, first", [
+    (lambda V, F: (V, np.vstack([F, F[:1]])), [162]),                                   # a doubled triangle
     (lambda V, F: (np.vstack([V, [0.5, 0.5, 1.0]]), np.vstack([F, [[F[40, 0], F[40, 1], V.shape[0]]]])),
-     "shared by more than two triangles"),                                                  # a fin
+     [(44, 45)]),                                                # a fin on edge F[40, :2] = (44, 45)
 ])
-def test_a_malformed_mesh_is_named_before_its_boundary(damage, message):
+def test_a_malformed_mesh_is_named_before_its_boundary(damage, first):
     V, F = grid(10, 10)
     V, F = damage(V, F)
-    with pytest.raises(MeshError, match=message):
+    with pytest.raises(MeshError) as e:
         edit_boundary(V, F, sine_displacement(0.1, axis=2))
+    assert (e.value.parameter, e.value.count, e.value.first) == ("F", 1, first)
 
 
 def test_a_doubled_triangle_is_named_not_the_broken_boundary_it_makes():
@@ -190,22 +193,24 @@ def test_a_doubled_triangle_is_named_not_the_broken_boundary_it_makes():
 def test_a_boundary_that_does_not_close_is_a_mesh_error():
     from curvdetail.curvature.boundary_editing import loop_of_boundary_edges
 
-    with pytest.raises(MeshError, match=r"the boundary does not close: its edge into vertex 2 has no edge out"):
+    with pytest.raises(MeshError) as e:
         loop_of_boundary_edges(np.array([[0, 1], [1, 2], [3, 0]]))
+    assert e.value.first == [2]                 # the vertex nothing leaves
 
 
 @pytest.mark.parametrize("kwargs, message", [
-    (dict(amplitude=0.1, axis=3), "axis=3; use 0, 1 or 2"),
-    (dict(amplitude=0.1, axis=True), "axis=True; use 0, 1 or 2"),
-    (dict(amplitude=0.1, axis=np.True_), "use 0, 1 or 2"),
-    (dict(amplitude=0.1, axis=2.0), r"axis=2\.0; use 0, 1 or 2"),     # would index columns with a float
-    (dict(amplitude=float("nan")), "amplitude=nan must be a finite number"),
-    (dict(amplitude=0.1, periods=float("inf")), "periods=inf must be a finite number"),
-    (dict(amplitude=0.1, phase="0"), "phase='0' must be a finite number"),
+    (dict(amplitude=0.1, axis=3), "axis=3"),
+    (dict(amplitude=0.1, axis=True), "axis=True"),
+    (dict(amplitude=0.1, axis=np.True_), "True"),
+    (dict(amplitude=0.1, axis=2.0), r"axis=2\.0"),     # would index columns with a float
+    (dict(amplitude=float("nan")), "amplitude=nan"),
+    (dict(amplitude=0.1, periods=float("inf")), "periods=inf"),
+    (dict(amplitude=0.1, phase="0"), "phase='0'"),
 ])
 def test_sine_displacement_refuses_what_would_give_no_displacement(kwargs, message):
-    with pytest.raises(ValueError, match=message):
+    with pytest.raises(CurvdetailError, match=message) as e:
         sine_displacement(**kwargs)
+    assert e.value.parameter == next(iter(k for k in kwargs if k != "amplitude"), "amplitude")
 
 
 def test_sine_displacement_takes_numpy_scalars():
@@ -216,8 +221,9 @@ def test_sine_displacement_takes_numpy_scalars():
 @pytest.mark.parametrize("flag", ["no", 0, None])
 def test_return_info_must_be_a_bool(flag):
     V, F = grid(6, 6)
-    with pytest.raises(ValueError, match=r"return_info=.* must be True or False"):
+    with pytest.raises(CurvdetailError) as e:
         edit_boundary(V, F, sine_displacement(0.05, axis=2), return_info=flag)
+    assert e.value.parameter == "return_info"
 
 
 def test_return_info_takes_a_numpy_bool():
@@ -230,26 +236,28 @@ def test_two_separate_disks_are_named_as_two_pieces_not_as_holes():
     V, F = grid(6, 6)
     V2 = np.vstack([V, V + [3.0, 0.0, 0.0]])
     F2 = np.vstack([F, F + V.shape[0]])
-    with pytest.raises(MeshError, match="the mesh has 2 separate pieces, each with its own boundary"):
-        boundary_loop(F2)
-    with pytest.raises(MeshError, match="2 separate pieces"):
-        edit_boundary(V2, F2, sine_displacement(0.1))
+    for call in (lambda: boundary_loop(F2), lambda: edit_boundary(V2, F2, sine_displacement(0.1))):
+        with pytest.raises(MeshError) as e:
+            call()
+        assert (e.value.parameter, e.value.count) == ("F", 2)
 
 
 def test_a_reversed_boundary_triangle_is_named_as_an_orientation_problem():
     V, F = grid(6, 6)
     F = F.copy()
     F[0] = F[0, ::-1]                                   # a corner triangle
-    with pytest.raises(MeshError, match="not consistently oriented: .*meshing_re_orient_faces_coherently"):
+    with pytest.raises(MeshError, match="meshing_re_orient_faces_coherently") as e:      # the repair filter
         edit_boundary(V, F, sine_displacement(0.1))
+    assert e.value.parameter == "F"
 
 
 def test_two_closed_pieces_are_named_as_closed_not_as_pieces_with_boundaries():
     from curvdetail.curvature.testing import icosphere
 
     V, F = icosphere(subdivisions=1)
-    with pytest.raises(MeshError, match=r"the mesh is closed \(no boundary loop\)"):
+    with pytest.raises(MeshError) as e:
         boundary_loop(np.vstack([F, F + V.shape[0]]))
+    assert (e.value.parameter, e.value.count) == ("F", 0)
 
 
 def _onto_first_neighbour(s, P):
@@ -260,17 +268,17 @@ def _onto_first_neighbour(s, P):
 
 @pytest.mark.filterwarnings("error")        # the refusal comes without numpy's RuntimeWarnings
 @pytest.mark.parametrize("displacement, message", [
-    (lambda s, P: -P, "moves all 36 boundary vertices onto one point"),
-    (lambda s, P: P.mean(axis=0) - P, "moves all 36 boundary vertices onto one point"),
-    (lambda s, P: -P * [1.0, 1.0, 0.0], "moves the boundary loop onto a line"),
-    (_onto_first_neighbour, r"collapses part of the boundary loop \(e\.g\. a vertex onto its neighbour\)"),
+    (lambda s, P: -P, r"\b36\b"),                       # all 36 boundary vertices onto one point
+    (lambda s, P: P.mean(axis=0) - P, r"\b36\b"),
+    (lambda s, P: -P * [1.0, 1.0, 0.0], ""),            # onto a line
+    (_onto_first_neighbour, ""),                        # a vertex onto its neighbour
 ])
 def test_a_displacement_that_collapses_the_boundary_is_refused_without_warnings(displacement, message):
     # divide-by-zero and invalid-value warnings from the provisional surface's cotangents came
     # first, then "details: 36 rows are NaN or infinite", naming values the caller never passed
     V, F = grid(10, 10)
     V[:, 2] = 0.1 * np.sin(3 * V[:, 0])
-    with pytest.raises(ConstraintError, match=message) as e:
+    with pytest.raises(ConstraintError, match=message or None) as e:
         edit_boundary(V, F, displacement)
     assert e.value.parameter == "displacement" and e.value.count >= 1
     # the advice: defined, no numpy warnings (a loop collapsed onto a point or a line does fold
@@ -295,8 +303,9 @@ def test_a_displaced_boundary_beyond_1e75_is_refused_before_any_algebra():
 def test_a_boundary_of_one_point_is_a_mesh_error_without_warnings():
     # the arc length divided by a loop length of 0 first (invalid-value warning)
     V, F = grid(6, 6)
-    with pytest.raises(MeshError, match="the mesh is 0 across"):
+    with pytest.raises(MeshError) as e:
         edit_boundary(np.zeros_like(V), F, sine_displacement(0.1))
+    assert (e.value.parameter, e.value.value) == ("V", 0.0)
 
 
 def test_a_displacement_callable_with_non_finite_values_is_named_as_such():
@@ -312,17 +321,15 @@ def test_a_displacement_callable_with_non_finite_values_is_named_as_such():
     assert (e.value.parameter, e.value.count, e.value.first) == ("displacement", 1, [0])
 
 
-@pytest.mark.parametrize("kwargs, error, message", [
-    (dict(boundary_detail=np.array(["rest", "deformed"])), ValueError,
-     r"boundary_detail=array\(.*\(ndarray, not a single str\); use 'deformed' or 'rest'"),
-    (dict(relations=np.array(["one-ring", "one+two-ring"])), ValueError, r"relations=array\(.*not a single str"),
-    (dict(backend=np.array(["auto", "splu"])), ValueError, r"backend=array\(.* is not a solver backend"),
-])
-def test_options_given_as_arrays_are_refused_before_the_displacement_runs(kwargs, error, message):
+@pytest.mark.parametrize("kwargs", [dict(boundary_detail=np.array(["rest", "deformed"])),
+                                    dict(relations=np.array(["one-ring", "one+two-ring"])),
+                                    dict(backend=np.array(["auto", "splu"]))])
+def test_options_given_as_arrays_are_refused_before_the_displacement_runs(kwargs):
     # numpy's "truth value of an array ... is ambiguous" before
     V, F = grid(6, 6)
-    with pytest.raises(error, match=message):
+    with pytest.raises(CurvdetailError, match="ndarray") as e:
         edit_boundary(V, F, lambda s, P: pytest.fail("the displacement ran"), **kwargs)
+    assert e.value.parameter == next(iter(kwargs))
 
 
 @pytest.mark.parametrize("raised", [IndexError("index 99 is out of bounds"), ValueError("my own check failed"),
@@ -344,10 +351,10 @@ def test_an_error_inside_the_displacement_callable_reaches_the_caller_unchanged(
 @pytest.mark.parametrize("displacement", [lambda s: np.zeros((s.size, 3)), lambda s, P, scale: P * scale])
 def test_a_displacement_callable_that_does_not_take_s_and_p_is_named_before_it_runs(displacement):
     V, F = grid(6, 6)
-    with pytest.raises(ValueError, match=r"the displacement callable cannot be called as displacement\(s, P\) "
-                                         r"\(.*\); it must map the boundary's arc lengths s \(20,\) and positions "
-                                         r"P \(20, 3\) to a \(20, 3\) float array of displacements"):
+    with pytest.raises(CurvdetailError, match=r"\(20, 3\)") as e:       # the shapes it must take and give
         edit_boundary(V, F, displacement)
+    assert (e.value.parameter, e.value.count) == ("displacement", 20)
+
 
 
 def test_a_displacement_callable_with_a_ragged_result_is_named_as_such():

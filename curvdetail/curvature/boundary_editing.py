@@ -15,7 +15,7 @@ from .topology import _compact_ids, boundary_edges, check_oriented, vertex_compo
 from .cotan_laplacian import _cotan_laplacian_unchecked, laplacian_product
 from .curvature_coefficients import DEFAULT_RCOND, check_rcond
 from .curvature_editor import CurvatureEditor, _check_relations
-from .errors import ConstraintError, FoldedTrianglesWarning, MeshError, counted, first_indices
+from .errors import ConstraintError, CurvdetailError, FoldedTrianglesWarning, MeshError, counted, first_indices
 from .sparse_solver import factorize, resolve_backend
 
 
@@ -108,7 +108,7 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
     seg = np.linalg.norm(np.roll(P, -1, axis=0) - P, axis=1)
     if not seg.sum() > 0:               # a loop of one point: its triangles have zero area
         check_mesh(V, F)
-        raise MeshError("the boundary loop has length 0 (all its vertices coincide); repair the mesh.")
+        raise MeshError("the boundary loop has length 0 (all its vertices coincide); repair the mesh.", parameter="V")
     s = np.concatenate([[0.0], np.cumsum(seg)[:-1]]) / seg.sum()
     if callable(displacement):
         _check_displacement_signature(displacement, loop.size)
@@ -185,9 +185,9 @@ def _check_displacement_signature(displacement, b):
     try:
         signature.bind(None, None)
     except TypeError as exc:
-        raise ValueError(f"the displacement callable cannot be called as displacement(s, P) ({exc}); it "
-                         f"must map the boundary's arc lengths s ({b},) and positions P ({b}, 3) to a ({b}, 3) "
-                         "float array of displacements.") from None
+        raise CurvdetailError(f"the displacement callable cannot be called as displacement(s, P) ({exc}); it "
+                              f"must map the boundary's arc lengths s ({b},) and positions P ({b}, 3) to a "
+                              f"({b}, 3) float array of displacements.", parameter="displacement", count=b) from None
 
 
 def _check_provisional_surface(Vp, F, P, Q):
@@ -262,11 +262,11 @@ def sine_displacement(amplitude, periods=1, axis=1, phase=0.0):
     [0.0, 2.0]
     """
     if isinstance(axis, (bool, np.bool_)) or not isinstance(axis, numbers.Integral) or axis not in (0, 1, 2):
-        raise ValueError(f"axis={axis!r}; use 0, 1 or 2 for x, y or z.")
+        raise CurvdetailError(f"axis={axis!r}; use 0, 1 or 2 for x, y or z.", parameter="axis", value=axis)
     axis = int(axis)
     for name, value in (("amplitude", amplitude), ("periods", periods), ("phase", phase)):
         if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
-            raise ValueError(f"{name}={value!r} must be a finite number.")
+            raise CurvdetailError(f"{name}={value!r} must be a finite number.", parameter=name, value=value)
 
     def displacement(s, P):
         out = np.zeros((np.asarray(s).size, 3))
@@ -316,7 +316,8 @@ def boundary_loop(F):
         twice = np.sort(first[counts > 1])
         raise MeshError(f"{counted(twice.size, 'triangle', verb='appear')} more than once (first: "
                         f"{', '.join(map(str, twice[:3]))}), which takes their edges off the boundary; "
-                        "remove the copies (e.g. pymeshlab's meshing_remove_duplicate_faces).")
+                        "remove the copies (e.g. pymeshlab's meshing_remove_duplicate_faces).", parameter="F",
+                        count=int(twice.size), first=twice[:3].tolist())
     check_oriented(F)
     labels, _ = vertex_components(F, int(F.max()) + 1)
     pieces = np.unique(labels[F.ravel()]).size          # unreferenced vertices are no pieces
@@ -324,7 +325,7 @@ def boundary_loop(F):
         raise MeshError(f"the mesh has {pieces} separate pieces, each with its own boundary; shape "
                         "editing of a boundary needs one disk-topology patch: edit each piece on its "
                         "own (e.g. keep one with pymeshlab's meshing_remove_connected_component_by_"
-                        "face_number).")
+                        "face_number).", parameter="F", count=int(pieces))
     raise problem
 
 
@@ -332,13 +333,14 @@ def loop_of_boundary_edges(E):
     """:func:`boundary_loop` from the boundary edges ``E`` (k, 2) of :func:`boundary_edges`."""
     if E.shape[0] == 0:
         raise MeshError("the mesh is closed (no boundary loop); shape editing of a boundary needs "
-                        "a patch with one boundary loop.")
+                        "a patch with one boundary loop.", parameter="F", count=0)
     starts, counts = np.unique(E[:, 0], return_counts=True)
     if np.any(counts > 1):
         bad = starts[counts > 1]
         raise MeshError(f"{counted(bad.size, 'boundary vertex', 'boundary vertices', verb='are')} on more than one "
                         f"boundary edge pair (first: {', '.join(map(str, bad[:3]))}); the boundary touches itself. "
-                        "Repair the mesh so that its boundary is one simple loop.")
+                        "Repair the mesh so that its boundary is one simple loop.", parameter="F",
+                        count=int(bad.size), first=bad[:3].tolist())
     # every vertex has at most one edge out: the walk is the successor graph's depth-first order
     n = int(E.max()) + 1
     successor = sp.csr_matrix((np.ones(E.shape[0], dtype=np.int8), (E[:, 0], E[:, 1])), shape=(n, n))
@@ -348,14 +350,15 @@ def loop_of_boundary_edges(E):
     if successor.indptr[last + 1] == successor.indptr[last]:
         raise MeshError(f"the boundary does not close: its edge into vertex {last} has no edge out of "
                         "it (triangles oriented inconsistently, or a mesh that is not manifold). "
-                        "Check the mesh with check_mesh and orient it consistently.")
+                        "Check the mesh with check_mesh and orient it consistently.", parameter="F", first=[last])
     back = int(successor.indices[successor.indptr[last]])
     if back != start:                           # the walk ran into itself elsewhere: a vertex ends two edges
         raise MeshError(f"the boundary walk from vertex {start} runs into vertex {back}, which ends two boundary "
                         "edges: the boundary touches itself. Repair the mesh so that its boundary is one simple "
-                        "loop.")
+                        "loop.", parameter="F", first=[start, back])
     if loop.size != E.shape[0]:
         raise MeshError(f"the boundary has {E.shape[0]} edges but the loop through vertex {start} has "
                         f"{loop.size}: the patch has several boundary loops (holes). Fill the holes, "
-                        "e.g. with pymeshlab's meshing_close_holes, or cut a disk-topology patch.")
+                        "e.g. with pymeshlab's meshing_close_holes, or cut a disk-topology patch.", parameter="F",
+                        count=int(E.shape[0]), first=[start])
     return loop.astype(np.int64, copy=False)
