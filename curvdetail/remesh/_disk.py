@@ -15,14 +15,14 @@ from scipy.spatial import cKDTree
 from ..curvature.checks import as_faces, check_mesh
 from ..curvature.topology import boundary_edges, check_oriented, non_manifold_edges, vertex_components
 from ..curvature.boundary_editing import loop_of_boundary_edges
-from ..curvature.errors import MeshError, counted, first_indices
+from ..curvature.errors import CurvdetailError, MeshError, counted, first_indices
 
 
 class NotADiskError(MeshError):
     """The mesh is not a disk-topology patch (one piece, one boundary loop, no handles)."""
 
 
-class RemeshError(ValueError):
+class RemeshError(CurvdetailError):
     """A remeshing option is out of range (e.g. a target edge length giving absurd sizes) or a
     remesher produced an unusable result."""
 

@@ -4,7 +4,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..curvature.checks import as_count
-from ..curvature.errors import MeshError, first_indices
+from ..curvature.errors import CurvdetailError, MeshError, first_indices
 from .closest_point import check_points_and_mesh, closest_in_frame, unit_frame
 
 #: Barycentric coordinates taken by interpolate / spread: entries in [-tol, 1 + tol], rows summing
@@ -205,8 +205,8 @@ def spread(values, F, face, bary, n):
     """
     n = as_count(n, "n")
     if n > MAX_SPREAD_VERTICES:
-        raise ValueError(f"n={n} asks for a dense ({n}, c) result, more than {MAX_SPREAD_VERTICES:,} rows; "
-                         "pass the vertex count of the mesh F indexes.")
+        raise CurvdetailError(f"n={n} asks for a dense ({n}, c) result, more than {MAX_SPREAD_VERTICES:,} rows; "
+                              "pass the vertex count of the mesh F indexes.", parameter="n", value=n)
     F, face, bary = _located(F, face, bary, "spread")
     if F.size and F.max() >= n:
         raise MeshError(f"spread: F has vertex indices outside [0, n={n}) (up to {F.max()})", parameter="n",

@@ -6,7 +6,7 @@ import scipy.sparse as sp
 from ..curvature.checks import ZERO_AREA_RELATIVE, as_count, as_values, check_choice, checked_arrays
 from ..curvature.geometry import bbox_diagonal, face_double_areas
 from ..curvature.topology import edge_keys as edge_keys
-from ..curvature.errors import MeshError, counted, first_indices
+from ..curvature.errors import CurvdetailError, MeshError, counted, first_indices
 from ..curvature.mean_curvature_normal import mean_curvature_normal
 from ..curvature.mixed_voronoi_area import mixed_voronoi_area
 from ..curvature.sparse_solver import factorize
@@ -154,7 +154,8 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
                             "(shared domain).")
     if samples_per_edge is not None:
         if method != "conservative":
-            raise ValueError("samples_per_edge is used by method='conservative' only; drop it for 'pointwise'.")
+            raise CurvdetailError("samples_per_edge is used by method='conservative' only; drop it for 'pointwise'.",
+                                  parameter="samples_per_edge")
         samples_per_edge = as_count(samples_per_edge, "samples_per_edge")
     Vs, Fs = checked_arrays(Vs, Fs)
     Vt, Ft = checked_arrays(Vt, Ft)
@@ -167,8 +168,8 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
             squashed_in_plane(UV, T, f"the planar map {name}", "Use another parameterization (e.g. "
                               "parameterize(..., method='harmonic')), or location='closest'.", MeshError)
     elif uv is not None:
-        raise ValueError("uv is only used with location='uv'; pass location='uv' to locate in the shared "
-                         "domain, or drop uv for the 3D closest point.")
+        raise CurvdetailError("uv is only used with location='uv'; pass location='uv' to locate in the shared "
+                              "domain, or drop uv for the 3D closest point.", parameter="uv")
     else:
         src_dom, tgt_dom, names = Vs, Vt, ("Vs", "Vt")
     if method == "pointwise":
@@ -259,7 +260,7 @@ def _check_same_surface(dist, Vs, location):
         raise MeshError(f"source and target lie up to {100 * worst:.3g} % of the source's bbox diagonal "
                         f"apart (more than {100 * SAME_SURFACE:.0f} %): location='closest' needs two "
                         "triangulations of the same surface. Align them, or locate in a shared "
-                        "parameterization with location='uv'.")
+                        "parameterization with location='uv'.", parameter="Vt", value=worst)
 
 
 def squashed_in_plane(UV, F, what, advice, error):
@@ -276,19 +277,20 @@ def squashed_in_plane(UV, F, what, advice, error):
     if zero.size:
         raise error(f"{what} maps {counted(zero.size, 'triangle')} (first: {first_indices(zero)}) to zero "
                     f"area in the plane (below {ZERO_AREA_RELATIVE:g} of its diagonal squared), where no "
-                    f"point can be located; the mesh itself may be fine there. {advice}")
+                    f"point can be located; the mesh itself may be fine there. {advice}", count=int(zero.size),
+                    first=zero[:3].tolist())
 
 
 def _check_uv(uv, n_s, n_t):
     """``uv`` as two float arrays (n_s, 2) and (n_t, 2), or ValueError / MeshError."""
     if not isinstance(uv, (tuple, list)) or len(uv) != 2:
         got = "None" if uv is None else type(uv).__name__
-        raise ValueError(f"location='uv' needs uv=(UVs, UVt), a pair of arrays, e.g. from "
-                         f"curvdetail.remesh.parameterize; got {got}.")
+        raise CurvdetailError(f"location='uv' needs uv=(UVs, UVt), a pair of arrays, e.g. from "
+                              f"curvdetail.remesh.parameterize; got {got}.", parameter="uv")
     UVs, UVt = (as_coordinates(u, name) for u, name in zip(uv, ("uv[0] (UVs)", "uv[1] (UVt)")))
     if UVs.shape != (n_s, 2) or UVt.shape != (n_t, 2):
-        raise ValueError(f"uv shapes {UVs.shape}, {UVt.shape} do not match the meshes "
-                         f"({n_s}, 2), ({n_t}, 2).")
+        raise CurvdetailError(f"uv shapes {UVs.shape}, {UVt.shape} do not match the meshes "
+                              f"({n_s}, 2), ({n_t}, 2).", parameter="uv")
     return UVs, UVt
 
 
@@ -303,6 +305,6 @@ def _samples_per_edge(Vs, E, Vt, Ft, count):
     else:
         total, what = count * E.shape[0], f"samples_per_edge={count!r} x {E.shape[0]:,} edges"
     if total > MAX_EDGE_SAMPLES:
-        raise ValueError(f"{what} asks for {float(total):.3g} edge samples, more than {MAX_EDGE_SAMPLES:,} "
-                         "(~10 GB); pass a smaller samples_per_edge.")
+        raise CurvdetailError(f"{what} asks for {float(total):.3g} edge samples, more than {MAX_EDGE_SAMPLES:,} "
+                              "(~10 GB); pass a smaller samples_per_edge.", parameter="samples_per_edge", value=total)
     return q.astype(np.int64) if count is None else np.full(E.shape[0], count, dtype=np.int64)
