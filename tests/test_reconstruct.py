@@ -12,6 +12,7 @@ from curvdetail import (ConstraintError, MeshError, Reconstructor, SolverError, 
 from curvdetail.curvature import sparse_solver
 from curvdetail.curvature.geometry import bbox_diagonal
 from curvdetail.curvature.testing import grid, icosphere
+from curvdetail.curvature.errors import CurvdetailError
 
 from conftest import InexactSolves, every_backend, jittered_grid
 
@@ -62,15 +63,17 @@ def test_rows_all_refinement_reaches_the_square_systems_accuracy(load_mesh):
 @pytest.mark.parametrize("steps", [-1, 1.5, True, "1"])
 def test_refinement_steps_must_be_a_whole_number(load_mesh, steps):
     V, F, fixed = _problem(load_mesh, "spot.obj")
-    with pytest.raises(ValueError, match="refinement_steps"):
+    with pytest.raises(CurvdetailError) as e:
         Reconstructor(V, F, fixed, refinement_steps=steps)
+    assert e.value.parameter == "refinement_steps"
 
 
 @pytest.mark.parametrize("steps", [101, 1e9])
 def test_refinement_steps_beyond_the_most_useful_are_refused_not_run_by_every_solve(load_mesh, steps):
     V, F, fixed = _problem(load_mesh, "spot.obj")
-    with pytest.raises(ValueError, match="must be at most 100"):
+    with pytest.raises(CurvdetailError, match=r"\b100\b") as e:          # the most it takes
         Reconstructor(V, F, fixed, refinement_steps=steps)
+    assert (e.value.parameter, e.value.value) == ("refinement_steps", steps)
     assert Reconstructor(V, F, fixed, refinement_steps=100).refinement_steps == 100
 
 
@@ -220,67 +223,77 @@ def test_component_without_fixed_vertex_is_refused_by_name():
     V1, F1 = icosphere(subdivisions=1)
     V = np.vstack([V1, V1 + [5.0, 0, 0]])
     F = np.vstack([F1, F1 + V1.shape[0]])
-    with pytest.raises(ConstraintError, match=r"1 of 2 connected components .* vertex 42"):
+    with pytest.raises(ConstraintError) as e:
         reconstruct(V, F, curvature_detail(V, F), [0], V[[0]])
+    assert (e.value.parameter, e.value.count, e.value.first) == ("fixed", 1, [42])
 
 
 def test_no_fixed_vertex_is_refused():
     V, F = icosphere(subdivisions=1)
-    with pytest.raises(ConstraintError, match="no fixed vertices"):
+    with pytest.raises(ConstraintError) as e:
         Reconstructor(V, F, [])
+    assert (e.value.parameter, e.value.count) == ("fixed", 0)
 
 
 def test_fixed_out_of_range_is_refused_with_the_indices():
     V, F = icosphere(subdivisions=1)
-    with pytest.raises(ConstraintError, match=r"2 indices are outside \[0, 42\) \(first: 42, -1\)"):
+    with pytest.raises(ConstraintError, match=r"\[0, 42\)") as e:
         Reconstructor(V, F, [0, 42, 3, -1])
+    assert (e.value.parameter, e.value.count, e.value.first) == ("fixed", 2, [42, -1])
 
 
 def test_repeated_fixed_indices_are_refused_with_the_indices():
     V, F = icosphere(subdivisions=1)
-    with pytest.raises(ConstraintError, match=r"2 indices are repeated \(first: 3, 7\)"):
+    with pytest.raises(ConstraintError) as e:
         Reconstructor(V, F, [3, 7, 3, 1, 7])
+    assert (e.value.parameter, e.value.count, e.value.first) == ("fixed", 2, [3, 7])
 
 
 def test_wrong_mask_length_is_refused():
     V, F = icosphere(subdivisions=1)
-    with pytest.raises(ConstraintError, match=r"shape \(41,\).*\(42,\)"):
+    with pytest.raises(ConstraintError, match=r"\(41,\).*\(42,\)") as e:
         Reconstructor(V, F, np.ones(41, dtype=bool))
+    assert e.value.parameter == "fixed"
 
 
 def test_wrong_detail_shape_is_refused_with_the_expected_shape():
     V, F = icosphere(subdivisions=1)
     rec = Reconstructor(V, F, [0, 1])
-    with pytest.raises(ConstraintError, match=r"detail has shape \(41, 3\); expected \(42, 3\)"):
+    with pytest.raises(ConstraintError, match=r"\(41, 3\).*\(42, 3\)") as e:
         rec.solve(np.zeros((41, 3)), V[[0, 1]])
+    assert e.value.parameter == "detail"
 
 
 def test_wrong_fixed_positions_shape_is_refused():
     V, F = icosphere(subdivisions=1)
     rec = Reconstructor(V, F, [0, 1])
-    with pytest.raises(ConstraintError, match=r"fixed_positions has shape \(3, 3\); expected \(2, 3\)"):
+    with pytest.raises(ConstraintError, match=r"\(3, 3\).*\(2, 3\)") as e:
         rec.solve(np.zeros((42, 3)), V[[0, 1, 2]])
+    assert e.value.parameter == "fixed_positions"
 
 
 def test_non_finite_detail_is_refused_with_the_rows():
     V, F = icosphere(subdivisions=1)
     D = np.zeros((42, 3))
     D[[5, 9], 1] = [np.nan, np.inf]
-    with pytest.raises(ConstraintError, match=r"2 rows are NaN or infinite \(first: 5, 9\)"):
+    with pytest.raises(ConstraintError) as e:
         reconstruct(V, F, D, [0], V[[0]])
+    assert (e.value.parameter, e.value.count, e.value.first) == ("detail", 2, [5, 9])
 
 
 def test_unknown_row_mode_is_refused():
     V, F = icosphere(subdivisions=1)
-    with pytest.raises(ValueError, match="rows='some'"):
+    with pytest.raises(CurvdetailError) as e:
         Reconstructor(V, F, [0], rows="some")
+    assert (e.value.parameter, e.value.value) == ("rows", "some")
 
 
 def test_malformed_mesh_is_refused_before_solving():
     V, F = icosphere(subdivisions=1)
     V[3] = np.nan
-    with pytest.raises(MeshError, match=r"1 vertex has NaN .*first: 3"):
+    with pytest.raises(MeshError) as e:
         reconstruct(V, F, np.zeros_like(V), [0], V[[0]])
+    assert (e.value.parameter, e.value.count, e.value.first) == ("V", 1, [3])
 
 
 def test_docstring_example_runs():
@@ -344,9 +357,9 @@ def test_rows_all_refuses_what_it_cannot_solve_instead_of_returning_a_wrong_surf
     # at 1e-12 the normal equations are beyond float64: 'splu' returned 0.4 of the diagonal off
     V, F = wavy_grid_with_a_sliver(1e-12)
     b = boundary_vertices(F)
-    with pytest.raises(SolverError,
-                       match=r"rows='all': the normal equations are too ill-conditioned .* Use rows='free'"):
+    with pytest.raises(SolverError, match="rows='free'") as e:          # the way out
         reconstruct(V, F, curvature_detail(V, F), b, V[b], backend="splu")
+    assert e.value.parameter == "rows"
     X = reconstruct(V, F, curvature_detail(V, F), b, V[b], rows="free", backend="splu")
     assert np.abs(X - V).max() < 1e-7 * bbox_diagonal(V)
 
@@ -359,8 +372,9 @@ def test_a_stalled_refinement_raises_or_returns_its_last_iterate_as_asked():
     def stalled(X):                  # corrections that never shrink, 1e-3 of the solution
         return np.full_like(X, 1e-3)
 
-    with pytest.raises(SolverError, match="refinement stalled"):
+    with pytest.raises(SolverError) as e:
         refine_least_squares(np.ones((4, 3)), stalled, 1)
+    assert e.value.value == pytest.approx(1e-3, rel=0.5)          # where it stalled
     X = refine_least_squares(np.ones((4, 3)), stalled, 1, stall="return")
     assert np.allclose(X, 1.002, rtol=0, atol=1e-12)           # two steps: the stall is seen
 
@@ -392,9 +406,10 @@ def test_a_row_mode_that_is_not_all_or_free_is_refused(rows):
     # an array was compared with ``in`` element-wise: np.array(["all"]) passed as the row mode
     V, F = grid(4, 4)
     b = boundary_vertices(F)
-    shown = "'some'" if isinstance(rows, str) else r".* \((ndarray|list), not a single str\)"
-    with pytest.raises(ValueError, match=rf"rows={shown} is not a row mode; use 'all'"):
+    with pytest.raises(CurvdetailError, match="'some'" if isinstance(rows, str) else "ndarray|list") as e:
         Reconstructor(V, F, b, rows=rows)
+    assert e.value.parameter == "rows"
+
 
 
 _SHARED_RECONSTRUCTOR_SCRIPT = """

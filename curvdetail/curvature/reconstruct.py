@@ -7,7 +7,7 @@ from .checks import as_count, as_index_set, as_values, check_choice
 from .geometry import bbox_centre
 from .topology import check_every_component_fixed
 from .cotan_laplacian import _symmetric_from_upper, checked_cotan_triangle
-from .errors import ConstraintError
+from .errors import ConstraintError, CurvdetailError
 from .sparse_solver import SolverError, _upper_triangle, factorize, resolve_backend
 
 ROW_MODES = ("all", "free")
@@ -91,8 +91,8 @@ class Reconstructor:
                                      f"{MAX_LEAST_REFINEMENT_STEPS}: each step is a back-substitution, "
                                      "and beyond a few the corrections are rounding")
             except ValueError as exc:
-                raise ValueError(f"{exc} (1, the default, gives solver precision; 0 skips the "
-                                 "refinement).") from None
+                raise CurvdetailError(f"{exc} (1, the default, gives solver precision; 0 skips the "
+                                      "refinement).", parameter="refinement_steps", value=refinement_steps) from None
         self.rows = rows
         system = self._build(V_ref, F, fixed, backend)
         self._factor = factorize(system, symmetric=True, backend=backend, upper=self._upper) \
