@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from curvdetail import curvature_coefficients, curvature_detail
-from curvdetail.curvature.errors import MeshError
+from curvdetail.curvature.errors import CurvdetailError, MeshError
 from curvdetail.curvature.testing import grid
 
 
@@ -109,8 +109,9 @@ def test_coefficients_at_extreme_scales_are_the_same_and_quiet(load_mesh, scale)
 def test_coefficients_of_a_mesh_too_small_for_its_areas_are_refused_by_name(load_mesh):
     # 0.9e-60 across: the triangle areas (~1e-122 per face) are on their way to underflow
     V, F = load_mesh("mannequin_nose.obj")
-    with pytest.raises(ValueError, match=r"below 1e-60: .* scale it up"):
+    with pytest.raises(MeshError, match=r"\b1e-60\b") as e:               # the limit
         curvature_coefficients(1e-60 * V, F)
+    assert e.value.parameter == "V" and e.value.value < 1e-60
 
 
 def test_coefficients_are_the_minimum_norm_solution(load_mesh, rng):
@@ -184,8 +185,10 @@ def test_bad_rcond_is_refused(plane_grid, rcond):
 @pytest.mark.parametrize("rcond", ["1e-6", True, np.True_, None])
 def test_rcond_that_is_not_a_number_is_refused_even_if_float_takes_it(plane_grid, rcond):
     # "1e-6" and True went through float() (the other numeric parameters refuse them)
-    with pytest.raises(ValueError, match=r"rcond=.* is not a number; pass a threshold in \(0, 1\)"):
+    with pytest.raises(CurvdetailError) as e:
         curvature_coefficients(*plane_grid, rcond=rcond)
+    assert (e.value.parameter, e.value.value) == ("rcond", rcond)
+
 
 
 def test_rcond_takes_numpy_scalars(plane_grid):

@@ -323,4 +323,5 @@ def check_target_boundary(P, X, d, advice):
             "source's boundary polyline "
             f"(up to {dist.max():.3g} of the larger of the source's bbox diagonal and its largest "
             f"coordinate; allowed {TARGET_BOUNDARY_TOLERANCE:g}): the target must be a retriangulation of "
-            f"the source with its boundary vertices on the source's boundary. {advice}")
+            f"the source with its boundary vertices on the source's boundary. {advice}", count=int(off.size),
+            first=off[:3].tolist())

@@ -6,7 +6,7 @@ from ..curvature.checks import as_faces, as_index_set, as_values, as_vertices, c
 from ..curvature.geometry import bbox_diagonal
 from ..curvature.topology import check_every_component_fixed
 from ..curvature.cotan_laplacian import cotan_laplacian
-from ..curvature.errors import ConstraintError, MeshError
+from ..curvature.errors import ConstraintError, CurvdetailError, MeshError
 from ..curvature.sparse_solver import factorize
 from ._disk import Polyline, check_disk, check_target_boundary
 
@@ -48,7 +48,8 @@ def flipped_triangles(UV, F):
     UV = as_vertices(UV, "UV", dim=2)
     F = as_faces(F, None)
     if F.max() >= UV.shape[0]:
-        raise MeshError(f"F has vertex indices outside [0, {UV.shape[0]}); pass one UV row per vertex.")
+        raise MeshError(f"F has vertex indices outside [0, {UV.shape[0]}); pass one UV row per vertex.",
+                        parameter="UV", count=UV.shape[0])
     a, b, c = UV[F[:, 0]], UV[F[:, 1]], UV[F[:, 2]]
     signed = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
     orientation = 1.0 if signed.sum() >= 0 else -1.0
@@ -96,7 +97,7 @@ def harmonic_map(V, F, boundary, boundary_uv, *, backend="auto"):
     if boundary.size == 0:
         raise ConstraintError("boundary is empty: with no pinned vertex the harmonic map is undetermined "
                               "(any constant solves it); pin the boundary loop, e.g. "
-                              "curvdetail.curvature.boundary_loop(F).")
+                              "curvdetail.curvature.boundary_loop(F).", parameter="boundary", count=0)
     check_every_component_fixed(F, V.shape[0], boundary)
     return _harmonic_map(V, F, boundary, as_values(boundary_uv, boundary.size, "boundary_uv", dim=2), backend)
 
@@ -179,8 +180,8 @@ def parameterize(Vs, Fs, Vt=None, Ft=None, *, method="harmonic", backend="auto")
     method = check_choice(method, "method", METHODS, f" is not a parameterization; use one of {', '.join(METHODS)}.")
     if (Vt is None) != (Ft is None):
         given, missing = ("Ft", "Vt") if Vt is None else ("Vt", "Ft")
-        raise ValueError(f"{given} was given without {missing}: pass both (the target mesh) or neither "
-                         "(the source alone).")
+        raise CurvdetailError(f"{given} was given without {missing}: pass both (the target mesh) or neither "
+                              "(the source alone).", parameter=missing)
     Vs, Fs, loop_s = check_disk(Vs, Fs, "the source")
     poly = Polyline(Vs[loop_s])
     s_src = poly.s0
