@@ -284,23 +284,27 @@ def test_an_engine_that_is_not_one_of_the_two_is_refused(engine):
         hausdorff(V, F, V, F, engine=engine)
 
 
-@pytest.mark.parametrize("which, words", [("Fa", r"^Fa: 2 triangles"), ("Va", r"^Va has shape \(16, 2\)")])
+@pytest.mark.parametrize("which, words", [("Fa", None), ("Va", r"\(16, 2\)")])
 def test_hausdorff_names_each_argument_as_the_caller_does(which, words):
     V, F = grid(4, 4)
     args = {"Va": V, "Fa": F, "Vb": V, "Fb": F}
     args[which] = F - 1 if which == "Fa" else V[:, :2]
     if which == "Va":
         args["Vb"] = V[:, :2]
-    with pytest.raises(MeshError, match=words):
+    with pytest.raises(MeshError, match=words) as e:
         hausdorff(args["Va"], args["Fa"], args["Vb"], args["Fb"])
+    assert e.value.parameter == which
+    if which == "Fa":
+        assert (e.value.count, e.value.first) == (2, [0, 9])      # the triangles of vertex 0
 
 
 def test_vertex_distance_refuses_nan_points_naming_them():
     V, F = grid(5, 5)
     P = V[:3].copy()
     P[1, 2] = np.inf
-    with pytest.raises(MeshError, match=r"^V: 1 vertex .*\(first: 1\)"):
+    with pytest.raises(MeshError) as e:
         vertex_distance(P, V, F)
+    assert (e.value.parameter, e.value.count, e.value.first) == ("V", 1, [1])
 
 
 def test_vertex_distance_refuses_a_collapsed_or_overflowing_surface():
@@ -308,8 +312,9 @@ def test_vertex_distance_refuses_a_collapsed_or_overflowing_surface():
     with pytest.raises(MeshError) as e:
         vertex_distance(V, np.zeros_like(V), F)
     assert (e.value.parameter, e.value.count) == ("Vs", 25)
-    with pytest.raises(MeshError, match=r"^Vs: 24 rows reach 1e\+155"):
+    with pytest.raises(MeshError, match=r"1e\+155") as e:
         vertex_distance(V, V * 1e155, F)
+    assert (e.value.parameter, e.value.count) == ("Vs", 24)
 
 
 def test_vertex_distance_refuses_unreferenced_source_vertices_as_hausdorff_does():
@@ -317,10 +322,13 @@ def test_vertex_distance_refuses_unreferenced_source_vertices_as_hausdorff_does(
     V, F = grid(5, 5)
     P = V + [0.0, 0.0, 0.3]
     stray = np.vstack([[[0.5, 0.5, 2.0]], V, [[3.0, 0.0, 0.0]]])
-    with pytest.raises(MeshError, match=r"2 vertices .*\(first: 0, 26\)"):
+    with pytest.raises(MeshError) as e:
         hausdorff(P, F, stray, F + 1)
-    with pytest.raises(MeshError, match=r"^Vs: 2 vertices .*\(first: 0, 26\)"):
+    assert (e.value.count, e.value.first) == (2, [0, 26])
+    with pytest.raises(MeshError) as e:
         vertex_distance(P, stray, F + 1)
+    assert (e.value.parameter, e.value.count, e.value.first) == ("Vs", 2, [0, 26])
+
     np.testing.assert_allclose(vertex_distance(P, V, F), 0.3, rtol=1e-14)      # the same surface without them
 
 
