@@ -21,21 +21,24 @@ def test_flat_disk_is_accepted_with_its_boundary_loop_in_face_order(flat_disk):
 
 
 def test_closed_mesh_is_refused_saying_it_is_closed():
-    with pytest.raises(NotADiskError, match="closed .0 boundary loops"):
+    with pytest.raises(NotADiskError) as e:
         check_disk(*icosphere(subdivisions=1))
+    assert (e.value.parameter, e.value.count) == ("F", 0)            # boundary loops
 
 
 def test_open_cylinder_is_refused_with_its_two_boundary_loops(open_cylinder):
-    with pytest.raises(NotADiskError, match="2 boundary loops"):
+    with pytest.raises(NotADiskError) as e:
         check_disk(*open_cylinder)
+    assert (e.value.parameter, e.value.count) == ("F", 2)
 
 
 def test_two_pieces_are_refused_with_the_count():
     V, F = disk(n_rings=3)
     V2 = np.vstack([V, V + [3.0, 0.0, 0.0]])
     F2 = np.vstack([F, F + V.shape[0]])
-    with pytest.raises(NotADiskError, match="2 separate pieces"):
+    with pytest.raises(NotADiskError) as e:
         check_disk(V2, F2)
+    assert (e.value.parameter, e.value.count) == ("F", 2)
 
 
 def test_non_manifold_edge_is_refused_as_not_manifold():
@@ -43,8 +46,9 @@ def test_non_manifold_edge_is_refused_as_not_manifold():
     a, b = F[0, 0], F[0, 1]
     V2 = np.vstack([V, [[0.0, 0.0, 1.0]]])
     F2 = np.vstack([F, [[a, b, V.shape[0]]]])
-    with pytest.raises(NotADiskError, match="not manifold: 1 edge is"):
+    with pytest.raises(NotADiskError) as e:
         check_disk(V2, F2)
+    assert (e.value.parameter, e.value.count, e.value.first) == ("F", 1, [sorted([a, b])])
 
 
 def test_polyline_projection_gives_arc_length_and_distance():
@@ -86,8 +90,9 @@ def test_patch_with_a_handle_is_refused_with_the_handle_count():
     c = (i * m + (j + 1) % m).ravel()
     d = (((i + 1) % n) * m + (j + 1) % m).ravel()
     F = np.concatenate([np.column_stack([a, b, d]), np.column_stack([a, d, c])])[1:]
-    with pytest.raises(NotADiskError, match="Euler characteristic -1 .1 handle\\)"):
+    with pytest.raises(NotADiskError) as e:
         check_disk(V, F)
+    assert (e.value.parameter, e.value.value) == ("F", -1)           # the Euler characteristic: 1 handle
 
 
 def test_a_reversed_boundary_triangle_is_named_as_an_orientation_problem(flat_disk):
@@ -100,9 +105,9 @@ def test_a_reversed_boundary_triangle_is_named_as_an_orientation_problem(flat_di
     on_boundary = np.isin(F, B).sum(axis=1)
     k = int(np.flatnonzero(on_boundary == 2)[0])
     F[k] = F[k, ::-1]
-    with pytest.raises(NotADiskError, match=r"not consistently oriented: 2 interior edges run the same way "
-                                            r"in both their triangles .*meshing_re_orient_faces_coherently"):
+    with pytest.raises(NotADiskError, match="meshing_re_orient_faces_coherently") as e:      # the repair
         check_disk(V, F)
+    assert (e.value.parameter, e.value.count) == ("F", 2)            # interior edges run both ways alike
 
 
 def test_fractional_indices_are_named_not_read_as_a_non_manifold_edge():
@@ -111,8 +116,10 @@ def test_fractional_indices_are_named_not_read_as_a_non_manifold_edge():
     a, b = 5, 6                                         # an interior edge: two triangles have it
     assert sum(set((a, b)) <= set(t) for t in F.tolist()) == 2
     F = np.vstack([F.astype(float), [a + 0.5, b, 15.0]])
-    with pytest.raises(MeshError, match="F has non-integer entries") as error:
+    with pytest.raises(MeshError) as error:
         check_disk(V, F)
+    assert (error.value.parameter, error.value.first) == ("F", [F.shape[0] - 1])
+
     assert not isinstance(error.value, NotADiskError)
 
 

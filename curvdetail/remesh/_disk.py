@@ -73,10 +73,10 @@ def check_disk(V, F, what="the source"):
     n = V.shape[0]
     _, pieces = vertex_components(F, n)
     if pieces > 1:
-        raise _refuse(f"{what} has {pieces} separate pieces", need)
+        raise _refuse(f"{what} has {pieces} separate pieces", need, count=int(pieces))
     B = boundary_edges(F)
     if B.shape[0] == 0:
-        raise _refuse(f"{what} is closed (0 boundary loops)", need)
+        raise _refuse(f"{what} is closed (0 boundary loops)", need, count=0)
     out_deg = np.bincount(B[:, 0], minlength=n)
     in_deg = np.bincount(B[:, 1], minlength=n)
     pinched = np.flatnonzero((out_deg > 1) | (in_deg > 1))
@@ -84,7 +84,7 @@ def check_disk(V, F, what="the source"):
         check_oriented(F, what, error=NotADiskError)
         raise _refuse(f"{what} is not vertex-manifold: the boundary passes "
                       f"{counted(pinched.size, 'vertex', 'vertices')} more than once "
-                      f"(first: {first_indices(pinched)})", need)
+                      f"(first: {first_indices(pinched)})", need, count=int(pinched.size), first=pinched[:3].tolist())
     G = sp.coo_matrix((np.ones(B.shape[0]), (B[:, 0], B[:, 1])), shape=(n, n))
     on_boundary = np.zeros(n, dtype=bool)
     on_boundary[B.ravel()] = True
@@ -92,13 +92,13 @@ def check_disk(V, F, what="the source"):
     loops = np.unique(labels[on_boundary]).size
     if loops != 1:
         check_oriented(F, what, error=NotADiskError)
-        raise _refuse(f"{what} has {loops} boundary loops (holes)", need)
+        raise _refuse(f"{what} has {loops} boundary loops (holes)", need, count=int(loops))
     # check_mesh refused edges in more than two triangles: every interior edge is two of the 3m
     # half-edges, every boundary edge one (np.unique over the edge rows took 1.6 s at 200k faces)
     chi = euler_characteristic(F, n, B.shape[0])
     if chi != 1:
         raise _refuse(f"{what} has one boundary loop but Euler characteristic {chi} "
-                      f"({counted((1 - chi) // 2, 'handle')})", need)
+                      f"({counted((1 - chi) // 2, 'handle')})", need, value=int(chi))
     try:
         return V, F, loop_of_boundary_edges(B)
     except MeshError:
@@ -124,7 +124,7 @@ def _checked(V, F, what, error=MeshError):
                f"triangles (first: {pairs})")
     hint = ("repair the mesh, e.g. with pymeshlab's meshing_repair_non_manifold_edges (it deletes the smallest "
             "triangles on each such edge until two are left) and meshing_remove_unreferenced_vertices")
-    raise error(problem, hint=hint, count=int(nm.shape[0]), first=nm[:3].tolist()) from None
+    raise error(problem, hint=hint, parameter="F", count=int(nm.shape[0]), first=nm[:3].tolist()) from None
 
 
 def check_surface(V, F, what="the source"):
@@ -201,10 +201,10 @@ def euler_characteristic(F, n, boundary_edge_count):
     return n - (3 * F.shape[0] + boundary_edge_count) // 2 + F.shape[0]
 
 
-def _refuse(problem, advice):
+def _refuse(problem, advice, **fields):
     """The NotADiskError ``problem; advice.``, with ``problem`` kept as its attribute ``problem``
     (where the mesh is a remesher's result, the advice to the user is another)."""
-    exc = NotADiskError(f"{problem}; {advice}.")
+    exc = NotADiskError(f"{problem}; {advice}.", parameter="F", **fields)
     exc.problem = problem
     return exc
 
