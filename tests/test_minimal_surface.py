@@ -10,6 +10,7 @@ from scipy.optimize import brentq
 
 from curvdetail import (ConstraintError, MeshError, boundary_vertices, cotan_laplacian,
                         minimal_surface)
+from curvdetail.curvature.errors import CurvdetailError
 from curvdetail.curvature.geometry import bbox_diagonal, face_double_areas
 from curvdetail.curvature.testing import cylinder, grid
 
@@ -88,8 +89,9 @@ def test_max_iterations_stops_without_converging(load_mesh):
 def test_circles_too_far_apart_collapse_with_a_clear_error():
     # no catenoid spans two unit circles more than 1.3255 apart: the neck pinches off
     V, F = cylinder(radius=1.0, height=2.0, n_around=32, n_along=21)
-    with pytest.raises(MeshError, match=r"triangles collapsed .* no minimal surface"):
+    with pytest.raises(MeshError) as e:
         minimal_surface(V, F, boundary_vertices(F), max_iterations=500)
+    assert e.value.count > 0 and len(e.value.first) == 3        # the collapsed triangles
 
 
 def test_no_fixed_vertex_is_refused():
@@ -101,21 +103,23 @@ def test_no_fixed_vertex_is_refused():
 
 def test_fixed_out_of_range_is_refused_with_the_index():
     V, F = grid(4, 4)
-    with pytest.raises(ConstraintError, match=r"1 index is outside \[0, 16\) \(first: 99\)"):
+    with pytest.raises(ConstraintError, match=r"\[0, 16\)") as e:
         minimal_surface(V, F, [0, 99])
+    assert (e.value.parameter, e.value.count, e.value.first) == ("fixed", 1, [99])
 
 
 @pytest.mark.parametrize("kwargs, pattern", [
-    ({"max_iterations": 0}, "max_iterations=0"), ({"max_iterations": 2.5}, "max_iterations=2.5 must be a whole"),
+    ({"max_iterations": 0}, "max_iterations=0"), ({"max_iterations": 2.5}, r"max_iterations=2\.5"),
     ({"max_iterations": True}, "max_iterations=True"), ({"max_iterations": "5"}, "max_iterations='5'"),
     ({"max_iterations": float("inf")}, "max_iterations=inf"), ({"max_iterations": None}, "max_iterations=None"),
     ({"tol": 0.0}, "tol=0.0"), ({"tol": np.nan}, "tol=nan"), ({"tol": None}, "tol=None"),
-    ({"tol": "5"}, "tol='5'"), ({"tol": 10 ** 400}, "tol=1000"), ({"callback": 3}, "callback=3 is not callable"),
+    ({"tol": "5"}, "tol='5'"), ({"tol": 10 ** 400}, "tol=1000"), ({"callback": 3}, "callback=3"),
 ])
 def test_bad_iteration_settings_are_refused(kwargs, pattern):
     V, F = grid(4, 4)
-    with pytest.raises(ValueError, match=pattern):
+    with pytest.raises(CurvdetailError, match=pattern) as e:
         minimal_surface(V, F, boundary_vertices(F), **kwargs)
+    assert e.value.parameter == next(iter(kwargs))
 
 
 def test_result_is_scale_equivariant(load_mesh):
@@ -305,9 +309,9 @@ def test_aligned_normals_take_the_largest_triangle_as_reference():
 def test_a_step_that_is_not_normal_or_full_is_refused(step):
     # an array was compared with ``in`` element-wise: np.array(["full"]) passed as the step
     V, F = grid(4, 4)
-    shown = "'half'" if isinstance(step, str) else r".* \((ndarray|list), not a single str\)"
-    with pytest.raises(ValueError, match=rf"step={shown}; use 'normal' \(the step across the surface\) or 'full'"):
+    with pytest.raises(CurvdetailError, match="'half'" if isinstance(step, str) else "ndarray|list") as e:
         minimal_surface(V, F, boundary_vertices(F), step=step)
+    assert e.value.parameter == "step"
 
 
 def test_a_neck_pinching_into_needles_is_refused_not_converged():
@@ -316,7 +320,7 @@ def test_a_neck_pinching_into_needles_is_refused_not_converged():
     # absolute zero-area threshold, and the result came back converged after 10 steps with a
     # neck of radius 2e-7
     V, F = cylinder(radius=1.0, height=2.0, n_around=24, n_along=8)
-    with pytest.raises(MeshError, match="no minimal surface of this topology") as e:
+    with pytest.raises(MeshError) as e:
         minimal_surface(V, F, boundary_vertices(F))
     assert (e.value.count, e.value.first) == (48, [72, 73, 74])
 
@@ -385,9 +389,10 @@ def test_a_degenerating_disk_blames_the_iteration_not_the_boundary(load_mesh):
 
 def test_a_pinned_inner_vertex_is_named_as_the_cause(load_mesh):
     V, F = load_mesh("mannequin_nose.obj")
-    with pytest.raises(MeshError, match=r"1 fixed vertex lies inside the surface \(first: 300\): a minimal "
-                                        r"surface cannot be held at isolated points.*around it into spikes"):
+    with pytest.raises(MeshError, match=r"\(first: 300\)") as e:          # the pinned vertex
         minimal_surface(V, F, np.union1d(boundary_vertices(F), [300]))
+    assert e.value.count > 0                                             # collapsed triangles around it
+
 
 
 def test_a_collapse_in_the_first_step_is_not_told_to_stop_earlier():
