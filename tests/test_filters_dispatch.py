@@ -18,18 +18,21 @@ def meshset(name="mannequin_nose.obj"):
 
 
 def test_unknown_filter_error_lists_close_matches():
-    with pytest.raises(UnknownFilterError, match="did you mean apply_curvature_reconstruction"):
+    with pytest.raises(UnknownFilterError, match=r"\bapply_curvature_reconstruction\b") as e:    # the close match
         apply(meshset(), "apply_curvature_reconstrution")
+    assert e.value.value == "apply_curvature_reconstrution"
 
 
 def test_unknown_parameter_error_lists_close_matches():
-    with pytest.raises(FilterParameterError, match="no parameter 'row'; did you mean rows"):
+    with pytest.raises(FilterParameterError, match=r"\brows\b") as e:                # the close match
         apply(meshset(), "apply_curvature_reconstruction", row="free")
+    assert e.value.value == "row"
 
 
 def test_wrong_type_error_names_parameter_and_type():
-    with pytest.raises(FilterParameterError, match="'fix_boundary' expects a bool"):
+    with pytest.raises(FilterParameterError, match=r"\bbool\b") as e:
         apply(meshset(), "apply_curvature_reconstruction", fix_boundary="yes")
+    assert e.value.parameter == "fix_boundary"
 
 
 def test_validation_happens_before_the_mesh_changes():
@@ -42,13 +45,16 @@ def test_validation_happens_before_the_mesh_changes():
 
 
 def test_empty_meshset_is_refused_clearly():
-    with pytest.raises(FilterError, match="holds no mesh"):
+    with pytest.raises(FilterError) as e:
         apply(pymeshlab.MeshSet(), "compute_curvature_detail")
+    assert (e.value.parameter, e.value.count) == ("ms", 0)
 
 
 def test_not_a_meshset_is_refused():
-    with pytest.raises(FilterError, match="needs a pymeshlab.MeshSet"):
+    with pytest.raises(FilterError, match=r"\bstr\b") as e:
         apply("mesh.obj", "compute_curvature_detail")
+    assert e.value.parameter == "ms"
+
 
 
 def test_left_out_parameters_take_defaults_not_earlier_values():

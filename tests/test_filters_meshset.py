@@ -69,10 +69,12 @@ def test_write_on_another_layer_keeps_the_current_one(ms, rng):
 
 
 def test_wrong_shape_and_nan_are_refused(ms):
-    with pytest.raises(MeshError, match=r"shape \(639, 3\); expected \(640, 3\)"):
+    with pytest.raises(MeshError, match=r"\(640, 3\)") as e:
         set_vertex_positions(ms, 0, np.zeros((639, 3)))
-    with pytest.raises(MeshError, match="NaN"):
+    assert e.value.value == (639, 3)
+    with pytest.raises(MeshError) as e:
         set_vertex_quality(ms, 0, np.full(640, np.nan))
+    assert (e.value.count, e.value.first) == (640, [0, 1, 2])
 
 
 def test_new_layer_becomes_current_with_quality_and_attributes(ms):
@@ -85,8 +87,10 @@ def test_new_layer_becomes_current_with_quality_and_attributes(ms):
 
 
 def test_missing_layer_lists_the_existing_ones(ms):
-    with pytest.raises(FilterError, match="sourcemesh layer id 4 does not exist.*layers 0"):
+    with pytest.raises(FilterError, match=r"layers 0\.") as e:                   # the ids there
         layer_id(ms, 4, role="sourcemesh")
+    assert (e.value.parameter, e.value.value) == ("sourcemesh", 4)
+
 
 
 def test_vertex_normals_point_outwards_on_a_sphere():

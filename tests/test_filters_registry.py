@@ -56,13 +56,15 @@ def test_parameters_match_the_function_signature():
 
 
 def test_unknown_filter_lists_close_matches():
-    with pytest.raises(UnknownFilterError, match="did you mean compute_curvature_detail"):
+    with pytest.raises(UnknownFilterError, match=r"\bcompute_curvature_detail\b") as e:      # the close match
         get_filter("compute_curvature_details")
+    assert e.value.value == "compute_curvature_details"
 
 
 def test_unrelated_name_points_to_the_list():
-    with pytest.raises(UnknownFilterError, match="curvdetail list"):
+    with pytest.raises(UnknownFilterError, match="`curvdetail list`") as e:                   # the command
         get_filter("zzzz")
+    assert e.value.value == "zzzz"
 
 
 def test_print_filter_list_prints_every_name(capsys):
@@ -85,7 +87,7 @@ def test_filter_without_parameters_prints_none(capsys):
 
 
 def test_declaration_refuses_a_name_outside_the_verb_families():
-    with pytest.raises(TypeError, match="start with one of"):
+    with pytest.raises(TypeError, match="'curvature_things'"):
         declare(name="curvature_things", category="c", description="d")(lambda ms: {})
 
 
@@ -93,7 +95,8 @@ def test_declaration_refuses_parameters_that_the_function_lacks():
     def f(ms, *, rows):
         return {}
 
-    with pytest.raises(TypeError, match="do not match"):
+    with pytest.raises(TypeError, match=r"\['rowz'\].*\['rows'\]"):
+
         declare(name="get_never_registered", category="c", description="d",
                 parameters=[Parameter("rowz", "str", "all", "d")])(f)
     with pytest.raises(UnknownFilterError):

@@ -72,7 +72,7 @@ def apply(ms, name, **params):
 
     spec = get_filter(name)
     if not isinstance(ms, pymeshlab.MeshSet):
-        raise FilterError(f"apply({name!r}) needs a pymeshlab.MeshSet, got {type(ms).__name__}.")
+        raise FilterError(f"apply({name!r}) needs a pymeshlab.MeshSet, got {type(ms).__name__}.", parameter="ms")
     values = complete_parameters(spec, params)
     layer_id(ms)                                   # an empty MeshSet fails here, clearly
     for p in spec.parameters:

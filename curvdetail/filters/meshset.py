@@ -32,13 +32,14 @@ def layer_id(ms, mesh_id=None, role="mesh"):
 
     Raises FilterError when the MeshSet is empty or the id does not exist (lists the ids there)."""
     if ms.mesh_number() == 0:
-        raise FilterError("the MeshSet holds no mesh; load one first (ms.load_new_mesh(path)).")
+        raise FilterError("the MeshSet holds no mesh; load one first (ms.load_new_mesh(path)).", parameter="ms",
+                          count=0)
     if mesh_id is None:
         return int(ms.current_mesh_id())
     if not ms.mesh_id_exists(int(mesh_id)):
         ids = _existing_ids(ms)
         raise FilterError(f"{role} layer id {mesh_id} does not exist; the MeshSet holds layers "
-                          f"{', '.join(map(str, ids))}.")
+                          f"{', '.join(map(str, ids))}.", parameter=role, value=mesh_id)
     return int(mesh_id)
 
 
@@ -95,7 +96,7 @@ def require_vertex_attribute(ms, mesh_id, name, kind, hint):
     if values is None:
         label = get_mesh(ms, mesh_id).label()
         raise FilterError(f"layer {mesh_id} ({label!r}) has no per-vertex {kind} attribute "
-                          f"{name!r}; {hint}")
+                          f"{name!r}; {hint}", value=name)
     return values
 
 
@@ -123,9 +124,11 @@ def _as_columns(mesh, values, width, what):
     arr = np.asarray(values, dtype=np.float64)
     shape = (n, width) if width > 1 else (n,)
     if arr.shape != shape:
-        raise MeshError(f"{what} has shape {arr.shape}; expected {shape} for this layer.")
+        raise MeshError(f"{what} has shape {arr.shape}; expected {shape} for this layer.", value=arr.shape)
     if not np.all(np.isfinite(arr)):
-        raise MeshError(f"{what} holds NaN or infinite values; refusing to store them.")
+        bad = np.flatnonzero(~np.isfinite(arr.reshape(n, -1)).all(axis=1))
+        raise MeshError(f"{what} holds NaN or infinite values; refusing to store them.", count=int(bad.size),
+                        first=bad[:3].tolist())
     return arr
 
 

@@ -211,7 +211,7 @@ def get_filter(name):
     matches = close_matches(str(name), _REGISTRY)
     hint = (f"did you mean {', '.join(matches)}?" if matches
             else "see curvdetail.filters.print_filter_list() or `curvdetail list`.")
-    raise UnknownFilterError(f"unknown filter {name!r}; {hint}")
+    raise UnknownFilterError(f"unknown filter {name!r}; {hint}", value=name)
 
 
 def print_filter_list():
