@@ -46,10 +46,9 @@ def test_detail_of_another_triangulation_is_refused_not_rebuilt(step):
         ms.meshing_edge_flip_by_planar_optimization(selection=False, pthreshold=1.0, planartype="area/max side",
                                                     iterations=1)
     n = ms.current_mesh().vertex_number()
-    with pytest.raises(FilterError, match=rf"'curvature_detail' belongs to another triangulation: [\d,]+ of "
-                                          rf"{n:,} vertices were added, removed, renumbered or re-connected.*"
-                                          "compute_curvature_detail again"):
+    with pytest.raises(FilterError, match=rf"\b{n:,}\b.*\bcompute_curvature_detail\b") as e:   # the fix's filter
         apply(ms, "apply_curvature_reconstruction")
+    assert e.value.value == "curvature_detail" and 0 < e.value.count <= n and len(e.value.first) >= 1
 
 
 def test_detail_survives_moved_vertices_and_a_ply_round_trip(tmp_path):
@@ -76,6 +75,7 @@ def test_detail_survives_moved_vertices_and_a_ply_round_trip(tmp_path):
     interior = np.setdiff1d(np.arange(V.shape[0]), b)
     expected = reconstruct(W, F, curvature_detail(V, F), b, W[b], rows="all")
     assert np.abs(X[interior] - expected[interior]).max() < 1e-9 * bbox_diagonal(W)
-    with pytest.raises(FilterError, match="another triangulation"):
+    with pytest.raises(FilterError) as e:
         _remeshed(ms2)
         apply(ms2, "apply_curvature_reconstruction")
+    assert e.value.value == "curvature_detail" and e.value.count > 0

@@ -109,15 +109,17 @@ def test_rebuild_of_a_moved_plane_from_its_stored_detail_has_no_error():
 def test_same_layer_twice_is_refused():
     ms = pymeshlab.MeshSet()
     ms.load_new_mesh(os.path.join(DATA, "mannequin_nose.obj"))
-    with pytest.raises(FilterError, match="both layer 0"):
+    with pytest.raises(FilterError, match=r"\b0\b") as e:             # the layer
         apply(ms, "get_curvature_reconstruction_error")
+    assert e.value.parameter == "sampledmesh"
 
 
 def test_missing_layer_is_refused():
     ms = pymeshlab.MeshSet()
     ms.load_new_mesh(os.path.join(DATA, "mannequin_nose.obj"))
-    with pytest.raises(FilterError, match="targetmesh layer id 3 does not exist"):
+    with pytest.raises(FilterError) as e:
         apply(ms, "get_curvature_reconstruction_error", targetmesh=3)
+    assert (e.value.parameter, e.value.value) == ("targetmesh", 3)
 
 
 def test_a_sample_count_beyond_the_limit_is_refused_before_the_layers_are_read(monkeypatch):
@@ -130,8 +132,9 @@ def test_a_sample_count_beyond_the_limit_is_refused_before_the_layers_are_read(m
     ms = pymeshlab.MeshSet()
     ms.add_mesh(pymeshlab.Mesh(V, F.astype(np.int32)))
     ms.add_mesh(pymeshlab.Mesh(V, F.astype(np.int32)))
-    with pytest.raises(FilterParameterError, match="parameter 'samplenum' is 2000000000; it must be at most 10000000"):
+    with pytest.raises(FilterParameterError, match=r"\b10000000\b") as e:      # the limit
         apply(ms, "get_curvature_reconstruction_error", samplenum=2_000_000_000)
+    assert e.value.parameter == "samplenum"
 
 
 def test_the_sample_limit_is_the_one_hausdorff_takes():

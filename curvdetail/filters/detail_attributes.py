@@ -63,5 +63,5 @@ def load_detail(ms, mesh_id, F):
             f"{', '.join(map(str, changed[:3]))}; MeshLab's remeshing filters keep custom "
             "attributes but do not interpolate them). Run compute_curvature_detail again for "
             "the detail of the current surface, or transfer_curvature_detail from a layer "
-            "that still holds the original.")
+            "that still holds the original.", value=DETAIL, count=int(changed.size), first=changed[:3].tolist())
     return D
