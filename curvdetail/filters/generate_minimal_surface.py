@@ -48,7 +48,7 @@ def generate_minimal_surface(ms, *, max_iterations, tol, step, backend):
     fixed = boundary_vertices(F)
     if fixed.size == 0:
         raise ConstraintError(f"layer {mid} ({label!r}) is closed: a minimal surface needs a "
-                              "boundary to span.")
+                              "boundary to span.", count=0)
     if not tol > 0:
         raise ConstraintError(f"tol={tol} must be positive (a fraction of the bbox diagonal).")
     X = minimal_surface(V, F, fixed, max_iterations=max_iterations, tol=tol, step=step, backend=backend)
