@@ -19,7 +19,7 @@ def planar_map(location, parameterization, default="harmonic"):
     if parameterization != default:
         raise FilterParameterError(f"parameterization={parameterization!r} applies to location='uv' only "
                                    f"(location={location!r} uses no planar map); pass location='uv' or "
-                                   "leave parameterization at its default.")
+                                   "leave parameterization at its default.", parameter="parameterization")
     return None
 
 
