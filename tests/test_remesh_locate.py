@@ -180,16 +180,18 @@ def test_nan_points_are_refused_naming_them(flat_disk, dim):
     V, F = flat_disk
     P = V[:4, :dim].copy()
     P[2, 0] = np.nan
-    with pytest.raises(MeshError, match=r"^points: 1 vertex .*\(first: 2\)"):
+    with pytest.raises(MeshError) as e:
         locate(P, V[:, :dim], F)
+    assert (e.value.parameter, e.value.count, e.value.first) == ("points", 1, [2])
 
 
 def test_triangle_indices_outside_v_are_refused(flat_disk):
     V, F = flat_disk
     G = F.copy()
     G[5, 1] = V.shape[0]
-    with pytest.raises(MeshError, match=r"^F: 1 triangle .*first: 5"):
+    with pytest.raises(MeshError) as e:
         locate(V[:3], V, G)
+    assert (e.value.parameter, e.value.count, e.value.first) == ("F", 1, [5])
 
 
 def test_a_mesh_collapsed_to_a_point_is_refused():
@@ -201,8 +203,9 @@ def test_a_mesh_collapsed_to_a_point_is_refused():
 
 def test_coordinates_whose_squares_overflow_are_refused():
     V, F = grid(5, 5)
-    with pytest.raises(MeshError, match=r"^V: 24 rows reach 1e\+155.*1e\+150"):
+    with pytest.raises(MeshError, match=r"1e\+155.*1e\+150") as e:          # the largest, the limit
         locate(V[:3], V * 1e155, F)
+    assert (e.value.parameter, e.value.count) == ("V", 24)
 
 
 def test_zero_area_triangles_are_refused_by_index():
@@ -230,11 +233,8 @@ def test_points_and_mesh_of_other_dimensions_are_refused():
 
 
 @pytest.mark.parametrize("what, value, words", [
-    ("F", "fractional", "^F "),
-    ("F", "bool", "^F has dtype bool"),
-    ("points", "str", "^points has dtype <U"),
-    ("points", "object", "^points has dtype object"),
-    ("V", "complex", "^V has dtype complex128"),
+    ("F", "fractional", None), ("F", "bool", "bool"), ("points", "str", "<U"), ("points", "object", "object"),
+    ("V", "complex", "complex128"),
 ])
 def test_inputs_that_are_not_real_numbers_or_integers_are_refused(what, value, words):
     V, F = grid(5, 5)
@@ -242,8 +242,9 @@ def test_inputs_that_are_not_real_numbers_or_integers_are_refused(what, value, w
     x = args[what]
     args[what] = {"fractional": x + 0.5, "bool": x.astype(bool), "str": x.astype(str),
                   "object": x.astype(object), "complex": x.astype(complex)}[value]
-    with pytest.raises(MeshError, match=words):
+    with pytest.raises(MeshError, match=words) as e:               # the dtype given
         locate(args["points"], args["V"], args["F"])
+    assert e.value.parameter == what
 
 
 def test_interpolate_and_spread_refuse_faces_that_are_not_located_ones(flat_disk):
