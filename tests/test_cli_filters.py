@@ -316,6 +316,7 @@ def test_run_missing_input(capsys, tmp_path):
                   "none.obj", tmp_path / "o.ply")
 
 
+@pytest.mark.slow
 def test_installed_command_exits_non_zero_with_one_line(tmp_path):
     proc = subprocess.run([sys.executable, "-m", "curvdetail.cli", "apply", "nope", NOSE,
                            str(tmp_path / "o.ply")], capture_output=True, text=True)
@@ -323,6 +324,7 @@ def test_installed_command_exits_non_zero_with_one_line(tmp_path):
     assert proc.stderr.startswith("curvdetail: error: unknown filter 'nope'")
 
 
+@pytest.mark.slow
 def test_list_into_a_closed_pipe_exits_quietly():
     # `curvdetail list | head -1`: the reader is gone before the listing is written
     import subprocess
@@ -339,6 +341,7 @@ def test_list_into_a_closed_pipe_exits_quietly():
     assert done.stderr == b""
 
 
+@pytest.mark.slow
 def test_a_closed_stderr_does_not_stop_the_work(tmp_path):
     # `curvdetail remesh ... 2>&1 | head -c 10`: the progress line met the closed pipe and the
     # run ended with status 0 and no output file; progress and notes now give up quietly

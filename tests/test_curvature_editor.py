@@ -684,6 +684,7 @@ print(max(max(np.abs(X - serial[k % 3]).max(), np.abs(Y - serial_fast[k % 3]).ma
 """
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("rows, relations", [("all", "one-ring"), ("free", "one+two-ring")])
 def test_threads_sharing_one_editor_get_the_serial_answers(rows, relations):
     # as test_reconstruct's shared Reconstructor, in a child process (a crash ends the child, not

@@ -158,6 +158,7 @@ def test_misnamed_meshlab_step_says_what_meshlab_calls_it(tmp_path, name):
 
 @pytest.mark.parametrize("body", [NATIVE_BORDER,
                                   '<filter name="Delete Current Mesh"/>\n ' + NATIVE_BORDER])
+@pytest.mark.slow
 def test_a_native_step_on_an_empty_meshset_is_refused_in_a_clean_process(tmp_path, body):
     # pymeshlab's script runner crashed the process (segmentation fault) on such a step
     import subprocess

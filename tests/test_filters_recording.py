@@ -28,6 +28,7 @@ def _pipeline(ms):
     apply(ms, "apply_curvature_reconstruction", rows="free")
 
 
+@pytest.mark.slow
 def test_a_recorded_mixed_pipeline_replays_bit_for_bit(tmp_path):
     # the recording process and a fresh `curvdetail run` give the same mesh to the last bit
     ms = load_meshset(example_path())

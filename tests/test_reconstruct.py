@@ -430,6 +430,7 @@ print(max(np.abs(X - serial[k % 3]).max() for k, X in enumerate(threaded)))
 """
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("rows", ROWS)
 def test_threads_sharing_one_reconstructor_get_the_serial_answers(rows):
     # in a child process: PARDISO's handle used by two threads at once crashed the process ("auto"

@@ -342,6 +342,7 @@ print(max(np.abs(x - serial[k % 4]).max() / np.abs(serial[k % 4]).max() for k, x
 """.replace("import numpy as np", "import numpy as np\nimport scipy.sparse as sp")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("symmetric", [True, False])
 @pytest.mark.parametrize("backend", every_backend(exclude=("cholmod",)))
 def test_threads_sharing_one_factorization_solve_as_serial_solves(backend, symmetric):
