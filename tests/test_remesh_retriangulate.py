@@ -84,11 +84,13 @@ def test_isotropic_remeshing_at_extreme_units_matches_unit_scale(load_mesh, scal
     assert median_edge(Vs, Fs) == pytest.approx(median_edge(Vt, Ft), rel=0.02)
 
 
-@pytest.mark.parametrize("pct,words", [(1e-5, "more than 5,000,000"), (0.9, "fewer than 50")])
-def test_absurd_target_edge_is_refused_with_the_numbers(load_mesh, pct, words):
+@pytest.mark.parametrize("pct,limit", [(1e-5, "5,000,000"), (0.9, r"\b50\b")])
+def test_absurd_target_edge_is_refused_with_the_numbers(load_mesh, pct, limit):
     V, F = load_mesh("mannequin_nose.obj")
-    with pytest.raises(RemeshError, match=words + ".*choose a target edge between"):
+    with pytest.raises(RemeshError, match=limit + r".* \d.* % and \d.* %") as e:      # the limit, the range
         retriangulate(V, F, target_edge=pct)
+    assert e.value.parameter == "target_edge"
+    assert e.value.count > 5_000_000 if pct == 1e-5 else e.value.count < 50      # the estimated vertices
 
 
 # the decimation messages reach Python callers, the filter and the command line alike: they name
@@ -98,9 +100,9 @@ _USE_ISOTROPIC = r'use method "isotropic"\.$'
 
 def test_decimation_refuses_to_refine(load_mesh):
     V, F = load_mesh("mannequin_nose.obj")
-    with pytest.raises(RemeshError, match=r"decimation can only coarsen.*decimation takes target edges from 3\.06 % "
-                                          r"to 10\.6 % of the bbox diagonal .*; choose one there or " + _USE_ISOTROPIC):
+    with pytest.raises(RemeshError, match=r"\b3\.06 % .*\b10\.6 % .*" + _USE_ISOTROPIC) as e:    # the range
         retriangulate(V, F, method="decimate", target_edge="0.5%")
+    assert e.value.parameter == "target_edge" and e.value.count > F.shape[0]       # triangles asked for
 
 
 def _percents(message):
@@ -126,8 +128,9 @@ def test_a_decimation_out_of_range_is_given_decimations_own_range(load_mesh, tar
     for edge in (shortest, longest):
         Vt, Ft = retriangulate(V, F, method="decimate", target_edge=f"{100 * edge!r}%")
         assert 50 <= Vt.shape[0] and Ft.shape[0] < F.shape[0]
-    with pytest.raises(RemeshError, match="decimation can only coarsen"):
+    with pytest.raises(RemeshError) as e:
         retriangulate(V, F, method="decimate", target_edge=f"{99 * shortest!r}%")     # below 3.054 %
+    assert e.value.parameter == "target_edge" and e.value.count >= F.shape[0]
 
 
 def test_the_isotropic_range_given_is_admissible_at_both_ends(load_mesh):
@@ -145,8 +148,7 @@ def test_a_patch_too_small_to_decimate_says_so(load_mesh):
     from curvdetail.curvature.testing import disk
 
     V, F = disk(n_rings=4)                                  # 61 vertices, 96 triangles
-    with pytest.raises(RemeshError, match=r"this 61-vertex patch is too small to decimate to 50 vertices or more "
-                                          r"\(96 triangles\); " + _USE_ISOTROPIC):
+    with pytest.raises(RemeshError, match=r"\b61\b.*\b50\b.*\b96\b.*" + _USE_ISOTROPIC):      # vertices, limit, triangles
         retriangulate(V, F, method="decimate", target_edge="30%")
 
 
@@ -163,14 +165,15 @@ def test_failed_decimation_points_to_isotropic_for_api_and_command_line(load_mes
 
     monkeypatch.setattr(module, "check_surface", no_decimated_disk)
     V, F = load_mesh("mannequin_nose.obj")
-    with pytest.raises(RemeshError, match=r"non-manifold edges \(decimation with agg=.*, 3 and 1\); " + _USE_ISOTROPIC):
+    with pytest.raises(RemeshError, match=r"agg=7.*, 3 and 1\b.*" + _USE_ISOTROPIC):       # each aggressiveness tried
         retriangulate(V, F, method="decimate", target_edge="6%")
 
 
 def test_unknown_method_is_refused(load_mesh):
     V, F = load_mesh("mannequin_nose.obj")
-    with pytest.raises(RemeshError, match="not a retriangulation method"):
+    with pytest.raises(RemeshError) as e:
         retriangulate(V, F, method="loop")
+    assert (e.value.parameter, e.value.value) == ("method", "loop")
 
 
 @pytest.mark.parametrize("method", [np.array(["isotropic"]), np.array(["isotropic", "decimate"]), ["decimate"]])
@@ -178,37 +181,42 @@ def test_a_method_that_is_not_one_str_is_refused_as_such(load_mesh, method):
     # ``in`` compared an array element-wise: one entry passed as the method, two raised numpy's
     # "truth value ... is ambiguous"
     V, F = load_mesh("mannequin_nose.obj")
-    with pytest.raises(RemeshError, match=r"method=.* \((ndarray|list), not a single str\) is not a retriangulation"):
+    with pytest.raises(RemeshError, match="ndarray|list") as e:
         retriangulate(V, F, method=method)
+    assert e.value.parameter == "method"
 
 
 @pytest.mark.parametrize("kwargs, words", [
-    ({"iterations": 0}, "at least 1"),
-    ({"iterations": "ten"}, "must be a whole number"),
-    ({"iterations": 2.5}, "must be a whole number"),
-    ({"method": "decimate", "aggressiveness": float("nan")}, "from 0 to 10"),
-    ({"method": "decimate", "aggressiveness": 11}, "from 0 to 10"),
+    ({"iterations": 0}, r"\b1\b"),
+    ({"iterations": "ten"}, None),
+    ({"iterations": 2.5}, None),
+    ({"method": "decimate", "aggressiveness": float("nan")}, r"\b0 to 10\b"),
+    ({"method": "decimate", "aggressiveness": 11}, r"\b0 to 10\b"),
     # bools were taken as 1, huge ints raised a TypeError, strings were parsed
-    ({"iterations": True}, "iterations=True must be a whole number"),
+    ({"iterations": True}, None),
     # 2**31 raised pybind11's RuntimeError "Unable to cast Python instance of type int"
-    ({"iterations": 2 ** 31}, r"iterations=2147483648 is more than 1,000: each is a full pass"),
-    ({"method": "decimate", "aggressiveness": 10 ** 30}, "from 0 to 10"),
-    ({"method": "decimate", "aggressiveness": True}, "from 0 to 10"),
+    ({"iterations": 2 ** 31}, r"\b1,000\b"),
+    ({"method": "decimate", "aggressiveness": 10 ** 30}, r"\b0 to 10\b"),
+    ({"method": "decimate", "aggressiveness": True}, r"\b0 to 10\b"),
     # target_edge ** 2 raised an OverflowError: the admissible range is given instead
-    ({"target_edge": 1e300}, r"fewer than 50; choose a target edge between 0.\d+ % and \d+.\d+ %"),
-    ({"target_edge": 1e-300}, r"about inf target vertices, more than 5,000,000; choose a target edge between"),
+    ({"target_edge": 1e300}, r"\b50\b.* 0.\d+ % and \d+.\d+ %"),
+    ({"target_edge": 1e-300}, r"\binf\b.*5,000,000"),
     # "no" or 0 would otherwise count as an answer (a truthy string as True)
-    ({"surface_check": "no"}, r"surface_check='no' must be True or False"),
-    ({"surface_check": 0}, r"surface_check=0 must be True or False"),
-    ({"surface_check": None}, r"surface_check=None must be True or False"),
-    ({"method": "decimate", "surface_check": "yes"}, r"surface_check='yes' must be True or False"),
+    ({"surface_check": "no"}, None),
+    ({"surface_check": 0}, None),
+    ({"surface_check": None}, None),
+    ({"method": "decimate", "surface_check": "yes"}, None),
 ])
 def test_out_of_range_remesher_options_are_refused_before_remeshing(load_mesh, kwargs, words):
     # they used to be passed on: -1 iterations returned the source unchanged, a negative surface
     # distance and a NaN aggressiveness were handed to the remeshers
     V, F = load_mesh("mannequin_nose.obj")
-    with pytest.raises(RemeshError, match=words):
+    with pytest.raises(RemeshError, match=words) as e:               # the limits given
         retriangulate(V, F, **{"target_edge": "5%", **kwargs})
+    name = [k for k in kwargs if k != "method"][0]
+    assert e.value.parameter == name
+    if name != "target_edge":
+        assert e.value.value is kwargs[name] or e.value.value == kwargs[name]
 
 
 @pytest.mark.parametrize("name, value", [("max_surface_distance", -0.01), ("max_surface_distance", float("nan")),
@@ -307,8 +315,9 @@ def test_a_long_run_is_not_announced_for_a_decimation_that_will_be_refused(load_
     assert module.estimated_vertices(V, F, finer) > 100 and module.estimated_vertices(V, F, coarser) > 100
     assert module.long_run_vertices(V, F, finer, method="isotropic") is not None
     assert module.long_run_vertices(V, F, finer, method="decimate") is None             # refused: refines
-    with pytest.raises(RemeshError, match="decimation can only coarsen"):
+    with pytest.raises(RemeshError) as e:
         retriangulate(V, F, method="decimate", target_edge="2%")
+    assert e.value.parameter == "target_edge" and e.value.count >= F.shape[0]
     assert module.long_run_vertices(V, F, coarser, method="decimate") is not None
     # without the measurements a decimation takes seconds (490k -> 251k vertices: 18 s)
     assert module.long_run_vertices(V, F, coarser, method="decimate", evaluate=False) is None
@@ -362,8 +371,9 @@ def test_one_pinched_boundary_vertex_and_one_handle_are_counted_in_the_singular(
     from curvdetail.remesh import NotADiskError
 
     V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [-1, 0, 0], [0, -1, 0]], dtype=float)
-    with pytest.raises(NotADiskError, match=r"the boundary passes 1 vertex more than once \(first: 0\); a disk"):
+    with pytest.raises(NotADiskError) as e:
         check_disk(V, [[0, 1, 2], [0, 3, 4]])                # two triangles touching at vertex 0
+    assert (e.value.parameter, e.value.count, e.value.first) == ("F", 1, [0])
     n, m = 12, 8                                             # a torus with one triangle taken out
     i, j = np.meshgrid(np.arange(n), np.arange(m), indexing="ij")
     u, v = 2 * np.pi * i.ravel() / n, 2 * np.pi * j.ravel() / m
@@ -371,8 +381,9 @@ def test_one_pinched_boundary_vertex_and_one_handle_are_counted_in_the_singular(
     a, b = (i * m + j).ravel(), (((i + 1) % n) * m + j).ravel()
     c, d = (i * m + (j + 1) % m).ravel(), (((i + 1) % n) * m + (j + 1) % m).ravel()
     F = np.concatenate([np.column_stack([a, b, d]), np.column_stack([a, d, c])])[1:]
-    with pytest.raises(NotADiskError, match=r"Euler characteristic -1 \(1 handle\);"):
+    with pytest.raises(NotADiskError) as e:
         check_disk(V, F)
+    assert (e.value.parameter, e.value.value) == ("F", -1)          # the Euler characteristic
 
 
 def _square_with_one_long_side(n=40, m=12):
@@ -412,11 +423,10 @@ def test_a_decimation_the_boundary_keeps_from_its_target_is_refused_not_returned
     V, F = grid(200, 3)
     V[:, 0] *= 20.0
     V[:, 2] = 0.1 * np.sin(V[:, 0])
-    with pytest.raises(RemeshError, match=r"keeps every boundary vertex: the target edge asks for about 289 "
-                                          r"triangles, but a disk with the source's 402 boundary vertices has at "
-                                          r"least 400, and it falls short of a count below 500 \(1.25 x that\); "
-                                          r"decimation takes target edges from 1.21 % to 1.51 %"):
+    # the counts (asked, boundary vertices, least, limit) and the range that works
+    with pytest.raises(RemeshError, match=r"\b289\b.*\b402\b.*\b400\b.*\b500\b.*\b1.21 % to 1.51 %") as e:
         retriangulate(V, F, method="decimate", target_edge="2%")
+    assert (e.value.parameter, e.value.count) == ("target_edge", 289)
 
 
 @pytest.mark.parametrize("where", [0.0, 0.5, 1.0])

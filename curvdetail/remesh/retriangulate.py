@@ -173,7 +173,7 @@ def _as(check, value, name, requirement):
     try:
         return check(value, name)
     except ValueError:
-        raise RemeshError(f"{name}={value!r} {requirement}") from None
+        raise RemeshError(f"{name}={value!r} {requirement}", parameter=name, value=value) from None
 
 
 def retriangulate(V, F, *, method="isotropic", target_edge="1%", iterations=10, max_surface_distance=None,
@@ -257,7 +257,8 @@ def retriangulate(V, F, *, method="isotropic", target_edge="1%", iterations=10, 
                      "must be a whole number of at least 1 (isotropic remeshing iterations, e.g. 10).")
     if iterations > MAX_ITERATIONS:      # pymeshlab takes a 32-bit int: 2**31 raised its cast error
         raise RemeshError(f"iterations={iterations!r} is more than {MAX_ITERATIONS:,}: each is a full pass of the "
-                          "isotropic remeshing (split, collapse, flip, smooth); 10 is the default.")
+                          "isotropic remeshing (split, collapse, flip, smooth); 10 is the default.",
+                          parameter="iterations", value=iterations)
     if max_surface_distance is not None:
         max_surface_distance = as_bbox_length(max_surface_distance, "max_surface_distance").fraction(d)
     aggressiveness = _check_aggressiveness(aggressiveness)
@@ -269,7 +270,8 @@ def retriangulate(V, F, *, method="isotropic", target_edge="1%", iterations=10, 
         side, limit = ("fewer than", MIN_VERTICES) if n_est < MIN_VERTICES else ("more than", MAX_VERTICES)
         raise RemeshError(
             f"target edge {100 * target_edge:.4g} % of the bbox diagonal ({h:.4g}) would give about "
-            f"{n_est:,.0f} target vertices, {side} {limit:,}; {_range_advice(V, F, method)}.")
+            f"{n_est:,.0f} target vertices, {side} {limit:,}; {_range_advice(V, F, method)}.",
+            parameter="target_edge", value=target_edge, count=n_est)
     # Both remeshers work in a unit frame (bbox centre at the origin, diagonal 1): their
     # tolerances are absolute (fast-simplification's collapse thresholds are, so a patch 1e12
     # across came back undecimated), and the result must not depend on where the patch sits
@@ -327,7 +329,7 @@ def _check_aggressiveness(value):
     number = as_float(value)
     if number is None or not 0 <= number <= 10:              # NaN fails too
         raise RemeshError(f"aggressiveness={value!r} must be a number from 0 to 10 (fast-simplification's "
-                          "agg; default 7).")
+                          "agg; default 7).", parameter="aggressiveness", value=value)
     return number
 
 
@@ -412,14 +414,15 @@ def _decimate(V, F, h, agg, boundary, topology):
     if target_faces >= F.shape[0]:
         raise RemeshError(
             f"decimation can only coarsen: the target edge asks for about {target_faces:,} triangles "
-            f"but the source has {F.shape[0]:,}; {_range_advice(V, F, 'decimate', why=False)}.")
+            f"but the source has {F.shape[0]:,}; {_range_advice(V, F, 'decimate', why=False)}.",
+            parameter="target_edge", count=target_faces)
     fewest = _fewest_decimated_faces(F, boundary)
     if target_faces < fewest:
         raise RemeshError(
             f"decimation keeps every boundary vertex: the target edge asks for about {target_faces:,} triangles, but "
             f"a disk with the source's {boundary:,} boundary vertices has at least {boundary - 2:,}, and it falls short of a "
             f"count below {fewest:,} ({DECIMATION_BOUNDARY_MARGIN:g} x that); "
-            f"{_range_advice(V, F, 'decimate', why=False)}.")
+            f"{_range_advice(V, F, 'decimate', why=False)}.", parameter="target_edge", count=target_faces)
     last = None
     for a in (agg, min(agg, 3.0), 1.0):
         scale = _decimation_scale(a)
