@@ -4,7 +4,7 @@ import time
 
 import numpy as np
 
-from ..curvature.errors import MeshError, warn
+from ..curvature.errors import CurvdetailError, MeshError, warn
 
 from ..curvature.checks import as_count, check_bool, check_choice
 from ..curvature.geometry import bbox_diagonal
@@ -349,9 +349,9 @@ def run_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="cons
     if parameterization is not None:
         parameterization = _check_choice("parameterization", parameterization, PARAMETERIZATIONS)
         if location != "uv":
-            raise ValueError(f"parameterization={parameterization!r} applies to location='uv' only "
-                             f"(location={location!r} uses no planar map); pass location='uv' or "
-                             "leave parameterization out.")
+            raise CurvdetailError(f"parameterization={parameterization!r} applies to location='uv' only "
+                                  f"(location={location!r} uses no planar map); pass location='uv' or "
+                                  "leave parameterization out.", parameter="parameterization")
     elif location == "uv":
         parameterization = "harmonic"
     resolve_backend(backend)               # an unknown or missing backend fails before the work
@@ -359,13 +359,13 @@ def run_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="cons
     # either way (as pymeshlab checks every parameter of a filter)
     length = as_bbox_length(target_edge, "target_edge")
     if target is not None and (not isinstance(target, (tuple, list)) or len(target) != 2):
-        raise ValueError(f"target must be a pair (Vt, Ft), a ready retriangulation, or None; got "
-                         f"{type(target).__name__}.")
+        raise CurvdetailError(f"target must be a pair (Vt, Ft), a ready retriangulation, or None; got "
+                              f"{type(target).__name__}.", parameter="target")
     check_bool(evaluate, "evaluate")
     check_bool(surface_check, "surface_check")
     if progress is not None and not callable(progress):
-        raise ValueError(f"progress must be callable (called with each stage name) or None; got "
-                         f"{type(progress).__name__}.")
+        raise CurvdetailError(f"progress must be callable (called with each stage name) or None; got "
+                              f"{type(progress).__name__}.", parameter="progress")
     anchors = as_count(anchors, "anchors")
     if location == "uv":
         check_disk(V, F, "the source")          # the planar map needs a disk: said before any work
