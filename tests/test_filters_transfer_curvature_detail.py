@@ -54,10 +54,17 @@ def test_stored_detail_equals_the_remesh_transfer(method):
     assert figures["target_vertices"] == Vt.shape[0] and figures["source_vertices"] == 640
 
 
-def test_conservative_transfer_keeps_the_total_detail():
-    figures = apply(remeshed_nose(), "transfer_curvature_detail", method="conservative")
-    assert figures["detail_total_gap"] < 1e-12
-    assert np.allclose(figures["detail_total_target"], figures["detail_total_source"], rtol=0, atol=1e-12)
+def test_the_detail_totals_reported_are_those_of_the_layers():
+    # conservation itself is the library's (test_remesh_transfer); the filter reports the sums
+    ms = remeshed_nose()
+    figures = apply(ms, "transfer_curvature_detail", method="pointwise")
+    Ds = curvature_detail(ms.mesh(0).vertex_matrix(), ms.mesh(0).face_matrix())
+    Dt = vertex_attribute(ms, 1, "curvature_detail", "point")
+    tiny = 1e-12 * np.abs(Ds).sum()                                   # rounding of the sums
+    assert figures["detail_total_source"] == pytest.approx(Ds.sum(axis=0).tolist(), rel=0, abs=tiny)
+    assert figures["detail_total_target"] == pytest.approx(Dt.sum(axis=0).tolist(), rel=0, abs=tiny)
+    gap = np.linalg.norm(Dt.sum(axis=0) - Ds.sum(axis=0)) / np.abs(Ds).sum()      # relative to the source's
+    assert figures["detail_total_gap"] == pytest.approx(gap, rel=1e-6) and gap > 1e-6
 
 
 def test_transfer_onto_an_identical_copy_rebuilds_the_source():
@@ -113,8 +120,9 @@ def test_uv_location_reports_the_parameterization_and_carries_the_detail():
 
 def test_a_parameterization_without_uv_location_is_refused_not_ignored():
     ms = remeshed_nose()
-    with pytest.raises(FilterParameterError, match="applies to location='uv' only"):
+    with pytest.raises(FilterParameterError, match="location='uv'") as e:        # the way to use it
         apply(ms, "transfer_curvature_detail", parameterization="meshlab_harmonic")
+    assert e.value.parameter == "parameterization"
     assert "parameterization" not in apply(ms, "transfer_curvature_detail")    # the default passes
 
 
@@ -132,8 +140,9 @@ def test_closed_mesh_onto_itself_carries_its_own_detail():
 def test_same_layer_is_refused():
     ms = pymeshlab.MeshSet()
     ms.load_new_mesh(os.path.join(DATA, "mannequin_nose.obj"))
-    with pytest.raises(FilterError, match="both layer 0"):
+    with pytest.raises(FilterError, match=r"\b0\b") as e:                      # the layer
         apply(ms, "transfer_curvature_detail")
+    assert e.value.parameter == "targetmesh"
 
 
 def smoothed_nose_with_stored_detail():
@@ -190,8 +199,9 @@ def test_a_source_retriangulated_since_its_detail_was_stored_is_refused():
     ms.meshing_isotropic_explicit_remeshing(iterations=5, targetlen=pymeshlab.PercentageValue(2.0))
     assert vertex_attribute(ms, 0, "curvature_detail", "point") is not None
     ms.generate_copy_of_current_mesh()
-    with pytest.raises(FilterError, match="belongs to another triangulation"):
+    with pytest.raises(FilterError) as e:
         apply(ms, "transfer_curvature_detail", sourcemesh=0, targetmesh=1)
+    assert e.value.value == "curvature_detail" and e.value.count > 0
 
 
 def test_a_planar_map_that_collapses_a_triangle_is_named_in_the_filters_words(monkeypatch):
@@ -211,8 +221,9 @@ def test_a_planar_map_that_collapses_a_triangle_is_named_in_the_filters_words(mo
     ms = pymeshlab.MeshSet()
     ms.add_mesh(pymeshlab.Mesh(V, F))
     ms.add_mesh(pymeshlab.Mesh(V, F))
-    with pytest.raises(FilterError, match=r"^the lscm parameterization of the target \(layer 1\) maps 1 triangle "
-                                          r"\(first: \d+\) to zero area in the plane .* Use parameterization="
-                                          r"'harmonic' or location='closest' \(no planar map\)\.$"):
+    # the map and layer at fault, and the options to use instead (the filter's words)
+    with pytest.raises(FilterError, match=r"\blscm\b.*\(layer 1\).*parameterization='harmonic' or "
+                                          r"location='closest'") as e:
         apply(ms, "transfer_curvature_detail", sourcemesh=0, targetmesh=1, location="uv", parameterization="lscm")
+    assert e.value.count == 1
     assert vertex_attribute(ms, 1, "curvature_detail", "point") is None
