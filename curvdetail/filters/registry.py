@@ -76,28 +76,31 @@ def filter(*, name, category, description, parameters=()):  # noqa: A001 (pymesh
 
     Parameters
     ----------
-    name : str          snake_case, starting with a verb family (:data:`FAMILIES`)
-    category : str      MeshLab menu-style category, e.g. ``"Curvature detail"``
-    description : str   one paragraph, with the paper reference where it applies
-    parameters : list of Parameter   in the order they are listed; each must match a keyword-only
-                        argument of the decorated function, and vice versa
-
-    The decorated function keeps working as a plain function; the spec is attached as
-    ``function.spec``.
+    name : str
+        snake_case, starting with a verb family (:data:`FAMILIES`).
+    category : str
+        MeshLab menu-style category, e.g. ``"Curvature detail"``.
+    description : str
+        One paragraph, with the paper reference where it applies.
+    parameters : list of Parameter
+        In the order they are listed; each must match a keyword-only argument of the decorated
+        function, and vice versa.
 
     Returns
     -------
-    register : callable   the decorator: it registers a :class:`FilterSpec` under ``name`` (the
-                          description with its whitespace collapsed to single spaces), sets
-                          ``function.spec``, gives a function without a docstring one built from
-                          the declaration, and returns the same function
+    register : callable
+        The decorator: it registers a :class:`FilterSpec` under ``name`` (the description with
+        its whitespace collapsed to single spaces), sets ``function.spec``, gives a function
+        without a docstring one built from the declaration, and returns the same function. The
+        decorated function keeps working as a plain function.
 
     Raises
     ------
-    TypeError   when the decorator is applied: ``name`` not snake_case or not starting with one of
-                :data:`FAMILIES`, already registered, an empty ``category`` or ``description``,
-                a parameter declared twice, or declared parameters that differ from the
-                function's keyword-only arguments
+    TypeError
+        When the decorator is applied: ``name`` not snake_case or not starting with one of
+        :data:`FAMILIES`, already registered, an empty ``category`` or ``description``, a
+        parameter declared twice, or declared parameters that differ from the function's
+        keyword-only arguments.
 
     Examples
     --------
