@@ -163,7 +163,8 @@ def list_filters():
 
     Returns
     -------
-    specs : list of FilterSpec   a new list each call, sorted by ``name``
+    specs : list of FilterSpec
+        A new list each call, sorted by ``name``
 
     Examples
     --------
@@ -185,17 +186,19 @@ def get_filter(name):
 
     Parameters
     ----------
-    name : str   the filter's exact name, e.g. ``"compute_curvature_detail"``
+    name : str
+        The filter's exact name, e.g. ``"compute_curvature_detail"``
 
     Returns
     -------
-    spec : FilterSpec   the registered declaration (name, category, description, parameters,
-                        function)
+    spec : FilterSpec
+        The registered declaration (name, category, description, parameters, function)
 
     Raises
     ------
-    UnknownFilterError   no filter of that name (also for a name that is not a string); the
-                         message lists up to three close matches or points to the list
+    UnknownFilterError
+        No filter of that name (also for a name that is not a string); the message lists up to three
+        close matches or points to the list
 
     Examples
     --------
@@ -246,11 +249,13 @@ def print_filter_parameter_list(name):
 
     Parameters
     ----------
-    name : str   the filter's exact name
+    name : str
+        The filter's exact name
 
     Raises
     ------
-    UnknownFilterError   no filter of that name (as :func:`get_filter`)
+    UnknownFilterError
+        No filter of that name (as :func:`get_filter`)
 
     Examples
     --------

@@ -36,24 +36,31 @@ def check_disk(V, F, what="the source"):
 
     Parameters
     ----------
-    V : (n, 3) float array   vertex positions (checked as in :func:`check_mesh`)
-    F : (m, 3) int array     triangles, consistently oriented; every vertex used
-    what : str               how the messages name the mesh, e.g. ``"the target"``
+    V : (n, 3) float array
+        Vertex positions (checked as in :func:`check_mesh`)
+    F : (m, 3) int array
+        Triangles, consistently oriented; every vertex used
+    what : str
+        How the messages name the mesh, e.g. ``"the target"``
 
     Returns
     -------
-    V : (n, 3) float64 array   the checked positions (C-contiguous)
-    F : (m, 3) int64 array     the checked triangles (C-contiguous)
-    loop : (k,) int64 array    the boundary loop, as above
+    V : (n, 3) float64 array
+        The checked positions (C-contiguous)
+    F : (m, 3) int64 array
+        The checked triangles (C-contiguous)
+    loop : (k,) int64 array
+        The boundary loop, as above
 
     Raises
     ------
-    MeshError        malformed mesh (shapes, NaN, zero-area triangles, unreferenced vertices, ...)
-    NotADiskError    (a MeshError) edges shared by more than two triangles, closed, several
-                     boundary loops, several pieces, a pinched boundary vertex or handles;
-                     triangles wound against their neighbours are named as such where they make
-                     the boundary look pinched, split or open. The message says what was found
-                     and what is needed
+    MeshError
+        Malformed mesh (shapes, NaN, zero-area triangles, unreferenced vertices, ...)
+    NotADiskError
+        (a MeshError) edges shared by more than two triangles, closed, several boundary loops,
+        several pieces, a pinched boundary vertex or handles; triangles wound against their
+        neighbours are named as such where they make the boundary look pinched, split or open. The
+        message says what was found and what is needed
 
     Examples
     --------
@@ -133,20 +140,26 @@ def check_surface(V, F, what="the source"):
 
     Parameters
     ----------
-    V : (n, 3) float array   vertex positions (checked as in :func:`check_mesh`)
-    F : (m, 3) int array     triangles, consistently oriented; every vertex used
-    what : str               how the messages name the mesh
+    V : (n, 3) float array
+        Vertex positions (checked as in :func:`check_mesh`)
+    F : (m, 3) int array
+        Triangles, consistently oriented; every vertex used
+    what : str
+        How the messages name the mesh
 
     Returns
     -------
-    V : (n, 3) float64 array, F : (m, 3) int64 array   the checked arrays
-    loops : list of (k,) int64 arrays   the boundary loops, each ordered as the faces wind and
-                                        starting at its smallest vertex, by that vertex; [] if closed
+    V : (n, 3) float64 array, F : (m, 3) int64 array
+        The checked arrays
+    loops : list of (k,) int64 arrays
+        The boundary loops, each ordered as the faces wind and starting at its smallest vertex, by
+        that vertex; [] if closed
 
     Raises
     ------
-    MeshError   malformed mesh; edges shared by more than two triangles (``count``, ``first``:
-                the first edges), a boundary passing a vertex twice, or misoriented triangles
+    MeshError
+        Malformed mesh; edges shared by more than two triangles (``count``, ``first``: the first
+        edges), a boundary passing a vertex twice, or misoriented triangles
 
     Examples
     --------
@@ -219,7 +232,8 @@ class Polyline:
 
     Parameters
     ----------
-    P : (k, 3) float array   the loop's points in order (closed: the last joins the first)
+    P : (k, 3) float array
+        The loop's points in order (closed: the last joins the first)
     """
 
     def __init__(self, P):

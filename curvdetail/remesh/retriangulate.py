@@ -183,8 +183,10 @@ def retriangulate(V, F, *, method="isotropic", target_edge="1%", iterations=10, 
 
     Parameters
     ----------
-    V : (n, 3) float array     source vertex positions
-    F : (m, 3) int array       source triangles (a manifold, consistently oriented surface)
+    V : (n, 3) float array
+        Source vertex positions
+    F : (m, 3) int array
+        Source triangles (a manifold, consistently oriented surface)
     method : {"isotropic", "decimate"}
         ``"isotropic"``: pymeshlab ``meshing_isotropic_explicit_remeshing`` (split, collapse,
         flip, smooth, reproject) at the target edge length, every parameter passed explicitly.
@@ -218,26 +220,28 @@ def retriangulate(V, F, *, method="isotropic", target_edge="1%", iterations=10, 
 
     Returns
     -------
-    Vt : (p, 3) float array    target vertex positions; boundary vertices lie on the source's
-                               boundary polylines (projected onto them, within 1e-12 of the bbox diagonal)
-    Ft : (q, 3) int array      target triangles, oriented as the source, with its pieces, boundary
-                               loops and Euler characteristic
+    Vt : (p, 3) float array
+        Target vertex positions; boundary vertices lie on the source's boundary polylines (projected
+        onto them, within 1e-12 of the bbox diagonal)
+    Ft : (q, 3) int array
+        Target triangles, oriented as the source, with its pieces, boundary loops and Euler
+        characteristic
 
     Raises
     ------
-    MeshError                  the source is malformed or not manifold (names the edges)
-    CurvdetailError            a ``target_edge`` or ``max_surface_distance`` that is not a positive
-                               length (``parameter`` names it)
-    RemeshError                unknown method, ``iterations`` not a whole number from 1 to 1,000,
-                               ``aggressiveness`` outside [0, 10] (bools and
-                               strings are refused), ``surface_check`` not
-                               True or False, a
-                               target edge length that would give fewer than
-                               50 or more than 5,000,000 vertices (the numbers are given), a
-                               decimation asked to refine, or for fewer than 1.25 x the b - 2
-                               triangles its b boundary vertices (which it keeps) need, or that
-                               stops at more than 1.25 x the triangles asked for, or a remesher
-                               result that changed the topology or moved the boundary
+    MeshError
+        The source is malformed or not manifold (names the edges)
+    CurvdetailError
+        A ``target_edge`` or ``max_surface_distance`` that is not a positive length (``parameter``
+        names it)
+    RemeshError
+        Unknown method, ``iterations`` not a whole number from 1 to 1,000, ``aggressiveness``
+        outside [0, 10] (bools and strings are refused), ``surface_check`` not True or False, a
+        target edge length that would give fewer than 50 or more than 5,000,000 vertices (the
+        numbers are given), a decimation asked to refine, or for fewer than 1.25 x the b - 2
+        triangles its b boundary vertices (which it keeps) need, or that stops at more than 1.25 x
+        the triangles asked for, or a remesher result that changed the topology or moved the
+        boundary
 
     Examples
     --------
