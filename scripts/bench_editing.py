@@ -96,7 +96,7 @@ def bench_cases(repeat):
             V, F = read_mesh(os.path.join(folder, name + ".off"))
             status = read_selection(os.path.join(folder, name + ".sel"), V.shape[0])
             T = read_transform(os.path.join(folder, name + ".def"))
-            X, ed = edit_with_selection(V, F, status, T, return_editor=True)
+            X, ed = edit_with_selection(V, F, status, T, method="paper", return_editor=True)
             totals.append(time.perf_counter() - t)
             h = ed.position_constrained
             t = time.perf_counter()

@@ -1,21 +1,21 @@
-"""Compare curvature-detail editing with the survey's Laplacian surface editing results.
+"""Compare curvature-detail editing with libigl and the survey on the Botsch-Sorkine benchmark.
 
-For each of the four Botsch-Sorkine cases (bar, cactus, cylinder, plane): run
-``edit_with_selection`` with the handles' details transformed (one-ring relations, the paper, and
-one- plus two-ring relations) and solved freely, measure the
-distance of every vertex to the survey's ``NAME-laplacian_editing.off`` (same connectivity, so
-vertex-to-vertex; mean and max as fractions of the rest mesh's bounding-box diagonal), the
-first-solve time (setup + solve) and the re-solve time (the median of RESOLVES re-solves after
-one warm-up re-solve, the best run and the warm-up kept too), and save pictures side by side.
-The JSON also holds the inputs (the reference file, the selection and transform files), the
-solver backend each stage used and the coefficients' rcond, the vertex and face counts, and the
-run's time, load average and peak memory.
+For each of the four cases (bar, cactus, cylinder, plane) run, with the files' selection and
+transform: ours rotation-aware (``edit_with_selection``'s default), the paper's linear edit
+(handle details transformed, one-ring relations) and its one- plus two-ring variant, libigl's
+ARAP (spokes-and-rims energy, ``MAX_ITER`` iterations from the rest shape, fixed and handle
+vertices constrained) and libigl's biharmonic deformation (``igl.harmonic`` with k = 2 on the
+displacements). Each result is measured against the survey's ``NAME-laplacian_editing.off``
+(same connectivity: vertex-to-vertex distance, mean and max over the bbox diagonal), for folded
+triangles (normal against both its rest normal and the handle-turned one), the mean relative
+edge-length change over the edges with a non-fixed end, and the area kept by the free region
+(status 1) and by the handles' triangles. Times: setup (factoring), one iteration (the
+iterative methods), and a re-solve (ours: a solve warm-started from the result; paper: a
+back-substitution; ARAP: one more iteration from its result).
 
-Usage: python scripts/compare_deformation_benchmark.py [--out out/compare] [--docs docs] [--force]
-Writes OUT/compare.json, OUT/compare.md and OUT/NAME.png (and docs/editing_NAME.png with --docs),
-each atomically as it is ready. Before any work,
-an existing one is refused unless --force is given (the pictures in docs/ are in the repository:
-refreshing them is ``--docs docs --force``).
+Usage: python scripts/compare_deformation_benchmark.py [--out docs/results] [--pictures DIR] [--force]
+Writes OUT/deformation.json and OUT/deformation.md (and DIR/deformation_NAME.png with --pictures),
+each atomically; an existing one is refused before any work unless --force is given.
 """
 
 import argparse
@@ -29,114 +29,175 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import _files  # noqa: E402
 from _meshes import MESHES, require  # noqa: E402
 
-from curvdetail import read_mesh
-from curvdetail.curvature.geometry import bbox_diagonal
-from curvdetail.curvature.curvature_coefficients import DEFAULT_RCOND
-from curvdetail.io.deformation import edit_with_selection, read_selection, read_transform
+from curvdetail import read_mesh  # noqa: E402
+from curvdetail.curvature.rotation_editor import RotationAwareEditor  # noqa: E402
+from curvdetail.curvature.geometry import bbox_diagonal, face_double_areas, folded_triangles  # noqa: E402
+from curvdetail.io.deformation import (apply_transform, edit_with_selection, read_selection,  # noqa: E402
+                                       read_transform)
 
 CASES = ("bar", "cactus", "cylinder", "plane")
-#: (handle details, curvature-stage relations): the paper, the steadier stacked relations, free
-VARIANTS = (("transform", "one-ring"), ("transform", "one+two-ring"), ("free", "one-ring"))
-LABELS = {"transform/one-ring": "handle details transformed (paper)",
-          "transform/one+two-ring": "transformed, one+two-ring",
-          "free/one-ring": "handle details free"}
-#: re-solves timed per variant (their median is reported), after one warm-up re-solve: a single
-#: re-solve straight after the constructor (the figure reported before 2026-12-01) varies
-#: several-fold from run to run
-RESOLVES = 7
-RCOND = DEFAULT_RCOND
+METHODS = ("rotation", "paper", "paper one+two-ring", "igl arap", "igl biharmonic")
+#: libigl ARAP iterations (its own default is 10; converged figures need more)
+MAX_ITER = 100
 VIEWS = {"bar": (15, -60), "cactus": (10, -90), "cylinder": (10, 0), "plane": (30, -60)}
 
 
+def _edges(F):
+    e = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
+    return np.unique(e, axis=0)
+
+
+def _ours(V, F, status, T, method):
+    if method == "rotation":
+        X = edit_with_selection(V, F, status, T)                    # the default settings
+        h = np.flatnonzero(status == 2)
+        t = time.perf_counter()
+        ed = RotationAwareEditor(V, F, h, roi=np.flatnonzero(status != 0))
+        setup = time.perf_counter() - t
+        t = time.perf_counter()
+        ed.solve(X[h])
+        solve = time.perf_counter() - t
+        iterations, converged = ed.iterations, ed.converged
+        t = time.perf_counter()
+        ed.solve(X[h], initial=X)
+        return X, {"setup_s": setup, "iterations": iterations, "converged": converged,
+                   "iteration_s": solve / max(iterations, 1), "resolve_s": time.perf_counter() - t,
+                   "resolve_iterations": ed.iterations, "backend": ed.backend}
+    relations = "one+two-ring" if method.endswith("one+two-ring") else "one-ring"
+    X, ed = edit_with_selection(V, F, status, T, method="paper", relations=relations, return_editor=True)
+    h = ed.position_constrained
+    details = ed.detail[h] @ T[:3, :3].T
+    ed.solve(positions=X[h], details=details)                  # warm-up
+    t = time.perf_counter()
+    ed.solve(positions=X[h], details=details)
+    resolve = time.perf_counter() - t
+    return X, {"setup_s": sum(ed.timings.values()), "iterations": None, "iteration_s": None, "resolve_s": resolve,
+               "backend": ed.backend}
+
+
+def _igl(V, F, status, T, method):
+    import igl
+
+    b = np.flatnonzero(status != 1)
+    bc = V[b].copy()
+    handles = status[b] == 2
+    bc[handles] = apply_transform(T, V[b][handles])
+    Fi = F.astype(np.int64)
+    if method == "igl biharmonic":
+        t = time.perf_counter()
+        X = V + igl.harmonic(V, Fi, b.astype(np.int64), bc - V[b], 2)
+        return X, {"setup_s": None, "iterations": None, "iteration_s": None, "resolve_s": time.perf_counter() - t,
+                   "backend": "libigl"}
+    data = igl.ARAPData()
+    data.energy = igl.ARAP_ENERGY_TYPE_SPOKES_AND_RIMS
+    t = time.perf_counter()
+    igl.arap_precomputation(V, Fi, 3, b.astype(np.int32), data)
+    setup = time.perf_counter() - t
+    data.max_iter = MAX_ITER
+    U0 = V.copy()
+    U0[b] = bc
+    t = time.perf_counter()
+    X = igl.arap_solve(bc, data, U0)
+    solve = time.perf_counter() - t
+    data.max_iter = 1
+    t = time.perf_counter()
+    igl.arap_solve(bc, data, X)
+    one = time.perf_counter() - t
+    return X, {"setup_s": setup, "iterations": MAX_ITER, "iteration_s": solve / MAX_ITER, "resolve_s": one,
+               "backend": "libigl"}
+
+
+def measure(V, F, status, T, X, ref, E):
+    diag = bbox_diagonal(V)
+    dist = np.linalg.norm(X - ref, axis=1) / diag
+    in_region = (status[E] != 0).any(axis=1)
+    l0 = np.linalg.norm(V[E[:, 0]] - V[E[:, 1]], axis=1)[in_region]
+    l1 = np.linalg.norm(X[E[:, 0]] - X[E[:, 1]], axis=1)[in_region]
+    A0, A1 = face_double_areas(V, F), face_double_areas(X, F)
+    free, handle = (status[F] == 1).all(axis=1), (status[F] == 2).any(axis=1)
+    return {"mean": float(dist.mean()), "max": float(dist.max()),
+            "folded": int(folded_triangles(V, F, X, T[:3, :3]).size),
+            "edge_change": float(np.mean(np.abs(l1 - l0) / l0)),
+            "area_free": float(A1[free].sum() / A0[free].sum()),
+            "area_handle": float(A1[handle].sum() / A0[handle].sum()),
+            "finite": bool(np.isfinite(X).all())}
+
+
 def run_case(name, folder):
-    files = {"mesh": name + ".off", "selection": name + ".sel", "transform": name + ".def",
-             "reference": name + "-laplacian_editing.off"}
-    V, F = read_mesh(os.path.join(folder, files["mesh"]))
-    status = read_selection(os.path.join(folder, files["selection"]), V.shape[0])
-    T = read_transform(os.path.join(folder, files["transform"]))
-    ref, Fr = read_mesh(os.path.join(folder, files["reference"]))
+    V, F = read_mesh(os.path.join(folder, name + ".off"))
+    status = read_selection(os.path.join(folder, name + ".sel"), V.shape[0])
+    T = read_transform(os.path.join(folder, name + ".def"))
+    ref, Fr = read_mesh(os.path.join(folder, name + "-laplacian_editing.off"))
     if not np.array_equal(Fr, F):
         raise ValueError(f"{name}: the reference result has a different connectivity.")
-    diag = bbox_diagonal(V)
-    out = {"case": name, "files": files, "vertices": int(V.shape[0]), "faces": int(F.shape[0]),
-           "n_fixed": int((status == 0).sum()), "n_free": int((status == 1).sum()),
-           "n_handles": int((status == 2).sum()), "rcond": RCOND,
-           "reference_moved_mean": float(np.linalg.norm(ref - V, axis=1).mean() / diag),
-           "reference_moved_max": float(np.linalg.norm(ref - V, axis=1).max() / diag)}
+    E = _edges(F)
+    row = {"case": name, "vertices": int(V.shape[0]), "faces": int(F.shape[0]),
+           "counts": np.bincount(status, minlength=3).tolist(), "survey": measure(V, F, status, T, ref, ref, E)}
     results = {}
-    for mode, relations in VARIANTS:
-        t = time.perf_counter()
-        X, ed = edit_with_selection(V, F, status, T, handle_detail=mode, relations=relations, rcond=RCOND,
-                                    return_editor=True)
-        first = time.perf_counter() - t
-        h = ed.position_constrained
-        details = ed.detail[h] @ T[:3, :3].T if mode == "transform" else None
-        variant = f"{mode}/{relations}"
-        resolves = []
-        for _ in range(1 + RESOLVES):                               # the first is the warm-up
-            t = time.perf_counter()
-            ed.solve(positions=X[h], details=details)
-            resolves.append(time.perf_counter() - t)
-        dist = np.linalg.norm(X - ref, axis=1) / diag
-        out[variant] = {"mean": float(dist.mean()), "max": float(dist.max()), "first_solve_s": first,
-                        "resolve_s": float(np.median(resolves[1:])), "resolve_best_s": min(resolves[1:]),
-                        "resolve_warmup_s": resolves[0], "resolves": RESOLVES, "backend": ed.backend,
-                        "rank_deficient": ed.rank_deficient, "detail_islands": ed.detail_islands,
-                        "finite": bool(np.isfinite(X).all())}
-        results[variant] = X
-    return out, (V, F, status, results, ref)
+    for method in METHODS:
+        X, times = (_igl if method.startswith("igl") else _ours)(V, F, status, T, method)
+        row[method] = {**measure(V, F, status, T, X, ref, E), **times}
+        results[method] = X
+        print(name, method, {k: (round(v, 4) if isinstance(v, float) else v) for k, v in row[method].items()},
+              flush=True)
+    return row, (V, F, status, results, ref)
+
+
+def _cell(value, fmt):
+    return "-" if value is None else format(value, fmt)
+
+
+def table(rows):
+    lines = ["| case | method | to survey mean / max (% diag) | folded | edge-length change | area free / handle "
+             "| setup (s) | iterations | per iteration (ms) | re-solve (ms) |",
+             "|---|---|---|---:|---:|---|---:|---:|---:|---:|"]
+    for r in rows:
+        for m in METHODS:
+            x = r[m]
+            lines.append(f"| {r['case']} | {m} | {100 * x['mean']:.2f} / {100 * x['max']:.2f} | {x['folded']} | "
+                         f"{x['edge_change']:.4f} | {x['area_free']:.3f} / {x['area_handle']:.3f} | "
+                         f"{_cell(x['setup_s'], '.3f')} | {_cell(x['iterations'], 'd')} | "
+                         f"{_cell(x['iteration_s'] and 1e3 * x['iteration_s'], '.2f')} | {1e3 * x['resolve_s']:.1f} |")
+    return "\n".join(lines)
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default="out/compare",
-                    help="folder for compare.json, compare.md and the pictures (default: %(default)s)")
-    ap.add_argument("--docs", default=None, help="also write small pictures docs/editing_NAME.png here")
+    ap.add_argument("--out", default="docs/results", help="folder for deformation.json/.md (default: %(default)s)")
+    ap.add_argument("--pictures", default=None, help="also write DIR/deformation_NAME.png, the methods side by side")
     ap.add_argument("--force", action="store_true", help="replace output files that exist")
     args = ap.parse_args(argv)
-    pictures = {name: [(os.path.join(args.out, name + ".png"), 3.5)]
-                + ([(os.path.join(args.docs, f"editing_{name}.png"), 2.4)] if args.docs else [])
-                for name in CASES}          # (file, panel size): the ones in docs/ are small
-    _files.check_outputs(ap, [os.path.join(args.out, name) for name in ("compare.json", "compare.md")]
-                         + [target for name in CASES for target, _ in pictures[name]], args.force)
+    json_path, md_path = (os.path.join(args.out, "deformation" + ext) for ext in (".json", ".md"))
+    pictures = [os.path.join(args.pictures, f"deformation_{n}.png") for n in CASES] if args.pictures else []
+    _files.check_outputs(ap, [json_path, md_path, *pictures], args.force)
     require("deformation")
     folder = os.path.join(MESHES, "deformation")
     rows = []
-    for name in CASES:
+    for k, name in enumerate(CASES):
         row, (V, F, status, results, ref) = run_case(name, folder)
         rows.append(row)
-        elev, azim = VIEWS[name]
-        # a diverged result would squash the other panels: draw it clipped to the reference's box
-        lo, hi = ref.min(0), ref.max(0)
-        pad = 0.5 * (hi - lo)
-        panels = [(V, F, "rest: fixed / free / handle", status)]
-        for mode in LABELS:
-            X = np.clip(results[mode], lo - pad, hi + pad)
-            label = (f"{LABELS[mode]}\nmean {100 * row[mode]['mean']:.1f} % / "
-                     f"max {100 * row[mode]['max']:.1f} %")
-            panels.append((X, F, label))
-        panels.append((ref, F, "survey: Laplacian editing"))
-        for target, size in pictures[name]:
-            _files.render_panels(target, panels, args.force, elev=elev, azim=azim, panel_size=size)
-        print(name, {m: (round(row[m]["mean"], 4), round(row[m]["max"], 4)) for m in LABELS})
-    lines = ["| case | vertices (fixed/free/handle) | survey result moved from rest (mean / max) | "
-             + " | ".join(f"{LABELS[m]}: distance to survey (mean / max)" for m in LABELS)
-             + f" | first solve incl. setup (s) | re-solve, median of {RESOLVES} (ms) | best re-solve (ms) |",
-             "|---|---|---|" + "---|" * len(LABELS) + "---|---|---|"]
-    for r in rows:
-        cells = [f"{100 * r[m]['mean']:.2f} % / {100 * r[m]['max']:.2f} %" for m in LABELS]
-        lines.append(f"| {r['case']} | {r['vertices']} ({r['n_fixed']}/{r['n_free']}/{r['n_handles']}) | "
-                     f"{100 * r['reference_moved_mean']:.1f} % / {100 * r['reference_moved_max']:.1f} % | "
-                     + " | ".join(cells) + " | "
-                     + " / ".join(f"{r[m]['first_solve_s']:.2f}" for m in LABELS) + " | "
-                     + " / ".join(f"{1e3 * r[m]['resolve_s']:.1f}" for m in LABELS) + " | "
-                     + " / ".join(f"{1e3 * r[m]['resolve_best_s']:.1f}" for m in LABELS) + " |")
-    table = "\n".join(lines)
-    print(table)
-    _files.write_json(os.path.join(args.out, "compare.json"),
-                      {"resolves": RESOLVES, "rcond": RCOND, "rows": rows, **_files.measured_conditions()},
-                   indent=2)
-    _files.write_text(os.path.join(args.out, "compare.md"), table + "\n", args.force)
+        if pictures:
+            lo, hi = ref.min(0), ref.max(0)
+            pad = 0.5 * (hi - lo)            # a diverged result is drawn clipped to the survey's box
+            panels = [(V, F, "rest: fixed / free / handle", status)]
+            panels += [(np.clip(results[m], lo - pad, hi + pad), F,
+                        f"{m}\n{row[m]['folded']} folded, edges {row[m]['edge_change']:.3f}") for m in METHODS]
+            panels.append((ref, F, "survey: Laplacian editing"))
+            elev, azim = VIEWS[name]
+            _files.render_panels(pictures[k], panels, args.force, elev=elev, azim=azim, panel_size=2.6)
+    text = table(rows)
+    print(text)
+    conditions = _files.measured_conditions()
+    _files.write_json(json_path, {"methods": METHODS, "igl_arap_iterations": MAX_ITER, "rows": rows, **conditions},
+                      args.force, indent=2, end="\n")
+    images = "".join(f"\n![{n}]({os.path.relpath(p, os.path.dirname(os.path.abspath(md_path)))})\n"
+                     for n, p in zip(CASES, map(os.path.abspath, pictures)))
+    _files.write_text(md_path, "# Deformation benchmark (Botsch & Sorkine 2008)\n\n"
+                      "Written by `python scripts/compare_deformation_benchmark.py --pictures docs/results --force` "
+                      "(see docs/editing.md); distances over the rest bbox diagonal, edge-length change relative "
+                      "to the rest lengths, areas as fractions of the rest areas. Times on a shared host, load "
+                      f"average {conditions['load_average'][0]:.1f} at the end (deformation.json): "
+                      "compare them within a run only.\n\n" + text + "\n" + images, args.force)
     return 0
 
 

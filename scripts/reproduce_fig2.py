@@ -84,8 +84,8 @@ def cow():
             ed = CurvatureEditor(V, F, np.empty(0, dtype=np.int64), handles, roi=roi, relations=relations)
             X = ed.solve(details=ed.detail[handles] @ R.T)
         else:
-            X, ed = edit_with_selection(V, F, status, T, handle_detail=handle_detail, relations=relations,
-                                        return_editor=True)
+            X, ed = edit_with_selection(V, F, status, T, method="paper", handle_detail=handle_detail,
+                                        relations=relations, return_editor=True)
         variant = f"{positions}/{handle_detail}/{relations}"
         moved = np.linalg.norm(X - V, axis=1)
         out[variant] = {"handle_positions": positions, "handle_detail": handle_detail, "relations": relations,

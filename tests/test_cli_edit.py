@@ -44,7 +44,7 @@ def test_edit_writes_the_mesh_with_fixed_and_handle_vertices_placed(tmp_path, ca
 
 def test_handle_detail_and_relations_options_change_only_the_interior(tmp_path):
     V, F, status, T, p = _case(tmp_path)
-    args = [str(p["off"]), "--sel", str(p["sel"]), "--def", str(p["def"])]
+    args = [str(p["off"]), "--sel", str(p["sel"]), "--def", str(p["def"]), "--method", "paper"]
     assert main(["edit", *args, str(tmp_path / "a.ply")]) == 0
     assert main(["edit", *args, str(tmp_path / "b.ply"), "--handle-detail", "free"]) == 0
     assert main(["edit", *args, str(tmp_path / "c.ply"), "--relations", "one+two-ring"]) == 0
@@ -57,9 +57,25 @@ def test_handle_detail_and_relations_options_change_only_the_interior(tmp_path):
     from curvdetail.curvature.geometry import bbox_diagonal
     from curvdetail.io.deformation import edit_with_selection
 
-    expected = edit_with_selection(V, F, status, T, relations="one+two-ring")
+    expected = edit_with_selection(V, F, status, T, method="paper", relations="one+two-ring")
     assert np.abs(C - expected).max() <= 1e-6 * bbox_diagonal(V)
-    assert np.abs(A - edit_with_selection(V, F, status, T)).max() <= 1e-6 * bbox_diagonal(V)
+    assert np.abs(A - edit_with_selection(V, F, status, T, method="paper")).max() <= 1e-6 * bbox_diagonal(V)
+
+
+def test_the_default_method_is_rotation_aware_and_refuses_the_paper_s_options(tmp_path, capsys):
+    from curvdetail.io.deformation import edit_with_selection
+
+    V, F, status, T, p = _case(tmp_path)
+    args = [str(p["off"]), "--sel", str(p["sel"]), "--def", str(p["def"])]
+    assert main(["edit", *args, str(tmp_path / "a.ply")]) == 0
+    assert "iterations" in capsys.readouterr().out
+    A = read_mesh(tmp_path / "a.ply")[0]
+    assert np.abs(A - edit_with_selection(V, F, status, T)).max() < 1e-6          # float32 PLY
+    assert np.abs(A - edit_with_selection(V, F, status, T, method="paper"))[status == 1].max() > 1e-3
+    for option in (["--relations", "one-ring"], ["--handle-detail", "free"]):
+        assert main(["edit", *args, str(tmp_path / "b.ply"), *option]) == 1
+        assert "--method" in capsys.readouterr().err
+        assert not (tmp_path / "b.ply").exists()
 
 
 def test_existing_output_is_refused_without_overwrite(tmp_path, capsys):
@@ -133,7 +149,7 @@ def test_a_selection_that_does_not_determine_the_edit_is_refused_with_what_to_ch
     write_selection(tmp_path / "q.sel", status)
     write_transform(tmp_path / "p.def", np.eye(4))
     rc = main(["edit", str(tmp_path / "plane.obj"), "--sel", str(tmp_path / "q.sel"), "--def",
-               str(tmp_path / "p.def"), str(tmp_path / "o.ply")])
+               str(tmp_path / "p.def"), str(tmp_path / "o.ply"), "--method", "paper"])
     err = capsys.readouterr().err
     assert rc == 1 and "do not determine the edit" in err
     # in the command's terms: the .sel file; not the library's roi, nor the default it already has
@@ -184,7 +200,8 @@ def test_an_edit_that_folds_triangles_is_written_with_exit_status_4(tmp_path, ca
     write_selection(paths["sel"], status)
     write_transform(paths["def"], T)
     out = tmp_path / "out.ply"
-    rc = main(["edit", str(paths["off"]), "--sel", str(paths["sel"]), "--def", str(paths["def"]), str(out)])
+    rc = main(["edit", str(paths["off"]), "--sel", str(paths["sel"]), "--def", str(paths["def"]), str(out),
+               "--method", "paper"])
     err = capsys.readouterr().err
     X = read_mesh(str(out))[0]
     moved = np.linalg.norm(X - V, axis=1)
@@ -193,6 +210,11 @@ def test_an_edit_that_folds_triangles_is_written_with_exit_status_4(tmp_path, ca
     assert folded.size == 12
     assert rc == 4
     assert f"warning: 12 of {F.shape[0]} triangles folded over" in err and "--relations one+two-ring" in err
+    # the default, rotation-aware edit of the same case folds nothing and exits 0
+    rc = main(["edit", str(paths["off"]), "--sel", str(paths["sel"]), "--def", str(paths["def"]),
+               str(tmp_path / "rotation.ply")])
+    assert rc == 0 and "warning" not in capsys.readouterr().err
+    assert folded_triangles(V, F, read_mesh(str(tmp_path / "rotation.ply"))[0], T[:3, :3]).size == 0
 
 
 def _mirrored_free_region(X, status):
@@ -214,10 +236,11 @@ def _blown_up_free_region(X, status):
 @pytest.mark.parametrize("spoil, warning", [(_mirrored_free_region, "folded over"),
                                             (_blown_up_free_region, "times as far as the handles")])
 @pytest.mark.parametrize("options, tries", [
-    ([], "try --relations one+two-ring or --handle-detail free."),
-    (["--relations", "one+two-ring"], "try --relations one-ring or --handle-detail free."),
-    (["--handle-detail", "free"], "try --relations one+two-ring."),
-    (["--handle-detail", "free", "--relations", "one+two-ring"], "try --relations one-ring."),
+    ([], "try more handles (status 2) or a larger free region (status 1)."),
+    (["--method", "paper"], "try --relations one+two-ring or --handle-detail free."),
+    (["--method", "paper", "--relations", "one+two-ring"], "try --relations one-ring or --handle-detail free."),
+    (["--method", "paper", "--handle-detail", "free"], "try --relations one+two-ring."),
+    (["--method", "paper", "--handle-detail", "free", "--relations", "one+two-ring"], "try --relations one-ring."),
 ])
 def test_the_warnings_suggest_only_options_not_in_use(tmp_path, capsys, monkeypatch, spoil, warning, options,
                                                       tries):
@@ -291,7 +314,7 @@ def test_a_backend_the_one_ring_stage_cannot_use_is_named_in_options(tmp_path, c
     V, F, status, T, p = _case(tmp_path)
     out = tmp_path / "out.ply"
     assert main(["edit", str(p["off"]), "--sel", str(p["sel"]), "--def", str(p["def"]), str(out),
-                 "--backend", "cholmod"]) == 1
+                 "--method", "paper", "--backend", "cholmod"]) == 1
     err = capsys.readouterr().err
     assert "(--backend: " in err and "one+two-ring" in err, err
     assert "do not determine" not in err and not out.exists()

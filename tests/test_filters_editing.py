@@ -50,12 +50,37 @@ def test_handles_follow_the_transform_and_unselected_vertices_stay():
     assert figures["amplification"] == pytest.approx(1.0, abs=0.05)   # nothing outruns a translation
 
 
+def test_the_default_rotation_aware_edit_turns_the_region_without_warning():
+    # the handles turned by 60 degrees about their centre: the paper's one-ring edit of this
+    # kind amplified or folded (see the status-4 test); the default runs silently, reports its
+    # iterations, and leaves the coefficient counts it does not compute as None
+    ms, V, d, handles = _meshset_with_roi()
+    c = V[handles].mean(axis=0)
+    T = np.eye(4)
+    T[:2, :2] = [[np.cos(1.0), -np.sin(1.0)], [np.sin(1.0), np.cos(1.0)]]
+    T[:3, 3] = c - T[:3, :3] @ c
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        figures = apply(ms, "apply_curvature_editing", handles=handles, transform=T)
+    assert figures["folded_triangles"] == 0 and figures["iterations"] >= 1
+    assert figures["amplification"] < AMPLIFICATION_LIMIT
+    assert figures["rank_deficient_vertices"] is None and figures["detail_amplification"] is None
+
+
+@pytest.mark.parametrize("params", [dict(detail_scale=0.5), dict(move_handles=False)])
+def test_paper_only_parameters_are_refused_with_the_rotation_aware_method(params):
+    ms, V, d, handles = _meshset_with_roi()
+    with pytest.raises(FilterParameterError, match="method='paper'"):
+        apply(ms, "apply_curvature_editing", handles=handles, **params)
+    assert np.array_equal(ms.current_mesh().vertex_matrix(), V)
+
+
 def test_amplification_is_none_where_the_handles_do_not_move():
     # a pure detail edit moves the region but not the handles: the ratio was reported as 1.0, and
     # rounding noise with move_handles=false as 3.4 (above the CLI's warning threshold);
     # one+two-ring relations: the one-ring ones fold 6 triangles here (see the fold test below)
     ms, V, d, handles = _meshset_with_roi()
-    figures = apply(ms, "apply_curvature_editing", handles=" ".join(map(str, handles)), detail_scale=0.5,
+    figures = apply(ms, "apply_curvature_editing", method="paper", handles=" ".join(map(str, handles)), detail_scale=0.5,
                     relations="one+two-ring")
     assert figures["amplification"] is None and figures["max_displacement_percent_of_diagonal"] > 0.1
 
@@ -68,14 +93,14 @@ def test_a_detail_edit_reports_its_amplification_in_the_details():
     ms, V, d, handles = _meshset_with_roi()
     with warnings.catch_warnings():
         warnings.simplefilter("error")                      # nothing folds or is amplified
-        figures = apply(ms, "apply_curvature_editing", handles=handles, detail_scale=0.5,
+        figures = apply(ms, "apply_curvature_editing", method="paper", handles=handles, detail_scale=0.5,
                         move_handles=False, relations="one+two-ring")
     assert figures["amplification"] is None
     assert 0.05 < figures["detail_amplification"] < 1.0
     assert figures["folded_triangles"] == 0
     # a translation asks no detail change
     ms, *_ = _meshset_with_roi()
-    figures = apply(ms, "apply_curvature_editing", handles=handles, transform="1 0 0 0 0 1 0 0 0 0 1 0.02 0 0 0 1")
+    figures = apply(ms, "apply_curvature_editing", method="paper", handles=handles, transform="1 0 0 0 0 1 0 0 0 0 1 0.02 0 0 0 1")
     assert figures["detail_amplification"] is None and figures["amplification"] == pytest.approx(1.0, abs=0.05)
 
 
@@ -95,7 +120,7 @@ def test_a_detail_edit_that_folds_triangles_warns_with_the_count_and_what_to_try
                                                     r"\d+ triangles of 2403 folded over .*first: \d+, \d+, \d+\).*"
                                                     r"try relations='one\+two-ring', more handles, a "
                                                     r"detail_scale closer to 1 or a larger region") as record:
-        figures = apply(ms, "apply_curvature_editing", handles=handles, detail_scale=2.0)
+        figures = apply(ms, "apply_curvature_editing", method="paper", handles=handles, detail_scale=2.0)
     X = ms.current_mesh().vertex_matrix()
     assert figures["folded_triangles"] == _folded(V, X, F) > 100
     assert f"{figures['folded_triangles']} triangles of 2403" in str(record[0].message)
@@ -104,7 +129,7 @@ def test_a_detail_edit_that_folds_triangles_warns_with_the_count_and_what_to_try
     ms, *_ = _meshset_with_roi()
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        figures = apply(ms, "apply_curvature_editing", handles=handles, detail_scale=2.0, relations="one+two-ring")
+        figures = apply(ms, "apply_curvature_editing", method="paper", handles=handles, detail_scale=2.0, relations="one+two-ring")
     assert figures["folded_triangles"] == _folded(V, ms.current_mesh().vertex_matrix(), F) == 0
 
 
@@ -146,13 +171,13 @@ def test_a_detail_edit_amplified_without_folds_warns_with_the_ratio():
     with pytest.warns(AmplifiedEditWarning, match=r"the details changed up to \d+\.\d times as much as the "
                                                   r"edit asks of the region \(vertex \d+\).*amplified.*try "
                                                   r"relations='one\+two-ring'"):
-        amplified = apply(ms, "apply_curvature_editing", **edit)
+        amplified = apply(ms, "apply_curvature_editing", method="paper", **edit)
     assert amplified["folded_triangles"] == 0 and amplified["amplification"] is None
     assert amplified["detail_amplification"] > 3.0 * AMPLIFICATION_LIMIT          # 14.2
     ms, *_ = _terrain_handles()
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        steady = apply(ms, "apply_curvature_editing", relations="one+two-ring", **edit)
+        steady = apply(ms, "apply_curvature_editing", method="paper", relations="one+two-ring", **edit)
     assert steady["detail_amplification"] < 1.05                                   # 0.80
     assert amplified["max_displacement_percent_of_diagonal"] > 5.0 * steady["max_displacement_percent_of_diagonal"]
 
@@ -181,14 +206,14 @@ def test_the_filter_warns_where_curvdetail_edit_exits_with_status_4(tmp_path, ca
     for relations, rc in (("one-ring", 4), ("one+two-ring", 0)):
         out = tmp_path / f"{relations}.ply"
         assert main(["edit", str(tmp_path / "nose.off"), "--sel", str(tmp_path / "nose.sel"), "--def",
-                     str(tmp_path / "nose.def"), str(out), "--relations", relations]) == rc
+                     str(tmp_path / "nose.def"), str(out), "--method", "paper", "--relations", relations]) == rc
         err = capsys.readouterr().err
         ms = pymeshlab.MeshSet()
         ms.add_mesh(pymeshlab.Mesh(vertex_matrix=V, face_matrix=F))
         with warnings.catch_warnings(record=True) as said:
             warnings.simplefilter("always")
-            figures = apply(ms, "apply_curvature_editing", handles=handles, transform=T, relations=relations,
-                            region_radius=BBoxLength(radius, percent=False))
+            figures = apply(ms, "apply_curvature_editing", method="paper", handles=handles, transform=T,
+                            relations=relations, region_radius=BBoxLength(radius, percent=False))
         assert figures["roi_vertices"] == int(np.count_nonzero(status))
         if rc == 4:
             assert figures["amplification"] > AMPLIFICATION_LIMIT                  # 4.26
@@ -200,7 +225,7 @@ def test_the_filter_warns_where_curvdetail_edit_exits_with_status_4(tmp_path, ca
             assert said == []
         # and `curvdetail apply` with the filter exits as `edit` does, the warning on stderr
         params = [f"handles={' '.join(map(str, handles))}", f"transform={' '.join(map(repr, T.ravel().tolist()))}",
-                  f"relations={relations}", f"region_radius={float(radius)!r}"]
+                  "method=paper", f"relations={relations}", f"region_radius={float(radius)!r}"]
         assert main(["apply", "apply_curvature_editing", str(tmp_path / "nose.off"), str(tmp_path / f"a-{relations}.ply"),
                      *[a for p in params for a in ("--param", p)]]) == rc
         err = capsys.readouterr().err
@@ -224,7 +249,7 @@ def test_detail_scale_below_1_shortens_a_protrusion_and_the_description_says_so(
         base = V[boundary_vertices(F)].mean(axis=0)
         tip = int(np.argmax(np.linalg.norm(V - base, axis=1)))
         handles = np.flatnonzero(np.linalg.norm(V - V[tip], axis=1) < 0.05 * np.linalg.norm(np.ptp(V, axis=0)))
-        apply(ms, "apply_curvature_editing", handles=handles, region_radius=pymeshlab.PercentageValue(40.0),
+        apply(ms, "apply_curvature_editing", method="paper", handles=handles, region_radius=pymeshlab.PercentageValue(40.0),
               detail_scale=scale, move_handles=False)
         X = ms.current_mesh().vertex_matrix()
         lengths[scale] = np.linalg.norm(X[tip] - base) / np.linalg.norm(V[tip] - base)
@@ -253,7 +278,7 @@ def test_ring_figures_count_the_region_not_the_whole_mesh(centre, radius):
 
     ms, V, F = _bump_on_a_plane()
     handles = np.flatnonzero(np.linalg.norm(V[:, :2] - centre, axis=1) < 0.05)
-    figures = apply(ms, "apply_curvature_editing", handles=handles, region_radius=BBoxLength(radius, percent=False),
+    figures = apply(ms, "apply_curvature_editing", method="paper", handles=handles, region_radius=BBoxLength(radius, percent=False),
                     transform="1 0 0 0 0 1 0 0 0 0 1 0.01 0 0 0 1", relations="one+two-ring")
     roi = np.flatnonzero(cKDTree(V[handles]).query(V)[0] <= radius)
     assert figures["roi_vertices"] == roi.size
@@ -295,7 +320,7 @@ def test_identity_edit_leaves_the_mesh_in_place():
 def test_filter_is_declared_with_its_parameters():
     spec = get_filter("apply_curvature_editing")
     assert spec.category == "Curvature detail"
-    expected = {"handles", "transform", "detail_scale", "move_handles", "handle_detail", "relations"}
+    expected = {"handles", "transform", "method", "detail_scale", "move_handles", "handle_detail", "relations"}
     assert expected <= set(spec.parameter_names)
 
 
@@ -326,7 +351,7 @@ def test_an_overflowing_edit_is_refused_before_the_mesh_is_touched(params, messa
     # before, the positions were written and only then the quality's infinities refused
     ms, V, d, handles = _meshset_with_roi()
     with pytest.raises(FilterParameterError, match=message):
-        apply(ms, "apply_curvature_editing", handles=" ".join(map(str, handles)), **params)
+        apply(ms, "apply_curvature_editing", method="paper", handles=" ".join(map(str, handles)), **params)
     assert np.array_equal(ms.current_mesh().vertex_matrix(), V)
 
 
@@ -368,12 +393,12 @@ def test_an_edit_the_handles_do_not_determine_is_refused_with_the_filter_s_optio
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=V, face_matrix=F))
     # free handle details on a flat grid: nothing ties the in-plane rings of the region down
     with pytest.raises(UndeterminedEditError, match="do not determine the edit.*more handles, handle_detail") as exc:
-        apply(ms, "apply_curvature_editing", handles="450 451 480", handle_detail="free",
+        apply(ms, "apply_curvature_editing", method="paper", handles="450 451 480", handle_detail="free",
               region_radius=pymeshlab.PercentageValue(45.0))
     assert "roi" not in str(exc.value)              # the filter's terms, not the library's
     assert np.array_equal(ms.current_mesh().vertex_matrix(), V)      # untouched
     # the advice works: the handles' details given
-    report = apply(ms, "apply_curvature_editing", handles="450 451 480", handle_detail="transform",
+    report = apply(ms, "apply_curvature_editing", method="paper", handles="450 451 480", handle_detail="transform",
                    region_radius=pymeshlab.PercentageValue(45.0))
     assert report["max_displacement_percent_of_diagonal"] < 1e-10
 
@@ -396,11 +421,11 @@ def test_a_selected_piece_with_one_handle_is_refused_in_the_filter_s_terms():
     T[2, 3] = 1.0
     with pytest.raises(UndeterminedEditError, match="wholly inside the edited region with only 1 detail "
                                                     "constraint.*Use more handles") as exc:
-        apply(ms, "apply_curvature_editing", handles=[n + 5], transform=T)
+        apply(ms, "apply_curvature_editing", method="paper", handles=[n + 5], transform=T)
     assert "roi" not in str(exc.value)
     assert np.array_equal(ms.current_mesh().vertex_matrix(), V2)      # untouched
     # three handles determine it: the translation moves the piece as a whole
-    apply(ms, "apply_curvature_editing", handles=[n + 5, n + 200, n + 400], transform=T)
+    apply(ms, "apply_curvature_editing", method="paper", handles=[n + 5, n + 200, n + 400], transform=T)
     X = ms.current_mesh().vertex_matrix()
     assert np.array_equal(X[:n], V)
     assert np.abs(X[n:] - (V2[n:] + [0.0, 0.0, 1.0])).max() < 1e-8 * np.linalg.norm(np.ptp(V, axis=0))
@@ -520,17 +545,17 @@ def test_a_translation_with_move_handles_false_is_refused_as_doing_nothing():
     ms, V, d, handles = _meshset_with_roi()
     shift = "1 0 0 0.1 0 1 0 0 0 0 1 0 0 0 0 1"
     with pytest.raises(FilterParameterError, match="only translates, and move_handles=false .* nothing would move"):
-        apply(ms, "apply_curvature_editing", handles=" ".join(map(str, handles)), transform=shift,
+        apply(ms, "apply_curvature_editing", method="paper", handles=" ".join(map(str, handles)), transform=shift,
               move_handles=False)
     assert np.array_equal(ms.current_mesh().vertex_matrix(), V)
     # what the advice names works: the handles move by the translation
-    apply(ms, "apply_curvature_editing", handles=" ".join(map(str, handles)), transform=shift,
+    apply(ms, "apply_curvature_editing", method="paper", handles=" ".join(map(str, handles)), transform=shift,
           move_handles=True)
     X = ms.current_mesh().vertex_matrix()
     assert np.allclose(X[handles] - V[handles], [0.1, 0.0, 0.0], atol=1e-12)
     # and so does a detail_scale with the handles left free to move (the details change)
     ms2, V2, _, _ = _meshset_with_roi()
-    apply(ms2, "apply_curvature_editing", handles=" ".join(map(str, handles)), transform=shift,
+    apply(ms2, "apply_curvature_editing", method="paper", handles=" ".join(map(str, handles)), transform=shift,
           move_handles=False, detail_scale=1.1)
     assert np.abs(ms2.current_mesh().vertex_matrix() - V2).max() > 1e-4 * np.linalg.norm(np.ptp(V2, axis=0))
 

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from curvdetail import CurvatureEditor
+from curvdetail.curvature.rotation_editor import RotationAwareEditor
 from curvdetail.curvature.errors import ConstraintError, MeshError
 from curvdetail.curvature.testing import grid
 from curvdetail.io.deformation import (DeformationFileError, apply_transform, edit_with_selection,
@@ -117,7 +118,7 @@ def test_writers_refuse_to_overwrite(tmp_path):
 def test_fixed_vertices_stay_and_handles_land_on_their_transformed_positions(mode, relations):
     V, F, status = _strip()
     T = _similarity(0.4, 1.0, [0.0, 0.3, 0.5])
-    X = edit_with_selection(V, F, status, T, handle_detail=mode, relations=relations)
+    X = edit_with_selection(V, F, status, T, method="paper", handle_detail=mode, relations=relations)
     fixed, handles = status == 0, status == 2
     assert np.array_equal(X[fixed], V[fixed])
     assert np.array_equal(X[handles], apply_transform(T, V[handles]))
@@ -130,7 +131,7 @@ def test_free_vertices_are_the_editors_solution_for_the_prescribed_constraints(m
     # details T_3x3 D ("transform") or unknown ("free"); the free vertices are the editor's answer
     V, F, status = _strip()
     T = _similarity(0.4, 1.0, [0.0, 0.3, 0.5])
-    X = edit_with_selection(V, F, status, T, handle_detail=mode)
+    X = edit_with_selection(V, F, status, T, method="paper", handle_detail=mode)
     handles = np.flatnonzero(status == 2)
     ed = CurvatureEditor(V, F, handles, handles if mode == "transform" else [], roi=np.flatnonzero(status != 0))
     Y = ed.solve(positions=apply_transform(T, V[handles]),
@@ -139,6 +140,20 @@ def test_free_vertices_are_the_editors_solution_for_the_prescribed_constraints(m
     assert np.abs(X - Y).max() < 1e-12
     # and they did follow the handles: lifted part of the way, between the fixed end and the handle
     assert 0.0 < X[free, 2].min() and X[free, 2].max() < 0.5 + 1e-9
+
+
+def test_the_default_is_the_rotation_aware_editor_and_paper_options_are_refused_with_it():
+    V, F, status = _strip()
+    T = _similarity(0.4, 1.0, [0.0, 0.3, 0.5])
+    X, ed = edit_with_selection(V, F, status, T, return_editor=True)
+    handles = np.flatnonzero(status == 2)
+    alone = RotationAwareEditor(V, F, handles, roi=np.flatnonzero(status != 0))
+    assert np.abs(X - alone.solve(apply_transform(T, V[handles]))).max() < 1e-12
+    assert ed.converged and ed.iterations >= 1
+    for option in ({"handle_detail": "free"}, {"relations": "one+two-ring"}):
+        with pytest.raises(ValueError) as e:
+            edit_with_selection(V, F, status, T, **option)
+        assert e.value.parameter == next(iter(option))
 
 
 def test_a_transform_beyond_double_precision_is_named():
@@ -178,10 +193,11 @@ def test_bad_selections_are_refused_with_their_counts():
 def test_unknown_handle_detail_mode_is_refused():
     V, F, status = _strip()
     with pytest.raises(ValueError, match="handle_detail"):
-        edit_with_selection(V, F, status, np.eye(4), handle_detail="rotate")
+        edit_with_selection(V, F, status, np.eye(4), method="paper", handle_detail="rotate")
     # an array was compared element-wise: numpy's "truth value ... is ambiguous" for two entries
     with pytest.raises(ValueError, match="handle_detail"):
-        edit_with_selection(V, F, status, np.eye(4), handle_detail=np.array(["transform", "free"]))
+        edit_with_selection(V, F, status, np.eye(4), method="paper",
+                            handle_detail=np.array(["transform", "free"]))
 
 
 def test_a_small_uniform_scaling_is_no_singular_transform(tmp_path):

@@ -339,10 +339,12 @@ def _edit(parser):
     parser.add_argument("--sel", required=True, metavar="SEL", help="per-vertex status: 0 fixed, 1 free, 2 handle")
     parser.add_argument("--def", dest="transform", required=True, metavar="DEF",
                         help="4x4 handle transform applied to homogeneous handle positions")
-    choice(parser, "--handle-detail", ("transform", "free"), "transform",
-           "handles' curvature details: transformed by the linear part of DEF (default) or solved")
-    choice(parser, "--relations", ("one-ring", "one+two-ring"), "one-ring",
-           "curvature stage: the paper's one-ring coefficients or one- and two-ring together (steadier)")
+    choice(parser, "--method", ("rotation", "paper"), "rotation",
+           "rotation: rest details turned with their neighbourhoods (default); paper: the paper's linear edit")
+    choice(parser, "--handle-detail", ("transform", "free"), None,
+           "--method paper: handles' curvature details transformed by the linear part of DEF (default) or solved")
+    choice(parser, "--relations", ("one-ring", "one+two-ring"), None,
+           "--method paper: the paper's one-ring coefficients (default) or one- and two-ring together")
     parser.add_argument("--image", metavar="PNG", help="also save a picture: rest (by status) | edited")
     add_backend(parser)
     add_overwrite(parser, also=("--image",))
@@ -351,18 +353,22 @@ def _edit(parser):
         import numpy as np
 
         from ..curvature.geometry import folded_triangles
-        from ..curvature.errors import UndeterminedEditError
+        from ..curvature.errors import CurvdetailError, UndeterminedEditError
         from ..io.deformation import edit_with_selection, read_selection, read_transform
         from ..plot import save_panels
 
         check_outputs(args, [("OUTPUT", args.output, True), ("--image", args.image, False)],
                       inputs=[("MESH", args.mesh)], other_inputs=[("--sel", args.sel), ("--def", args.transform)])
+        paper = args.method == "paper"
+        if not paper and (args.handle_detail or args.relations):
+            raise CurvdetailError("--handle-detail and --relations apply to --method paper only",
+                                  parameter="--method", hint="add --method paper, or drop them")
         V, F = read_checked(args.mesh)
         status = read_selection(args.sel, V.shape[0])
         T = read_transform(args.transform)
         t = time.perf_counter()
         try:
-            X, editor = edit_with_selection(V, F, status, T, handle_detail=args.handle_detail,
+            X, editor = edit_with_selection(V, F, status, T, method=args.method, handle_detail=args.handle_detail,
                                             relations=args.relations, backend=args.backend, return_editor=True)
         except UndeterminedEditError as exc:
             raise UndeterminedEditError(exc.problem, f"Add handles (status 2) or fixed vertices (status 0) "
@@ -371,16 +377,18 @@ def _edit(parser):
         moved = np.linalg.norm(X - V, axis=1)
         if args.image:
             save_panels(args.image, [(V, F, "rest (status 0/1/2)", status),
-                                     (X, F, f"edited (handle detail: {args.handle_detail})", moved)],
+                                     (X, F, f"edited ({args.method})", moved)],
                                   overwrite=args.overwrite)
         write_measured(args.output, X, F, moved, diagonal_of=V, overwrite=args.overwrite)
         counts = np.bincount(status, minlength=3)
+        solver = (f"{editor.rank_deficient} rank-deficient rings, {editor.detail_islands} island vertices" if paper
+                  else f"{editor.iterations} iterations{'' if editor.converged else ' (not converged)'}")
         print_figures(f"{V.shape[0]} vertices ({counts[0]} fixed, {counts[1]} free, {counts[2]} handles); largest "
-                      f"move {moved.max() / diagonal(V):.3e} of the bbox diagonal; {editor.rank_deficient} "
-                      f"rank-deficient rings, {editor.detail_islands} island vertices; {seconds:.3f} s")
+                      f"move {moved.max() / diagonal(V):.3e} of the bbox diagonal; {solver}; {seconds:.3f} s")
         note_dropped(args.output, quality=True)
         other = "one-ring" if args.relations == "one+two-ring" else "one+two-ring"
-        tries = f"--relations {other}" + (" or --handle-detail free" if args.handle_detail == "transform" else "")
+        tries = (f"--relations {other}" + (" or --handle-detail free" if args.handle_detail != "free" else "")
+                 if paper else "more handles (status 2) or a larger free region (status 1)")
         code = 0
         handle_move = moved[status == 2].max(initial=0.0)
         if moved.max() > 3.0 * handle_move + 1e-12 * diagonal(V):
@@ -395,6 +403,16 @@ def _edit(parser):
         return code
 
     return run
+
+
+# --- evaluate -------------------------------------------------------------------------------
+
+@command("evaluate", help="run a study: mesh files x remeshing configurations, on Dask, into a results "
+                          "table (exit status 0 when it ran, failed cells included)")
+def _evaluate(parser):
+    from .evaluate import add_arguments
+
+    return add_arguments(parser)
 
 
 # --- entry point ----------------------------------------------------------------------------

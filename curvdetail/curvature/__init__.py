@@ -16,11 +16,12 @@ from .mean_curvature_normal import mean_curvature_normal
 from .minimal_surface import minimal_surface
 from .mixed_voronoi_area import mixed_voronoi_area
 from .reconstruct import Reconstructor, reconstruct
+from .rotation_editor import RotationAwareEditor
 from .sparse_solver import SolverError, available_backends
 
 __all__ = [
-    "CoefficientInfo", "ConstraintError", "CurvatureEditor", "MeshError", "Reconstructor", "SolverError",
-    "anchor_vertices",
+    "CoefficientInfo", "ConstraintError", "CurvatureEditor", "MeshError", "Reconstructor", "RotationAwareEditor",
+    "SolverError", "anchor_vertices",
     "available_backends", "boundary_edges", "boundary_loop", "boundary_vertices", "check_mesh",
     "cotan_laplacian", "curvature_coefficients", "curvature_detail", "edit_boundary", "mean_curvature_normal",
     "minimal_surface", "mixed_voronoi_area", "reconstruct", "sine_displacement",

@@ -3,28 +3,24 @@
 import time
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
-from .checks import as_index_set, as_values, check_bool, check_choice
+from .checks import as_values, check_bool, check_choice
 from .geometry import bbox_centre, bbox_diagonal, centroid_diameter
-from .topology import vertex_components
 from .cotan_laplacian import checked_cotan_laplacian, laplacian_product
 from .curvature_coefficients import (DEFAULT_MAX_RING, DEFAULT_RCOND, _coefficients, _one_ring_pairs, check_max_ring,
                                      check_rcond)
+from ._editor_checks import (RELATIONS, _check_pieces_detail_constrained, _check_reached, _check_relations,  # noqa: F401
+                             _check_whole_mesh_constraints,
+                             _detail_islands, _index_set, _pattern, _positions_in, _two_ring_pairs, embedding_system,
+                             region_mask,                              square_curvature_system, stacked_curvature_system)
 from .errors import ConstraintError, UndeterminedEditError, counted, first_indices
 from .mixed_voronoi_area import _mixed_voronoi_area_unchecked
 from .reconstruct import refine_least_squares
 from .sparse_solver import SolverError, _chosen_automatically, factorize, resolve_backend
 
 
-RELATIONS = ("one-ring", "one+two-ring")
-
-#: Below this many free-detail unknowns "auto" factors the curvature stage (I - C) with SuperLU,
-#: from it on with the general "auto" choice (PARDISO where installed). Measured on a height-field
-#: grid (2 cores), factor / three-column solve: 100k SuperLU 1.1 / 0.073 s, PARDISO 0.7 / 0.114 s;
-#: 300k 4.1 / 0.30 against 2.1 / 0.33 s; 1M 24 / 0.85 against 8.5 / 1.0 s (SuperLU's
-#: factorization grows faster than linearly).
+#: Below this many free-detail unknowns "auto" factors the curvature stage (I - C) with SuperLU
+#: (faster back-substitution), from it on with the general "auto" choice (faster factoring).
 CURVATURE_SPLU_MAX = 300_000
 
 #: Largest distance (over the bbox diagonal) at which the rest constraints may give back the
@@ -121,14 +117,9 @@ class CurvatureEditor:
     >>> X = ed.solve(positions=V[b], details=ed.detail[b])  # back-substitution only
     >>> bool(abs(X - V).max() < 1e-9)
     True
-    >>> X = ed.solve(positions=V[b] + [0, 0, 0.5], details=ed.detail[b])   # lift the frame
-    >>> bool(np.allclose(X, V + [0, 0, 0.5]))
-    True
     """
 
-    #: corrected semi-normal refinement steps of every normal-equation solve: the ``rows="all"``
-    #: embedding and the ``"one+two-ring"`` curvature stage (each one more back-substitution);
-    #: 0 gives the plain normal-equation solutions (~cond^2 eps)
+    #: corrected semi-normal refinement steps of every normal-equation solve (0: none)
     refinement_steps = 1
 
     def __init__(self, V, F, position_constrained, detail_constrained, *, roi=None,
@@ -150,38 +141,15 @@ class CurvatureEditor:
         V, F, L = checked_cotan_laplacian(V, F)       # every mesh check, and L in the same pass
         self.relations = relations
         n = V.shape[0]
-        # own read-only copies: the checks pass a contiguous caller array through, and an edit of
-        # it afterwards would reach the vertices outside the ROI but not L or the coefficients
+        # own read-only copies: a later edit of the caller's array must not reach the editor
         V, F = V.copy(), F.copy()
         V.flags.writeable = F.flags.writeable = False
         self.n, self.V, self.F, self.rows = n, V, F, rows
         pc = _index_set(position_constrained, n, "position_constrained", "positions")
         dc = _index_set(detail_constrained, n, "detail_constrained", "details")
-        in_roi = np.ones(n, dtype=bool)
-        if roi is not None:
-            r = _index_set(roi, n, "roi")
-            if r.size == 0:
-                raise ConstraintError("roi is empty: nothing would be edited. Pass the vertices to "
-                                      "edit, or roi=None for the whole mesh.")
-            in_roi[:] = False
-            in_roi[r] = True
-        whole = bool(in_roi.all())
-        for name, idx in (("position_constrained", pc), ("detail_constrained", dc)):
-            out = idx[~in_roi[idx]]
-            if out.size:
-                raise ConstraintError(
-                    f"{name}: {counted(out.size, 'vertex', 'vertices', verb='lie')} outside the roi (first: {first_indices(out)}); "
-                    "vertices outside the roi are fixed already. Add them to the roi or drop them.")
-        if whole and pc.size == 0:
-            raise ConstraintError("position_constrained is empty and the roi is the whole mesh: the "
-                                  "result is only determined up to a translation. Constrain at least "
-                                  "one vertex per connected piece, or pass a smaller roi.")
-        if whole and dc.size < 3:
-            state = "is empty" if dc.size == 0 else f"has only {counted(dc.size, 'vertex', 'vertices')}"
-            raise ConstraintError(f"detail_constrained {state} and the roi is the whole mesh: the "
-                                  "curvature stage is only determined up to a linear map (9 unknowns, "
-                                  "3 per constrained detail). Constrain the details of at least three "
-                                  "vertices (e.g. the handles), or pass a smaller roi.")
+        in_roi = region_mask(n, roi, (("position_constrained", pc), ("detail_constrained", dc)))
+        if in_roi.all():
+            _check_whole_mesh_constraints(pc, dc)
         _check_pieces_detail_constrained(F, in_roi, dc)
         self.position_constrained, self.detail_constrained = pc, dc
         self.roi = np.flatnonzero(in_roi)
@@ -241,13 +209,9 @@ class CurvatureEditor:
                         "embedding": self._embed.backend if self._embed else "none"}
 
     def _check_rest_state(self):
-        """Distance from ``V`` (over the bbox diagonal) of the shape the rest constraints give;
-        UndeterminedEditError above :data:`MAX_REST_ERROR`.
-
-        The rest state solves both stages exactly, so anything but rounding means a system
-        singular to working precision. Both stages are linear: the shape's error is the
-        embedding's response to the curvature stage's rest-detail error (one unrefined
-        back-substitution of each stage; the embedding's own rounding is not counted)."""
+        """Distance from ``V`` (over the bbox diagonal) of the shape the rest constraints give
+        (the embedding's response to the curvature stage's rest-detail error: anything but
+        rounding is a singular system); UndeterminedEditError above :data:`MAX_REST_ERROR`."""
         error = 0.0
         if self._curv is not None and self._embed is not None:
             dc_rest = self.detail[self._dc]
@@ -268,12 +232,9 @@ class CurvatureEditor:
         return error
 
     def _check_rest_details(self):
-        """Every roi position given: the shape is exact whatever the curvature stage gives, so the
-        rest check looks at the details, which only :meth:`solve_details` and ``solve(...,
-        return_details=True)`` return: where the rest constraints give back details further than
-        :data:`MAX_REST_ERROR` of the roi's largest rest detail from the rest ones, those two raise
-        UndeterminedEditError (a flat grid with three detail constraints: 0.2 off, returned
-        without a word, as the shape's check had nothing to measure); positions are still solved."""
+        """Every roi position given: where the rest constraints give back details further than
+        :data:`MAX_REST_ERROR` of the roi's largest rest detail from the rest ones,
+        :meth:`solve_details` and ``solve(..., return_details=True)`` raise UndeterminedEditError."""
         Du = self._curvature_solve(self.detail[self._dc])
         scale = float(np.linalg.norm(self.detail[self.roi], axis=1).max())
         error = float(np.linalg.norm(Du - self.detail[self._fd], axis=1).max())
@@ -296,9 +257,7 @@ class CurvatureEditor:
                 "smaller roi.")
 
     def _factor_curvature_stage(self, M, symmetric, backend):
-        """factorize(M), a failure named as constraints that do not determine the edit (an
-        exactly singular stage: the cylinder with free handle details and one+two-ring
-        relations, where PARDISO stopped with only "error -4")."""
+        """factorize(M), a failure named as constraints that do not determine the edit."""
         try:
             return factorize(M, symmetric=symmetric, backend=backend)
         except SolverError as exc:
@@ -307,102 +266,27 @@ class CurvatureEditor:
                                         f"constraints ({exc})", self._undetermined_advice()) from None
 
     def _square_system(self, D, in_roi, free_d, fd, dc, at_fd, at_dc, rows, cols, cvals, curv_backend):
-        """The paper's linear-system form: (I - C)_uu D_u = C_uk D_k over the free rows (square,
-        not symmetric). The paper's implementation minimized |(I - C) D|^2 over all rows instead;
-        through normal equations that squares a condition number of up to 1e14 (docs/editing.md)."""
-        r_in = free_d[rows]
-        both = r_in & free_d[cols]
-        M = sp.csr_matrix((np.concatenate([-cvals[both], np.ones(fd.size)]),
-                           (np.concatenate([at_fd[rows[both]], np.arange(fd.size)]),
-                            np.concatenate([at_fd[cols[both]], np.arange(fd.size)]))),
-                          shape=(fd.size, fd.size))
-        to_dc = r_in & (at_dc[cols] >= 0)
-        self._C_dc = sp.csr_matrix((cvals[to_dc], (at_fd[rows[to_dc]], at_dc[cols[to_dc]])),
-                                   shape=(fd.size, dc.size))
-        # constant term: the exterior details as in V (C_u,ext D_ext), plus the rest detail's
-        # residual (I - C) D kept as it is: rank-deficient rings (a grid's valence-2 corners, flat
-        # regions) do not reproduce their detail, and (I - C)_uu amplified that into a rest shape
-        # 5 diagonals off with 8 handles. Together: D_u - C_u,roi D_roi at rest, so the rest
-        # state solves the system exactly
-        inside = r_in & in_roi[cols]
-        w = cvals[inside][:, None] * D[cols[inside]]
-        self._d_const = D[fd] - np.stack([np.bincount(at_fd[rows[inside]], weights=w[:, k], minlength=fd.size)
-                                          for k in range(3)], axis=1)
+        """The paper's linear-system form (see :func:`square_curvature_system`)."""
+        M, self._C_dc, self._d_const = square_curvature_system(D, in_roi, free_d, fd, dc, at_fd, at_dc,
+                                                               rows, cols, cvals)
         # "auto" takes SuperLU (symmetric mode, no pivoting) for (I - C) below CURVATURE_SPLU_MAX
         # unknowns, for its faster back-substitution (see there).
         self._curv = self._factor_curvature_stage(M, False, curv_backend) if fd.size else None
         self._Au = None                                     # square: solved exactly, no refinement
 
     def _stacked_system(self, D, in_roi, fd, dc, at_fd, at_dc, rel1, rel2, backend):
-        """Least squares over the region's rows of both (I - C1) and (I - C2): normal equations
-        ``(A_u^T A_u) D_u = -A_u^T (A_dc D_dc + A_ext D_ext)``, symmetric positive definite."""
-        n = D.shape[0]
-        roi = np.flatnonzero(in_roi)
-        at_roi = _positions_in(roi, n)
-        r_parts, c_parts, v_parts = [], [], []
-        for k, (r, c, v) in enumerate((rel1, rel2)):
-            keep = in_roi[r]
-            r_parts += [k * roi.size + at_roi[r[keep]], k * roi.size + np.arange(roi.size)]
-            c_parts += [c[keep], roi]
-            v_parts += [-v[keep], np.ones(roi.size)]
-        mr, mc, mv = np.concatenate(r_parts), np.concatenate(c_parts), np.concatenate(v_parts)
-        m = 2 * roi.size
-        k = at_fd[mc] >= 0
-        Au = sp.csr_matrix((mv[k], (mr[k], at_fd[mc[k]])), shape=(m, fd.size))
-        k = at_dc[mc] >= 0
-        Bdc = sp.csr_matrix((mv[k], (mr[k], at_dc[mc[k]])), shape=(m, dc.size))
-        AuT = Au.T.tocsr()
-        # the least squares |A_u D_u - b| with b = b_rest - A_dc D_dc: b_rest holds the exterior
-        # details as in V and the rest residual of every stacked row, kept as it is (see
-        # _square_system), so that the rest state solves it exactly. Au and its transpose are
-        # kept for the corrected semi-normal refinement (_curvature_solve): the normal equations
-        # square the coefficients' condition number (fandisk, 3 handles: the rest shape 7e-3 ...
-        # 3e-2 of the diagonal off without it)
-        self._Au, self._AuT, self._Bdc = Au, AuT, Bdc
-        self._b_rest = Au @ D[fd] + Bdc @ D[dc]
-        self._curv = self._factor_curvature_stage((AuT @ Au).tocsr(), True, backend) if fd.size else None
+        """Both relations in least squares (see :func:`stacked_curvature_system`)."""
+        self._Au, self._AuT, self._Bdc, self._b_rest = stacked_curvature_system(D, in_roi, fd, dc, at_fd, at_dc,
+                                                                                rel1, rel2)
+        normal = (self._AuT @ self._Au).tocsr()
+        self._curv = self._factor_curvature_stage(normal, True, backend) if fd.size else None
 
     def _embedding(self, L, V, F, in_roi, pc, rows, cols, backend):
-        """E_Q over the rows that involve the free positions (normal equations) or the free rows."""
-        n = V.shape[0]
-        free_p = in_roi.copy()
-        free_p[pc] = False
-        _check_reached(rows, cols, free_p, n, "position", "position_constrained")
-        fp = np.flatnonzero(free_p)
-        touch = free_p.copy()
-        if self.rows == "all":
-            touch[cols[free_p[rows]]] = True
-        R = np.flatnonzero(touch)                              # rows of E_Q that involve fp
-        self._fp, self._pc, self._R = fp, pc, R
-        Lc = L.tocoo()
-        li, lj, lv = Lc.row, Lc.col, Lc.data
-        at_R, at_fp, at_pc = _positions_in(R, n), _positions_in(fp, n), _positions_in(pc, n)
-        in_R = at_R[li] >= 0
-        k = in_R & (at_fp[lj] >= 0)
-        A = sp.csr_matrix((lv[k], (at_R[li[k]], at_fp[lj[k]])), shape=(R.size, fp.size))
-        k = in_R & (at_pc[lj] >= 0)
-        self._L_pc = sp.csr_matrix((lv[k], (at_R[li[k]], at_pc[lj[k]])), shape=(R.size, pc.size))
-        # positions about a centre inside the constraints: large coordinates (UTM, ECEF) do not
-        # cancel in the right-hand side (L 1 = 0: the solution moves with the centre)
-        self._centre = bbox_centre(V[pc] if pc.size else V)
-        k = in_R & ~in_roi[lj]                                 # exterior positions stay as in V
-        w = lv[k][:, None] * (V[lj[k]] - self._centre)
-        self._rhs_const = -np.stack([np.bincount(at_R[li[k]], weights=w[:, c], minlength=R.size)
-                                     for c in range(3)], axis=1)
-        # sum of each row's exterior weights: moves rhs_const to another centre (see _solve)
-        self._exterior_weight = np.bincount(at_R[li[k]], weights=lv[k], minlength=R.size)
-        self._A_T = A.T.tocsr()
-        # where each row of R gets its detail from: solved (fd), given (dc) or rest (exterior)
-        self._R_fd = at_R[self._fd] >= 0
-        self._R_fd_at = at_R[self._fd][self._R_fd]
-        self._R_dc = at_R[self._dc] >= 0
-        self._R_dc_at = at_R[self._dc][self._R_dc]
-        self._D_R_rest = self.detail[R].copy()
-        if self.rows == "all":                                 # normal equations of E_Q
-            system, self._A = self._A_T @ A, A
-        else:                                                  # square: L_ff X_f = D_f - L_fc X_c
-            system, self._A_T = A, None
-        self._embed = factorize(system, symmetric=True, backend=backend) if fp.size else None
+        """E_Q over the rows that involve the free positions (see :func:`embedding_system`)."""
+        parts, system = embedding_system(L, V, in_roi, pc, rows, cols, self._fd, self._dc, self.detail,
+                                         self.rows == "all")
+        vars(self).update(parts)
+        self._embed = factorize(system, symmetric=True, backend=backend) if self._fp.size else None
 
     def solve_details(self, details=None):
         """Curvature stage only: every vertex's detail, by back-substitution.
@@ -464,16 +348,13 @@ class CurvatureEditor:
         ValueError
             If ``return_details`` is not True or False.
         """
-        # "no" or 0 would otherwise count as an answer, and an array as numpy's ambiguous truth value
         return_details = check_bool(return_details, "return_details")
         if return_details:
             self._refuse_undetermined_details()
         return self._solve(self._positions(positions), self._details(details), return_details)
 
     def _solve(self, Xk, Dk, return_details=False, fast_path=True):
-        # one read of the response: precompute_handles in another thread may replace it between
-        # two (a solve then read None and failed with a TypeError); each response is complete
-        response = self._response
+        response = self._response          # one read: precompute_handles may replace it
         if response is not None and fast_path and not return_details:
             fast = self._fast_path(response, Xk, Dk)
             if fast is not None:
@@ -487,8 +368,7 @@ class CurvatureEditor:
         X = self.V.copy()
         X[self._pc] = Xk
         if self._embed is not None:
-            # about the centre of the constraints as given (they may have moved far), with the
-            # exterior's constant term moved there: -L_ext (V_ext - c) = rhs_const + w_ext (c - c0)
+            # about the constraints' centre: -L_ext (V_ext - c) = rhs_const + w_ext (c - c0)
             centre = bbox_centre(Xk) if Xk.size else self._centre
             rhs = (D_R + self._rhs_const + self._exterior_weight[:, None] * (centre - self._centre)
                    - self._L_pc @ (Xk - centre))
@@ -618,125 +498,3 @@ class CurvatureEditor:
         if self._dc.size == self._user_dc:
             return given
         return np.concatenate([given, self.detail[self._dc[self._user_dc:]]])
-
-
-def _check_relations(relations):
-    """``relations`` as one of :data:`RELATIONS`, or ValueError naming them."""
-    return check_choice(relations, "relations", RELATIONS,
-                        "; use 'one-ring' (the paper's relations) or 'one+two-ring'.")
-
-
-def _index_set(indices, n, name, values=None):
-    """:func:`as_index_set`, with None, a set, True/False among numbers and fractions named as
-    such (the first three were "dtype object" or read as vertices 1 and 0, the last named only
-    by its dtype). Whole floats (3.0) are indices. A set has no order: where row r of the
-    ``values`` given to solve belongs to ``name[r]`` it is refused, elsewhere (``values`` None:
-    a region, the handles of precompute_handles) it is taken."""
-    if indices is None:
-        raise ConstraintError(f"{name} is None; pass vertex indices ([] for none) or an ({n},) boolean mask.")
-    if isinstance(indices, (set, frozenset)):
-        if values is not None:
-            raise ConstraintError(f"{name} is a {type(indices).__name__}, which has no order; pass a list or "
-                                  f"array of vertex indices (row r of the {values} belongs to {name}[r]), e.g. "
-                                  f"sorted({name}).")
-        try:
-            indices = sorted(indices)
-        except TypeError:               # values that do not compare: as_index_set names them
-            indices = list(indices)
-    if isinstance(indices, (list, tuple)):
-        flags = [isinstance(i, (bool, np.bool_)) for i in indices]
-        if any(flags) and not all(flags):       # numpy reads [True, 3] as vertices 1 and 3
-            raise ConstraintError(f"{name} has True/False among its vertex indices (first at position "
-                                  f"{flags.index(True)}); pass indices only, or an ({n},) boolean mask.")
-    return as_index_set(indices, n, name)             # names non-whole values too
-
-
-def _pattern(C):
-    """(rows, cols, values) of the stored entries of the CSR matrix ``C``, explicit zeros too."""
-    return np.repeat(np.arange(C.shape[0]), np.diff(C.indptr)), C.indices.astype(np.int64), C.data
-
-
-def _two_ring_pairs(rows, cols, n):
-    """Directed pairs (i, j), j within two edges of i, i != j, sorted by i then j."""
-    P = sp.csr_matrix((np.ones(rows.size), (rows, cols)), shape=(n, n))
-    P2 = (P @ P + P).tocsr()
-    P2.setdiag(0)
-    P2.eliminate_zeros()
-    P2.sort_indices()
-    r = np.repeat(np.arange(n), np.diff(P2.indptr))
-    return r, P2.indices.astype(np.int64)
-
-
-def _positions_in(idx, n):
-    """``pos[v]`` = position of vertex ``v`` in ``idx``, -1 where absent; shape (n,)."""
-    pos = np.full(n, -1, dtype=np.int64)
-    pos[idx] = np.arange(idx.size)
-    return pos
-
-
-def _anchored_components(a, b, n, anchors):
-    """Label the graph with edges (a, b); True per vertex whose component holds an anchor."""
-    G = sp.csr_matrix((np.ones(a.size, dtype=np.int8), (a, b)), shape=(n, n))
-    count, labels = connected_components(G, directed=False)
-    anchored = np.zeros(count, dtype=bool)
-    anchored[labels[anchors]] = True
-    return anchored[labels]
-
-
-def _detail_islands(rows, cols, cvals, free, rank, n):
-    """Free vertices whose detail the coefficients cannot determine, shape (n,) bool.
-
-    ``C`` is invariant under any linear map of the detail, so a group of free vertices whose
-    coefficient rows reach no known detail (through non-zero coefficients, across flat vertices
-    whose rows are zero) has its detail fixed only up to a 3x3 linear map: the square system is
-    singular there (e.g. a bump in a flat plane). Such islands keep their rest detail.
-    """
-    active = free & (rank > 0)
-    if not active.any():
-        return np.zeros(n, dtype=bool)
-    # links from an active row to an active or a known vertex (flat free vertices are D = 0)
-    k = active[rows] & (cvals != 0) & (active[cols] | ~free[cols])
-    anchored = _anchored_components(rows[k], cols[k], n, np.flatnonzero(~free))
-    return active & ~anchored
-
-
-def _check_pieces_detail_constrained(F, in_roi, dc):
-    """UndeterminedEditError if a connected piece of the mesh lies wholly inside the roi with one
-    or two detail constraints: ``C`` is invariant under any linear map of the detail, and one or
-    two given details fix only 3 or 6 of its 9 unknowns (the rest check missed it: a second
-    piece with one detail constraint came back 0.03-0.2 % of the diagonal off at rest, and
-    accepted). A piece with none is named by the reach check; a single piece as the whole roi
-    by the constructor's own message."""
-    labels, count = vertex_components(F, in_roi.size)
-    outside = np.bincount(labels[~in_roi], minlength=count) > 0
-    given = np.bincount(labels[dc], minlength=count)
-    short = np.flatnonzero(~outside & (given > 0) & (given < 3))
-    if not short.size:
-        return
-    first = int(np.flatnonzero(labels == short[0])[0])
-    pieces = counted(short.size, "piece", verb="lie") if short.size > 1 else "a piece of the mesh lies"
-    raise UndeterminedEditError(
-        f"{pieces} wholly inside the edited region with only {counted(int(given[short[0]]), 'detail constraint')} (e.g. "
-        f"the piece containing vertex {first}): its details are determined only up to a linear map "
-        "(9 unknowns, 3 per constrained detail).",
-        "Constrain the details of at least three vertices of each such piece (e.g. its handles), or leave "
-        "part of it outside the roi.")
-
-
-def _check_reached(rows, cols, free, n, what, name):
-    """Raise if a connected region of free vertices touches no constrained (or exterior) vertex."""
-    if not free.any():
-        return
-    k = free[rows]
-    anchored = _anchored_components(rows[k], cols[k], n, np.flatnonzero(~free))
-    lost = np.flatnonzero(free & ~anchored)
-    if lost.size:
-        G = sp.csr_matrix((np.ones(int(k.sum()), dtype=np.int8), (rows[k], cols[k])), shape=(n, n))
-        _, labels = connected_components(G, directed=False)
-        regions = np.unique(labels[lost])
-        example = [int(lost[np.flatnonzero(labels[lost] == c)[0]]) for c in regions[:3]]
-        raise UndeterminedEditError(
-            f"{regions.size} connected free {'region touches' if regions.size == 1 else 'regions touch'} no "
-            f"{what} constraint (e.g. the {'region' if regions.size == 1 else 'regions'} containing vertex "
-            f"{', '.join(map(str, example))}); their {what}s are undetermined.",
-            f"Add a vertex of each region to {name}, or shrink the roi.")

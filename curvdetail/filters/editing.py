@@ -8,6 +8,7 @@ from ..curvature.geometry import folded_triangles
 from ..curvature.checks import affine_transform_problem, check_transformed_values, non_whole_index_error, real_word
 from ..curvature.geometry import bbox_diagonal
 from ..curvature.curvature_editor import CurvatureEditor
+from ..curvature.rotation_editor import RotationAwareEditor
 from ..curvature.errors import (warn, ConstraintError, FoldedTrianglesWarning, UndeterminedEditError, counted,
                                 first_indices)
 from .apply_curvature_reconstruction import BACKEND_DESCRIPTION, BACKENDS
@@ -110,13 +111,16 @@ def _matrix(text):
     name="apply_curvature_editing",
     category="Curvature detail",
     description=f"""
-        Mesh editing with curvature coefficients: the handle vertices are moved by a 4x4
-        transform, their curvature normals are transformed by its linear part and scaled by
-        detail_scale, and the region of interest - the selected vertices, the handles and, with
-        region_radius, every vertex that close to a handle - is rebuilt in two stages: the
-        details of the other region vertices from the rotation- and scale-invariant curvature
-        coefficients (min |(I - C) D|^2), then the positions from the details (E_Q). Vertices
-        outside the region do not move. Vertices move in place; the vertex quality is set to
+        Mesh editing with curvature detail: the handle vertices are moved by a 4x4 transform and
+        the region of interest - the selected vertices, the handles and, with region_radius,
+        every vertex that close to a handle - is rebuilt from its curvature details. With
+        method 'rotation' (the default) each rest detail turns with its neighbourhood (local
+        rotations fitted to the one-rings, alternated with the embedding until the vertices move
+        less than 1e-4 of the diagonal). With method 'paper' the handles' curvature normals are
+        transformed by the transform's linear part and scaled by detail_scale, and the region is
+        rebuilt in two stages: the details of the other region vertices from the rotation- and
+        scale-invariant curvature coefficients (min |(I - C) D|^2), then the positions from the
+        details (E_Q). Vertices outside the region do not move. Vertices move in place; the vertex quality is set to
         the distance each vertex moved. Returns the largest move, how far the curvature stage
         amplified the handles' motion (amplification) and their detail change
         (detail_amplification), the triangles that folded over and the region's counts; a
@@ -137,8 +141,13 @@ def _matrix(text):
         Parameter("transform", "str", IDENTITY,
                   "4x4 handle transform, 16 numbers row by row, applied to homogeneous positions "
                   "(from Python also a 4x4 array)", shape=(4, 4), validate=_matrix),
+        Parameter("method", "str", "rotation",
+                  "'rotation': rest details turned with their neighbourhoods (fold-free on the "
+                  "Botsch-Sorkine benchmark); 'paper': the paper's linear two-stage edit (needed for "
+                  "detail_scale, move_handles=false, handle_detail and relations)",
+                  choices=("rotation", "paper")),
         Parameter("detail_scale", "float", 1.0,
-                  "factor on the handles' curvature details D = K A after the transform (1 keeps "
+                  "method 'paper': factor on the handles' curvature details D = K A after the transform (1 keeps "
                   "them); below 1 flattens what the handles sit on, above 1 sharpens it "
                   "(mannequin_devil, move_handles=false, a horn's tip as handles: x0.5 makes the "
                   "horn 0.49-0.50 times as long, x2 2.01-2.02 times, region_radius 10-20 %)",
@@ -156,12 +165,15 @@ def _matrix(text):
         Parameter("backend", "str", "auto", BACKEND_DESCRIPTION, choices=BACKENDS),
     ],
 )
-def apply_curvature_editing(ms, *, handles, region_radius, transform, detail_scale, move_handles,
+def apply_curvature_editing(ms, *, handles, region_radius, transform, method, detail_scale, move_handles,
                             handle_detail, relations, backend):
     mid = layer_id(ms)
     V, F = mesh_arrays(ms, mid)
     h = _indices(handles, V.shape[0])
     T = _matrix(transform)
+    if method == "rotation" and (detail_scale != 1.0 or not move_handles):
+        raise FilterParameterError("method='rotation' moves the handles and keeps their details' size; "
+                                   "detail_scale and move_handles=false need method='paper'.")
     if not move_handles and handle_detail == "free":
         raise FilterParameterError("move_handles=false with handle_detail='free' leaves the handles "
                                    "unconstrained; set one of them.")
@@ -196,6 +208,8 @@ def apply_curvature_editing(ms, *, handles, region_radius, transform, detail_sca
         raise ConstraintError(f"every vertex is in the region of interest (selection plus handles{reach}), so "
                               f"nothing stays fixed; leave part of the mesh unselected{smaller}.")
     t = time.perf_counter()
+    if method == "rotation":
+        return _rotation_edit(ms, mid, V, F, h, roi, T, backend, t)
     pc = h if move_handles else np.empty(0, dtype=np.int64)
     dc = h if handle_detail == "transform" else np.empty(0, dtype=np.int64)
     try:
@@ -237,10 +251,43 @@ def apply_curvature_editing(ms, *, handles, region_radius, transform, detail_sca
         "rank_deficient_vertices": rank_deficient,
         "widened_ring_vertices": widened,
         "detail_island_vertices": int(editor.detail_islands),
+        "iterations": None,
         "seconds": float(seconds),
     }
     _warn_if_amplified(figures, folded, F.shape[0], moved, D, editor.detail, dict(
-        relations=relations, detail_scale=detail_scale, handle_detail=handle_detail,
+        method="paper", relations=relations, detail_scale=detail_scale, handle_detail=handle_detail,
+        handles_moved=figures["amplification"] is not None))
+    return figures
+
+
+def _rotation_edit(ms, mid, V, F, h, roi, T, backend, t):
+    """The filter's body for method 'rotation': the handles placed, the details turned."""
+    editor = RotationAwareEditor(V, F, h, roi=roi, backend=backend)
+    with np.errstate(over="ignore", invalid="ignore"):      # named below instead
+        positions = V[h] @ T[:3, :3].T + T[:3, 3]
+    check_transformed_values(positions, "the transform", "use a smaller transform", FilterParameterError)
+    X = editor.solve(positions)
+    seconds = time.perf_counter() - t
+    moved = np.linalg.norm(X - V, axis=1)
+    set_vertex_positions(ms, mid, X)
+    set_vertex_quality(ms, mid, moved)
+    diagonal = bbox_diagonal(V)
+    folded = folded_triangles(V, F, X, T[:3, :3])
+    figures = {
+        "max_displacement_percent_of_diagonal": float(100 * moved.max() / diagonal),
+        "amplification": float(moved.max() / moved[h].max()) if moved[h].max() > 1e-12 * diagonal else None,
+        "detail_amplification": None,
+        "folded_triangles": int(folded.size),
+        "roi_vertices": int(roi.size),
+        "handle_vertices": int(h.size),
+        "rank_deficient_vertices": None,
+        "widened_ring_vertices": None,
+        "detail_island_vertices": None,
+        "iterations": int(editor.iterations),
+        "seconds": float(seconds),
+    }
+    _warn_if_amplified(figures, folded, F.shape[0], moved, None, None, dict(
+        method="rotation", relations=None, detail_scale=1.0, handle_detail=None,
         handles_moved=figures["amplification"] is not None))
     return figures
 
@@ -291,7 +338,7 @@ def _warn_if_amplified(figures, folded, m, moved, D, D0, options):
                      f"region (vertex {changed_most})")
     relations = options["relations"]
     other = "one+two-ring" if relations == "one-ring" else "one-ring"
-    tries = [f"relations={other!r}"]
+    tries = [f"relations={other!r}"] if options["method"] == "paper" else ["method='paper'"]
     if options["handles_moved"] and options["handle_detail"] == "transform":
         tries.append("handle_detail='free'")
     tries.append("more handles")
@@ -304,7 +351,8 @@ def _warn_if_amplified(figures, folded, m, moved, D, D0, options):
                  "region, or coefficients that distort it")
         tries.append("a larger region")
     category = FoldedTrianglesWarning if folded.size else AmplifiedEditWarning
-    warn(f"apply_curvature_editing with relations={relations!r}: {'; '.join(parts)}: {cause}, see "
+    setting = f"relations={relations!r}" if options["method"] == "paper" else "method='rotation'"
+    warn(f"apply_curvature_editing with {setting}: {'; '.join(parts)}: {cause}, see "
                   "docs/editing.md). "
                   f"The mesh was edited all the same; try {', '.join(tries[:-1])} or {tries[-1]} on the original.",
                   category)

@@ -13,11 +13,13 @@ import numpy as np
 from ..curvature.checks import affine_transform_problem, as_vertices, check_bool, check_choice, check_transformed_values, real_word
 from ..curvature.curvature_coefficients import DEFAULT_RCOND
 from ..curvature.curvature_editor import CurvatureEditor
+from ..curvature.rotation_editor import DEFAULT_MAX_ITERATIONS, DEFAULT_TOL, RotationAwareEditor
 from ..curvature.errors import ConstraintError, CurvdetailError, counted, first_indices
 from .atomic import atomic_write
 
 FIXED, FREE, HANDLE = 0, 1, 2
 HANDLE_DETAIL_MODES = ("transform", "free")
+METHODS = ("rotation", "paper")
 
 
 class DeformationFileError(CurvdetailError):
@@ -195,12 +197,12 @@ def apply_transform(T, P):
     return np.asarray(P, dtype=np.float64) @ T[:3, :3].T + T[:3, 3]
 
 
-def edit_with_selection(V, F, status, T, *, handle_detail="transform", relations="one-ring",
-                        rcond=DEFAULT_RCOND, backend="auto", return_editor=False):
-    """Deform a mesh as a benchmark case prescribes, with a :class:`CurvatureEditor`.
+def edit_with_selection(V, F, status, T, *, method="rotation", handle_detail=None, relations=None,
+                        rcond=DEFAULT_RCOND, scaling=False, tol=DEFAULT_TOL, max_iterations=DEFAULT_MAX_ITERATIONS,
+                        backend="auto", return_editor=False):
+    """Deform a mesh as a benchmark case prescribes: fixed vertices stay, handles move by ``T``.
 
-    The region of interest is every vertex of status 1 or 2; fixed vertices keep their positions
-    and handles are moved by ``T``.
+    The region of interest is every vertex of status 1 or 2.
 
     Parameters
     ----------
@@ -212,11 +214,20 @@ def edit_with_selection(V, F, status, T, *, handle_detail="transform", relations
         0 fixed, 1 free, 2 handle (see :func:`read_selection`).
     T : (4, 4) float array
         Affine handle transform with an invertible linear part (see :func:`read_transform`).
-    handle_detail : {"transform", "free"}
-        ``"transform"``: the handles' details are constrained to ``T[:3, :3] @ D`` (exact for a
-        similarity); ``"free"``: they are solved like the free ones.
-    relations, rcond, backend
-        As for :class:`~curvdetail.curvature.CurvatureEditor`.
+    method : {"rotation", "paper"}
+        ``"rotation"``: a :class:`~curvdetail.curvature.rotation_editor.RotationAwareEditor`
+        (the rest details turn with their neighbourhoods; fold-free on the benchmark cases);
+        ``"paper"``: the paper's linear two-stage :class:`~curvdetail.curvature.CurvatureEditor`.
+    handle_detail : {"transform", "free"}, optional
+        ``method="paper"`` only (default "transform"): the handles' details constrained to
+        ``T[:3, :3] @ D`` (exact for a similarity), or solved like the free ones.
+    relations, rcond
+        ``method="paper"`` only, as for :class:`~curvdetail.curvature.CurvatureEditor`
+        (``relations`` default "one-ring").
+    scaling, tol, max_iterations
+        ``method="rotation"`` only, as for ``RotationAwareEditor``.
+    backend : str
+        Sparse solver backend.
     return_editor : bool
         Also return the factored editor (for re-solves).
 
@@ -224,7 +235,7 @@ def edit_with_selection(V, F, status, T, *, handle_detail="transform", relations
     -------
     X : (n, 3) float array
         Fixed vertices exactly at ``V``, handles exactly at ``T`` applied to ``V``.
-    editor : CurvatureEditor
+    editor : RotationAwareEditor or CurvatureEditor
         Only with ``return_editor=True``.
 
     Raises
@@ -234,7 +245,8 @@ def edit_with_selection(V, F, status, T, *, handle_detail="transform", relations
     ConstraintError
         If ``status`` does not fit (length, values, no handle, no fixed vertex) or ``T`` is refused.
     ValueError
-        If ``handle_detail`` is unknown or ``return_editor`` is not a bool.
+        If ``method`` or ``handle_detail`` is unknown, a paper-only option is given with
+        ``method="rotation"`` (``e.parameter``), or ``return_editor`` is not a bool.
 
     Examples
     --------
@@ -246,7 +258,14 @@ def edit_with_selection(V, F, status, T, *, handle_detail="transform", relations
     >>> bool(np.all(X[status == 2, 2] == 0.3) and np.all(X[status == 0] == V[status == 0]))
     True
     """
-    handle_detail = check_choice(handle_detail, "handle_detail", HANDLE_DETAIL_MODES, "; use 'transform' or 'free'.")
+    method = check_choice(method, "method", METHODS, "; use 'rotation' (rotation-aware) or 'paper'.")
+    if method == "rotation":
+        for name, value in (("handle_detail", handle_detail), ("relations", relations)):
+            if value is not None:
+                raise CurvdetailError(f"{name} applies to method='paper' only", parameter=name, value=value,
+                                      hint="drop it, or pass method='paper'")
+    handle_detail = check_choice("transform" if handle_detail is None else handle_detail, "handle_detail",
+                                 HANDLE_DETAIL_MODES, "; use 'transform' or 'free'.")
     return_editor = check_bool(return_editor, "return_editor")
     V = as_vertices(V)
     status = np.asarray(status).reshape(-1)
@@ -267,13 +286,19 @@ def edit_with_selection(V, F, status, T, *, handle_detail="transform", relations
                               hint="fix part of the mesh so that the handle transform deforms rather than moves it")
     roi = np.flatnonzero(status != FIXED)
     T = _as_transform(T, ConstraintError)
-    dc = handles if handle_detail == "transform" else np.empty(0, dtype=np.int64)
-    editor = CurvatureEditor(V, F, handles, dc, roi=roi, relations=relations, rcond=rcond,
-                             backend=backend)
     with np.errstate(over="ignore", invalid="ignore"):      # named below instead
+        positions = apply_transform(T, V[handles])
+    check_transformed_values(positions, "the handle transform T", "use a smaller transform")
+    if method == "rotation":
+        editor = RotationAwareEditor(V, F, handles, roi=roi, scaling=scaling, tol=tol,
+                                     max_iterations=max_iterations, backend=backend)
+        X = editor.solve(positions)
+        return (X, editor) if return_editor else X
+    dc = handles if handle_detail == "transform" else np.empty(0, dtype=np.int64)
+    editor = CurvatureEditor(V, F, handles, dc, roi=roi, relations=relations or "one-ring", rcond=rcond,
+                             backend=backend)
+    with np.errstate(over="ignore", invalid="ignore"):
         details = editor.detail[handles] @ T[:3, :3].T if handle_detail == "transform" else None
-        positions = apply_transform(T, editor.V[handles])
-    for values in (positions, details):
-        check_transformed_values(values, "the handle transform T", "use a smaller transform")
+    check_transformed_values(details, "the handle transform T", "use a smaller transform")
     X = editor.solve(positions=positions, details=details)
     return (X, editor) if return_editor else X

@@ -1,0 +1,344 @@
+"""Rotation-aware curvature-detail editing: the rest details turn with their neighbourhoods."""
+
+import numpy as np
+import scipy.sparse as sp
+
+from ._editor_checks import _check_reached, _index_set, region_mask
+from .checks import as_count, as_positive_number, as_values, check_bool
+from .cotan_laplacian import checked_cotan_laplacian, laplacian_product
+from .errors import ConstraintError
+from .geometry import bbox_centre, bbox_diagonal
+from .sparse_solver import factorize, resolve_backend
+
+#: Default stopping tolerance: the largest vertex move of an iteration over the bbox diagonal.
+DEFAULT_TOL = 1e-4
+#: Default cap on the number of iterations of :meth:`RotationAwareEditor.solve`.
+DEFAULT_MAX_ITERATIONS = 500
+
+
+class RotationAwareEditor:
+    """Edit a mesh by its curvature detail, turning each rest detail with its neighbourhood.
+
+    The result minimizes, over the free positions ``X`` and one rotation ``R_i`` (times a scale
+    ``s_i`` with ``scaling=True``, else ``s_i = 1``) per vertex, the energy
+
+        ``E(X, R) = sum_{i in S} sum_{j ~ i} w_ij |(x_i - x_j) - s_i R_i (v_i - v_j)|^2``
+
+    with ``w_ij = max(-L_ij, 0)`` the cotangent weights of the rest mesh ``V`` clamped at zero (a
+    negative weight makes ``E`` unbounded below) and ``S`` the vertices with a free vertex in
+    their closed one-ring (the as-rigid-as-possible energy of Sorkine & Alexa 2007).
+    :meth:`solve` alternates two steps, each minimizing ``E`` exactly over its variables:
+
+    - local: every ``R_i`` in closed form, the rotation nearest the 3x3 covariance
+      ``sum_j w_ij (x_i - x_j) (v_i - v_j)^T`` (all vertices at once, reflections excluded);
+    - global: the embedding ``(L X)_f = B_f`` over the free vertices ``f`` (``L`` with the
+      weights ``w``), with the turned rest details ``B_i = sum_j w_ij (s_i R_i + s_j R_j) / 2
+      (v_i - v_j)``; where the neighbourhood turns as one, ``B_i = s R D_i``.
+
+    Steps are Anderson-accelerated (:attr:`anderson_memory`); an accelerated step is kept only
+    where it lowers ``E``, so ``E`` never increases from one iteration to the next
+    (``energies``). The rotations start at the best-fit rotation of the handles (rest to given
+    positions), blended towards the identity at the fixed part by a harmonic weight, so a rigid
+    motion of every handle with ``roi=None`` is reproduced in the first iteration. The
+    iterations stop when the plain step would move no vertex more than ``tol`` times the bbox
+    diagonal, or after ``max_iterations``. The constructor does all factoring; an iteration of
+    :meth:`solve` is one back-substitution plus the batched local fits.
+
+    Parameters
+    ----------
+    V : (n, 3) float array
+        Rest positions.
+    F : (m, 3) int array
+        Triangles.
+    handles : (p,) int array or (n,) bool mask
+        Vertices whose positions are given to :meth:`solve`, inside ``roi``.
+    roi : (r,) int array or (n,) bool mask, optional
+        Region of interest; vertices outside keep their rest positions. None: the whole mesh.
+    scaling : bool
+        Fit a uniform scale with each rotation (as-similar-as-possible), else rotations only.
+    tol : float
+        Stopping tolerance, over the bbox diagonal of ``V``.
+    max_iterations : int
+        Most iterations of :meth:`solve`.
+    backend : str
+        Sparse solver backend ("auto" or one of :func:`available_backends`).
+
+    Attributes
+    ----------
+    detail : (n, 3) float array
+        Rest detail ``D_i = sum_j w_ij (v_i - v_j)``: the curvature detail ``L V`` wherever no
+        weight was clamped.
+    iterations : int
+        Iterations of the last :meth:`solve` (global steps).
+    converged : bool
+        Whether the last :meth:`solve` met ``tol`` within ``max_iterations``.
+    energies : list of float
+        ``E`` after each local step of the last :meth:`solve`; non-increasing up to rounding.
+    backend : str
+        Solver backend of the embedding.
+
+    Raises
+    ------
+    MeshError
+        If the mesh is malformed.
+    ConstraintError
+        If ``handles`` or ``roi`` are out of range or repeated, ``roi`` is empty, a handle lies
+        outside it, or the whole mesh is the region and there is no handle.
+    UndeterminedEditError
+        If a connected free region touches no handle and no fixed vertex.
+    ValueError
+        If ``scaling``, ``tol`` or ``max_iterations`` is not a valid value.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from curvdetail.curvature.testing import grid
+    >>> V, F = grid(12, 12)
+    >>> h = np.flatnonzero(V[:, 0] > 0.9)
+    >>> ed = RotationAwareEditor(V, F, h, roi=np.flatnonzero(V[:, 0] > 0.1))
+    >>> X = ed.solve(V[h] + [0, 0, 0.3])
+    >>> bool(np.allclose(X[h, 2], 0.3)), ed.converged
+    (True, True)
+    """
+
+    #: Anderson acceleration of the iterations: how many earlier steps it combines (0: off)
+    anderson_memory = 5
+
+    def __init__(self, V, F, handles, *, roi=None, scaling=False, tol=DEFAULT_TOL,
+                 max_iterations=DEFAULT_MAX_ITERATIONS, backend="auto"):
+        self.scaling = check_bool(scaling, "scaling")
+        self.tol = as_positive_number(tol, "tol")
+        self.max_iterations = as_count(max_iterations, "max_iterations")
+        resolve_backend(backend)
+        V, F, L = checked_cotan_laplacian(V, F)
+        n = V.shape[0]
+        self.V, self.F, self.n = V.copy(), F.copy(), n
+        pc = _index_set(handles, n, "handles", "positions")
+        in_roi = region_mask(n, roi, (("handles", pc),))
+        if in_roi.all() and pc.size == 0:
+            raise ConstraintError("handles is empty and the roi is the whole mesh: the result is only "
+                                  "determined up to a rigid motion", parameter="handles", count=0,
+                                  hint="give at least one handle per connected piece, or a smaller roi")
+        free = in_roi.copy()
+        free[pc] = False
+        L = L.tocsr()
+        L.sort_indices()
+        rows = np.repeat(np.arange(n), np.diff(L.indptr))
+        off = rows != L.indices
+        # non-negative cotangent weights: a negative one (an obtuse pair of opposite angles) makes
+        # E unbounded below, and the benchmark plane folded 3,649 triangles with them
+        rows, cols, w = rows[off], L.indices[off], np.maximum(-L.data[off], 0.0)
+        L = sp.csr_matrix((np.concatenate([-w, np.bincount(rows, weights=w, minlength=n)]),
+                           (np.concatenate([rows, np.arange(n)]), np.concatenate([cols, np.arange(n)]))),
+                          shape=(n, n)).tocsr()
+        _check_reached(rows, cols, free, n, "position", "handles")
+        self.position_constrained, self.roi = pc, np.flatnonzero(in_roi)
+        self.diagonal = bbox_diagonal(V)
+        fp = np.flatnonzero(free)
+        # S: the vertices whose one-ring holds a free vertex (their rotations enter E's free part)
+        in_s = free.copy()
+        in_s[cols[free[rows]]] = True
+        s_idx = np.flatnonzero(in_s)
+        at_s = np.full(n, -1, dtype=np.int64)
+        at_s[s_idx] = np.arange(s_idx.size)
+        k = in_s[rows]                                     # CSR order: sorted by row
+        self._s, self._fp, self._pc = s_idx, fp, pc
+        self.detail = laplacian_product(L, V)              # sum_j w_ij (v_i - v_j)
+        # per vertex i of S, sparse rows over its neighbours j: w_ij and w_ij (v_i - v_j)[c]
+        ei, ej, we = rows[k], cols[k], w[k]
+        rest_e = V[ei] - V[ej]
+        at_rows = at_s[ei]
+        self._W = sp.csr_matrix((we, (at_rows, ej)), shape=(s_idx.size, n))
+        self._We = [sp.csr_matrix((we * rest_e[:, c], (at_rows, ej)), shape=(s_idx.size, n)) for c in range(3)]
+        self._wsum = np.asarray(self._W.sum(axis=1)).ravel()
+        self._rest_sq = np.bincount(at_rows, weights=we * np.einsum("ij,ij->i", rest_e, rest_e),
+                                    minlength=s_idx.size)
+        # the global step's rows: free i, columns j in S (every neighbour of a free vertex is)
+        kf = free[ei]
+        at_f = np.full(n, -1, dtype=np.int64)
+        at_f[fp] = np.arange(fp.size)
+        self._Wf = [sp.csr_matrix((we[kf] * rest_e[kf, c], (at_f[ei[kf]], at_s[ej[kf]])), shape=(fp.size, s_idx.size))
+                    for c in range(3)]
+        self._fp_s = at_s[fp]
+        L_free = L[fp]
+        self._L_pc = L_free[:, pc].tocsr()
+        outside = ~in_roi
+        self._L_out_V = L_free[:, outside] @ V[outside]    # the exterior stays at rest
+        self._L_out_sum = np.asarray(L_free[:, outside].sum(axis=1)).ravel()
+        self._embed = factorize(L_free[:, fp].tocsc(), symmetric=True, backend=backend) if fp.size else None
+        self.backend = self._embed.backend if self._embed is not None else "none"
+        # harmonic blend weight per vertex of S: 1 at the handles, 0 outside the roi (the start
+        # of the rotations: the handles' turn, blended towards the fixed part)
+        phi = np.zeros(n)
+        phi[pc] = 1.0
+        if fp.size:
+            phi[fp] = self._embed.solve(-(self._L_pc @ np.ones(pc.size)))
+        self._blend = np.clip(phi[s_idx], 0.0, 1.0)
+        self.iterations, self.converged, self.energies = 0, True, []
+
+    def solve(self, positions=None, *, initial=None):
+        """Edited positions for the handles at ``positions``, by alternating local and global steps.
+
+        Parameters
+        ----------
+        positions : (p, 3) float array, optional
+            Positions of ``handles`` (row r for vertex ``handles[r]``); None: rest positions.
+        initial : (n, 3) float array, optional
+            A start for the rotations (e.g. the previous result of an interactive edit); None
+            starts from the handles' best-fit rotation.
+
+        Returns
+        -------
+        X : (n, 3) float array
+            ``X[handles] == positions`` exactly; vertices outside the roi at rest exactly.
+
+        Raises
+        ------
+        ConstraintError
+            If ``positions`` or ``initial`` is not of the right shape of finite numbers.
+        """
+        Xk = self.V[self._pc] if positions is None else as_values(positions, self._pc.size, "positions")
+        # everything about a centre among the handles (large coordinates do not cancel)
+        centre = bbox_centre(Xk) if Xk.size else bbox_centre(self.V)
+        X = self.V - centre
+        X[self._pc] = Xk - centre
+        if initial is not None:
+            X[self._fp] = as_values(initial, self.n, "initial")[self._fp] - centre
+            R, energy = self._local(X)
+        else:
+            R = _blended_rotations(_best_rotation(self.V[self._pc], Xk), self._blend)
+            energy = None
+        self.energies = [] if energy is None else [energy]
+        self.iterations, self.converged = 0, self._embed is None
+        const = -(self._L_pc @ X[self._pc]) - (self._L_out_V - self._L_out_sum[:, None] * centre)
+        fp, history = self._fp, []
+        while self._embed is not None and self.iterations < self.max_iterations:
+            x = X[fp]
+            g = self._embed.solve(self._turned_details(R) + const)
+            self.iterations += 1
+            change = np.abs(g - x).max() / self.diagonal      # the plain step's move: the residual
+            step = g
+            if energy is not None and self.anderson_memory:
+                history = (history + [(g.ravel(), (g - x).ravel())])[-(self.anderson_memory + 1):]
+                step = _anderson(history).reshape(g.shape) if len(history) > 1 else g
+            X[fp] = step
+            R_step, E_step = self._local(X)
+            if step is not g and not E_step <= energy:       # the plain step never increases E
+                X[fp] = g
+                R_step, E_step = self._local(X)
+                history = history[-1:]
+            R, energy = R_step, E_step
+            self.energies.append(energy)
+            if change < self.tol:
+                self.converged = True
+                break
+        X += centre
+        X[self._pc] = Xk                                      # exactly, as given
+        outside = np.ones(self.n, dtype=bool)
+        outside[self.roi] = False
+        X[outside] = self.V[outside]
+        return X
+
+    def _local(self, X):
+        """Rotations (scaled with ``scaling``) of every vertex of S fitted to X, and E(X, R).
+        ``X`` about a centre near the mesh (the sums below cancel large coordinates)."""
+        Xs = X[self._s]
+        # cov_i = sum_j w_ij (x_i - x_j) (v_i - v_j)^T, column c by column c
+        cov = np.stack([Xs * self.detail[self._s, c, None] - self._We[c] @ X for c in range(3)], axis=2)
+        R = _closest_rotations(cov)
+        fit = np.einsum("kij,kij->k", R, cov)                # trace(R^T cov)
+        # sum_j w_ij |x_i - x_j|^2
+        def_sq = (self._wsum * np.einsum("ij,ij->i", Xs, Xs) - 2 * np.einsum("ij,ij->i", Xs, self._W @ X)
+                  + self._W @ np.einsum("ij,ij->i", X, X))
+        if self.scaling:
+            s = np.maximum(fit, 0.0) / np.maximum(self._rest_sq, np.finfo(float).tiny)
+            R = R * s[:, None, None]
+            energy = def_sq - 2 * s * fit + s * s * self._rest_sq
+        else:
+            energy = def_sq - 2 * fit + self._rest_sq
+        return R, float(energy.sum())
+
+    def _turned_details(self, R):
+        """``B_f = sum_j w_ij (R_i + R_j) / 2 (v_i - v_j)`` over the free rows (R scaled):
+        ``(R_f D_f + sum_j R_j w_ij (v_i - v_j)) / 2``."""
+        own = np.einsum("kab,kb->ka", R[self._fp_s], self.detail[self._fp])
+        other = sum(self._Wf[c] @ np.ascontiguousarray(R[:, :, c]) for c in range(3))
+        return 0.5 * (own + other)
+
+
+def _anderson(history):
+    """Anderson-accelerated next iterate from ``(g_k, f_k = g_k - x_k)`` of the last steps:
+    ``g - dG gamma`` with ``gamma`` minimizing ``|f - dF gamma|`` (Walker & Ni 2011)."""
+    G = np.stack([g for g, _ in history], axis=1)
+    Fr = np.stack([f for _, f in history], axis=1)
+    dG, dF = np.diff(G, axis=1), np.diff(Fr, axis=1)
+    gamma = np.linalg.lstsq(dF, Fr[:, -1], rcond=None)[0]
+    return G[:, -1] - dG @ gamma
+
+
+def _closest_rotations(C, steps=8):
+    """The rotations ``R_k`` maximizing ``trace(R_k^T C_k)`` for (k, 3, 3) ``C``: the SVD
+    solution ``U diag(1, 1, d) W^T``, ``d = det(U) det(W)``.
+
+    ``C + cof(C)`` (``C`` scaled to unit Frobenius norm) is ``U diag(s1 + d s2 s3, s2 + d s1 s3,
+    s3 + d s1 s2) W^T``: where its first two entries are positive and the third has the sign of
+    ``d`` (always for ``d = 1``, rank 2 included), its orthogonal polar factor is the answer,
+    found by ``steps`` scaled Newton steps ``X <- (g X + X^-T / g) / 2``. The rest (a factor
+    that is no rotation to 1e-12) goes through :func:`_closest_rotations_eigh`."""
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        X = C / np.sqrt(np.einsum("kij,kij->k", C, C))[:, None, None]
+        X = X + _cofactor(X)
+        for _ in range(steps):
+            inv_t = _cofactor(X)
+            inv_t /= np.einsum("ki,ki->k", X[..., 0], inv_t[..., 0])[:, None, None]       # X^-T
+            g = (np.einsum("kij,kij->k", inv_t, inv_t) / np.einsum("kij,kij->k", X, X)) ** 0.25
+            X = 0.5 * (g[:, None, None] * X + inv_t / g[:, None, None])
+        error = np.abs(np.swapaxes(X, 1, 2) @ X - np.eye(3)).max(axis=(1, 2))
+        bad = ~((error < 1e-12) & (np.einsum("ki,ki->k", X[..., 0], np.cross(X[..., 1], X[..., 2])) > 0))
+    if bad.any():
+        X[bad] = _closest_rotations_eigh(C[bad])
+    return X
+
+
+def _cofactor(A):
+    """Cofactor matrices ``det(A) A^-T`` of (k, 3, 3) ``A``: columns ``a1 x a2, a2 x a0, a0 x a1``."""
+    a0, a1, a2 = A[..., 0], A[..., 1], A[..., 2]
+    return np.stack([np.cross(a1, a2), np.cross(a2, a0), np.cross(a0, a1)], axis=2)
+
+
+def _closest_rotations_eigh(C):
+    """:func:`_closest_rotations` from the eigenvectors of ``C^T C`` (rank 2 included)."""
+    _, W = np.linalg.eigh(np.swapaxes(C, 1, 2) @ C)          # ascending: W[..., 2] the largest
+    w1, w2 = W[..., 2], W[..., 1]
+    u1 = np.einsum("kij,kj->ki", C, w1)
+    u1 /= np.maximum(np.linalg.norm(u1, axis=1), np.finfo(float).tiny)[:, None]
+    u2 = np.einsum("kij,kj->ki", C, w2)
+    u2 -= np.einsum("ki,ki->k", u1, u2)[:, None] * u1
+    u2 /= np.maximum(np.linalg.norm(u2, axis=1), np.finfo(float).tiny)[:, None]
+    return (np.einsum("ki,kj->kij", u1, w1) + np.einsum("ki,kj->kij", u2, w2)
+            + np.einsum("ki,kj->kij", np.cross(u1, u2), np.cross(w1, w2)))
+
+
+def _blended_rotations(R, t):
+    """``R`` turned by the fractions ``t`` (k,) of its angle about its own axis, shape (k, 3, 3)."""
+    angle = np.arccos(np.clip((np.trace(R) - 1) / 2, -1.0, 1.0))
+    axis = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+    if angle < 1e-12 or np.linalg.norm(axis) < 1e-12 * max(angle, 1.0):
+        if angle < 1e-12:
+            return np.broadcast_to(np.eye(3), (t.size, 3, 3))
+        w, v = np.linalg.eigh(R + R.T)                    # a half turn: the axis is R's eigenvector 1
+        axis = v[:, -1]
+    axis = axis / np.linalg.norm(axis)
+    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    a = (t * angle)[:, None, None]
+    return np.eye(3) + np.sin(a) * K + (1 - np.cos(a)) * (K @ K)
+
+
+def _best_rotation(P, Q):
+    """The rotation ``R`` minimizing ``sum |(q - mean q) - R (p - mean p)|^2`` (Kabsch); the
+    identity for fewer than three points."""
+    if P.shape[0] < 3:
+        return np.eye(3)
+    U, _, Wt = np.linalg.svd((Q - Q.mean(0)).T @ (P - P.mean(0)))
+    d = np.sign(np.linalg.det(U @ Wt)) or 1.0
+    return U @ np.diag([1.0, 1.0, d]) @ Wt
