@@ -11,6 +11,7 @@ PLY element counts (plyfile reads exactly those), the OFF header's, and an OBJ f
 import contextlib
 import errno
 import os
+import re
 import shutil
 
 import numpy as np
@@ -155,19 +156,35 @@ def load_new_mesh(ms, path):
     return V, F
 
 
+#: A line that may be an OFF face row of more than three corners (a vertex row of whole numbers
+#: may match too: the rows are then read).
+_POLYGON_ROW = re.compile(rb"(?m)^[ \t]*0*([4-9]|[1-9][0-9]+)[ \t]+[0-9]+[ \t]+[0-9]+[ \t]+[0-9]+[ \t]+[0-9]+")
+
+
 def _off_polygons(path, count):
     """``(F, k)``: the last ``count`` face rows of the OFF file ``path`` (k of them) fanned from
     their first corner where one is a polygon (more than three corners), else ``(None, None)``
     (pymeshlab's triangles are the file's)."""
     with open(path, "rb") as f:
-        rows = [row for row in (line.split(b"#")[0].split() for line in f.read().splitlines()) if row]
-    rows = rows[-count:] if count else []           # the face rows end the file
+        data = f.read()
+    if not _POLYGON_ROW.search(data):               # fast: no row starts as a polygon's would
+        return None, None
+    comments = b"#" in data
+    rows = []                                       # the face rows end the file: (corners, rest)
+    for line in reversed(data.splitlines()):
+        if len(rows) == count:
+            break
+        row = (line.split(b"#", 1)[0] if comments else line).split(None, 1)
+        if row:
+            rows.append(row)
+    rows.reverse()
     try:
         sizes = np.array([int(row[0]) for row in rows], dtype=np.int64)
         if not (sizes > 3).any():
             return None, None
         faces = np.empty(len(rows), dtype=object)
-        faces[:] = [np.array(row[1:1 + k], dtype=np.int64) for row, k in zip(rows, sizes)]
+        faces[:] = [np.array(row[1].split()[:k] if len(row) > 1 else [], dtype=np.int64)
+                    for row, k in zip(rows, sizes)]
         if any(len(face) != k for face, k in zip(faces, sizes)):
             raise ValueError("a face row holds fewer indices than it states")
         return triangles(faces), len(rows)

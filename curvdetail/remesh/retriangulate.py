@@ -234,8 +234,9 @@ def retriangulate(V, F, *, method="isotropic", target_edge="1%", iterations=10, 
     MeshError                  the source is malformed or not manifold (names the edges)
     CurvdetailError            a ``target_edge`` or ``max_surface_distance`` that is not a positive
                                length (``parameter`` names it)
-    RemeshError                isotropic: a vertex with more than ``MAX_VALENCE`` (1,000) triangles
-                               around it (``first``: the vertex, ``count``: its triangles); unknown method, ``iterations`` not a whole number from 1 to 1,000,
+    RemeshError                isotropic: a vertex with more than ``MAX_VALENCE`` (1,000)
+                               triangles around it (``first``: [the vertex], ``count``: its
+                               triangles); unknown method, ``iterations`` not a whole number from 1 to 1,000,
                                ``aggressiveness`` outside [0, 10] (bools and
                                strings are refused), ``surface_check`` not
                                True or False, a
