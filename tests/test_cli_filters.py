@@ -561,7 +561,7 @@ def test_an_editing_warning_from_apply_exits_4_with_the_output_written(capsys, t
     assert "curvdetail: warning: apply_curvature_editing" in err and str(folded) in err, err
 
 
-@pytest.mark.parametrize("params", [["backend=pardiso"], ["handles=0 1 2", "region_radius=20%", "backend=cholmod"]])
+@pytest.mark.parametrize("params", [["backend=pardiso"], ["handles=0 1 2", "region_radius=20%", "method=paper", "backend=cholmod"]])
 def test_a_backend_error_names_the_backend_param(capsys, tmp_path, monkeypatch, params):
     import curvdetail.curvature.sparse_solver as solver
 

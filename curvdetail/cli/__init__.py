@@ -151,6 +151,9 @@ def _remesh(parser):
            "planar domain for --location uv (default: harmonic)")
     parser.add_argument("--no-surface-check", action="store_true",
                         help="isotropic remeshing without its surface-distance check (faster on big targets)")
+    choice(parser, "--laplacian", ("auto", "cotan", "robust"), "auto",
+           "the source's Laplacian for its detail: robust = mollified, for zero-area triangles; auto "
+           "uses it only where cotan refuses the source (the report says which)")
     add_backend(parser)
     parser.add_argument("--report", metavar="R.json", help="write the JSON report here")
     parser.add_argument("--image", metavar="FIG.png", help="write a picture: source, rebuilt, zero-detail baseline")
@@ -195,7 +198,7 @@ def _remesh(parser):
                                     rows=args.rows, location=args.location, parameterization=args.parameterization,
                                     backend=args.backend, evaluate=not args.no_evaluate,
                                     source_path=os.path.abspath(args.input), progress=progress.stage,
-                                    surface_check=not args.no_surface_check)
+                                    surface_check=not args.no_surface_check, laplacian=args.laplacian)
         report = result["report"]
         if args.image is not None:
             from ..plot import save_remeshing_figure

@@ -62,6 +62,11 @@ from .transfer_curvature_detail import planar_map
                   "the target edge (pymeshlab's checksurfdist); false skips it, 25-50 % faster at "
                   "100k-400k target vertices, and the retriangulation may differ where the "
                   "remesher's smoothing would leave the surface"),
+        Parameter("laplacian", "str", "auto",
+                  "the source's Laplacian for its detail: 'cotan' (refuses zero-area triangles), 'robust' "
+                  "(mollified intrinsic cotan, zero-area caps flipped) or 'auto' (cotan unless the source "
+                  "has zero-area triangles); the report says which was used and why",
+                  choices=("auto", "cotan", "robust")),
         Parameter("evaluate", "bool", True,
                   "measure the distances to the source (half or more of the time on big meshes with "
                   "decimation, up to half with isotropic remeshing); false leaves the rebuilt and "
@@ -71,7 +76,7 @@ from .transfer_curvature_detail import planar_map
     ],
 )
 def generate_curvature_remeshing(ms, *, method, target_edge, transfer, rows, location,
-                                 parameterization, backend, surface_check, evaluate, add_baseline):
+                                 parameterization, backend, surface_check, laplacian, evaluate, add_baseline):
     from ..remesh.experiment import run_experiment
 
     mid = layer_id(ms)
@@ -89,7 +94,7 @@ def generate_curvature_remeshing(ms, *, method, target_edge, transfer, rows, loc
     result = run_experiment(V, F, method=method, target_edge=target_edge, transfer=transfer, rows=rows,
                             location=location, parameterization=planar_map(location, parameterization),
                             backend=backend, evaluate=evaluate, source_path=path, surface_check=surface_check,
-                            progress=progress)
+                            progress=progress, laplacian=laplacian)
     Ft = result["Ft"]
     layers = {"source": mid,
               "retriangulated": add_layer(ms, result["Vt"], Ft, f"{label} retriangulated")}

@@ -9,6 +9,7 @@ from ..curvature.errors import MeshError, warn
 from ..curvature.checks import as_count, check_bool, check_choice
 from ..curvature.geometry import bbox_diagonal
 from ..curvature.anchors import anchor_vertices
+from ..curvature.robust_laplacian import degenerate_triangles, flip_caps, robust_laplacian
 from ..curvature.topology import boundary_vertices
 from ..curvature.reconstruct import ROW_MODES, Reconstructor
 from ..curvature.sparse_solver import resolve_backend
@@ -52,10 +53,15 @@ RMS, MAX = "hausdorff_rms_percent_of_diagonal", "hausdorff_max_percent_of_diagon
 #: Measurements of the evaluate stage, reported one by one as ``progress("evaluate", done, total)``.
 EVALUATION_STEPS = 5
 
+#: The source's Laplacian (its detail D = L V): "auto" uses "cotan" unless the plain checks
+#: refuse the source's zero-area triangles, then "robust" (:func:`_source`).
+LAPLACIANS = ("auto", "cotan", "robust")
+
 STAGES = ("retriangulate", "parameterize", "transfer", "reconstruct", "evaluate")
 
 DEFAULTS = {"method": "isotropic", "target_edge": "1%", "transfer": "conservative", "rows": "free",
-            "location": "closest", "parameterization": None, "backend": "auto", "surface_check": True}
+            "location": "closest", "parameterization": None, "backend": "auto", "surface_check": True,
+            "laplacian": "auto"}
 
 
 class WorseThanZeroDetailWarning(UserWarning):
@@ -107,7 +113,8 @@ def worse_than_zero_detail(report, cli=False):
 
 def remesh_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="conservative", rows="free",
                       location="closest", parameterization=None, backend="auto", evaluate=True,
-                      source_path=None, progress=None, target=None, surface_check=True, anchors=1):
+                      source_path=None, progress=None, target=None, surface_check=True, anchors=1,
+                      laplacian="auto"):
     """Retriangulate a surface, carry its curvature detail over, rebuild it, and measure.
 
     Stages (timed): retriangulate (:func:`retriangulate`), parameterize (only for
@@ -167,6 +174,16 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="c
                                                (None for a given ``target`` or ``"decimate"``)
     anchors : int                              fixed vertices on each closed piece of the target
                                                (farthest-point sampled from its flattest vertex)
+    laplacian : {"auto", "cotan", "robust"}   the source's detail ``D = L V``: "cotan" the plain
+                                               cotangent Laplacian (refuses zero-area triangles);
+                                               "robust" the mollified one
+                                               (:func:`~curvdetail.curvature.robust_laplacian.robust_laplacian`),
+                                               and the geometric stages see the source with its
+                                               zero-area caps flipped away
+                                               (:func:`~curvdetail.curvature.robust_laplacian.flip_caps`:
+                                               the same surface); "auto" "cotan" unless the plain
+                                               checks refuse the source's zero-area triangles.
+                                               The rebuild on the target uses the plain one always
 
     Returns
     -------
@@ -188,14 +205,18 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="c
         a target equal to the source), with the reason under ``ratio_notes``
         (``{ratio name: reason}``, present only then),
         ``parameterization`` (flip counts, for ``location="uv"``) and
-        ``seconds.{retriangulate, parameterize, transfer, reconstruct, evaluate, total}``.
+        ``seconds.{retriangulate, parameterize, transfer, reconstruct, evaluate, total}``,
+        ``laplacian`` ("cotan" or "robust": the one used for the source's detail) and
+        ``laplacian_reason`` (why, with the zero-area triangles counted and the caps flipped).
         With ``evaluate=False`` the measured keys (``error``, ``baseline_zero_detail``,
         ``floor_retriangulated``, ``improvement_over_zero_detail``, ``ratio_to_floor``) are
         absent, not None
 
     Raises
     ------
-    MeshError                  malformed or non-manifold source (names the edges)
+    MeshError                  malformed or non-manifold source (names the edges); zero-area
+                               source triangles with ``laplacian="cotan"``, or ones no flip removes
+                               (a needle: two vertices at one point) with the others
     NotADiskError              (a MeshError) ``location="uv"`` with a source that is not a disk
     CurvdetailError            ``target_edge`` not a positive length (even with a ``target``)
     RemeshError                absurd target edge (with the numbers), a failed retriangulation, or a ``target`` with
@@ -226,7 +247,7 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="c
     result = run_experiment(V, F, method=method, target_edge=target_edge, transfer=transfer, rows=rows,
                             location=location, parameterization=parameterization, backend=backend,
                             evaluate=evaluate, source_path=source_path, progress=progress, target=target,
-                            surface_check=surface_check, anchors=anchors)
+                            surface_check=surface_check, anchors=anchors, laplacian=laplacian)
     return (result["X"], result["Ft"]), result["report"]
 
 
@@ -283,9 +304,38 @@ def _check_choice(name, value, choices):
     return check_choice(value, name, choices, f" is not one of {', '.join(map(repr, choices))}.")
 
 
+def _source(V, F, laplacian):
+    """The checked source ``(V, F, loops)`` for the geometric stages, its detail (None: the plain
+    cotan one, which the transfer computes itself) and the report's ``laplacian`` and
+    ``laplacian_reason``. "auto" falls back to "robust" only where :func:`check_surface` refuses
+    zero-area triangles; the robust path flips the zero-area caps away (a needle, two vertices at
+    one point, is still refused, by the same checks, naming it)."""
+    if laplacian != "robust":
+        try:
+            return (*check_surface(V, F, "the source"), None,
+                    {"laplacian": "cotan", "laplacian_reason": f"laplacian={laplacian!r}: the plain "
+                     "cotangent Laplacian (the source has no zero-area triangle)"})
+        except MeshError:
+            if laplacian == "cotan" or not degenerate_triangles(V, F).size:
+                raise
+    zero = degenerate_triangles(V, F)
+    flipped = flip_caps(V, F)
+    V, F_geometric, loops = check_surface(V, flipped, "the source (its zero-area caps flipped)")
+    L, _, delta = robust_laplacian(V, F)
+    why = ("asked for (laplacian='robust')" if laplacian == "robust" else
+           "laplacian='auto': the plain cotangent Laplacian refuses them")
+    return V, F_geometric, loops, L @ V, {
+        "laplacian": "robust",
+        "laplacian_reason": f"{zero.size} zero-area source triangles (first: {zero[:3].tolist()}), {why}; "
+                            f"mollified (every edge + {delta:.3g}), and for the other stages "
+                            f"{int((flipped != np.asarray(F)).any(axis=1).sum())} triangles re-cut by "
+                            "flipping the caps' long edges (the same surface)"}
+
+
 def run_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="conservative", rows="free",
                    location="closest", parameterization=None, backend="auto", evaluate=True,
-                   source_path=None, progress=None, target=None, surface_check=True, anchors=1):
+                   source_path=None, progress=None, target=None, surface_check=True, anchors=1,
+                   laplacian="auto"):
     """:func:`remesh_experiment` returning everything as a dict: ``X``, ``Ft``, ``Vt`` (the
     retriangulated surface), ``Z`` (zero-detail baseline; None where the target has a closed
     piece), ``Dt``, ``distance`` and
@@ -295,6 +345,7 @@ def run_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="cons
     transfer = _check_choice("transfer", transfer, TRANSFERS)
     rows = _check_choice("rows", rows, ROW_MODES)
     location = _check_choice("location", location, LOCATIONS)
+    laplacian = _check_choice("laplacian", laplacian, LAPLACIANS)
     if parameterization is not None:
         parameterization = _check_choice("parameterization", parameterization, PARAMETERIZATIONS)
         if location != "uv":
@@ -318,7 +369,7 @@ def run_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="cons
     anchors = as_count(anchors, "anchors")
     if location == "uv":
         check_disk(V, F, "the source")          # the planar map needs a disk: said before any work
-    V, F, loops_s = check_surface(V, F, "the source")
+    V, F, loops_s, detail, used = _source(V, F, laplacian)
     d = bbox_diagonal(V)
     seconds = dict.fromkeys(STAGES, 0.0)
     t_all = time.perf_counter()
@@ -352,7 +403,7 @@ def run_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="cons
         seconds["parameterize"] = time.perf_counter() - t
 
     t = stage("transfer")
-    Dt = transfer_curvature(V, F, Vt, Ft, method=transfer, location=location, uv=uv)
+    Dt = transfer_curvature(V, F, Vt, Ft, method=transfer, location=location, uv=uv, detail=detail)
     seconds["transfer"] = time.perf_counter() - t
 
     t = stage("reconstruct")
@@ -386,7 +437,9 @@ def run_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="cons
                     "location": location, "parameterization": parameterization if location == "uv" else None,
                     "backend": solver,
                     "surface_check": (bool(surface_check) if target is None and method == "isotropic"
-                                      else None)},
+                                      else None),
+                    "laplacian": laplacian},
+        **used,
     }
     if param_info is not None:
         report["parameterization"] = param_info
