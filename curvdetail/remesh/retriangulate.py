@@ -78,14 +78,8 @@ def long_run_vertices(V, F, target_edge, method="isotropic", evaluate=True):
 def long_run_reason(method="isotropic", evaluate=True, cli=False):
     """What takes the time of a run that :func:`long_run_vertices` announces and what shortens
     it: a sentence for the note said beforehand (``cli``: naming the command line's options,
-    else the filter's parameters).
-
-    Measured on the 2-core development machine (2026-12-01): isotropic remeshing to 263k
-    vertices (terrainA_1k) 61 s, of which the remeshing 47 s and the measurements 10 s; to 199k
-    (mannequin_nose) 104 s, remeshing 48 s and measurements 52 s (its zero-detail surface lies
-    far from the source); to 2.25M the remeshing alone 554 s (it grows faster than the
-    vertices, the measurements about with them). Decimation of a 490k-vertex grid to 251k: 92 s,
-    of which the measurements 75 s, the transfer 13 s and the decimation 3 s."""
+    else the filter's parameters). Isotropic remeshing grows faster than the vertex count, the
+    measurements about with it; a decimation's time is mostly the measurements."""
     no_evaluate = "--no-evaluate" if cli else "evaluate=False"
     no_check = "--no-surface-check" if cli else "surface_check=False"
     if method == "decimate":
