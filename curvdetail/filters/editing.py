@@ -235,7 +235,7 @@ def apply_curvature_editing(ms, *, handles, region_radius, transform, method, de
     rank_deficient, widened = _region_ring_counts(V, F, roi, editor)
     figures = {
         "max_displacement_percent_of_diagonal": float(100 * moved.max() / diagonal),
-        # far above 1: the curvature stage amplified the handle details (see docs/editing.md);
+        # far above 1: the curvature stage amplified the handle details (see docs/guide/editing.md);
         # None where the handles are not placed or do not move (a ratio of rounding, or of a pure
         # detail edit, which detail_amplification measures)
         "amplification": (float(moved.max() / moved[h].max())
@@ -350,6 +350,6 @@ def _warn_if_amplified(figures, folded, m, moved, D, D0, options):
     category = FoldedTrianglesWarning if folded.size else AmplifiedEditWarning
     setting = f"relations={relations!r}" if options["method"] == "paper" else "method='rotation'"
     warn(f"apply_curvature_editing with {setting}: {'; '.join(parts)}: {cause}, see "
-                  "docs/editing.md). "
+                  "docs/guide/editing.md). "
                   f"The mesh was edited all the same; try {', '.join(tries[:-1])} or {tries[-1]} on the original.",
                   category)

@@ -108,7 +108,7 @@ def worse_than_zero_detail(report, cli=False):
     return (f"the rebuilt surface is farther from the source than the zero-detail surface (RMS "
             f"{rms:.4g} % against {zero:.4g} % of the bbox diagonal): the transferred detail made it "
             f"worse than no detail at all, so this configuration failed on this patch. Try "
-            f"{'; and '.join(tries)}. docs/remeshing.md has what was measured.")
+            f"{'; and '.join(tries)}. docs/results/fig3_table.md has what was measured.")
 
 
 def remesh_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="conservative", rows="free",
