@@ -15,12 +15,12 @@ cube-sphere with a polar cap fixed) at 10k / 100k / 1M vertices, both row modes
 with each case in its own subprocess, so that its peak RSS (``ru_maxrss``) is its own. The error
 is the largest vertex distance to the known surface, as a fraction of the bbox diagonal.
 
-Results go to JSON (``--out``) and a markdown table between the markers in docs/benchmarks.md
+Results go to JSON (``--out``) and a markdown table between the markers in docs/results/reconstruct.md
 (``--markdown``), each written atomically: ``--out`` after each (surface, size, rows) group, so
 that a run stopped part-way keeps the groups done (``--merge`` continues from them), and the
 markdown at the end. Before any case runs, an existing file is refused
 unless ``--overwrite`` is given (``--merge`` alone allows updating ``--out``). ``--force`` is not that flag: it runs the cases left
-out by default. docs/benchmarks.md is in the repository, so refreshing its table takes
+out by default. docs/results/reconstruct.md is in the repository, so refreshing its table takes
 ``--overwrite`` (or ``--markdown ''`` for none).
 
 Usage::
@@ -417,7 +417,7 @@ def main(argv=None):
                         help="comma list of reconstruct, pardiso, cholmod, splu, spsolve "
                              "(default: reconstruct, every installed backend, spsolve)")
     parser.add_argument("--out", default="out/bench_reconstruct.json", help="JSON results")
-    parser.add_argument("--markdown", default="docs/benchmarks.md",
+    parser.add_argument("--markdown", default="docs/results/reconstruct.md",
                         help="file whose bench:begin/end block receives the table ('' for none)")
     parser.add_argument("--merge", action="store_true",
                         help="keep the cases of an existing --out file that this run does not redo "

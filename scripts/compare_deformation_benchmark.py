@@ -194,7 +194,7 @@ def main(argv=None):
                      for n, p in zip(CASES, map(os.path.abspath, pictures)))
     _files.write_text(md_path, "# Deformation benchmark (Botsch & Sorkine 2008)\n\n"
                       "Written by `python scripts/compare_deformation_benchmark.py --pictures docs/results --force` "
-                      "(see docs/editing.md); distances over the rest bbox diagonal, edge-length change relative "
+                      "(see docs/guide/editing.md); distances over the rest bbox diagonal, edge-length change relative "
                       "to the rest lengths, areas as fractions of the rest areas. Times on a shared host, load "
                       f"average {conditions['load_average'][0]:.1f} at the end (deformation.json): "
                       "compare them within a run only.\n\n" + text + "\n" + images, args.force)

@@ -7,7 +7,7 @@ configuration is run on that same target: transfer {conservative, pointwise} x r
 x location {closest, uv}. The default configuration is also run with decimation, and on
 terrainA_100k for the timing at 100k.
 
-Usage: python scripts/reproduce_fig3.py [--out out/fig3] [--docs docs] [--readme README.md]
+Usage: python scripts/reproduce_fig3.py [--out out/fig3] [--docs docs/results]
                                         [--meshes DIR] [--quick] [--force]
 (DIR defaults to $CURVDETAIL_MESHES, else ../shared/meshes beside the repository; --out to
 out/fig3 in the repository.) Writes
@@ -15,14 +15,12 @@ out/fig3 in the repository.) Writes
                         configurations that failed (with their error) and the peak memory
   OUT/fig3_table.md     the markdown tables and the run's speed paragraph
   OUT/fig3.png          the Fig. 3 patches, default configuration
-and with --docs DIR also DIR/fig3_table.md, DIR/fig3.png and the copy of the tables between
-the <!-- fig3-table --> markers of DIR/remeshing.md (where it has them); with --readme FILE the
-short table between FILE's <!-- fig3-readme-table --> markers. With --quick (a subset) only
-OUT/results.json and OUT/table_quick.md (--docs and --readme are refused: the committed files
-hold a full run). Each file is written atomically at the end; one that exists is refused before
+and with --docs DIR also DIR/fig3_table.md and DIR/fig3.png. With --quick (a subset) only
+OUT/results.json and OUT/table_quick.md (--docs is refused: the committed files hold a full
+run). Each file is written atomically at the end; one that exists is refused before
 any work unless --force is given; a mesh missing from DIR stops the script before
-any work. The files in docs/ and README.md are in the repository: refreshing them is
-``--docs docs --readme README.md --force``.
+any work. The files in docs/results are in the repository: refreshing them is
+``--docs docs/results --force``.
 
 Exit status 0 when every configuration ran; 1 when one failed (everything is still written,
 the failure recorded in the JSON's ``failures`` and as a FAILED line in the tables); 2 for a
@@ -46,9 +44,6 @@ from curvdetail.remesh import retriangulate
 from curvdetail.remesh.experiment import run_experiment
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-#: where docs/remeshing.md holds its copy of the tables, and README.md its short table
-TABLE_MARKERS = ("<!-- fig3-table -->\n", "<!-- /fig3-table -->")
-README_MARKERS = ("<!-- fig3-readme-table -->\n", "<!-- /fig3-readme-table -->")
 PATCHES = ["mannequin_nose.obj", "mannequin_ear.obj", "elephant_trunk.obj", "terrainA_10k.obj",
            "camelhead.off", "mannequin_disk_1k.obj"]
 FIGURE_PATCHES = ("mannequin_nose.obj", "mannequin_ear.obj", "elephant_trunk.obj")
@@ -114,20 +109,6 @@ HEADER = ("| patch | source V | target V | retriangulation | transfer | rows | l
           "RMS / max (%) | zero-detail RMS / max (%) | floor RMS / max (%) | better than zero | RMS / floor | "
           "targets met | seconds: retriangulate / parameterize / transfer / reconstruct / evaluate / total |\n"
           "|---|---:|---:|---|---|---|---|---:|---:|---:|---:|---:|---|---|")
-README_HEADER = ("| patch | source V | target V | rebuilt RMS / max | zero detail RMS / max | floor RMS / max | "
-                 "better than zero detail | seconds |\n|---|---:|---:|---:|---:|---:|---:|---:|")
-
-
-def readme_row(name, rep, t_retri=None):
-    """One line of README.md's short table (the same figures as :func:`row`'s)."""
-    e, b, f = rep["error"], rep["baseline_zero_detail"], rep["floor_retriangulated"]
-    return (f"| {name} | {rep['source']['vertices']:,} | {rep['target']['vertices']:,} | "
-            f"**{pct(e['hausdorff_rms_percent_of_diagonal'], 4)}** / {pct(e['hausdorff_max_percent_of_diagonal'])} | "
-            f"{pct(b['hausdorff_rms_percent_of_diagonal'], 2)} / {pct(b['hausdorff_max_percent_of_diagonal'], 1)} | "
-            f"{pct(f['hausdorff_rms_percent_of_diagonal'], 4)} / {pct(f['hausdorff_max_percent_of_diagonal'])} | "
-            f"{_ratio(rep['improvement_over_zero_detail'], ',.0f', 'x')} | {_total(rep, t_retri):.1f} |")
-
-
 def retriangulation_record(method, target_edge, diagonal, seconds, shared, **settings):
     """What made a report's target, for the JSON: ``method``, ``target_edge_percent_of_diagonal``
     and ``target_edge_model_units`` (``target_edge`` as the functions take it), the other settings of
@@ -141,19 +122,6 @@ def retriangulation_record(method, target_edge, diagonal, seconds, shared, **set
     record.update({name: settings.get(name, RETRIANGULATE_DEFAULTS[name]) for name in relevant})
     record.update(seconds=None if seconds is None else round(seconds, 4), shared=shared)
     return record
-
-
-def _with_table(doc, table, markers=TABLE_MARKERS):
-    """The text of ``doc`` with ``table`` between its ``markers``, or None where there is no
-    such file or it has no markers (then it is not written)."""
-    if not os.path.exists(doc):
-        return None
-    with open(doc, encoding="utf-8") as fh:
-        text = fh.read()
-    begin, end = markers
-    if begin not in text or end not in text:
-        return None
-    return text[:text.index(begin) + len(begin)] + table + text[text.index(end):]
 
 
 def _missing_meshes(folder, names):
@@ -202,9 +170,7 @@ def main(argv=None):
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "fig3"),
                     help="folder for results.json, the tables and the picture (default: out/fig3 in the repository)")
     ap.add_argument("--docs", default=None,
-                    help="also refresh DOCS/fig3_table.md, DOCS/fig3.png and the tables in DOCS/remeshing.md")
-    ap.add_argument("--readme", default=None,
-                    help="also refresh the short table between README's <!-- fig3-readme-table --> markers")
+                    help="also refresh DOCS/fig3_table.md and DOCS/fig3.png (the repository's: docs/results)")
     ap.add_argument("--meshes", default=MESHES,
                     help="folder of the public meshes (default: $CURVDETAIL_MESHES, else ../shared/meshes)")
     ap.add_argument("--quick", action="store_true",
@@ -213,26 +179,18 @@ def main(argv=None):
     ap.add_argument("--force", action="store_true", help="replace output files that exist")
     args = ap.parse_args(argv)
     meshes = args.meshes
-    if args.quick and (args.docs or args.readme):
-        ap.error("--docs and --readme refresh the committed tables and picture, which hold a full run; "
-                 "leave out --quick (or --docs / --readme).")
+    if args.quick and args.docs:
+        ap.error("--docs refreshes the committed table and picture, which hold a full run; "
+                 "leave out --quick (or --docs).")
     results_json = os.path.join(args.out, "results.json")
-    figure = docs_figure = doc = docs_table = None
+    figure = docs_figure = docs_table = None
     if args.quick:
         table_file = os.path.join(args.out, "table_quick.md")
     else:
         table_file, figure = os.path.join(args.out, "fig3_table.md"), os.path.join(args.out, "fig3.png")
         if args.docs is not None:
             docs_table, docs_figure = os.path.join(args.docs, "fig3_table.md"), os.path.join(args.docs, "fig3.png")
-            doc = os.path.join(args.docs, "remeshing.md")     # the copy between its markers, if it has them
-            if _with_table(doc, "") is None:
-                doc = None
-    if args.readme is not None and _with_table(args.readme, "", README_MARKERS) is None:
-        why = ("does not exist" if not os.path.isfile(args.readme) else
-               f"has no {README_MARKERS[0].strip()} ... {README_MARKERS[1]} block to refresh")
-        ap.error(f"--readme {args.readme} {why}; name the repository's README.md, or leave out --readme.")
-    _files.check_outputs(ap, [results_json, table_file, figure, docs_table, doc, docs_figure, args.readme],
-                         args.force)
+    _files.check_outputs(ap, [results_json, table_file, figure, docs_table, docs_figure], args.force)
     if not os.path.isdir(meshes):
         ap.error(f"mesh folder {meshes!r} does not exist; pass --meshes DIR or set CURVDETAIL_MESHES")
     extra_runs = EXTRA_RUNS + ([] if args.quick else EXTRA_RUNS_FULL)
@@ -244,7 +202,7 @@ def main(argv=None):
                  "(../shared/meshes beside the repository).")
 
     started = time.strftime("%Y-%m-%d %H:%M", time.gmtime())
-    results, failures, lines_main, lines_all, lines_readme = [], [], [], [], []
+    results, failures, lines_main, lines_all = [], [], [], []
     figure_inputs, timings = {}, {}
 
     def record(rep, retriangulation):
@@ -283,7 +241,6 @@ def main(argv=None):
             lines_all.append(line)
             if (transfer, rows, location) == CONFIGS[0]:
                 lines_main.append(line)
-                lines_readme.append(readme_row(short, rep, t_retri))
                 timings[short] = (rep, t_retri)
                 if name in FIGURE_PATCHES:
                     figure_inputs[name] = (V, F, out)
@@ -331,8 +288,6 @@ def main(argv=None):
         extra.append(line)
         if name == "terrainA_100k.ply":
             timings[short + (" decimate" if method == "decimate" else "")] = (rep, None)
-            if method == "isotropic":
-                lines_readme.append(readme_row(short, rep))
         print(line, flush=True)
 
     conditions = _files.measured_conditions()     # utc (the end), load_average, peak_rss_gb
@@ -361,13 +316,6 @@ def main(argv=None):
     _files.write_text(table_file, table, args.force)
     if docs_table is not None:
         _files.write_text(docs_table, table, args.force)
-    text = _with_table(doc, table) if doc else None
-    if text is not None:      # refresh the copy between the markers in DOCS/remeshing.md
-        _files.write_text(doc, text, args.force)
-    if args.readme is not None:
-        _files.write_text(args.readme, _with_table(
-            args.readme, f"Seconds end to end from the run of {started} UTC (the tables in docs/remeshing.md).\n\n"
-                         f"{README_HEADER}\n" + "\n".join(lines_readme) + "\n", README_MARKERS), args.force)
     if figure is not None and figure_inputs:
         _figure(figure_inputs, figure, args.force)
         if docs_figure is not None:

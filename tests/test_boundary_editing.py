@@ -441,7 +441,7 @@ def test_a_small_smooth_edit_neither_folds_nor_warns(load_mesh):
     X, info = edit_boundary(V, F, f, return_info=True)
     assert info["folded_triangles"] == 0 == _folded_against_rest(V, F, X)
     assert info["amplification"] > 3
-    # the docstring's example and the one of docs/editing.md (the package's terrain)
+    # the docstring's example and the one of docs/guide/editing.md (the package's terrain)
     V, F = grid(12, 12)
     V[:, 2] = 0.05 * np.sin(6 * V[:, 0]) * np.sin(6 * V[:, 1])
     _, info = edit_boundary(V, F, sine_displacement(0.1, periods=2, axis=2), return_info=True)

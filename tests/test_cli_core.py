@@ -256,3 +256,19 @@ def test_main_puts_the_sigterm_handler_back():
         main(["--version"])
     assert main(["list", "compute_curvature_detail"]) == 0
     assert signal.getsignal(signal.SIGTERM) is before
+
+
+@pytest.mark.parametrize("command", ["reconstruct", "minimal"])
+def test_input_colours_and_normals_not_carried_get_a_note(tmp_path, capsys, command):
+    from curvdetail.io.ply import write_ply
+
+    V, F = read_mesh(NOSE)
+    rgb = {c: np.full(len(V), 200, dtype=np.uint8) for c in ("red", "green", "blue")}
+    normals = {f"n{a}": np.full(len(V), 1.0 if a == "z" else 0.0) for a in "xyz"}
+    for fields, said in ((rgb, ["vertex colours"]), (normals, ["normals"]), ({**rgb, **normals}, ["vertex colours", "normals"]),
+                         ({}, [])):
+        write_ply(str(tmp_path / "in.ply"), V, F, fields)
+        assert main([command, str(tmp_path / "in.ply"), str(tmp_path / "out.ply"), "--overwrite"]) == 0
+        notes = [line for line in capsys.readouterr().err.splitlines() if "in.ply" in line]
+        assert [w for w in ("vertex colours", "normals") if any(w in line for line in notes)] == said
+        assert all(line.startswith("curvdetail: note: out.ply") for line in notes)

@@ -1,8 +1,7 @@
-"""The Python examples of the README and docs/ run as written, with the figures they quote.
+"""The code of the README and of the site's pages runs as written, with the figures it quotes.
 
-Paths in them are relative to the repository root (the bundled example, tests/data, the example
-scripts), except the README's first example, which reads a ``patch.obj`` of the user's: it runs in
-a scratch folder holding the bundled terrain under that name."""
+Each page runs in a scratch folder holding what the pages read: ``patch.obj`` (the bundled
+terrain), ``tests/data`` and ``scripts/examples``."""
 
 import os
 import re
@@ -41,52 +40,81 @@ def test_readme_python_example_rebuilds_the_patch_to_solver_precision(tmp_path, 
     assert sorted(os.listdir(tmp_path)) == ["patch.obj", "rebuilt.ply"]
 
 
-def test_readme_filter_example_runs_the_remeshing_and_the_script(monkeypatch, capsys):
-    monkeypatch.chdir(ROOT)
+#: The site's pages whose code runs, in the order of its navigation.
+PAGES = ["docs/index.md"] + [f"docs/tutorials/{name}.md" for name in
+                             ("reconstruct", "minimal", "editing", "remeshing", "closed", "filters", "evaluate")]
+#: Commands the pages show but the tests do not run: ``edit`` reads the deformation benchmark's
+#: files (not shipped), ``evaluate`` starts a second Dask cluster after the page's Python one.
+NOT_RUN = {"edit", "evaluate"}
+
+
+def page_blocks(name):
+    """``(kind, text)`` of every ```python and ```console block of a page, in order."""
+    with open(os.path.join(ROOT, name), encoding="utf-8") as f:
+        return re.findall(r"```(python|console)\n(.*?)```", f.read(), flags=re.S)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("page", PAGES)
+def test_site_page_code_runs_in_order(page, tmp_path, monkeypatch, capsys):
+    # In a scratch folder with what the pages read: patch.obj (the bundled terrain), the test
+    # meshes and the example scripts, so that nothing is written into the repository.
+    from curvdetail.cli import main
+
+    shutil.copy(os.path.join(ROOT, "curvdetail", "data", "terrainA_1k.obj"), tmp_path / "patch.obj")
+    shutil.copytree(os.path.join(ROOT, "tests", "data"), tmp_path / "tests" / "data")
+    shutil.copytree(os.path.join(ROOT, "scripts", "examples"), tmp_path / "scripts" / "examples")
+    monkeypatch.chdir(tmp_path)
+    scope, ran = {"__name__": "__docs__"}, 0
+    for kind, text in page_blocks(page):
+        if kind == "python":
+            exec(compile(text, page, "exec"), scope)
+            ran += 1
+            continue
+        for line in text.splitlines():
+            argv = shlex.split(line.split(" #")[0])[2:] if line.startswith("$ curvdetail ") else []
+            if argv and argv[0] not in NOT_RUN:
+                assert main(argv) == 0, line
+                ran += 1
+    assert ran > 0
+    capsys.readouterr()
+
+
+def test_site_pages_quote_what_they_compute(tmp_path, monkeypatch):
+    # the figures the getting-started example and the reconstruct tutorial state in comments
+    shutil.copy(os.path.join(ROOT, "curvdetail", "data", "terrainA_1k.obj"), tmp_path / "patch.obj")
+    monkeypatch.chdir(tmp_path)
     scope = {}
-    exec(block_under("README.md", "## MeshLab-style filters"), scope)
-    assert scope["figures"]["error"]["hausdorff_rms_percent_of_diagonal"] < 0.1        # the terrain: ~0.014 %
-    assert [s["filter"] for s in scope["steps"]][-1] == "get_curvature_reconstruction_error"
-    assert "generate_curvature_remeshing" in capsys.readouterr().out
+    exec(python_blocks("docs/tutorials/minimal.md")[0], scope)
+    M, V, b = scope["M"], scope["V"], scope["b"]
+    assert M.converged and np.array_equal(M[b], V[b])
+    exec(python_blocks("docs/tutorials/editing.md")[0], scope)
+    C, D, info = scope["C"], scope["D"], scope["info"]
+    assert np.abs(C @ D - D).max() < 1e-9 * np.abs(D).max() and info.rank_deficient == 0
 
 
-def test_filters_doc_examples_run_with_the_quoted_error(monkeypatch):
-    monkeypatch.chdir(ROOT)
-    printed = []
-    scope = {"print": printed.append}
-    exec(python_blocks("docs/filters.md")[0], scope)
-    assert printed[0]["hausdorff_rms_percent_of_diagonal"] == pytest.approx(0.022, abs=0.002)   # as its comment says
-    figures = {s["filter"]: s["figures"] for s in scope["steps"]}
-    assert figures["generate_minimal_surface"]["converged"]
-
-
-def test_remeshing_doc_example_runs_on_the_bundled_nose(monkeypatch):
-    monkeypatch.chdir(ROOT)
-    scope = {}
-    exec(python_blocks("docs/remeshing.md")[0], scope)
-    report = scope["report"]
-    assert report["error"]["hausdorff_rms_percent_of_diagonal"] < 0.1 < report["baseline_zero_detail"]["hausdorff_rms_percent_of_diagonal"]
-    assert scope["Dt"].shape == scope["Vt"].shape and scope["Vt"].shape[0] < 640
-
-
-#: The documents in the order the README sends a new user through them, and the options of the
-#: ``curvdetail`` commands that take a value (the values that are output files are marked True).
-READING_ORDER = ["README.md", "docs/filters.md", "docs/remeshing.md", "docs/editing.md", "docs/benchmarks.md"]
+#: Two ways in, each followed top to bottom in one folder: the README alone, and the site's pages
+#: in the order of its navigation; and the options of the ``curvdetail`` commands that take a
+#: value (the values that are output files are marked True).
+READING_ORDERS = [["README.md"],
+                  PAGES + [f"docs/guide/{name}.md" for name in ("solvers", "editing", "remeshing", "filters", "evaluate")]]
 VALUE_OPTIONS = {"--report": True, "--image": True, "--param": False, "--add": False, "--sel": False,
                  "--def": False, "--target-edge": False, "--method": False, "--transfer": False,
                  "--rows": False, "--location": False, "--parameterization": False, "--backend": False,
                  "--max-iterations": False, "--tol": False, "--step": False, "--handle-detail": False,
-                 "--relations": False}
+                 "--relations": False, "--laplacian": False, "--results": False, "--workers": False,
+                 "--study": False, "--summary": False, "--cell-timeout": False, "--cell-memory": False,
+                 "--scheduler": False}
 FLAG_OPTIONS = {"--overwrite", "--example", "--quiet", "--no-evaluate", "--no-surface-check", "--fix-boundary",
                 "--json", "--help"}
 
 
-def documented_writes():
+def documented_writes(order):
     """``(document, file, overwrite)`` for every file the docs' commands and Python examples
     write, in reading order: the ``curvdetail`` command lines of every fenced block (OUTPUT,
     ``--report``, ``--image``), ``write_mesh`` and pymeshlab's ``save_current_mesh``."""
     writes = []
-    for name in READING_ORDER:
+    for name in order:
         with open(os.path.join(ROOT, name), encoding="utf-8") as f:
             blocks = re.findall(r"```[a-z]*\n(.*?)```", f.read(), flags=re.S)
         for block in blocks:
@@ -119,12 +147,12 @@ def command_writes(name, command):
     return [(name, path, "--overwrite" in words) for path in outputs]
 
 
-def test_docs_commands_run_in_reading_order_never_write_a_file_an_earlier_one_made():
+@pytest.mark.parametrize("order", READING_ORDERS, ids=["README", "site"])
+def test_docs_commands_run_in_reading_order_never_write_a_file_an_earlier_one_made(order):
     # Followed top to bottom in one folder, a command whose OUTPUT an earlier step made stops with
-    # 'exists; pass --overwrite' (the README's reconstruct wrote the rebuilt.ply of its Python
-    # example; docs/filters.md the rebuilt.ply, remeshed.ply and out.ply of the README's).
-    writes = documented_writes()
-    assert len(writes) >= 15 and ("README.md", "report.json", True) in writes
+    # 'exists; pass --overwrite'.
+    writes = documented_writes(order)
+    assert ("README.md", "report.json", True) in writes if order == ["README.md"] else len(writes) >= 15
     made, clashes = {}, []
     for name, path, overwrite in writes:
         if path in made and not overwrite:

@@ -30,7 +30,7 @@ def run_example(name, before=None):
 
 def test_remesh_transfer_rebuild_pipeline():
     # measured (2026-12-01, exact vertex maxima): RMS 0.0373 %, max 0.369 % of the diagonal after
-    # pymeshlab's remeshing at 2 %, as docs/filters.md says; the RMS is a Monte Carlo estimate
+    # pymeshlab's remeshing at 2 %, as docs/guide/filters.md says; the RMS is a Monte Carlo estimate
     # whose samples depend on pymeshlab's generator state in this process (~1 %)
     retriangulated = {}
 
@@ -62,7 +62,7 @@ def test_remesh_transfer_rebuild_pipeline():
 
 def test_minimal_surface_pipeline():
     # the terrain's relief: the minimal surface lies 1.30 % (RMS), 3.19 % (max) of the diagonal
-    # away from it, after 22 steps (docs/filters.md)
+    # away from it, after 22 steps (docs/guide/filters.md)
     ms, steps = run_example("minimal_surface.mlx")
     assert ms.mesh_number() == 2 and ms.mesh(0).selected_vertex_number() == 128    # Select Border
     minimal = steps[2]["figures"]

@@ -148,3 +148,24 @@ def test_inputs_that_cannot_be_read_are_named(tmp_path):
             load_meshset(tmp_path / name)
         assert e.value.value == str(tmp_path / name)
     assert e.value.declared == (5, 2) and e.value.loaded == (4, 2)
+
+
+def test_a_ply_loaded_by_pymeshlab_itself_lacks_the_attributes_and_the_error_says_how_to_keep_them(tmp_path):
+    # pymeshlab's load_new_mesh reads no custom attribute: the next filter's error points to
+    # load_meshset, and that load serves it
+    from curvdetail.filters import FilterError
+
+    ms = load_meshset(NOSE)
+    apply(ms, "compute_curvature_detail")
+    save_current_mesh(ms, tmp_path / "d.ply")
+    own = pymeshlab.MeshSet()
+    own.load_new_mesh(str(tmp_path / "d.ply"))
+    with pytest.raises(FilterError) as e:
+        apply(own, "apply_curvature_reconstruction")
+    assert e.value.value == "curvature_detail"
+    assert "curvdetail.filters.files.load_meshset" in e.value.hint
+    assert "curvdetail.filters.files.save_current_mesh" in e.value.hint
+    back = load_meshset(tmp_path / "d.ply")
+    apply(back, "apply_curvature_reconstruction")
+    V = ms.current_mesh().vertex_matrix()
+    assert np.abs(back.current_mesh().vertex_matrix() - V).max() < 1e-9 * np.linalg.norm(np.ptp(V, axis=0))

@@ -254,7 +254,7 @@ def test_a_layer_id_written_empty_or_current_reads_back_as_the_current_mesh(text
 @pytest.mark.parametrize("value, expected", [(np.array(1), "free"), (np.array(0, dtype=np.int32), "all"),
                                              (np.array(np.uint8(1)), "free")])
 def test_an_enum_index_given_as_a_zero_dimensional_array_is_taken(value, expected):
-    # docs/filters.md: "numpy scalars and 0-d arrays are taken as the numbers they hold", and an
+    # docs/guide/filters.md: "numpy scalars and 0-d arrays are taken as the numbers they hold", and an
     # enumeration takes its index; np.array(1) was refused as "expects a str (... or its index)"
     # while np.int64(1) was taken
     p = Parameter("rows", "str", "all", "rows", choices=("all", "free"))

@@ -227,3 +227,35 @@ def test_a_planar_map_that_collapses_a_triangle_is_named_in_the_filters_words(mo
         apply(ms, "transfer_curvature_detail", sourcemesh=0, targetmesh=1, location="uv", parameterization="lscm")
     assert e.value.count == 1
     assert vertex_attribute(ms, 1, "curvature_detail", "point") is None
+
+
+def test_a_target_that_is_another_surface_is_refused_with_the_distance():
+    # terrainA_1k onto another terrain of the same size and place (its heights mirrored): the
+    # rebuilt surface came out 16.6 % of the diagonal off, exit 0
+    from curvdetail.curvature.topology import boundary_vertices as on_boundary
+    from curvdetail.remesh import RETRIANGULATION_TOLERANCE
+
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(os.path.join(DATA, "terrainA_1k.obj"))
+    V, F = ms.mesh(0).vertex_matrix().copy(), ms.mesh(0).face_matrix()
+    V[:, 2] = V[:, 2].min() + V[:, 2].max() - V[:, 2]
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=V, face_matrix=F))
+    with pytest.raises(FilterError) as info:
+        apply(ms, "transfer_curvature_detail", sourcemesh=0, targetmesh=1)
+    e = info.value
+    assert e.parameter == "targetmesh" and e.value > 10 * RETRIANGULATION_TOLERANCE
+    assert set(e.first) <= set(on_boundary(F).tolist()) and e.count >= len(e.first)
+    assert vertex_attribute(ms, 1, "curvature_detail", "point") is None
+
+
+def test_pymeshlabs_own_retriangulation_of_a_curved_boundary_is_taken():
+    # its smoothing slides boundary vertices along the curve, 2e-4 of the diagonal off (measured)
+    from curvdetail.curvature.testing import disk
+
+    V, F = disk(n_rings=24)
+    V[:, 2] = 0.3 * np.sin(3 * V[:, 0]) * V[:, 1]
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=V, face_matrix=F))
+    ms.generate_copy_of_current_mesh()
+    ms.meshing_isotropic_explicit_remeshing(iterations=10, targetlen=pymeshlab.PercentageValue(3.0))
+    assert apply(ms, "transfer_curvature_detail", sourcemesh=0, targetmesh=1)["target_vertices"] > 0

@@ -81,17 +81,49 @@ PENTAGON = [[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0], [2, 0.5, 0]]      # conv
 
 def test_polygons_are_fanned_from_their_first_corner(tmp_path):
     (tmp_path / "p.obj").write_text("".join(f"v {x} {y} {z}\n" for x, y, z in PENTAGON) + "f 1 2 5 4 3\n")
+    (tmp_path / "p.off").write_text("OFF\n5 1 0\n" + "".join(f"{x} {y} {z}\n" for x, y, z in PENTAGON) + "5 0 1 4 3 2\n")
     face = np.empty(1, dtype=[("vertex_indices", "O")])
     face[0] = (np.array([0, 1, 4, 3, 2], dtype=np.int32),)
     vertex = np.array([tuple(p) for p in PENTAGON], dtype=[("x", "f8"), ("y", "f8"), ("z", "f8")])
     plyfile.PlyData([plyfile.PlyElement.describe(vertex, "vertex"),
                      plyfile.PlyElement.describe(face, "face")]).write(str(tmp_path / "p.ply"))
-    for ext in ("obj", "ply"):
+    for ext in ("obj", "ply", "off"):
         V, F = read_mesh(tmp_path / f"p.{ext}")
         assert np.array_equal(V, PENTAGON) and F.tolist() == [[0, 1, 4], [0, 4, 3], [0, 3, 2]]
 
 
-def test_off_quads_are_read_and_larger_polygons_refused(tmp_path):
+def _quad_grid(n):
+    """An n x n grid of non-planar quads: ``(V, Q)``."""
+    j, i = np.divmod(np.arange((n + 1) ** 2), n + 1)
+    V = np.column_stack([i, j, 0.1 * ((7 * i + 3 * j) % 5)]).astype(np.float64)
+    c = (np.arange(n)[:, None] * (n + 1) + np.arange(n)).ravel()
+    return V, np.column_stack([c, c + 1, c + n + 2, c + n + 1])
+
+
+def test_quads_are_split_the_same_way_by_every_reader(tmp_path):
+    # pymeshlab's OFF loader cut them along the other diagonal (the grid remeshed to 400 vertices as
+    # OBJ, 256 as OFF)
+    V, Q = _quad_grid(4)
+    (tmp_path / "g.obj").write_text("".join(f"v {x} {y} {z}\n" for x, y, z in V)
+                                    + "".join(f"f {a} {b} {c} {d}\n" for a, b, c, d in Q + 1))
+    (tmp_path / "g.off").write_text(f"OFF\n{len(V)} {len(Q)} 0\n" + "".join(f"{x} {y} {z}\n" for x, y, z in V)
+                                    + "".join(f"4 {a} {b} {c} {d}\n" for a, b, c, d in Q))
+    face = np.empty(len(Q), dtype=[("vertex_indices", "O")])
+    face["vertex_indices"] = list(Q.astype(np.int32))
+    vertex = np.array([tuple(p) for p in V], dtype=[("x", "f8"), ("y", "f8"), ("z", "f8")])
+    plyfile.PlyData([plyfile.PlyElement.describe(vertex, "vertex"),
+                     plyfile.PlyElement.describe(face, "face")]).write(str(tmp_path / "g.ply"))
+    expected = np.column_stack([Q[:, [0, 1, 2]], Q[:, [0, 2, 3]]]).reshape(-1, 3)
+    for ext in ("obj", "off", "ply"):
+        W, F = read_mesh(tmp_path / f"g.{ext}")
+        assert np.array_equal(W, V) and np.array_equal(F, expected), ext
+    ms = pymeshlab.MeshSet()                  # a MeshSet layer (what the filters get) is the same
+    mesh_io.load_new_mesh(ms, tmp_path / "g.obj")
+    mesh_io.load_new_mesh(ms, tmp_path / "g.off")
+    assert ms.current_mesh_id() == 1 and np.array_equal(ms.mesh(1).face_matrix(), expected)
+
+
+def test_off_quads_and_larger_polygons_are_read(tmp_path):
     # pymeshlab's OFF loader cut a pentagon into triangles of vertices 0-4 wherever its corners were
     rows = "".join(f"{x} {y} {z}\n" for x, y, z in PENTAGON)
     (tmp_path / "q.off").write_text(f"OFF\n5 2 0\n{rows}4 0 1 3 2\n3 1 4 3\n")
@@ -99,9 +131,17 @@ def test_off_quads_are_read_and_larger_polygons_refused(tmp_path):
     V, F = read_mesh(tmp_path / "q.off")
     twice_areas = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])[:, 2]
     assert F.shape == (3, 3) and (twice_areas > 0).all() and twice_areas.sum() == 3.0    # shoelace: 1.5
-    with pytest.raises(MeshFileError) as e:
-        read_mesh(tmp_path / "p.off")
-    assert e.value.value == str(tmp_path / "p.off")
+    assert read_mesh(tmp_path / "p.off")[1].tolist() == [[0, 1, 2], [1, 2, 5], [1, 5, 4], [1, 4, 3]]
+
+
+def test_off_colours_and_normals_are_read_as_fields(tmp_path):
+    (tmp_path / "c.off").write_text("COFF\n3 1 0\n0 0 0 255 0 0 255\n1 0 0 0 255 0 255\n0 1 0 0 0 255 255\n3 0 1 2\n")
+    (tmp_path / "n.off").write_text("NOFF\n3 1 0\n0 0 0 0 0 -1\n1 0 0 0 0 -1\n0 1 0 0 0 -1\n3 0 1 2\n")
+    (tmp_path / "a.off").write_text("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")
+    colours = read_mesh(tmp_path / "c.off", fields=True)[2]
+    assert colours["red"].tolist() == [255, 0, 0] and colours["blue"].tolist() == [0, 0, 255]
+    assert read_mesh(tmp_path / "n.off", fields=True)[2]["nz"].tolist() == [-1.0, -1.0, -1.0]
+    assert read_mesh(tmp_path / "a.off", fields=True)[2] == {}
 
 
 @pytest.mark.parametrize("name, text, declared, loaded", [

@@ -443,3 +443,32 @@ def test_every_decimation_target_in_the_range_is_reached(load_mesh, where):
     h = target_edge * bbox_diagonal(V)
     asked = 0.5 * face_double_areas(V, F).sum() / (np.sqrt(3.0) / 4.0 * h * h)
     assert Ft.shape[0] == pytest.approx(asked, rel=0.05)
+
+
+def _fan(n):
+    """A disk of ``n`` triangles all meeting at vertex 0 (raised 0.1 above the unit circle)."""
+    t = 2 * np.pi * np.arange(n) / n
+    V = np.zeros((n + 1, 3))
+    V[1:, 0], V[1:, 1], V[0, 2] = np.cos(t), np.sin(t), 0.1
+    i = np.arange(n)
+    return V, np.stack([np.zeros(n, dtype=np.int64), 1 + i, 1 + (i + 1) % n], axis=1)
+
+
+def test_a_vertex_of_too_high_valence_is_refused_before_the_isotropic_remesher_runs(isotropic_calls):
+    from curvdetail.remesh.retriangulate import MAX_VALENCE
+
+    V, F = _fan(MAX_VALENCE + 1)
+    with pytest.raises(RemeshError) as info:
+        retriangulate(V, F, method="isotropic", target_edge="3%")
+    assert (info.value.first, info.value.count) == ([0], MAX_VALENCE + 1)
+    assert "source" in info.value.problem and not isotropic_calls
+
+
+def test_a_remesher_result_problem_names_that_mesh_not_the_source():
+    from curvdetail.remesh._disk import check_surface
+
+    V, F = grid(3, 3)
+    V[4] = V[3]                               # two triangles at vertex 4 collapse to zero area
+    with pytest.raises(MeshError) as info:
+        check_surface(V, F, "the rebuilt mesh")
+    assert info.value.problem.startswith("the rebuilt mesh") and info.value.count == 2

@@ -25,6 +25,7 @@ from .options import (AMPLIFIED, NOT_CONVERGED, Progress, add_backend, add_fix, 
                           error_line, input_output, length, note_dropped, positive_number, print_figures,
                           quality_for, read_checked, run_on_file, say, show_warning, whole_number_from_one,
                           write_measured)
+from .options import note_not_carried, read_noting_extras
 
 __all__ = ["AMPLIFIED", "NOT_CONVERGED", "Terminated", "build_parser", "error_line", "main",
            "positive_number", "whole_number_from_one"]
@@ -65,7 +66,7 @@ def _reconstruct(parser):
 
         inputs = input_output(args)
         check_outputs(args, [("OUTPUT", args.output, True)], **inputs)
-        V, F = read_checked(args.input)
+        V, F, extras = read_noting_extras(args.input)
         # the boundary (or --fix), and an anchor on each piece with no fixed vertex (a closed one)
         fixed = anchor_vertices(V, F, fixed=None if args.fix is None else fixed_vertices(args, V, F, purpose=""))
         t = time.perf_counter()
@@ -77,6 +78,7 @@ def _reconstruct(parser):
         print_figures(f"max vertex error {dist.max() / diagonal(V):.3e} of the bbox diagonal ({V.shape[0]} "
                       f"vertices, {fixed.size} fixed, rows={args.rows}, {seconds:.3f} s)")
         note_dropped(args.output, quality=True)
+        note_not_carried(args.input, args.output, extras)
         return 0
 
     return run
@@ -107,7 +109,7 @@ def _minimal(parser):
 
         inputs = input_output(args)
         check_outputs(args, [("OUTPUT", args.output, True)], **inputs)
-        V, F = read_checked(args.input)
+        V, F, extras = read_noting_extras(args.input)
         fixed = fixed_vertices(args, V, F, purpose="(a minimal surface needs a boundary to span)")
         loose = np.setdiff1d(boundary_vertices(F), fixed)
         if loose.size:                      # a free boundary shrinks towards nothing
@@ -124,6 +126,7 @@ def _minimal(parser):
         print_figures(f"{state} after {X.iterations} step{'' if X.iterations == 1 else 's'}, last step {step:.2e} of the bbox diagonal "
                       f"({'normal to the surface' if args.step == 'normal' else 'full displacement'})")
         note_dropped(args.output, quality=True)
+        note_not_carried(args.input, args.output, extras)
         return 0 if X.converged else NOT_CONVERGED
 
     return run

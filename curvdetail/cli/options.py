@@ -111,6 +111,26 @@ def read_checked(path):
     return check_mesh(*read_mesh(path))
 
 
+def read_noting_extras(path):
+    """``(V, F, extras)``: :func:`read_checked`, and what else INPUT holds per vertex that a
+    command writing new geometry does not carry (``"vertex colours"``, ``"normals"``), for
+    :func:`note_not_carried`."""
+    from .. import check_mesh, read_mesh
+
+    V, F, fields = read_mesh(path, fields=True)
+    extras = [what for what, names in (("vertex colours", ("red", "green", "blue")), ("normals", ("nx", "ny", "nz")))
+              if set(names) <= set(fields)]
+    return (*check_mesh(V, F), extras)
+
+
+def note_not_carried(input_path, output_path, extras):
+    """Say on stderr that OUTPUT does not carry INPUT's ``extras`` (from :func:`read_noting_extras`)."""
+    if extras:
+        name = os.path.basename(os.fspath(output_path))
+        say(f"curvdetail: note: {name} does not carry the {' and '.join(extras)} of "
+            f"{os.path.basename(os.fspath(input_path))} (new geometry; a PLY output's colours show the distance).")
+
+
 def fixed_vertices(args, V, F, *, purpose):
     """The vertices ``--fix`` / ``--fix-boundary`` name (the boundary when neither is given)."""
     import numpy as np

@@ -178,7 +178,7 @@ def _check_reached(rows, cols, free, n, what, name):
 def square_curvature_system(D, in_roi, free_d, fd, dc, at_fd, at_dc, rows, cols, cvals):
     """The paper's linear-system form: (I - C)_uu D_u = C_uk D_k over the free rows (square,
     not symmetric). The paper's implementation minimized |(I - C) D|^2 over all rows instead;
-    through normal equations that squares a condition number of up to 1e14 (docs/editing.md).
+    through normal equations that squares a condition number of up to 1e14 (docs/guide/editing.md).
     Returns the matrix ``(I - C)_uu``, ``C_uk`` and the constant term."""
     r_in = free_d[rows]
     both = r_in & free_d[cols]

@@ -28,7 +28,7 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
     the paper: the details of a provisional surface, the boundary's best-fitting similarity applied
     to the patch and the rest of the move spread harmonically inside; ``"rest"``: kept); then a
     :class:`CurvatureEditor` with the boundary's positions and details constrained rebuilds the
-    interior. See docs/editing.md, "Shape editing of a boundary".
+    interior. See docs/guide/editing.md, "Shape editing of a boundary".
 
     Parameters
     ----------
@@ -163,7 +163,7 @@ def _warn_folded(figures, folded, m, boundary_detail, relations):
                f"vertices moved up to {100 * moved:.3g} % of the bbox diagonal, the boundary not at all")
     other = "one+two-ring" if relations == "one-ring" else "one-ring"
     if boundary_detail == "deformed":
-        cause = "; the curvature stage amplified the boundary's detail change (see docs/editing.md)"
+        cause = "; the curvature stage amplified the boundary's detail change (see docs/guide/editing.md)"
         tries = (f"relations={other!r}, a smaller displacement or boundary_detail='rest' (the inside keeps "
                  "its rest detail and follows the boundary)")
     else:

@@ -73,7 +73,7 @@ def curvature_coefficients(V, F, *, rcond=DEFAULT_RCOND, max_ring=DEFAULT_MAX_RI
     twice the largest distance of a vertex from the vertices' centroid): a ring flatter than
     curvature ``rcond / size`` gets zero coefficients. Where the kept span does not hold ``D_i``
     (a grid's valence-2 corner), the row is fitted over the two-ring instead (without the vertex),
-    then the three-ring, up to ``max_ring``. See docs/editing.md, "Curvature coefficients".
+    then the three-ring, up to ``max_ring``. See docs/guide/editing.md, "Curvature coefficients".
 
     Parameters
     ----------

@@ -40,7 +40,7 @@ class CurvatureEditor:
     and details. The constructor does all factoring; :meth:`solve` only back-substitutes. With
     ``roi=None``, moving the position constraints by a similarity ``x -> s R x + t`` and the
     detail constraints by ``D -> s R D`` moves the result by the same similarity (see
-    docs/editing.md, "Invariance of the editor").
+    docs/guide/editing.md, "The two-stage editor").
 
     Parameters
     ----------

@@ -28,20 +28,26 @@ def robust_laplacian(V, F, eps=MOLLIFY):
 
     Parameters
     ----------
-    V : (n, 3) float array   vertex positions
-    F : (m, 3) int array     triangles (zero-area ones allowed)
-    eps : float              least triangle-inequality slack, x the mean edge length
+    V : (n, 3) float array
+        Vertex positions
+    F : (m, 3) int array
+        Triangles (zero-area ones allowed)
+    eps : float
+        Least triangle-inequality slack, x the mean edge length
 
     Returns
     -------
-    L : (n, n) scipy.sparse.csr_matrix   the Laplacian
-    M : (n, n) scipy.sparse.dia_matrix   lumped (barycentric) mass: a third of each intrinsic
-                                         triangle area to each of its corners
-    delta : float                        the length added to every edge (0 on a clean mesh)
+    L : (n, n) scipy.sparse.csr_matrix
+        The Laplacian
+    M : (n, n) scipy.sparse.dia_matrix
+        Lumped (barycentric) mass: a third of each intrinsic triangle area to each of its corners
+    delta : float
+        The length added to every edge (0 on a clean mesh)
 
     Raises
     ------
-    MeshError   malformed ``V`` or ``F`` (shapes, dtypes, NaN, indices)
+    MeshError
+        Malformed ``V`` or ``F`` (shapes, dtypes, NaN, indices)
 
     Examples
     --------
@@ -90,11 +96,13 @@ def flip_caps(V, F, rounds=8):
 
     Parameters
     ----------
-    V : (n, 3) float array, F : (m, 3) int array   a consistently oriented manifold mesh
+    V : (n, 3) float array, F : (m, 3) int array
+        A consistently oriented manifold mesh
 
     Returns
     -------
-    F : (m, 3) int64 array   a new array, same triangle count and vertices
+    F : (m, 3) int64 array
+        A new array, same triangle count and vertices
 
     Examples
     --------

@@ -5,7 +5,7 @@ or a TOML/JSON file, :func:`load_study`) times the meshes of a collection gives 
 :func:`run_study` runs those not yet in a results folder as Dask tasks, each in a child process
 of its worker that a time limit can stop, and writes one table row per cell as it finishes
 (:mod:`.table`: Parquet and CSV); :func:`write_summary` writes a Markdown summary and plots.
-``curvdetail evaluate`` is the command line; docs/evaluate.md the guide.
+``curvdetail evaluate`` is the command line; docs/guide/evaluate.md the guide.
 """
 
 from .run import run_study

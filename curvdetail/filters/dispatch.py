@@ -43,7 +43,8 @@ def apply(ms, name, **params):
     Parameters
     ----------
     ms : pymeshlab.MeshSet
-    name : str       a registered filter (see :func:`list_filters`)
+    name : str
+        A registered filter (see :func:`list_filters`)
     **params         the filter's parameters by name
 
     Returns
@@ -52,9 +53,12 @@ def apply(ms, name, **params):
 
     Raises
     ------
-    UnknownFilterError      no filter of that name (the message lists the close matches)
-    FilterParameterError    unknown parameter, wrong type, out of range or not a choice
-    FilterError             an empty MeshSet, a missing layer or attribute, or pymeshlab failed
+    UnknownFilterError
+        No filter of that name (the message lists the close matches)
+    FilterParameterError
+        Unknown parameter, wrong type, out of range or not a choice
+    FilterError
+        An empty MeshSet, a missing layer or attribute, or pymeshlab failed
     MeshError, ConstraintError   the mesh or the constraints do not suit the filter
 
     Examples

@@ -22,10 +22,7 @@ IDENTITY = "1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1"
 
 #: ``amplification`` or ``detail_amplification`` above this says that the curvature stage
 #: amplified the handles' change: the threshold of ``curvdetail edit``'s warning and exit status
-#: 4 (vertices moved more than 3 times as far as the handles). Measured 2026-12-01 with
-#: one+two-ring relations (terrainA_1k/10k, mannequin_ear, mannequin_nose, mannequin_devil):
-#: detail_amplification 0.2-1.1, amplification 1.0-2.8 (handles inside the region, turned);
-#: with one-ring relations on the same edits up to 160 and 1100 (see docs/editing.md).
+#: 4 (vertices moved more than 3 times as far as the handles); well-posed edits stay below it.
 AMPLIFICATION_LIMIT = 3.0
 
 
@@ -245,7 +242,7 @@ def apply_curvature_editing(ms, *, handles, region_radius, transform, method, de
     rank_deficient, widened = _region_ring_counts(V, F, roi, editor)
     figures = {
         "max_displacement_percent_of_diagonal": float(100 * moved.max() / diagonal),
-        # far above 1: the curvature stage amplified the handle details (see docs/editing.md);
+        # far above 1: the curvature stage amplified the handle details (see docs/guide/editing.md);
         # None where the handles are not placed or do not move (a ratio of rounding, or of a pure
         # detail edit, which detail_amplification measures)
         "amplification": (float(moved.max() / moved[h].max())
@@ -360,6 +357,6 @@ def _warn_if_amplified(figures, folded, m, moved, D, D0, options):
     category = FoldedTrianglesWarning if folded.size else AmplifiedEditWarning
     setting = f"relations={relations!r}" if options["method"] == "paper" else "method='rotation'"
     warn(f"apply_curvature_editing with {setting}: {'; '.join(parts)}: {cause}, see "
-                  "docs/editing.md). "
+                  "docs/guide/editing.md). "
                   f"The mesh was edited all the same; try {', '.join(tries[:-1])} or {tries[-1]} on the original.",
                   category)

@@ -90,13 +90,23 @@ def vertex_attribute(ms, mesh_id, name, kind):
         return None
 
 
+#: How a missing attribute's error says to keep attributes through a file: pymeshlab's own
+#: ``load_new_mesh`` and ``save_current_mesh`` read and write no custom attribute.
+KEEP_ATTRIBUTES = ("if the layer came from a PLY file written with them, load it with "
+                   "curvdetail.filters.files.load_meshset (pymeshlab's load_new_mesh drops custom attributes), "
+                   "and save with curvdetail.filters.files.save_current_mesh (pymeshlab's save_current_mesh "
+                   "does not write them)")
+
+
 def require_vertex_attribute(ms, mesh_id, name, kind, hint):
-    """Like :func:`vertex_attribute` but raises FilterError naming the attribute and ``hint``."""
+    """Like :func:`vertex_attribute` but raises FilterError (``value``: the attribute's name)
+    naming the attribute, ``hint`` and how to keep attributes through a file
+    (:data:`KEEP_ATTRIBUTES`)."""
     values = vertex_attribute(ms, mesh_id, name, kind)
     if values is None:
         label = get_mesh(ms, mesh_id).label()
-        raise FilterError(f"layer {mesh_id} ({label!r}) has no per-vertex {kind} attribute "
-                          f"{name!r}; {hint}", value=name)
+        raise FilterError(f"layer {mesh_id} ({label!r}) has no per-vertex {kind} attribute {name!r}",
+                          value=name, hint=f"{hint.rstrip('.')}; {KEEP_ATTRIBUTES}")
     return values
 
 

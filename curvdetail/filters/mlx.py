@@ -109,9 +109,11 @@ def run_script(ms, path, *, progress=None):
 
     Parameters
     ----------
-    ms : pymeshlab.MeshSet   with the input mesh(es) loaded
+    ms : pymeshlab.MeshSet
+        With the input mesh(es) loaded
     path : str or os.PathLike
-    progress : callable or None   called as ``progress(step, total, name)`` before each step
+    progress : callable or None
+        Called as ``progress(step, total, name)`` before each step
 
     Returns
     -------
@@ -120,18 +122,18 @@ def run_script(ms, path, *, progress=None):
 
     Raises
     ------
-    FileNotFoundError   the script does not exist
-    ScriptError         not a MeshSet, ``path`` not a path or a folder, malformed XML (or an
-                        unknown encoding), a parameter given twice, a step name that is a typo of
-                        one of ours, a parameter of one of ours unknown or of the wrong type or
-                        range, a parameter of a MeshLab step that MeshLab would misread without a
-                        word (a bool other than 'true'/'false', a number that does not parse, a
-                        RichAbsPerc without min and max, a name the filter does not have): all
-                        these found before any step runs (:func:`check_script`), except a MeshLab
-                        parameter name right but for its capitals, found after its step; then, as
-                        the steps run, a MeshLab filter that needs a mesh on an empty MeshSet, or
-                        a step failed (the message names the step number and filter, then the
-                        reason), or the last step left the MeshSet with no mesh
+    FileNotFoundError
+        The script does not exist
+    ScriptError
+        Not a MeshSet, ``path`` not a path or a folder, malformed XML (or an unknown encoding), a
+        parameter given twice, a step name that is a typo of one of ours, a parameter of one of ours
+        unknown or of the wrong type or range, a parameter of a MeshLab step that MeshLab would
+        misread without a word (a bool other than 'true'/'false', a number that does not parse, a
+        RichAbsPerc without min and max, a name the filter does not have): all these found before
+        any step runs (:func:`check_script`), except a MeshLab parameter name right but for its
+        capitals, found after its step; then, as the steps run, a MeshLab filter that needs a mesh
+        on an empty MeshSet, or a step failed (the message names the step number and filter, then
+        the reason), or the last step left the MeshSet with no mesh
 
     Examples
     --------
@@ -186,7 +188,8 @@ def check_script(path):
 
     Parameters
     ----------
-    path : str or os.PathLike   the script
+    path : str or os.PathLike
+        The script
 
     Returns
     -------
@@ -233,20 +236,25 @@ def save_script(path, steps, *, overwrite=False):
 
     Parameters
     ----------
-    path : str or os.PathLike   destination (.mlx); written atomically (or the MeshSet, then
-                                ``steps`` is the destination)
-    steps : list   each a filter name or ``(name, {parameter: value})``; every parameter is
-                   written (defaults for those not given), except a layer id left to the current
-                   mesh where that is its default (a layer id whose default is a layer, set to
-                   None, the current mesh, is written as ``value=""``)
-    overwrite : bool            replace an existing file
+    path : str or os.PathLike
+        Destination (.mlx); written atomically (or the MeshSet, then ``steps`` is the destination)
+    steps : list
+        Each a filter name or ``(name, {parameter: value})``; every parameter is written (defaults
+        for those not given), except a layer id left to the current mesh where that is its default
+        (a layer id whose default is a layer, set to None, the current mesh, is written as
+        ``value=""``)
+    overwrite : bool
+        Replace an existing file
 
     Raises
     ------
-    FileExistsError        ``path`` exists and ``overwrite`` is False
-    FileNotFoundError      the destination folder does not exist
-    ScriptError            ``steps`` is not a list of names or (name, parameters) pairs; a
-                           MeshSet on which no filter has run
+    FileExistsError
+        ``path`` exists and ``overwrite`` is False
+    FileNotFoundError
+        The destination folder does not exist
+    ScriptError
+        ``steps`` is not a list of names or (name, parameters) pairs; a MeshSet on which no filter
+        has run
     UnknownFilterError, FilterParameterError   as :func:`~curvdetail.filters.apply`
 
     Examples

@@ -99,7 +99,8 @@ def apply_native(ms, name, **params):
 
     Raises
     ------
-    FilterError   pymeshlab failed (its words)
+    FilterError
+        Pymeshlab failed (its words)
 
     Examples
     --------

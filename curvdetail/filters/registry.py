@@ -76,28 +76,31 @@ def filter(*, name, category, description, parameters=()):  # noqa: A001 (pymesh
 
     Parameters
     ----------
-    name : str          snake_case, starting with a verb family (:data:`FAMILIES`)
-    category : str      MeshLab menu-style category, e.g. ``"Curvature detail"``
-    description : str   one paragraph, with the paper reference where it applies
-    parameters : list of Parameter   in the order they are listed; each must match a keyword-only
-                        argument of the decorated function, and vice versa
-
-    The decorated function keeps working as a plain function; the spec is attached as
-    ``function.spec``.
+    name : str
+        snake_case, starting with a verb family (:data:`FAMILIES`).
+    category : str
+        MeshLab menu-style category, e.g. ``"Curvature detail"``.
+    description : str
+        One paragraph, with the paper reference where it applies.
+    parameters : list of Parameter
+        In the order they are listed; each must match a keyword-only argument of the decorated
+        function, and vice versa.
 
     Returns
     -------
-    register : callable   the decorator: it registers a :class:`FilterSpec` under ``name`` (the
-                          description with its whitespace collapsed to single spaces), sets
-                          ``function.spec``, gives a function without a docstring one built from
-                          the declaration, and returns the same function
+    register : callable
+        The decorator: it registers a :class:`FilterSpec` under ``name`` (the description with
+        its whitespace collapsed to single spaces), sets ``function.spec``, gives a function
+        without a docstring one built from the declaration, and returns the same function. The
+        decorated function keeps working as a plain function.
 
     Raises
     ------
-    TypeError   when the decorator is applied: ``name`` not snake_case or not starting with one of
-                :data:`FAMILIES`, already registered, an empty ``category`` or ``description``,
-                a parameter declared twice, or declared parameters that differ from the
-                function's keyword-only arguments
+    TypeError
+        When the decorator is applied: ``name`` not snake_case or not starting with one of
+        :data:`FAMILIES`, already registered, an empty ``category`` or ``description``, a
+        parameter declared twice, or declared parameters that differ from the function's
+        keyword-only arguments.
 
     Examples
     --------
@@ -160,7 +163,8 @@ def list_filters():
 
     Returns
     -------
-    specs : list of FilterSpec   a new list each call, sorted by ``name``
+    specs : list of FilterSpec
+        A new list each call, sorted by ``name``
 
     Examples
     --------
@@ -182,17 +186,19 @@ def get_filter(name):
 
     Parameters
     ----------
-    name : str   the filter's exact name, e.g. ``"compute_curvature_detail"``
+    name : str
+        The filter's exact name, e.g. ``"compute_curvature_detail"``
 
     Returns
     -------
-    spec : FilterSpec   the registered declaration (name, category, description, parameters,
-                        function)
+    spec : FilterSpec
+        The registered declaration (name, category, description, parameters, function)
 
     Raises
     ------
-    UnknownFilterError   no filter of that name (also for a name that is not a string); the
-                         message lists up to three close matches or points to the list
+    UnknownFilterError
+        No filter of that name (also for a name that is not a string); the message lists up to three
+        close matches or points to the list
 
     Examples
     --------
@@ -243,11 +249,13 @@ def print_filter_parameter_list(name):
 
     Parameters
     ----------
-    name : str   the filter's exact name
+    name : str
+        The filter's exact name
 
     Raises
     ------
-    UnknownFilterError   no filter of that name (as :func:`get_filter`)
+    UnknownFilterError
+        No filter of that name (as :func:`get_filter`)
 
     Examples
     --------

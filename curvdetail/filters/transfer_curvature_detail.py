@@ -23,12 +23,32 @@ def planar_map(location, parameterization, default="harmonic"):
     return None
 
 
+def check_retriangulation(Vs, loops_s, Vt, loops_t, source, target):
+    """FilterError (``parameter`` 'targetmesh', ``value`` the largest distance as a fraction of
+    the source's diagonal, ``first`` target vertices) unless the target's boundary vertices lie
+    on the source's boundary within ``RETRIANGULATION_TOLERANCE``, as ``remesh_experiment``
+    asks of a given target: another surface gives a result that measures nothing."""
+    from ..curvature.geometry import bbox_diagonal
+    from ..remesh import RETRIANGULATION_TOLERANCE, RemeshError, check_target_boundary
+
+    given = np.concatenate(loops_t) if loops_t else np.zeros(0, dtype=np.int64)
+    try:
+        check_target_boundary([Vs[loop] for loop in loops_s], Vt[given], bbox_diagonal(Vs),
+                              f"pass a retriangulation of layer {source} as the target (e.g. from "
+                              "generate_curvature_remeshing)", tolerance=RETRIANGULATION_TOLERANCE)
+    except RemeshError as exc:
+        first = None if exc.first is None else given[exc.first].tolist()
+        raise FilterError(f"layer {target}: {exc.problem}", parameter="targetmesh", value=exc.value,
+                          hint=exc.hint, count=exc.count, first=first) from None
+
+
 @filter(
     name="transfer_curvature_detail",
     category="Curvature detail",
     description=f"""
         Carry the curvature detail of the source layer (a manifold surface; a disk-topology
-        patch for location 'uv') over to the target layer (a retriangulation of it), the transfer
+        patch for location 'uv') over to the target layer (a retriangulation of it: its boundary
+        vertices within 0.1 % of the diagonal of the source's boundary, else refused), the transfer
         step of the paper's remeshing experiment. The detail carried is the source's stored 'curvature_detail' where it holds
         one (from compute_curvature_detail, kept while its vertices were moved; refused if the
         source was retriangulated since, as apply_curvature_reconstruction refuses it), else the
@@ -71,8 +91,9 @@ def transfer_curvature_detail(ms, *, sourcemesh, targetmesh, method, location, p
                           hint="load or generate the retriangulation as another layer (e.g. layer 1)")
     Vs, Fs = mesh_arrays(ms, source)
     Vt, Ft = mesh_arrays(ms, target)
-    check_surface(Vs, Fs, f"the source (layer {source})")       # location='uv': parameterize asks for disks
-    check_surface(Vt, Ft, f"the target (layer {target})")
+    _, _, loops_s = check_surface(Vs, Fs, f"the source (layer {source})")   # 'uv': parameterize asks for disks
+    _, _, loops_t = check_surface(Vt, Ft, f"the target (layer {target})")
+    check_retriangulation(Vs, loops_s, Vt, loops_t, source, target)
     # stored detail outlives moved vertices (the editing use); a broken stamp is refused in load_detail
     stored = vertex_attribute(ms, source, DETAIL, "point") is not None
     Ds = load_detail(ms, source, Fs) if stored else curvature_detail(Vs, Fs)

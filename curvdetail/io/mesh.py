@@ -11,6 +11,7 @@ PLY element counts (plyfile reads exactly those), the OFF header's, and an OBJ f
 import contextlib
 import errno
 import os
+import re
 import shutil
 
 import numpy as np
@@ -18,7 +19,7 @@ import numpy as np
 from ..curvature.checks import as_faces, as_vertices
 from ..curvature.errors import MeshError, counted
 from .atomic import atomic_write, check_output_path
-from .ply import read_ply, write_ply
+from .ply import read_ply, triangles, write_ply
 
 
 class MeshFileError(MeshError):
@@ -59,15 +60,18 @@ def read_mesh(path, *, fields=False):
     path : str or os.PathLike
         The file; its extension picks the reader.
     fields : bool, optional
-        Also return the file's other per-vertex properties (PLY only; ``{}`` otherwise).
+        Also return the file's other per-vertex properties: every one of a PLY file; of other
+        formats the vertex colours (``red``, ``green``, ``blue``, ``alpha``, uint8) where the
+        file holds them and an OFF file's normals (``nx``, ``ny``, ``nz``; an OBJ file's
+        ``vn`` belong to face corners and are not read).
 
     Returns
     -------
     V : (n, 3) float64 array
         Vertex positions, in file order (a PLY file's doubles exactly).
     F : (m, 3) int64 array
-        Triangles; polygons are cut into triangles (PLY and OBJ: fanned from their first
-        corner).
+        Triangles; polygons are fanned from their first corner (a polygon of corners
+        a, b, c, d gives (a, b, c), (a, c, d)), whatever the format.
     fields : dict of str to array
         With ``fields=True``: (n,) arrays, and (n, 3) for points (see :mod:`curvdetail.io.ply`).
 
@@ -77,8 +81,7 @@ def read_mesh(path, *, fields=False):
         The file does not exist.
     MeshFileError
         The file cannot be read (which file and why); a file named .obj is not a text OBJ
-        file; an OFF file has polygons of more than four corners (pymeshlab's loader cuts
-        them into triangles of the wrong vertices); fewer or more vertices or faces were
+        file; fewer or more vertices or faces were
         loaded than the file states (``e.declared``, ``e.loaded``); or the arrays fail the
         checks of array input (non-finite coordinates, face indices out of range or
         repeated).
@@ -94,8 +97,9 @@ def read_mesh(path, *, fields=False):
     if _extension(path) != ".ply":
         import pymeshlab
 
-        V, F = load_new_mesh(pymeshlab.MeshSet(), path)
-        return (V, F, {}) if fields else (V, F)
+        ms = pymeshlab.MeshSet()
+        V, F = load_new_mesh(ms, path)
+        return (V, F, _loaded_fields(ms.current_mesh(), path)) if fields else (V, F)
     try:
         V, F, extra = read_ply(path)
     except (ValueError, OSError) as exc:
@@ -109,22 +113,32 @@ def load_new_mesh(ms, path):
     as :func:`read_mesh` checks it; return the layer's ``(V, F)``.
 
     pymeshlab's loader reads the file (PLY too: read those with :func:`read_mesh` to keep their
-    doubles and custom properties). Raises as :func:`read_mesh`.
+    doubles and custom properties). An OFF file's polygons are fanned from their first corner
+    here, as pymeshlab fans an OBJ file's and :func:`read_mesh` a PLY file's (its OFF loader
+    cuts a quad along the other diagonal, a larger polygon into triangles of the wrong
+    vertices); such a layer is built from the arrays (its normals recomputed). Raises as
+    :func:`read_mesh`.
     """
+    import pymeshlab
+
     path = _input_path(path)
     declared = _declared_counts(path)
+    fanned, polygons = _off_polygons(path, declared[1]) if declared is not None and _extension(path) == ".off" \
+        else (None, None)
+    into = ms if fanned is None else pymeshlab.MeshSet()
     cwd = os.getcwd()
     try:
-        ms.load_new_mesh(path)
+        into.load_new_mesh(path)
     except Exception as exc:                    # pymeshlab.PyMeshLabException, or a path it refuses
         raise _error(path, f"could not read {path!r}: {_why(exc)}",
                      "check the file, or export it again, e.g. as PLY") from None
     finally:
         os.chdir(cwd)                           # a failed load left the process in the file's folder
-    mesh = ms.current_mesh()
-    V, F = mesh.vertex_matrix(), mesh.face_matrix()
+    mesh = into.current_mesh()
+    V, F = mesh.vertex_matrix(), mesh.face_matrix() if fanned is None else fanned
     if declared is not None:
-        faces = F.shape[0] if F.shape[0] == declared[1] else _polygons(path, mesh, declared[1])
+        faces = polygons if fanned is not None else F.shape[0] if F.shape[0] == declared[1] else \
+            len(mesh.polygonal_face_list())
         if (V.shape[0], faces) != declared:
             nv, nf = declared
             what = f"has {counted(nv, 'v line')} and {counted(nf, 'f line')}" if _extension(path) == ".obj" else \
@@ -135,22 +149,63 @@ def load_new_mesh(ms, path):
                          "malformed line); fix those rows or export the file again, e.g. as PLY")
             err.declared, err.loaded = declared, (V.shape[0], faces)
             raise err
-    return _checked(path, V, F)
+    V, F = _checked(path, V, F)
+    if fanned is not None:
+        colours = {"v_color_matrix": mesh.vertex_color_matrix()} if mesh.has_vertex_color() else {}
+        ms.add_mesh(pymeshlab.Mesh(vertex_matrix=V, face_matrix=F.astype(np.int32), **colours), mesh.label())
+    return V, F
 
 
-def _polygons(path, mesh, declared):
-    """How many faces of the file pymeshlab's triangles make, where they are more than the faces
-    (polygons). pymeshlab's OFF loader (2025.7) cuts a polygon of more than four corners into
-    triangles of the wrong vertices (the corners' numbers within the polygon taken as vertex
-    ids): such OFF files are refused."""
+#: A line that may be an OFF face row of more than three corners (a vertex row of whole numbers
+#: may match too: the rows are then read).
+_POLYGON_ROW = re.compile(rb"(?m)^[ \t]*0*([4-9]|[1-9][0-9]+)[ \t]+[0-9]+[ \t]+[0-9]+[ \t]+[0-9]+[ \t]+[0-9]+")
+
+
+def _off_polygons(path, count):
+    """``(F, k)``: the last ``count`` face rows of the OFF file ``path`` (k of them) fanned from
+    their first corner where one is a polygon (more than three corners), else ``(None, None)``
+    (pymeshlab's triangles are the file's)."""
+    with open(path, "rb") as f:
+        data = f.read()
+    if not _POLYGON_ROW.search(data):               # fast: no row starts as a polygon's would
+        return None, None
+    comments = b"#" in data
+    rows = []                                       # the face rows end the file: (corners, rest)
+    for line in reversed(data.splitlines()):
+        if len(rows) == count:
+            break
+        row = (line.split(b"#", 1)[0] if comments else line).split(None, 1)
+        if row:
+            rows.append(row)
+    rows.reverse()
+    try:
+        sizes = np.array([int(row[0]) for row in rows], dtype=np.int64)
+        if not (sizes > 3).any():
+            return None, None
+        faces = np.empty(len(rows), dtype=object)
+        faces[:] = [np.array(row[1].split()[:k] if len(row) > 1 else [], dtype=np.int64)
+                    for row, k in zip(rows, sizes)]
+        if any(len(face) != k for face, k in zip(faces, sizes)):
+            raise ValueError("a face row holds fewer indices than it states")
+        return triangles(faces), len(rows)
+    except ValueError as exc:
+        raise _error(path, f"could not read the faces of {path!r}: {_why(exc)}",
+                     "check the file, or export it again, e.g. as PLY") from None
+
+
+def _loaded_fields(mesh, path):
+    """The vertex colours (other than the opaque white of a layer built from arrays) and (OFF)
+    normals pymeshlab loaded from ``path``, named as in PLY."""
+    fields = {}
+    if mesh.has_vertex_color() and not np.all(mesh.vertex_color_matrix() == 1.0):
+        rgba = np.rint(mesh.vertex_color_matrix() * 255.0).astype(np.uint8)
+        fields.update(zip(("red", "green", "blue", "alpha"), rgba.T))
     if _extension(path) == ".off":
         with open(path, "rb") as f:
-            rows = [row for row in (line.split(b"#")[0].split() for line in f.read().splitlines()) if row]
-        corners = [row[0] for row in rows[-declared:]] if declared else []   # the face rows end the file
-        if any(not c.isdigit() or int(c) > 4 for c in corners):
-            raise _error(path, f"{path!r} has faces pymeshlab's OFF loader does not cut right (polygons of more "
-                               "than four corners)", "triangulate them, or save the file as OBJ or PLY")
-    return len(mesh.polygonal_face_list())
+            keyword = f.read(16).split()[:1]
+        if keyword and b"N" in keyword[0].removesuffix(b"OFF"):           # NOFF, CNOFF, STNOFF
+            fields.update(zip(("nx", "ny", "nz"), np.array(mesh.vertex_normal_matrix(), dtype=np.float64).T))
+    return fields
 
 
 def _input_path(path):

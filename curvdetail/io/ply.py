@@ -59,12 +59,13 @@ def read_ply(path):
     lists = [name for name in _FACE_LISTS if name in face.dtype.names]
     if not lists:
         raise ValueError("its face element has no vertex_indices list")
-    F = _triangles(face[lists[0]])
+    F = triangles(face[lists[0]])
     return V, F, _fields(vertex)
 
 
-def _triangles(faces):
-    """(m, 3) triangles of ``faces``: an (m, 3) array, or an object array of index lists."""
+def triangles(faces):
+    """(m, 3) triangles of ``faces``: an (m, 3) array, or an object array of index lists
+    (polygons fanned from their first corner); ValueError for a face of fewer than 3 corners."""
     if faces.dtype != object:
         return faces.reshape(-1, 3)
     sizes = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))

@@ -5,7 +5,7 @@ Depends on :mod:`curvdetail.curvature` (operators and solvers), pymeshlab (isotr
 Hausdorff distance), libigl (closest points) and fast-simplification (decimation).
 """
 
-from ._disk import NotADiskError, RemeshError, check_disk, check_surface
+from ._disk import RETRIANGULATION_TOLERANCE, NotADiskError, RemeshError, check_disk, check_surface, check_target_boundary
 from .closest_point import closest_points
 from .evaluate import hausdorff, vertex_distance
 from .experiment import WorseThanZeroDetailWarning, remesh_experiment
@@ -16,7 +16,7 @@ from .transfer import edge_curvature_measure, transfer_curvature
 
 __all__ = [
     "LongRunWarning", "NotADiskError", "RemeshError", "WorseThanZeroDetailWarning", "check_disk", "check_surface",
-    "closest_points",
+    "RETRIANGULATION_TOLERANCE", "check_target_boundary", "closest_points",
     "edge_curvature_measure", "flipped_triangles", "harmonic_map", "hausdorff", "interpolate", "locate",
     "parameterize", "remesh_experiment", "retriangulate", "spread", "transfer_curvature", "vertex_distance",
 ]

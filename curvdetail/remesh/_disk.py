@@ -23,8 +23,8 @@ class NotADiskError(MeshError):
 
 
 class RemeshError(CurvdetailError):
-    """A remeshing option is out of range (e.g. a target edge length giving absurd sizes) or a
-    remesher produced an unusable result."""
+    """A remeshing option is out of range (e.g. a target edge length giving absurd sizes), a
+    mesh the remesher cannot handle, or a remesher produced an unusable result."""
 
 
 def check_disk(V, F, what="the source"):
@@ -36,24 +36,31 @@ def check_disk(V, F, what="the source"):
 
     Parameters
     ----------
-    V : (n, 3) float array   vertex positions (checked as in :func:`check_mesh`)
-    F : (m, 3) int array     triangles, consistently oriented; every vertex used
-    what : str               how the messages name the mesh, e.g. ``"the target"``
+    V : (n, 3) float array
+        Vertex positions (checked as in :func:`check_mesh`)
+    F : (m, 3) int array
+        Triangles, consistently oriented; every vertex used
+    what : str
+        How the messages name the mesh, e.g. ``"the target"``
 
     Returns
     -------
-    V : (n, 3) float64 array   the checked positions (C-contiguous)
-    F : (m, 3) int64 array     the checked triangles (C-contiguous)
-    loop : (k,) int64 array    the boundary loop, as above
+    V : (n, 3) float64 array
+        The checked positions (C-contiguous)
+    F : (m, 3) int64 array
+        The checked triangles (C-contiguous)
+    loop : (k,) int64 array
+        The boundary loop, as above
 
     Raises
     ------
-    MeshError        malformed mesh (shapes, NaN, zero-area triangles, unreferenced vertices, ...)
-    NotADiskError    (a MeshError) edges shared by more than two triangles, closed, several
-                     boundary loops, several pieces, a pinched boundary vertex or handles;
-                     triangles wound against their neighbours are named as such where they make
-                     the boundary look pinched, split or open. The message says what was found
-                     and what is needed
+    MeshError
+        Malformed mesh (shapes, NaN, zero-area triangles, unreferenced vertices, ...)
+    NotADiskError
+        (a MeshError) edges shared by more than two triangles, closed, several boundary loops,
+        several pieces, a pinched boundary vertex or handles; triangles wound against their
+        neighbours are named as such where they make the boundary look pinched, split or open. The
+        message says what was found and what is needed
 
     Examples
     --------
@@ -111,13 +118,14 @@ def _checked(V, F, what, error=MeshError):
     (``count``, ``first`` set) with the repair to make."""
     try:
         return check_mesh(V, F)
-    except MeshError:
+    except MeshError as exc:
         try:
             nm = non_manifold_edges(as_faces(F, None))    # checked: a cast would truncate 1.5 to 1
         except Exception:  # F too malformed to look at: the original message says why
             nm = None
-        if nm is None or not nm.shape[0]:
-            raise
+        if nm is None or not nm.shape[0]:          # say which mesh the problem is in
+            raise MeshError(f"{what}: {exc.problem}", parameter=exc.parameter, value=exc.value, hint=exc.hint,
+                            count=exc.count, first=exc.first) from None
     pairs = ", ".join(f"({a}, {b})" for a, b in nm[:3])
     # a repair, not a cut: such edges are mostly a few stray triangles (a fin, a doubled face)
     problem = (f"{what} is not manifold: {counted(nm.shape[0], 'edge', verb='are')} shared by more than two "
@@ -133,20 +141,26 @@ def check_surface(V, F, what="the source"):
 
     Parameters
     ----------
-    V : (n, 3) float array   vertex positions (checked as in :func:`check_mesh`)
-    F : (m, 3) int array     triangles, consistently oriented; every vertex used
-    what : str               how the messages name the mesh
+    V : (n, 3) float array
+        Vertex positions (checked as in :func:`check_mesh`)
+    F : (m, 3) int array
+        Triangles, consistently oriented; every vertex used
+    what : str
+        How the messages name the mesh
 
     Returns
     -------
-    V : (n, 3) float64 array, F : (m, 3) int64 array   the checked arrays
-    loops : list of (k,) int64 arrays   the boundary loops, each ordered as the faces wind and
-                                        starting at its smallest vertex, by that vertex; [] if closed
+    V : (n, 3) float64 array, F : (m, 3) int64 array
+        The checked arrays
+    loops : list of (k,) int64 arrays
+        The boundary loops, each ordered as the faces wind and starting at its smallest vertex, by
+        that vertex; [] if closed
 
     Raises
     ------
-    MeshError   malformed mesh; edges shared by more than two triangles (``count``, ``first``:
-                the first edges), a boundary passing a vertex twice, or misoriented triangles
+    MeshError
+        Malformed mesh; edges shared by more than two triangles (``count``, ``first``: the first
+        edges), a boundary passing a vertex twice, or misoriented triangles
 
     Examples
     --------
@@ -219,7 +233,8 @@ class Polyline:
 
     Parameters
     ----------
-    P : (k, 3) float array   the loop's points in order (closed: the last joins the first)
+    P : (k, 3) float array
+        The loop's points in order (closed: the last joins the first)
     """
 
     def __init__(self, P):
@@ -301,27 +316,36 @@ class Polyline:
 TARGET_BOUNDARY_TOLERANCE = 1e-6
 
 
-def check_target_boundary(P, X, d, advice):
+#: The looser tolerance for a target retriangulated elsewhere (the filters take any layer):
+#: pymeshlab's isotropic remeshing slides boundary vertices along a curved boundary, up to 2e-4
+#: of the diagonal at 3 % edges (a flat and a wavy 24-ring disk); a different patch lies a few
+#: % off.
+RETRIANGULATION_TOLERANCE = 1e-3
+
+
+def check_target_boundary(P, X, d, advice, tolerance=TARGET_BOUNDARY_TOLERANCE):
     """RemeshError unless every target boundary vertex ``X`` lies on a source boundary
-    polyline (``P``: one loop's points, or a list of loops) within
-    ``TARGET_BOUNDARY_TOLERANCE`` times the larger of the diagonal ``d``
+    polyline (``P``: one loop's points, or a list of loops) within ``tolerance``
+    (default ``TARGET_BOUNDARY_TOLERANCE``) times the larger of the diagonal ``d``
     and the largest coordinate (float32 files far from the origin round by more than 1e-6 of a
-    small diagonal); ``advice``: the sentence that ends the message (what to pass instead)."""
+    small diagonal); ``advice``: the hint that ends the message (what to pass instead). The
+    error's ``value`` is the largest distance found (in those units), ``count`` the vertices
+    off and ``first`` the first of them (rows of ``X``)."""
     loops = P if isinstance(P, list) else [P]
     if not loops or X.shape[0] == 0:
         if len(loops) or X.shape[0]:
             raise RemeshError(f"the target has {X.shape[0]} boundary vertices and the source {len(loops)} "
-                              f"boundary loops: the target must be a retriangulation of the source. {advice}")
+                              "boundary loops: the target must be a retriangulation of the source", hint=advice)
         return
     scale = max(d, max(float(np.abs(p).max()) for p in loops), float(np.abs(X).max()))
     # exact: every segment where it must be
     dist = np.min([Polyline(p).project(X)[2] for p in loops], axis=0) / scale
-    off = np.flatnonzero(dist > TARGET_BOUNDARY_TOLERANCE)
+    off = np.flatnonzero(dist > tolerance)
     if off.size:
         raise RemeshError(
             f"{off.size} of {X.shape[0]} target boundary vertices {'is' if off.size == 1 else 'are'} off the "
             "source's boundary polyline "
             f"(up to {dist.max():.3g} of the larger of the source's bbox diagonal and its largest "
-            f"coordinate; allowed {TARGET_BOUNDARY_TOLERANCE:g}): the target must be a retriangulation of "
-            f"the source with its boundary vertices on the source's boundary. {advice}", count=int(off.size),
-            first=off[:3].tolist())
+            f"coordinate; allowed {tolerance:g}): the target must be a retriangulation of "
+            "the source with its boundary vertices on the source's boundary", hint=advice,
+            value=float(dist.max()), count=int(off.size), first=off[:3].tolist())

@@ -108,7 +108,7 @@ def worse_than_zero_detail(report, cli=False):
     return (f"the rebuilt surface is farther from the source than the zero-detail surface (RMS "
             f"{rms:.4g} % against {zero:.4g} % of the bbox diagonal): the transferred detail made it "
             f"worse than no detail at all, so this configuration failed on this patch. Try "
-            f"{'; and '.join(tries)}. docs/remeshing.md has what was measured.")
+            f"{'; and '.join(tries)}. docs/results/fig3_table.md has what was measured.")
 
 
 def remesh_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="conservative", rows="free",
@@ -130,111 +130,114 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="c
 
     Parameters
     ----------
-    V : (n, 3) float array, F : (m, 3) int array   the source: a manifold, consistently oriented
-                                               surface (closed, holes, pieces, handles; a disk for
-                                               ``location="uv"``)
-    method : {"isotropic", "decimate"}         retriangulation
-    target_edge : float or str                 target edge length: model units, or a percentage of
-                                               the bbox diagonal ("1%", PercentageValue(1); see
-                                               :func:`~.units.as_length`)
-    transfer : {"conservative", "pointwise"}   how detail is carried over (conservative: measured better)
-    rows : {"free", "all"}                     residual rows of the reconstruction energy
-    location : {"closest", "uv"}               3D closest point, or a shared planar domain (disks only)
-    parameterization : {"harmonic", "meshlab_harmonic", "lscm"} or None   the planar domain of
-                                               ``location="uv"`` (None: "harmonic"); refused with
-                                               ``location="closest"``, which uses no planar map
-    backend : str                              sparse solver backend
-    evaluate : bool                            measure distances (the costly part on big meshes).
-                                               The error and the floor are measured with
-                                               pymeshlab's engine (see :func:`hausdorff`): a fresh
-                                               process repeats their figures exactly, a second
-                                               call in the same process draws other face samples
-                                               (the bundled example's RMS: up to 1.1e-6 of the
-                                               diagonal, 0.8 %, apart over three calls; the
-                                               maxima, at vertices, stay the same)
-    source_path : str or None                  recorded in the report
-    progress : callable or None                called with each stage name as it starts, and in
-                                               the evaluation (the longest stage of a big run)
-                                               as ``progress("evaluate", done, total)`` after
-                                               each of its ``EVALUATION_STEPS`` measurements
-    target : tuple (Vt, Ft) or None            a ready retriangulation to use instead of making one
-                                               (a disk whose boundary vertices lie on the source's
-                                               boundary polyline); ``method`` / ``target_edge`` are then
-                                               unused (but still checked), the report's
-                                               ``options.method`` is ``"given"`` and its
-                                               ``options.target_edge_model_units`` and
-                                               ``target_edge_percent_of_diagonal`` None, and
-                                               ``seconds.retriangulate`` is 0
-    surface_check : bool                       isotropic retriangulation: check the distance an edge
-                                               collapse or flip moves the surface (pymeshlab's
-                                               ``checksurfdist``; see :func:`retriangulate`).
-                                               ``False`` is faster on large patches (terrainA_100k
-                                               at 100k targets 26.1 s -> 19.9 s) and may change the
-                                               retriangulation; recorded in ``options.surface_check``
-                                               (None for a given ``target`` or ``"decimate"``)
-    anchors : int                              fixed vertices on each closed piece of the target
-                                               (farthest-point sampled from its flattest vertex)
-    laplacian : {"auto", "cotan", "robust"}   the source's detail ``D = L V``: "cotan" the plain
-                                               cotangent Laplacian (refuses zero-area triangles);
-                                               "robust" the mollified one
-                                               (:func:`~curvdetail.curvature.robust_laplacian.robust_laplacian`),
-                                               and the geometric stages see the source with its
-                                               zero-area caps flipped away
-                                               (:func:`~curvdetail.curvature.robust_laplacian.flip_caps`:
-                                               the same surface); "auto" "cotan" unless the plain
-                                               checks refuse the source's zero-area triangles.
-                                               The rebuild on the target uses the plain one always
+    V : (n, 3) float array, F : (m, 3) int array
+        The source: a manifold, consistently oriented surface (closed, holes, pieces, handles; a
+        disk for ``location="uv"``)
+    method : {"isotropic", "decimate"}
+        Retriangulation
+    target_edge : float or str
+        Target edge length: model units, or a percentage of the bbox diagonal ("1%",
+        PercentageValue(1); see :func:`~.units.as_length`)
+    transfer : {"conservative", "pointwise"}
+        How detail is carried over (conservative: measured better)
+    rows : {"free", "all"}
+        Residual rows of the reconstruction energy
+    location : {"closest", "uv"}
+        3D closest point, or a shared planar domain (disks only)
+    parameterization : {"harmonic", "meshlab_harmonic", "lscm"} or None
+        The planar domain of ``location="uv"`` (None: "harmonic"); refused with
+        ``location="closest"``, which uses no planar map
+    backend : str
+        Sparse solver backend
+    evaluate : bool
+        Measure distances (the costly part on big meshes). The error and the floor are measured with
+        pymeshlab's engine (see :func:`hausdorff`): a fresh process repeats their figures exactly, a
+        second call in the same process draws other face samples (the bundled example's RMS: up to
+        1.1e-6 of the diagonal, 0.8 %, apart over three calls; the maxima, at vertices, stay the
+        same)
+    source_path : str or None
+        Recorded in the report
+    progress : callable or None
+        Called with each stage name as it starts, and in the evaluation (the longest stage of a big
+        run) as ``progress("evaluate", done, total)`` after each of its ``EVALUATION_STEPS``
+        measurements
+    target : tuple (Vt, Ft) or None
+        A ready retriangulation to use instead of making one (a disk whose boundary vertices lie on
+        the source's boundary polyline); ``method`` / ``target_edge`` are then unused (but still
+        checked), the report's ``options.method`` is ``"given"`` and its
+        ``options.target_edge_model_units`` and ``target_edge_percent_of_diagonal`` None, and
+        ``seconds.retriangulate`` is 0
+    surface_check : bool
+        Isotropic retriangulation: check the distance an edge collapse or flip moves the surface
+        (pymeshlab's ``checksurfdist``; see :func:`retriangulate`). ``False`` is faster on large
+        patches (terrainA_100k at 100k targets 26.1 s -> 19.9 s) and may change the retriangulation;
+        recorded in ``options.surface_check`` (None for a given ``target`` or ``"decimate"``)
+    anchors : int
+        Fixed vertices on each closed piece of the target (farthest-point sampled from its flattest
+        vertex)
+    laplacian : {"auto", "cotan", "robust"}
+        The source's detail ``D = L V``: "cotan" the plain cotangent Laplacian (refuses zero-area
+        triangles); "robust" the mollified one
+        (:func:`~curvdetail.curvature.robust_laplacian.robust_laplacian`), and the geometric stages
+        see the source with its zero-area caps flipped away
+        (:func:`~curvdetail.curvature.robust_laplacian.flip_caps`: the same surface); "auto" "cotan"
+        unless the plain checks refuse the source's zero-area triangles. The rebuild on the target
+        uses the plain one always
 
     Returns
     -------
-    mesh : tuple ``(X, Ft)``   the rebuilt target: (p, 3) positions and (q, 3) triangles
-    report : dict              JSON-ready: ``source.{path, vertices, faces, bbox_diagonal}``,
-        ``target.{vertices, faces, boundary_vertices, boundary_loops}``, ``anchors`` (fixed
-        vertices on closed pieces), ``options``, ``error``,
-        ``baseline_zero_detail`` and ``floor_retriangulated`` (each
-        ``{hausdorff_max_percent_of_diagonal, hausdorff_rms_percent_of_diagonal}``, % of the
-        source bbox diagonal; ``error`` also has ``vertex_max_percent_of_diagonal``, the largest
-        distance of a rebuilt vertex to the source, exact),
-        ``improvement_over_zero_detail`` (zero-detail RMS / error RMS) and ``ratio_to_floor``
-        (error RMS / floor RMS). Where the target has a closed piece there is no zero-detail
-        surface (it collapses onto the anchors): ``baseline_zero_detail`` and the improvement are
-        None, with the reason in ``ratio_notes``. Each ratio is None where one of its two RMS
-        values is rounding, not a
-        measurement (below ``ROUNDING_RMS``: 1e-5 % of the diagonal as pymeshlab's single-precision
-        engine measures, 1e-10 % as the exact engine does; e.g. every surface of a flat patch, or
-        a target equal to the source), with the reason under ``ratio_notes``
-        (``{ratio name: reason}``, present only then),
-        ``parameterization`` (flip counts, for ``location="uv"``) and
+    mesh : tuple ``(X, Ft)``
+        The rebuilt target: (p, 3) positions and (q, 3) triangles
+    report : dict
+        JSON-ready: ``source.{path, vertices, faces, bbox_diagonal}``, ``target.{vertices, faces,
+        boundary_vertices, boundary_loops}``, ``anchors`` (fixed vertices on closed pieces),
+        ``options``, ``error``, ``baseline_zero_detail`` and ``floor_retriangulated`` (each
+        ``{hausdorff_max_percent_of_diagonal, hausdorff_rms_percent_of_diagonal}``, % of the source
+        bbox diagonal; ``error`` also has ``vertex_max_percent_of_diagonal``, the largest distance
+        of a rebuilt vertex to the source, exact), ``improvement_over_zero_detail`` (zero-detail RMS
+        / error RMS) and ``ratio_to_floor`` (error RMS / floor RMS). Where the target has a closed
+        piece there is no zero-detail surface (it collapses onto the anchors):
+        ``baseline_zero_detail`` and the improvement are None, with the reason in ``ratio_notes``.
+        Each ratio is None where one of its two RMS values is rounding, not a measurement (below
+        ``ROUNDING_RMS``: 1e-5 % of the diagonal as pymeshlab's single-precision engine measures,
+        1e-10 % as the exact engine does; e.g. every surface of a flat patch, or a target equal to
+        the source), with the reason under ``ratio_notes`` (``{ratio name: reason}``, present only
+        then), ``parameterization`` (flip counts, for ``location="uv"``) and
         ``seconds.{retriangulate, parameterize, transfer, reconstruct, evaluate, total}``,
         ``laplacian`` ("cotan" or "robust": the one used for the source's detail) and
-        ``laplacian_reason`` (why, with the zero-area triangles counted and the caps flipped).
-        With ``evaluate=False`` the measured keys (``error``, ``baseline_zero_detail``,
-        ``floor_retriangulated``, ``improvement_over_zero_detail``, ``ratio_to_floor``) are
-        absent, not None
+        ``laplacian_reason`` (why, with the zero-area triangles counted and the caps flipped). With
+        ``evaluate=False`` the measured keys (``error``, ``baseline_zero_detail``,
+        ``floor_retriangulated``, ``improvement_over_zero_detail``, ``ratio_to_floor``) are absent,
+        not None
 
     Raises
     ------
-    MeshError                  malformed or non-manifold source (names the edges); zero-area
-                               source triangles with ``laplacian="cotan"``, or ones no flip removes
-                               (a needle: two vertices at one point) with the others
-    NotADiskError              (a MeshError) ``location="uv"`` with a source that is not a disk
-    CurvdetailError            ``target_edge`` not a positive length (even with a ``target``)
-    RemeshError                absurd target edge (with the numbers), a failed retriangulation, or a ``target`` with
-                               boundary vertices off the source's boundary polyline (by more than
-                               ``TARGET_BOUNDARY_TOLERANCE`` = 1e-6 of the larger of the bbox
-                               diagonal and the largest coordinate)
-    ValueError                 unknown option values, or a ``parameterization`` without
-                               ``location="uv"``; ``target`` not a pair; ``progress`` not
-                               callable; ``evaluate`` or ``surface_check`` not a bool
-    SolverError                unknown or uninstalled ``backend`` (before any work)
+    MeshError
+        Malformed or non-manifold source (names the edges); zero-area source triangles with
+        ``laplacian="cotan"``, or ones no flip removes (a needle: two vertices at one point) with
+        the others
+    NotADiskError
+        (a MeshError) ``location="uv"`` with a source that is not a disk
+    CurvdetailError
+        ``target_edge`` not a positive length (even with a ``target``)
+    RemeshError
+        Absurd target edge (with the numbers), a failed retriangulation, or a ``target`` with
+        boundary vertices off the source's boundary polyline (by more than
+        ``TARGET_BOUNDARY_TOLERANCE`` = 1e-6 of the larger of the bbox diagonal and the largest
+        coordinate)
+    ValueError
+        Unknown option values, or a ``parameterization`` without ``location="uv"``; ``target`` not a
+        pair; ``progress`` not callable; ``evaluate`` or ``surface_check`` not a bool
+    SolverError
+        Unknown or uninstalled ``backend`` (before any work)
 
     Warns
     -----
-    WorseThanZeroDetailWarning   the rebuild is farther from the source than the zero-detail
-                                 surface (RMS; ``improvement_over_zero_detail`` below 1, or None
-                                 where the zero-detail surface lies on the source to rounding),
-                                 and farther than rounding: the configuration failed on this
-                                 patch; the message says what to try
+    WorseThanZeroDetailWarning
+        The rebuild is farther from the source than the zero-detail surface (RMS;
+        ``improvement_over_zero_detail`` below 1, or None where the zero-detail surface lies on the
+        source to rounding), and farther than rounding: the configuration failed on this patch; the
+        message says what to try
 
     Examples
     --------

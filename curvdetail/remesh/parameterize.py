@@ -22,17 +22,21 @@ def flipped_triangles(UV, F):
 
     Parameters
     ----------
-    UV : (n, 2) float array   planar positions, finite
-    F : (m, 3) int array      triangles, indices in [0, n)
+    UV : (n, 2) float array
+        Planar positions, finite
+    F : (m, 3) int array
+        Triangles, indices in [0, n)
 
     Returns
     -------
-    flipped : (k,) int64 array   indices into ``F``, increasing; empty when no triangle is flipped
+    flipped : (k,) int64 array
+        Indices into ``F``, increasing; empty when no triangle is flipped
 
     Raises
     ------
-    MeshError   ``UV`` not a finite (n, 2) array of real numbers, or ``F`` not an (m, 3) integer
-                array with indices in [0, n) and no repeated index in a triangle
+    MeshError
+        ``UV`` not a finite (n, 2) array of real numbers, or ``F`` not an (m, 3) integer array with
+        indices in [0, n) and no repeated index in a triangle
 
     Examples
     --------
@@ -61,23 +65,29 @@ def harmonic_map(V, F, boundary, boundary_uv, *, backend="auto"):
 
     Parameters
     ----------
-    V : (n, 3) float array          vertex positions (supply the cotangent weights)
-    F : (m, 3) int array            triangles
-    boundary : (k,) int array       pinned vertices (or an (n,) bool mask: its true positions in
-                                    increasing order)
-    boundary_uv : (k, 2) float      their planar positions, row r for ``boundary[r]``
-    backend : str                   sparse solver backend (one factorization, two right-hand sides)
+    V : (n, 3) float array
+        Vertex positions (supply the cotangent weights)
+    F : (m, 3) int array
+        Triangles
+    boundary : (k,) int array
+        Pinned vertices (or an (n,) bool mask: its true positions in increasing order)
+    boundary_uv : (k, 2) float
+        Their planar positions, row r for ``boundary[r]``
+    backend : str
+        Sparse solver backend (one factorization, two right-hand sides)
 
     Returns
     -------
-    UV : (n, 2) float array         planar positions; ``UV[boundary] == boundary_uv`` exactly
+    UV : (n, 2) float array
+        Planar positions; ``UV[boundary] == boundary_uv`` exactly
 
     Raises
     ------
-    MeshError         malformed mesh (as :func:`check_mesh` names it)
-    ConstraintError   ``boundary`` empty, out of range or repeated, a piece of the mesh without a
-                      pinned vertex (the map is undetermined there), or ``boundary_uv`` not a
-                      finite (k, 2) array
+    MeshError
+        Malformed mesh (as :func:`check_mesh` names it)
+    ConstraintError
+        ``boundary`` empty, out of range or repeated, a piece of the mesh without a pinned vertex
+        (the map is undetermined there), or ``boundary_uv`` not a finite (k, 2) array
 
     Examples
     --------
@@ -149,25 +159,29 @@ def parameterize(Vs, Fs, Vt=None, Ft=None, *, method="harmonic", backend="auto")
     Vs, Fs : source mesh (a disk)
     Vt, Ft : target mesh whose boundary vertices lie on the source boundary polyline, or None
     method : {"harmonic", "meshlab_harmonic", "lscm"}
-    backend : str   sparse solver backend for ``"harmonic"``
+    backend : str
+        Sparse solver backend for ``"harmonic"``
 
     Returns
     -------
-    UVs : (n_s, 2) float array     source domain positions
+    UVs : (n_s, 2) float array
+        Source domain positions
     UVt : (n_t, 2) float array or None
-    info : dict                    ``method``, ``flipped_source``, ``flipped_target`` (counts) and
-                                   ``boundary_mismatch`` (largest distance, in the domain, between a
-                                   target boundary vertex and where the source's map puts its point
-                                   of the source boundary; 0 with ``"harmonic"``, which pins it there;
-                                   the last two only with a target)
+    info : dict
+        ``method``, ``flipped_source``, ``flipped_target`` (counts) and ``boundary_mismatch``
+        (largest distance, in the domain, between a target boundary vertex and where the source's
+        map puts its point of the source boundary; 0 with ``"harmonic"``, which pins it there; the
+        last two only with a target)
 
     Raises
     ------
     MeshError, NotADiskError   either mesh malformed or not a disk
-    RemeshError                a target boundary vertex off the source's boundary polyline (by
-                               more than ``TARGET_BOUNDARY_TOLERANCE`` = 1e-6 of the larger of the
-                               bbox diagonal and the largest coordinate, as ``remesh_experiment``)
-    ValueError                 unknown method; only one of ``Vt`` and ``Ft`` given
+    RemeshError
+        A target boundary vertex off the source's boundary polyline (by more than
+        ``TARGET_BOUNDARY_TOLERANCE`` = 1e-6 of the larger of the bbox diagonal and the largest
+        coordinate, as ``remesh_experiment``)
+    ValueError
+        Unknown method; only one of ``Vt`` and ``Ft`` given
 
     Examples
     --------

@@ -31,6 +31,12 @@ class LongRunWarning(UserWarning):
     :func:`long_run_vertices`), with what takes the time; silence it with
     ``warnings.simplefilter("ignore", LongRunWarning)``."""
 
+#: Most triangles meeting at one vertex that the isotropic remeshing is given: pymeshlab's
+#: time grows about with the cube of it (a fan disk at a 3 % target edge: 1,000 triangles at
+#: the centre 1.6 s, 2,000 11 s, 5,000 212 s and a degenerate result, 20,000 over 25 minutes;
+#: a 3,000-triangle fan refilled by meshing_close_holes(refinehole=True) had 46 at most).
+MAX_VALENCE = 1000
+
 #: A boundary vertex of the remesher's result further than this (x the target edge length) from
 #: the source boundary polyline is an error; closer ones are projected onto the polyline. The
 #: isotropic remesher's smoothing step slides boundary vertices along a curved boundary and so
@@ -72,14 +78,8 @@ def long_run_vertices(V, F, target_edge, method="isotropic", evaluate=True):
 def long_run_reason(method="isotropic", evaluate=True, cli=False):
     """What takes the time of a run that :func:`long_run_vertices` announces and what shortens
     it: a sentence for the note said beforehand (``cli``: naming the command line's options,
-    else the filter's parameters).
-
-    Measured on the 2-core development machine (2026-12-01): isotropic remeshing to 263k
-    vertices (terrainA_1k) 61 s, of which the remeshing 47 s and the measurements 10 s; to 199k
-    (mannequin_nose) 104 s, remeshing 48 s and measurements 52 s (its zero-detail surface lies
-    far from the source); to 2.25M the remeshing alone 554 s (it grows faster than the
-    vertices, the measurements about with them). Decimation of a 490k-vertex grid to 251k: 92 s,
-    of which the measurements 75 s, the transfer 13 s and the decimation 3 s."""
+    else the filter's parameters). Isotropic remeshing grows faster than the vertex count, the
+    measurements about with it; a decimation's time is mostly the measurements."""
     no_evaluate = "--no-evaluate" if cli else "evaluate=False"
     no_check = "--no-surface-check" if cli else "surface_check=False"
     if method == "decimate":
@@ -183,8 +183,10 @@ def retriangulate(V, F, *, method="isotropic", target_edge="1%", iterations=10, 
 
     Parameters
     ----------
-    V : (n, 3) float array     source vertex positions
-    F : (m, 3) int array       source triangles (a manifold, consistently oriented surface)
+    V : (n, 3) float array
+        Source vertex positions
+    F : (m, 3) int array
+        Source triangles (a manifold, consistently oriented surface)
     method : {"isotropic", "decimate"}
         ``"isotropic"``: pymeshlab ``meshing_isotropic_explicit_remeshing`` (split, collapse,
         flip, smooth, reproject) at the target edge length, every parameter passed explicitly.
@@ -218,26 +220,29 @@ def retriangulate(V, F, *, method="isotropic", target_edge="1%", iterations=10, 
 
     Returns
     -------
-    Vt : (p, 3) float array    target vertex positions; boundary vertices lie on the source's
-                               boundary polylines (projected onto them, within 1e-12 of the bbox diagonal)
-    Ft : (q, 3) int array      target triangles, oriented as the source, with its pieces, boundary
-                               loops and Euler characteristic
+    Vt : (p, 3) float array
+        Target vertex positions; boundary vertices lie on the source's boundary polylines (projected
+        onto them, within 1e-12 of the bbox diagonal)
+    Ft : (q, 3) int array
+        Target triangles, oriented as the source, with its pieces, boundary loops and Euler
+        characteristic
 
     Raises
     ------
-    MeshError                  the source is malformed or not manifold (names the edges)
-    CurvdetailError            a ``target_edge`` or ``max_surface_distance`` that is not a positive
-                               length (``parameter`` names it)
-    RemeshError                unknown method, ``iterations`` not a whole number from 1 to 1,000,
-                               ``aggressiveness`` outside [0, 10] (bools and
-                               strings are refused), ``surface_check`` not
-                               True or False, a
-                               target edge length that would give fewer than
-                               50 or more than 5,000,000 vertices (the numbers are given), a
-                               decimation asked to refine, or for fewer than 1.25 x the b - 2
-                               triangles its b boundary vertices (which it keeps) need, or that
-                               stops at more than 1.25 x the triangles asked for, or a remesher
-                               result that changed the topology or moved the boundary
+    MeshError
+        The source is malformed or not manifold (names the edges)
+    CurvdetailError
+        A ``target_edge`` or ``max_surface_distance`` that is not a positive length (``parameter``
+        names it)
+    RemeshError
+        Isotropic: a vertex with more than ``MAX_VALENCE`` (1,000) triangles around it (``first``:
+        [the vertex], ``count``: its triangles); unknown method, ``iterations`` not a whole number
+        from 1 to 1,000, ``aggressiveness`` outside [0, 10] (bools and strings are refused),
+        ``surface_check`` not True or False, a target edge length that would give fewer than 50 or
+        more than 5,000,000 vertices (the numbers are given), a decimation asked to refine, or for
+        fewer than 1.25 x the b - 2 triangles its b boundary vertices (which it keeps) need, or that
+        stops at more than 1.25 x the triangles asked for, or a remesher result that changed the
+        topology or moved the boundary
 
     Examples
     --------
@@ -264,6 +269,8 @@ def retriangulate(V, F, *, method="isotropic", target_edge="1%", iterations=10, 
     aggressiveness = _check_aggressiveness(aggressiveness)
     surface_check = _as(check_bool, surface_check, "surface_check",
                         "must be True or False (check the distance an edge collapse or flip moves the surface).")
+    if method == "isotropic":
+        _check_valence(F)
     h = target_edge * d
     n_est = estimated_vertices(V, F, h)
     if not MIN_VERTICES <= n_est <= MAX_VERTICES:
@@ -294,6 +301,20 @@ def retriangulate(V, F, *, method="isotropic", target_edge="1%", iterations=10, 
     for loop_t in loops_t:
         Vt = _snap_boundary(V, loops, Vt, loop_t, d, h)
     return Vt, Ft
+
+
+def _check_valence(F):
+    """RemeshError where a vertex of the source ``F`` has more than ``MAX_VALENCE`` triangles."""
+    count = np.bincount(F.ravel())
+    v = int(np.argmax(count))
+    if count[v] > MAX_VALENCE:
+        raise RemeshError(
+            f"the source's vertex {v} has {count[v]:,} triangles around it, more than the {MAX_VALENCE:,} "
+            "pymeshlab's isotropic remeshing handles in reasonable time (its time grows with the cube of it)",
+            hint="spread them first, e.g. remove the vertex with pymeshlab's compute_selection_by_condition_per_"
+                 f"vertex(condselect='vi=={v}') and meshing_remove_selected_vertices, then refill the hole evenly "
+                 "with meshing_close_holes(maxholesize=..., refinehole=True)",
+            count=int(count[v]), first=[v])
 
 
 def _topology(F, n, loops):

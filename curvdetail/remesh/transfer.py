@@ -32,17 +32,22 @@ def edge_curvature_measure(V, F):
 
     Parameters
     ----------
-    V : (n, 3) float array    vertex positions
-    F : (m, 3) int array      triangles (non-manifold edges and unused vertices are allowed)
+    V : (n, 3) float array
+        Vertex positions
+    F : (m, 3) int array
+        Triangles (non-manifold edges and unused vertices are allowed)
 
     Returns
     -------
-    E : (k, 2) int64 array    undirected edges as sorted pairs (low, high), rows in lexicographic order
-    c : (k, 3) float array    their measures, row r for edge ``E[r]``
+    E : (k, 2) int64 array
+        Undirected edges as sorted pairs (low, high), rows in lexicographic order
+    c : (k, 3) float array
+        Their measures, row r for edge ``E[r]``
 
     Raises
     ------
-    MeshError   malformed ``V`` or ``F`` or a zero-area triangle (as :func:`check_mesh` names them)
+    MeshError
+        Malformed ``V`` or ``F`` or a zero-area triangle (as :func:`check_mesh` names them)
 
     Examples
     --------
@@ -110,32 +115,39 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
 
     Parameters
     ----------
-    Vs, Fs : (n_s, 3) float, (m_s, 3) int   source mesh
-    Vt, Ft : (n_t, 3) float, (m_t, 3) int   target mesh (a retriangulation of the source)
+    Vs, Fs : (n_s, 3) float, (m_s, 3) int
+        Source mesh
+    Vt, Ft : (n_t, 3) float, (m_t, 3) int
+        Target mesh (a retriangulation of the source)
     method : {"conservative", "pointwise"}
     location : {"closest", "uv"}
-    uv : tuple (UVs (n_s, 2), UVt (n_t, 2)) or None   required for ``location="uv"``, refused
-                       with ``"closest"`` (it would not be used)
-    samples_per_edge : int or None   conservative only: samples per source edge, a whole number
-                       >= 1 (the total over all edges at most 20,000,000, ~10 GB); ``None`` =
-                       enough that samples are at most half the target's mean edge length apart
-    detail : (n_s, 3) float array or None   the source's detail to carry (pointwise: ``K`` =
-                       ``detail`` / the source's mixed Voronoi area); ``None`` = the detail of
-                       ``Vs, Fs``
+    uv : tuple (UVs (n_s, 2), UVt (n_t, 2)) or None
+        Required for ``location="uv"``, refused with ``"closest"`` (it would not be used)
+    samples_per_edge : int or None
+        Conservative only: samples per source edge, a whole number >= 1 (the total over all edges at
+        most 20,000,000, ~10 GB); ``None`` = enough that samples are at most half the target's mean
+        edge length apart
+    detail : (n_s, 3) float array or None
+        The source's detail to carry (pointwise: ``K`` = ``detail`` / the source's mixed Voronoi
+        area); ``None`` = the detail of ``Vs, Fs``
 
     Returns
     -------
-    Dt : (n_t, 3) float array   target curvature detail (rows of boundary vertices included)
+    Dt : (n_t, 3) float array
+        Target curvature detail (rows of boundary vertices included)
 
     Raises
     ------
-    MeshError    malformed meshes or ``uv`` (dtypes, NaN, zero-area triangles in the plane); with
-                 ``"closest"``, meshes more than ``SAME_SURFACE`` (25 %) of the source's bbox
-                 diagonal apart (not two triangulations of one surface)
-    ValueError   unknown method / location; ``uv`` missing, not a pair or of the wrong shape for
-                 ``"uv"``, or given with ``"closest"``; ``samples_per_edge`` not a whole number
-                 >= 1, too many samples, or given with ``"pointwise"``
-    ConstraintError   (a ValueError) ``detail`` not a finite (n_s, 3) array
+    MeshError
+        Malformed meshes or ``uv`` (dtypes, NaN, zero-area triangles in the plane); with
+        ``"closest"``, meshes more than ``SAME_SURFACE`` (25 %) of the source's bbox diagonal apart
+        (not two triangulations of one surface)
+    ValueError
+        Unknown method / location; ``uv`` missing, not a pair or of the wrong shape for ``"uv"``, or
+        given with ``"closest"``; ``samples_per_edge`` not a whole number >= 1, too many samples, or
+        given with ``"pointwise"``
+    ConstraintError
+        (a ValueError) ``detail`` not a finite (n_s, 3) array
 
     Examples
     --------

@@ -87,8 +87,8 @@ def as_length(value, diagonal, name="length"):
 
     Raises
     ------
-    CurvdetailError   not a number or a percentage, or not positive and finite (``parameter``
-                      is ``name``)
+    CurvdetailError
+        Not a number or a percentage, or not positive and finite (``parameter`` is ``name``)
 
     Examples
     --------
