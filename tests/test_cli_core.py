@@ -201,6 +201,7 @@ def test_a_full_stderr_does_not_stop_the_progress_of_remesh(tmp_path, monkeypatc
     assert out.exists()
 
 
+@pytest.mark.slow
 def test_stdout_on_a_full_device_still_exits_0_with_the_output_written(tmp_path):
     out = tmp_path / "out.ply"
     with open("/dev/full", "w") as full:
@@ -232,6 +233,7 @@ sys.exit(main(["reconstruct", "--example", sys.argv[1]]))
 """
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("signum, status", [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
 def test_a_signal_during_the_write_leaves_no_file_and_exits_128_plus_it(tmp_path, signum, status):
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([ROOT, os.environ.get("PYTHONPATH", "")])}
