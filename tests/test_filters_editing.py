@@ -117,7 +117,9 @@ def test_a_detail_edit_that_folds_triangles_warns_with_the_count_and_what_to_try
     # triangles; the filter said nothing (amplification None, "the handles do not move")
     ms, V, d, handles = _meshset_with_roi()
     F = ms.current_mesh().face_matrix()
-    with pytest.warns(FoldedTrianglesWarning, match=r"relations='one-ring'.* 2403\b.*relations='one\+two-ring'") as record:
+    # the relations used, the triangle count, the relations to try
+    with pytest.warns(FoldedTrianglesWarning,
+                      match=r"relations='one-ring'.* 2403\b.*relations='one\+two-ring'") as record:
         figures = apply(ms, "apply_curvature_editing", method="paper", handles=handles, detail_scale=2.0)
     X = ms.current_mesh().vertex_matrix()
     assert figures["folded_triangles"] == _folded(V, X, F) > 100

@@ -148,7 +148,8 @@ def test_a_patch_too_small_to_decimate_says_so(load_mesh):
     from curvdetail.curvature.testing import disk
 
     V, F = disk(n_rings=4)                                  # 61 vertices, 96 triangles
-    with pytest.raises(RemeshError, match=r"\b61\b.*\b50\b.*\b96\b.*" + _USE_ISOTROPIC):      # vertices, limit, triangles
+    # its vertices, the fewest a decimation gives, its triangles
+    with pytest.raises(RemeshError, match=r"\b61\b.*\b50\b.*\b96\b.*" + _USE_ISOTROPIC):
         retriangulate(V, F, method="decimate", target_edge="30%")
 
 
