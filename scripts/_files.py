@@ -86,3 +86,25 @@ def measured_conditions():
     return {"utc": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M:%S"),
             "load_average": list(os.getloadavg()),
             "peak_rss_gb": rss / 1024.0 ** (3 if sys.platform == "darwin" else 2)}
+
+
+def environment():
+    """``{"machine", "cpus", "python", "versions"}``: the machine and the library versions of a run
+    (numpy, scipy, pymeshlab, pypardiso where installed)."""
+    import platform
+    from importlib import metadata
+
+    versions = {}
+    for name in ("numpy", "scipy", "pymeshlab", "pypardiso"):
+        try:
+            versions[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            pass
+    return {"machine": platform.platform(), "cpus": os.cpu_count(), "python": platform.python_version(),
+            "versions": versions}
+
+
+def environment_line(env):
+    """The line that heads a table: machine, CPU count, Python and library versions."""
+    libs = ", ".join(f"{name} {version}" for name, version in env["versions"].items())
+    return f"Machine: {env['machine']}, {env['cpus']} CPUs; Python {env['python']}, {libs}."

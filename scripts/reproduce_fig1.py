@@ -17,11 +17,14 @@ Euclidean distance. The JSON holds each edit's settings (``config``, radii and m
 fractions of the bounding-box diagonal), sizes, and the run's time, load and peak memory.
 Every edit is one CurvatureEditor (constructor = all factoring) and one solve.
 
-Usage: python scripts/reproduce_fig1.py [--out out/fig1] [--docs docs] [--force]
-Writes OUT/fig1.json, OUT/fig1a.png, OUT/fig1b.png, OUT/fig1c.png (docs/editing_fig1.png with --docs),
-each atomically as it is ready. Before any work,
-an existing one is refused unless --force is given (the picture in docs/ is in the repository:
-refreshing it is ``--docs docs --force``).
+Every edit is the paper's linear one (``CurvatureEditor``, one-ring relations), so the figure is
+the paper's; the rotation-aware editor is compared in the deformation benchmark.
+
+Usage: python scripts/reproduce_fig1.py [--out out/fig1] [--docs docs/results] [--force]
+Writes OUT/fig1.json, OUT/fig1.md, OUT/fig1a.png, OUT/fig1b.png, OUT/fig1c.png, and with --docs DIR
+also DIR/fig1.json, DIR/fig1.md and DIR/fig1.png (one row per sub-figure), each atomically as it is
+ready. Before any work, an existing one is refused unless --force is given (the files in
+docs/results are in the repository: refreshing them is ``--docs docs/results --force``).
 """
 
 import argparse
@@ -175,17 +178,45 @@ def devil():
     return V, F, X, info, False
 
 
+def markdown(report, env):
+    """The Fig. 1 page: one table of the edits, one of the horn's detail scales."""
+    lines = ["# Fig. 1: mesh editing with curvature detail (the paper's edit, `CurvatureEditor`)", "",
+             "Written by `python scripts/reproduce_fig1.py --docs docs/results --force`; settings, counts and "
+             "the run's load in [fig1.json](fig1.json). Moves in % of the bounding-box diagonal.", "",
+             _files.environment_line(env), "",
+             "| edit | model | vertices | faces | region | position constrained | detail constrained | "
+             "largest move (%) | seconds |",
+             "|---|---|---:|---:|---:|---:|---:|---:|---:|"]
+    for key, r in zip("abc", report):
+        lines.append(f"| ({key}) | {r['model']} | {r['vertices']} | {r['faces']} | {r['roi']} | "
+                     f"{r['position_constrained']} | {r['detail_constrained']} | "
+                     f"{100 * r['max_move_fraction']:.1f} | {r['seconds']:.2f} |")
+    devil_ = report[-1]
+    lines += ["", f"(c) the horn's curvature detail `D = K A` scaled ({devil_['horn_vertices']} vertices; "
+              "ratios to the rest shape):", "",
+              "| horn detail | horn length | other horn length | head height | mean \|K\| at the tip | "
+              "largest move (%) |", "|---|---:|---:|---:|---:|---:|"]
+    for scale in DEVIL["detail_scales"]:
+        r = devil_[f"detail_x{scale}"]
+        lines.append(f"| x{scale:g} | {r['horn_length_ratio']:.2f} | {r['other_horn_length_ratio']:.2f} | "
+                     f"{r['head_height_ratio']:.2f} | {r['tip_curvature_normal_ratio']:.2f} | "
+                     f"{100 * r['max_move_fraction']:.1f} |")
+    lines += ["", "![Fig. 1](fig1.png)", ""]
+    return "\n".join(lines)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="out/fig1", help="folder for fig1.json and the pictures (default: %(default)s)")
-    ap.add_argument("--docs", default=None, help="also write DOCS/editing_fig1.png (a folder that exists)")
+    ap.add_argument("--docs", default=None,
+                    help="also write DOCS/fig1.md, fig1.json and fig1.png (the repository's: docs/results)")
     ap.add_argument("--force", action="store_true", help="replace output files that exist")
     args = ap.parse_args(argv)
     # (elevation, azimuth); (c) shows both horns, the edited one in front
     views = {"fig1a": (10, 0), "fig1b": (10, -90), "fig1c": (10, 20)}
+    docs = [os.path.join(args.docs, "fig1" + ext) for ext in (".md", ".json", ".png")] if args.docs else []
     _files.check_outputs(ap, [os.path.join(args.out, key + ".png") for key in views]
-                         + [os.path.join(args.out, "fig1.json"),
-                            os.path.join(args.docs, "editing_fig1.png") if args.docs else None],
+                         + [os.path.join(args.out, "fig1.json"), os.path.join(args.out, "fig1.md")] + docs,
                          args.force)
     require("elephant.obj", "cactus.off", "mannequin_devil.off")
     report = []
@@ -203,12 +234,16 @@ def main(argv=None):
         panels.append((show(X), F, label, moved))
         _files.render_panels(os.path.join(args.out, key + ".png"), panels, args.force, elev=elev, azim=azim)
         print(json.dumps(info))
+    env = _files.environment()
+    result = {"edits": report, **env, **_files.measured_conditions()}
+    page = markdown(report, env)
+    for folder in [args.out] + ([args.docs] if args.docs else []):
+        _files.write_json(os.path.join(folder, "fig1.json"), result, args.force, indent=2, end="\n")
+        _files.write_text(os.path.join(folder, "fig1.md"), page, args.force)
     if args.docs:
         # one row per sub-figure, each picture at its own resolution (100 dpi, 4 in per panel)
-        _files.stack_pictures(os.path.join(args.docs, "editing_fig1.png"),
+        _files.stack_pictures(os.path.join(args.docs, "fig1.png"),
                               [os.path.join(args.out, key + ".png") for key in views], args.force)
-    _files.write_json(os.path.join(args.out, "fig1.json"),
-                      {"edits": report, **_files.measured_conditions()}, args.force, indent=2)
     return 0
 
 

@@ -17,11 +17,14 @@ The JSON holds the settings (``config``: the thresholds, the turn, the offset, t
 the terrain's sines), the meshes' vertex and face counts, and the run's time, load and peak
 memory.
 
-Usage: python scripts/reproduce_fig2.py [--out out/fig2] [--docs docs] [--force]
-Writes OUT/fig2.json, OUT/fig2a.png, OUT/fig2b.png (docs/editing_fig2.png with --docs), all
-each atomically as it is ready. Before any work, an
-existing one is refused unless --force is given (the picture in docs/ is in the repository:
-refreshing it is ``--docs docs --force``).
+Every edit is the paper's linear one (``CurvatureEditor`` / ``edit_with_selection(method="paper")``
+/ ``edit_boundary``), so the figure is the paper's.
+
+Usage: python scripts/reproduce_fig2.py [--out out/fig2] [--docs docs/results] [--force]
+Writes OUT/fig2.json, OUT/fig2.md, OUT/fig2a.png, OUT/fig2b.png, and with --docs DIR also
+DIR/fig2.json, DIR/fig2.md and DIR/fig2.png (one row per sub-figure), each atomically as it is
+ready. Before any work, an existing one is refused unless --force is given (the files in
+docs/results are in the repository: refreshing them is ``--docs docs/results --force``).
 """
 
 import argparse
@@ -139,14 +142,48 @@ def terrain():
     return V, F, meshes, out
 
 
+def markdown(cow_, terrain_, env):
+    """The Fig. 2 page: one table per sub-figure."""
+    lines = ["# Fig. 2: shape editing (the paper's edit)", "",
+             "Written by `python scripts/reproduce_fig2.py --docs docs/results --force`; settings, counts and "
+             "the run's load in [fig2.json](fig2.json). Moves in % of the bounding-box diagonal.", "",
+             _files.environment_line(env), "",
+             f"(a) cow ({cow_['vertices']} vertices, region {cow_['roi']}, handles {cow_['handles']}): head "
+             f"turned by {cow_['config']['turn_degrees']:g} degrees. Handle positions \"paper\": only the "
+             "handles' curvature normals turned; \"moved\": the handles also placed by the turn and a move of "
+             f"{100 * cow_['config']['offset_towards_reader']:g} % towards the reader.", "",
+             "| handle positions | handle detail | relations | largest move (%) | handle centroid move (%) | seconds |",
+             "|---|---|---|---:|---:|---:|"]
+    for positions, detail, relations in COW_VARIANTS:
+        r = cow_[f"{positions}/{detail}/{relations}"]
+        lines.append(f"| {positions} | {detail} | {relations} | {100 * r['max_move_fraction']:.1f} | "
+                     f"{100 * r['handle_centroid_move_fraction']:.1f} | {r['seconds']:.2f} |")
+    lines += ["", f"(b) {terrain_['model']} ({terrain_['vertices']} vertices, {terrain_['faces']} triangles): "
+              f"the boundary moved by {terrain_['config']['periods']} periods of a sine; folded = normals "
+              "pointing down (at rest: " + str(terrain_["rest_folded"]) + ").", "",
+              "| sine | amplitude | boundary detail | relations | largest move (%) | height range | folded | "
+              "folded against rest normals | seconds |",
+              "|---|---:|---|---|---:|---:|---:|---:|---:|"]
+    for key, r in terrain_.items():
+        if isinstance(r, dict) and "boundary_detail" in r:
+            lines.append(f"| {key.split('_')[0] + '_' + key.split('_')[1]} | {r['amplitude']:.3g} | "
+                         f"{r['boundary_detail']} | {r['relations']} | {100 * r['max_move_fraction']:.1f} | "
+                         f"x{r['height_range_ratio']:.2f} | {r['folded_triangles']} | {r['folded_against_rest']} | "
+                         f"{r['seconds']:.2f} |")
+    lines += ["", "![Fig. 2](fig2.png)", ""]
+    return "\n".join(lines)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="out/fig2", help="folder for fig2.json and the pictures (default: %(default)s)")
-    ap.add_argument("--docs", default=None, help="also write DOCS/editing_fig2.png (a folder that exists)")
+    ap.add_argument("--docs", default=None,
+                    help="also write DOCS/fig2.md, fig2.json and fig2.png (the repository's: docs/results)")
     ap.add_argument("--force", action="store_true", help="replace output files that exist")
     args = ap.parse_args(argv)
-    _files.check_outputs(ap, [os.path.join(args.out, name) for name in ("fig2a.png", "fig2b.png", "fig2.json")]
-                         + [os.path.join(args.docs, "editing_fig2.png") if args.docs else None],
+    docs = [os.path.join(args.docs, "fig2" + ext) for ext in (".md", ".json", ".png")] if args.docs else []
+    _files.check_outputs(ap, [os.path.join(args.out, name)
+                              for name in ("fig2a.png", "fig2b.png", "fig2.json", "fig2.md")] + docs,
                          args.force)
     require("cow.off", "terrainA_10k.obj")
     V, F, status, meshes, info_a = cow()
@@ -171,11 +208,15 @@ def main(argv=None):
             folds = info_b[key + "_" + mode]["folded_triangles"]
             panels.append((X, Ft, f"{label} {short}\n{folds} folded triangles", X[:, 2]))
     _files.render_panels(os.path.join(args.out, "fig2b.png"), panels, args.force, elev=35, azim=-60, panel_size=3.0)
-    _files.write_json(os.path.join(args.out, "fig2.json"),
-                      {"cow": info_a, "terrain": info_b, **_files.measured_conditions()}, args.force, indent=2)
+    env = _files.environment()
+    result = {"cow": info_a, "terrain": info_b, **env, **_files.measured_conditions()}
+    page = markdown(info_a, info_b, env)
+    for folder in [args.out] + ([args.docs] if args.docs else []):
+        _files.write_json(os.path.join(folder, "fig2.json"), result, args.force, indent=2, end="\n")
+        _files.write_text(os.path.join(folder, "fig2.md"), page, args.force)
     if args.docs:
         # one row per sub-figure, each picture at its own resolution
-        _files.stack_pictures(os.path.join(args.docs, "editing_fig2.png"),
+        _files.stack_pictures(os.path.join(args.docs, "fig2.png"),
                               [os.path.join(args.out, key + ".png") for key in ("fig2a", "fig2b")], args.force)
     return 0
 
