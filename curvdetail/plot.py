@@ -1,8 +1,8 @@
 """Pictures of meshes (matplotlib, headless): one renderer for every figure of the package.
 
-:func:`draw_mesh` draws a mesh, grey or coloured by per-vertex values, into a 2-D matplotlib axes
-(orthographic camera, Lambert shading, faces drawn far to near); :func:`save_panels` saves a row
-of such panels as a PNG; :func:`save_remeshing_figure` is the picture of one remeshing experiment.
+`draw_mesh` draws a mesh, grey or coloured by per-vertex values, into a 2-D matplotlib axes
+(orthographic camera, Lambert shading, faces drawn far to near); `save_panels` saves a row
+of such panels as a PNG; `save_remeshing_figure` is the picture of one remeshing experiment.
 """
 
 import os
@@ -64,7 +64,7 @@ def draw_mesh(ax, V, F, values=None, *, elev=20.0, azim=-60.0, cmap="viridis", t
         the values' minimum to their maximum; values beyond it take the end colours). Without
         values the mesh is grey.
     elev, azim : float
-        Camera, as for :func:`camera`.
+        Camera, as for `camera`.
     cmap : str or matplotlib.colors.Colormap
         Colour map of ``values``.
     title : str
@@ -118,9 +118,9 @@ def save_panels(path, panels, *, elev=20.0, azim=-60.0, title=None, panel_size=4
     path : str or os.PathLike
         Destination ``.png``; ``panel_size * dpi`` pixels high, ``len(panels)`` times that wide.
     panels : list of (V, F, label) or (V, F, label, values)
-        The meshes, drawn by :func:`draw_mesh`.
+        The meshes, drawn by `draw_mesh`.
     elev, azim : float
-        Camera, as for :func:`camera`.
+        Camera, as for `camera`.
     title : str, optional
         Figure title.
     panel_size : float
@@ -130,7 +130,7 @@ def save_panels(path, panels, *, elev=20.0, azim=-60.0, title=None, panel_size=4
     colorbar : str, optional
         Label of a colour bar drawn under every panel with values; none without it.
     vrange : (float, float), optional
-        One colour scale for every panel (:func:`draw_mesh`); default: each panel its own.
+        One colour scale for every panel (`draw_mesh`); default: each panel its own.
     overwrite : bool
         Replace an existing file.
 
@@ -186,7 +186,7 @@ def save_remeshing_figure(path, V, F, X, Ft, Z, distance, report, *, zero_distan
         Distance of each vertex of ``Z`` to the source (``run_experiment``'s
         ``result["zero_distance"]``); the zero-detail panel is grey without it.
     report : dict
-        The report of :func:`curvdetail.remesh.remesh_experiment`, measured (``evaluate=True``).
+        The report of `curvdetail.remesh.remesh_experiment`, measured (``evaluate=True``).
 
     Raises
     ------

@@ -1,10 +1,10 @@
 """The ``curvdetail`` command: thin front ends over the library and the filters.
 
 ``reconstruct``, ``minimal``, ``remesh`` and ``edit`` parse their options, call the library
-function the filters call, write their outputs (each through :func:`curvdetail.io.atomic_write`,
+function the filters call, write their outputs (each through `curvdetail.io.atomic_write`,
 one after another) and print one line of figures; ``list``, ``apply`` and ``run`` run the
 filters. Errors carry their facts as fields (``parameter``, ``hint``): the command line says them
-with its own option names (:func:`error_line`), never by rewriting the library's sentence.
+with its own option names (`error_line`), never by rewriting the library's sentence.
 
 Exit status: 0 done; 1 an error, said on stderr, OUTPUT not written; 2 a command line argparse
 cannot parse; 3 OUTPUT written, but an iteration stopped before it converged; 4 OUTPUT written,
@@ -43,8 +43,8 @@ def command(name, help):
 
 
 class Terminated(KeyboardInterrupt):
-    """SIGTERM, raised in the main thread by :func:`main`'s handler, so that every ``finally``
-    (the temporary file of :func:`curvdetail.io.atomic_write` included) runs as for Ctrl-C."""
+    """SIGTERM, raised in the main thread by `main`'s handler, so that every ``finally``
+    (the temporary file of `curvdetail.io.atomic_write` included) runs as for Ctrl-C."""
 
 
 # --- reconstruct / minimal ------------------------------------------------------------------
@@ -449,7 +449,7 @@ def _terminate(signum, frame):
 
 def main(argv=None):
     """Run the ``curvdetail`` command; returns its exit status. SIGTERM raises
-    :class:`Terminated` in the main thread while it runs (status 143), Ctrl-C KeyboardInterrupt
+    `Terminated` in the main thread while it runs (status 143), Ctrl-C KeyboardInterrupt
     (130): the temporary file of an output being written is removed either way."""
     args = build_parser().parse_args(argv)
     try:

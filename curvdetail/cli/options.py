@@ -38,7 +38,7 @@ def positive_number(text):
 
 def length(text):
     """A length option (``--target-edge``): a positive number in model units, or a percentage of
-    the bbox diagonal such as ``1%`` (:func:`curvdetail.remesh.units.as_bbox_length`)."""
+    the bbox diagonal such as ``1%`` (`curvdetail.remesh.units.as_bbox_length`)."""
     from ..remesh.units import as_bbox_length
 
     number = text if text.strip().endswith("%") else positive_number(text)
@@ -112,9 +112,9 @@ def read_checked(path):
 
 
 def read_noting_extras(path):
-    """``(V, F, extras)``: :func:`read_checked`, and what else INPUT holds per vertex that a
+    """``(V, F, extras)``: `read_checked`, and what else INPUT holds per vertex that a
     command writing new geometry does not carry (``"vertex colours"``, ``"normals"``), for
-    :func:`note_not_carried`."""
+    `note_not_carried`."""
     from .. import check_mesh, read_mesh
 
     V, F, fields = read_mesh(path, fields=True)
@@ -124,7 +124,7 @@ def read_noting_extras(path):
 
 
 def note_not_carried(input_path, output_path, extras):
-    """Say on stderr that OUTPUT does not carry INPUT's ``extras`` (from :func:`read_noting_extras`)."""
+    """Say on stderr that OUTPUT does not carry INPUT's ``extras`` (from `read_noting_extras`)."""
     if extras:
         name = os.path.basename(os.fspath(output_path))
         say(f"curvdetail: note: {name} does not carry the {' and '.join(extras)} of "
@@ -248,7 +248,7 @@ def check_outputs(args, outputs, *, inputs=(), other_inputs=(), mesh_check=None)
     ``outputs``: ``(option, path, is_mesh)``, path None where not asked for. ``inputs``: the
     input mesh, which OUTPUT may replace with --overwrite; ``other_inputs`` (scripts, --add
     meshes, --sel / --def, the bundled example): never replaced. Both ``(option, path)``.
-    ``mesh_check``: how a mesh OUTPUT is checked (default :func:`curvdetail.io.mesh.check_mesh_output`).
+    ``mesh_check``: how a mesh OUTPUT is checked (default `curvdetail.io.mesh.check_mesh_output`).
     """
     from ..curvature.errors import CurvdetailError
     from ..io.atomic import check_output_path
@@ -287,7 +287,7 @@ def quality_for(path, quality):
 
 def write_measured(path, V, F, quality, *, diagonal_of, overwrite):
     """Write OUTPUT with its per-vertex ``quality`` (model units) and, in a PLY, vertex colours
-    from :data:`curvdetail.plot.COLOUR_MAP` over [0, max |quality|], which MeshLab shows on open.
+    from `curvdetail.plot.COLOUR_MAP` over [0, max |quality|], which MeshLab shows on open.
     Returns that colour range in % of the bbox diagonal of ``diagonal_of`` (vertices; the
     figures' reference), or None where the format keeps neither quality nor colours."""
     import numpy as np
@@ -365,7 +365,7 @@ def run_on_file(args, work, *, other_inputs=()):
 
 def figures_status(steps, output):
     """The exit status of ``apply`` / ``run`` from the figures of each step (``(name, figures)``):
-    :data:`AMPLIFIED` where an edit folded triangles or amplified its constraints, :data:`NOT_CONVERGED`
+    `AMPLIFIED` where an edit folded triangles or amplified its constraints, `NOT_CONVERGED`
     (with a note) where they say ``converged: false``, else 0; the first step's status where
     several apply."""
     from ..filters.editing import AMPLIFICATION_LIMIT

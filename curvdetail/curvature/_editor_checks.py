@@ -51,13 +51,13 @@ def _check_whole_mesh_constraints(pc, dc):
 
 
 def _check_relations(relations):
-    """``relations`` as one of :data:`RELATIONS`, or ValueError naming them."""
+    """``relations`` as one of `RELATIONS`, or ValueError naming them."""
     return check_choice(relations, "relations", RELATIONS,
                         "; use 'one-ring' (the paper's relations) or 'one+two-ring'.")
 
 
 def _index_set(indices, n, name, values=None):
-    """:func:`as_index_set`, with None, a set, True/False among numbers and fractions named as
+    """`as_index_set`, with None, a set, True/False among numbers and fractions named as
     such (the first three were "dtype object" or read as vertices 1 and 0, the last named only
     by its dtype). Whole floats (3.0) are indices. A set has no order: where row r of the
     ``values`` given to solve belongs to ``name[r]`` it is refused, elsewhere (``values`` None:

@@ -13,7 +13,7 @@ def anchor_vertices(V, F, k=1, detail=None, fixed=None):
     all loops), plus ``k`` anchors on each connected piece with no vertex among them.
 
     The detail ``D = L X`` sums to zero over a closed piece and fixes its shape up to a
-    translation; one fixed vertex removes that freedom, and :class:`Reconstructor` then has a
+    translation; one fixed vertex removes that freedom, and `Reconstructor` then has a
     unique solution (``rows="free"``: ``L_ff`` is positive definite; ``rows="all"``: ``L_:f`` has
     full column rank). The first anchor of a piece is its *flattest* vertex, the one with the
     smallest ``|D_i| / A_i = |K_i|`` (A: mixed Voronoi area; ties: the smallest index), where the
@@ -42,7 +42,7 @@ def anchor_vertices(V, F, k=1, detail=None, fixed=None):
     Raises
     ------
     MeshError
-        If the mesh is malformed (see :func:`check_mesh`).
+        If the mesh is malformed (see `check_mesh`).
     ConstraintError
         If ``detail`` or ``fixed`` is malformed.
     ValueError

@@ -27,7 +27,7 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
     The boundary loop is moved by ``displacement`` and its curvature detail updated (``"deformed"``,
     the paper: the details of a provisional surface, the boundary's best-fitting similarity applied
     to the patch and the rest of the move spread harmonically inside; ``"rest"``: kept); then a
-    :class:`CurvatureEditor` with the boundary's positions and details constrained rebuilds the
+    `CurvatureEditor` with the boundary's positions and details constrained rebuilds the
     interior. See docs/guide/editing.md, "Shape editing of a boundary".
 
     Parameters
@@ -39,14 +39,14 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
     displacement : callable or (b, 3) float array
         ``displacement(s, P) -> (b, 3)`` with ``s`` the normalized arc length in [0, 1) of each
         boundary vertex along the loop and ``P`` their (b, 3) positions; or the displacements
-        themselves, row r for ``info["boundary"][r]``. :func:`sine_displacement` builds the
+        themselves, row r for ``info["boundary"][r]``. `sine_displacement` builds the
         paper's sine.
     boundary_detail : {"deformed", "rest"}
         How the boundary's detail is updated.
     relations : {"one-ring", "one+two-ring"}
-        Curvature-stage relations of :class:`CurvatureEditor`.
+        Curvature-stage relations of `CurvatureEditor`.
     rcond : float
-        Threshold of :func:`curvature_coefficients`.
+        Threshold of `curvature_coefficients`.
     backend : str
         Sparse solver backend.
     return_info : bool
@@ -156,7 +156,7 @@ def _deformed_boundary_detail(V, F, L, loop, P, Q, s_, R, t, backend):
 
 
 def _warn_folded(figures, folded, m, boundary_detail, relations):
-    """A :class:`FoldedTrianglesWarning` with the figures and what to try."""
+    """A `FoldedTrianglesWarning` with the figures and what to try."""
     ratio, moved, on_loop = (figures[k] for k in ("amplification", "max_displacement", "boundary_displacement"))
     how_far = (f"vertices moved up to {ratio:.1f} times as far as the boundary ({100 * moved:.3g} % against "
                f"{100 * on_loop:.3g} % of the bbox diagonal)" if ratio is not None else
@@ -248,7 +248,7 @@ def sine_displacement(amplitude, periods=1, axis=1, phase=0.0):
     Returns
     -------
     displacement : callable
-        ``(s, P) -> (b, 3)``, for :func:`edit_boundary`.
+        ``(s, P) -> (b, 3)``, for `edit_boundary`.
 
     Raises
     ------
@@ -330,7 +330,7 @@ def boundary_loop(F):
 
 
 def loop_of_boundary_edges(E):
-    """:func:`boundary_loop` from the boundary edges ``E`` (k, 2) of :func:`boundary_edges`."""
+    """`boundary_loop` from the boundary edges ``E`` (k, 2) of `boundary_edges`."""
     if E.shape[0] == 0:
         raise MeshError("the mesh is closed (no boundary loop); shape editing of a boundary needs "
                         "a patch with one boundary loop.", parameter="F", count=0)

@@ -1,6 +1,6 @@
 """Array checks run once at the boundary of every public function, before any sparse
 algebra: shapes, dtypes, finite values, index ranges, degenerate triangles. They raise
-:class:`MeshError` / :class:`ConstraintError` (subclasses of ``ValueError``) that name the
+`MeshError` / `ConstraintError` (subclasses of ``ValueError``) that name the
 problem, carry the facts as fields (``parameter``, ``count``, ``first``) and say the fix."""
 
 import math
@@ -115,7 +115,7 @@ def check_mesh(V, F, *, check_manifold=True, check_unreferenced=True):
 
 
 def checked_arrays(V, F, *, check_manifold=True, check_unreferenced=True):
-    """:func:`check_mesh` without its copy, for callers that only read the arrays."""
+    """`check_mesh` without its copy, for callers that only read the arrays."""
     return _check_mesh(V, F, check_manifold, check_unreferenced)[:2]
 
 
@@ -283,7 +283,7 @@ def as_count(value, name, minimum=1):
 
 
 def as_positive_number(value, name, hint=""):
-    """Return ``value`` as a finite float > 0 (see :func:`as_float`), or raise ValueError."""
+    """Return ``value`` as a finite float > 0 (see `as_float`), or raise ValueError."""
     number = as_float(value)
     if number is None or not (math.isfinite(number) and number > 0):
         raise CurvdetailError(f"{name}={value!r} must be a positive number{hint}.", parameter=name, value=value)

@@ -49,13 +49,13 @@ def cotan_laplacian(V, F):
 
 
 def checked_cotan_laplacian(V, F):
-    """Every :func:`check_mesh` check and ``L`` in one pass: ``(V, F, L)``, V and F converted."""
+    """Every `check_mesh` check and ``L`` in one pass: ``(V, F, L)``, V and F converted."""
     V, F, U, diagonal = checked_cotan_triangle(V, F)
     return V, F, _symmetric_from_upper(U, diagonal)
 
 
 def checked_cotan_triangle(V, F):
-    """Like :func:`checked_cotan_laplacian`, with ``L`` as its strict upper triangle ``U`` (CSR,
+    """Like `checked_cotan_laplacian`, with ``L`` as its strict upper triangle ``U`` (CSR,
     sorted, explicit zeros kept: the edge pattern) and its diagonal: ``(V, F, U, diagonal)``."""
     V, F, cot = _check_mesh(V, F, check_manifold=False, check_unreferenced=True, cotangents=True)
     U, diagonal = _assemble_upper(V, F, cot, check_manifold=True)

@@ -22,13 +22,13 @@ DEFAULT_MAX_RING = 3
 WELL_CONDITIONED = 1e-6
 
 #: A ring goes through the SVD of its ring matrix where one of its singular value ratios
-#: ``sigma_k / sigma_1`` (from ``G_i``'s eigenvalues) lies in this band (see :func:`_coefficients`).
+#: ``sigma_k / sigma_1`` (from ``G_i``'s eigenvalues) lies in this band (see `_coefficients`).
 SVD_BAND = (1e-7, 1e-3)
 
 
 @dataclass(frozen=True)
 class CoefficientInfo:
-    """What :func:`curvature_coefficients` found about each one-ring.
+    """What `curvature_coefficients` found about each one-ring.
 
     Attributes
     ----------
@@ -86,7 +86,7 @@ def curvature_coefficients(V, F, *, rcond=DEFAULT_RCOND, max_ring=DEFAULT_MAX_RI
     max_ring : int
         Widest ring for a vertex whose one-ring cannot represent its detail (1: one-ring only).
     return_info : bool
-        Also return a :class:`CoefficientInfo`.
+        Also return a `CoefficientInfo`.
 
     Returns
     -------
@@ -99,7 +99,7 @@ def curvature_coefficients(V, F, *, rcond=DEFAULT_RCOND, max_ring=DEFAULT_MAX_RI
     Raises
     ------
     MeshError
-        If the mesh is malformed (as for :func:`cotan_laplacian`).
+        If the mesh is malformed (as for `cotan_laplacian`).
     ValueError
         If ``rcond`` is outside (0, 1), ``max_ring`` is not a count >= 1 or ``return_info`` is not
         a bool.
@@ -263,7 +263,7 @@ def _coefficients(D, A, rows, cols, n, rcond, size, *, want_scale=False, max_rin
 
 
 def _surely_in_svd_band(c00, c11, c22, tr):
-    """Rows whose Gram matrix ``G`` certainly has ``sigma_2 / sigma_1`` inside :data:`SVD_BAND`,
+    """Rows whose Gram matrix ``G`` certainly has ``sigma_2 / sigma_1`` inside `SVD_BAND`,
     told from its invariants alone (no eigendecomposition); (k,) bool. ``c00, c11, c22`` (k,):
     the diagonal cofactors, ``tr`` the trace.
 
@@ -378,7 +378,7 @@ def _truncated_fit(D, A, target, counts, cols, rcond, size, *, area_scale=None):
 
 def _fit(Di, U, sigma, area_scale, rcond):
     """The truncated pseudo-inverse fit from a ring's singular directions ``U`` (t, 3, 3),
-    columns, and values ``sigma`` (t, 3): (w, rank, s_i, residual) as :func:`_truncated_fit`."""
+    columns, and values ``sigma`` (t, 3): (w, rank, s_i, residual) as `_truncated_fit`."""
     s_ref = np.maximum(sigma.max(axis=1), area_scale)
     keep = sigma > rcond * s_ref[:, None]
     proj = np.einsum("tab,ta->tb", U, Di)                            # U^T D_i

@@ -24,7 +24,7 @@ def curvature_detail(V, F):
     Raises
     ------
     MeshError
-        If the mesh is malformed (as for :func:`cotan_laplacian`).
+        If the mesh is malformed (as for `cotan_laplacian`).
 
     Examples
     --------

@@ -33,11 +33,11 @@ class CurvatureEditor:
 
     Two stages (the paper's Sections 3.1-3.2). The curvature stage gives the details ``D_u`` of
     the region's vertices without a detail constraint: the square system
-    ``(I - C)_uu D_u = C_uk D_k`` (``C`` from :func:`curvature_coefficients`, LU-factored), or
+    ``(I - C)_uu D_u = C_uk D_k`` (``C`` from `curvature_coefficients`, LU-factored), or
     with ``relations="one+two-ring"`` the least squares of ``|(I - C) D|^2 + |(I - C2) D|^2``.
     The embedding stage gives the positions minimizing ``E_Q = sum_i |(L X)_i - D_i|^2`` over the
-    free positions, as :class:`Reconstructor`. Vertices outside ``roi`` keep their rest positions
-    and details. The constructor does all factoring; :meth:`solve` only back-substitutes. With
+    free positions, as `Reconstructor`. Vertices outside ``roi`` keep their rest positions
+    and details. The constructor does all factoring; `solve` only back-substitutes. With
     ``roi=None``, moving the position constraints by a similarity ``x -> s R x + t`` and the
     detail constraints by ``D -> s R D`` moves the result by the same similarity (see
     docs/guide/editing.md, "The two-stage editor").
@@ -49,9 +49,9 @@ class CurvatureEditor:
     F : (m, 3) int array
         Triangles.
     position_constrained : (p,) int array or (n,) bool mask
-        Vertices whose positions are given to :meth:`solve` (the handles), inside ``roi``.
+        Vertices whose positions are given to `solve` (the handles), inside ``roi``.
     detail_constrained : (q,) int array or (n,) bool mask
-        Vertices whose curvature details are given to :meth:`solve`, inside ``roi``; may overlap
+        Vertices whose curvature details are given to `solve`, inside ``roi``; may overlap
         ``position_constrained``.
     roi : (r,) int array or (n,) bool mask, optional
         Region of interest, in any order (a set is taken too); None is the whole mesh.
@@ -62,11 +62,11 @@ class CurvatureEditor:
         Curvature stage: the paper's one-ring relations, or two-ring ones as well (twice the
         equations: far less amplification of inconsistent constraints, a denser factorization).
     rcond : float
-        Singular-value threshold of :func:`curvature_coefficients`.
+        Singular-value threshold of `curvature_coefficients`.
     max_ring : int
-        Widest ring of :func:`curvature_coefficients` (1: the paper's one-ring everywhere).
+        Widest ring of `curvature_coefficients` (1: the paper's one-ring everywhere).
     backend : str
-        Sparse solver backend ("auto" or one of :func:`available_backends`).
+        Sparse solver backend ("auto" or one of `available_backends`).
 
     Attributes
     ----------
@@ -99,7 +99,7 @@ class CurvatureEditor:
         If constraint indices are out of range, repeated or outside ``roi``, ``roi`` is empty,
         there are too few constraints, or a free region touches no constraint.
     UndeterminedEditError
-        If the constraints do not determine the edit (``rest_error`` above :data:`MAX_REST_ERROR`,
+        If the constraints do not determine the edit (``rest_error`` above `MAX_REST_ERROR`,
         or the curvature stage cannot be factored).
     ValueError
         If ``rows``, ``relations`` or ``rcond`` is not one of its choices.
@@ -211,7 +211,7 @@ class CurvatureEditor:
     def _check_rest_state(self):
         """Distance from ``V`` (over the bbox diagonal) of the shape the rest constraints give
         (the embedding's response to the curvature stage's rest-detail error: anything but
-        rounding is a singular system); UndeterminedEditError above :data:`MAX_REST_ERROR`."""
+        rounding is a singular system); UndeterminedEditError above `MAX_REST_ERROR`."""
         error = 0.0
         if self._curv is not None and self._embed is not None:
             dc_rest = self.detail[self._dc]
@@ -233,8 +233,8 @@ class CurvatureEditor:
 
     def _check_rest_details(self):
         """Every roi position given: where the rest constraints give back details further than
-        :data:`MAX_REST_ERROR` of the roi's largest rest detail from the rest ones,
-        :meth:`solve_details` and ``solve(..., return_details=True)`` raise UndeterminedEditError."""
+        `MAX_REST_ERROR` of the roi's largest rest detail from the rest ones,
+        `solve_details` and ``solve(..., return_details=True)`` raise UndeterminedEditError."""
         Du = self._curvature_solve(self.detail[self._dc])
         scale = float(np.linalg.norm(self.detail[self.roi], axis=1).max())
         error = float(np.linalg.norm(Du - self.detail[self._fd], axis=1).max())
@@ -268,7 +268,7 @@ class CurvatureEditor:
                                         parameter="detail_constrained") from None
 
     def _square_system(self, D, in_roi, free_d, fd, dc, at_fd, at_dc, rows, cols, cvals, curv_backend):
-        """The paper's linear-system form (see :func:`square_curvature_system`)."""
+        """The paper's linear-system form (see `square_curvature_system`)."""
         M, self._C_dc, self._d_const = square_curvature_system(D, in_roi, free_d, fd, dc, at_fd, at_dc,
                                                                rows, cols, cvals)
         # "auto" takes SuperLU (symmetric mode, no pivoting) for (I - C) below CURVATURE_SPLU_MAX
@@ -277,14 +277,14 @@ class CurvatureEditor:
         self._Au = None                                     # square: solved exactly, no refinement
 
     def _stacked_system(self, D, in_roi, fd, dc, at_fd, at_dc, rel1, rel2, backend):
-        """Both relations in least squares (see :func:`stacked_curvature_system`)."""
+        """Both relations in least squares (see `stacked_curvature_system`)."""
         self._Au, self._AuT, self._Bdc, self._b_rest = stacked_curvature_system(D, in_roi, fd, dc, at_fd, at_dc,
                                                                                 rel1, rel2)
         normal = (self._AuT @ self._Au).tocsr()
         self._curv = self._factor_curvature_stage(normal, True, backend) if fd.size else None
 
     def _embedding(self, L, V, F, in_roi, pc, rows, cols, backend):
-        """E_Q over the rows that involve the free positions (see :func:`embedding_system`)."""
+        """E_Q over the rows that involve the free positions (see `embedding_system`)."""
         parts, system = embedding_system(L, V, in_roi, pc, rows, cols, self._fd, self._dc, self.detail,
                                          self.rows == "all")
         vars(self).update(parts)
@@ -346,7 +346,7 @@ class CurvatureEditor:
         ConstraintError
             If ``positions`` or ``details`` is not of shape (p, 3) / (q, 3) of finite numbers.
         UndeterminedEditError
-            With ``return_details=True``, as :meth:`solve_details`.
+            With ``return_details=True``, as `solve_details`.
         ValueError
             If ``return_details`` is not True or False.
         """
@@ -387,7 +387,7 @@ class CurvatureEditor:
         """The curvature stage's unknown details for the constraint values ``Dk`` (q, 3), or its
         response to the detail constraints ``columns`` (one column each, values 1). The square
         system is solved exactly; the stacked least squares (``relations="one+two-ring"``) through
-        its normal equations and corrected semi-normal refinement (:func:`refine_least_squares`,
+        its normal equations and corrected semi-normal refinement (`refine_least_squares`,
         at least ``refinement_steps`` steps; where it stalls, as on near-null directions of detail
         islands, the last iterate is taken and the rest check judges the shape it gives)."""
         if self._Au is None:
@@ -401,8 +401,8 @@ class CurvatureEditor:
     def _embedding_solve(self, rhs):
         """Free positions minimizing ``|A X_f - rhs|`` over the rows ``R`` (rows="all"), or
         solving the square system (rows="free"); ``rhs`` (|R|, k). The normal equations are
-        followed by corrected semi-normal refinement, as in :class:`Reconstructor`
-        (:func:`refine_least_squares`: at least ``refinement_steps`` steps, more where the error
+        followed by corrected semi-normal refinement, as in `Reconstructor`
+        (`refine_least_squares`: at least ``refinement_steps`` steps, more where the error
         estimate asks, SolverError where it stalls): without it the error grows with the
         squared condition number."""
         if self._A_T is None:
@@ -416,7 +416,7 @@ class CurvatureEditor:
 
         Both stages are linear in the constraint values, so the result is the solution at a base
         state plus one response column per handle vertex, computed here by back-substitution.
-        Afterwards a :meth:`solve` whose values differ from the base only at ``handles`` is one
+        Afterwards a `solve` whose values differ from the base only at ``handles`` is one
         dense ``(free x h) @ (h x 3)`` product (exact up to rounding); any other falls back to the
         full solve. Threads may share the editor; of calls made at once, the last to finish stays.
 
@@ -425,7 +425,7 @@ class CurvatureEditor:
         handles : (h,) int array
             Position- and/or detail-constrained vertices whose values will change (any order).
         positions, details : float arrays, optional
-            The base constraint values, as in :meth:`solve` (None: rest values).
+            The base constraint values, as in `solve` (None: rest values).
 
         Returns
         -------
@@ -435,7 +435,7 @@ class CurvatureEditor:
         ------
         ConstraintError
             If ``handles`` are out of range, repeated, or not constrained vertices, or
-            ``positions`` / ``details`` are refused as in :meth:`solve`.
+            ``positions`` / ``details`` are refused as in `solve`.
         """
         h = _index_set(handles, self.n, "handles")
         is_p = np.zeros(self.n, dtype=bool)

@@ -21,12 +21,12 @@ def mean_curvature_normal(V, F):
         centre with ``|K| = 2 / R``. Intensive: independent of the mesh density. On boundary
         vertices it carries the boundary's geodesic-curvature term as well.
     A : (n,) float array
-        Mixed Voronoi areas (:func:`mixed_voronoi_area`); ``A.sum()`` is the surface area.
+        Mixed Voronoi areas (`mixed_voronoi_area`); ``A.sum()`` is the surface area.
 
     Raises
     ------
     MeshError
-        If the mesh is malformed (as for :func:`cotan_laplacian`).
+        If the mesh is malformed (as for `cotan_laplacian`).
 
     Examples
     --------

@@ -29,7 +29,7 @@ def mixed_voronoi_area(V, F):
     Raises
     ------
     MeshError
-        If the mesh is malformed (as for :func:`cotan_laplacian`).
+        If the mesh is malformed (as for `cotan_laplacian`).
 
     Examples
     --------

@@ -18,9 +18,9 @@ class Reconstructor:
 
     Minimizes the paper's ``E_Q = sum_i |(L X)_i - D_i|^2`` over the free positions ``X_f``, the
     fixed positions ``X_c`` kept exactly; ``L`` is the cotangent Laplacian of ``V_ref`` (positive
-    semi-definite, see :func:`cotan_laplacian`). ``rows="all"`` sums over every vertex (the
+    semi-definite, see `cotan_laplacian`). ``rows="all"`` sums over every vertex (the
     paper): normal equations ``(L_:f^T L_:f) X_f = L_:f^T (D - L_:c X_c)``, each solve followed by
-    corrected semi-normal refinement (:func:`refine_least_squares`), which keeps the error at
+    corrected semi-normal refinement (`refine_least_squares`), which keeps the error at
     ~1e-14 of the solution. ``rows="free"`` sums over the free vertices only: the square system
     ``L_ff X_f = D_f - L_fc X_c``. Both reproduce ``V_ref`` from its own detail. Solves run
     relative to the fixed positions' centre, so coordinates far from the origin lose no digits.
@@ -33,12 +33,12 @@ class Reconstructor:
         Triangles.
     fixed : (k,) int array or (n,) bool mask
         Constrained vertices; every connected piece needs one. For a closed surface, several
-        boundary loops or several pieces, :func:`anchor_vertices` gives every boundary vertex
+        boundary loops or several pieces, `anchor_vertices` gives every boundary vertex
         and one anchor per closed piece.
     rows : {"all", "free"}
         Which residual rows enter the energy.
     backend : str
-        Sparse solver backend ("auto" or one of :func:`available_backends`).
+        Sparse solver backend ("auto" or one of `available_backends`).
     refinement_steps : int, optional
         Least refinement steps of ``rows="all"`` solves (default: the class attribute, 1), at
         most ``MAX_LEAST_REFINEMENT_STEPS``; 0 gives the plain normal-equation solution.
@@ -57,7 +57,7 @@ class Reconstructor:
     Raises
     ------
     MeshError
-        If the mesh is malformed (see :func:`check_mesh`).
+        If the mesh is malformed (see `check_mesh`).
     ConstraintError
         If there is no fixed vertex, ``fixed`` is out of range, repeated or a mask of the wrong
         length, or a connected piece has no fixed vertex.
@@ -185,7 +185,7 @@ class Reconstructor:
     def _refine(self, X_f, r):
         """Corrected semi-normal refinement of the normal-equation solution ``X_f`` (3, f) for
         the right-hand side ``r`` (3, n): each correction solves the same factored system with
-        the least-squares residual ``r - L_:f X_f`` (see :func:`refine_least_squares`)."""
+        the least-squares residual ``r - L_:f X_f`` (see `refine_least_squares`)."""
         L_f, L_f_T = self._L_f, self._L_f.T
 
         def correction(X):
@@ -252,7 +252,7 @@ class _FreeSystemLayout:
     sorted) and diagonal, go in the free-row system: the upper triangle, diagonal included, of
     ``L[free][:, free]`` (CSR, sorted, renumbered to ``0 .. f - 1``) and ``L[free][:, fixed]``
     (CSR, columns in the order of ``fixed``). Built from ``U``'s pattern alone, so that it serves
-    every ``U`` with that pattern (the steps of :func:`minimal_surface`)."""
+    every ``U`` with that pattern (the steps of `minimal_surface`)."""
 
     def __init__(self, U, is_free, fixed):
         n = U.shape[0]
@@ -301,7 +301,7 @@ class _FreeSystemLayout:
 def reconstruct(V_ref, F, detail, fixed, fixed_positions, *, rows="all", backend="auto"):
     """Rebuild positions from curvature detail with some vertices fixed (one-off solve).
 
-    Builds a :class:`Reconstructor` and calls :meth:`Reconstructor.solve` once; keep a
+    Builds a `Reconstructor` and calls `Reconstructor.solve` once; keep a
     ``Reconstructor`` to answer many details or boundary positions with one factorization.
 
     Parameters
@@ -313,12 +313,12 @@ def reconstruct(V_ref, F, detail, fixed, fixed_positions, *, rows="all", backend
     detail : (n, 3) float array
         Target curvature detail ``D = K A``.
     fixed : (k,) int array or (n,) bool mask
-        Constrained vertices, e.g. :func:`anchor_vertices` (the boundary and one anchor per
+        Constrained vertices, e.g. `anchor_vertices` (the boundary and one anchor per
         closed piece).
     fixed_positions : (k, 3) float array
         Their positions, row r for vertex ``fixed[r]`` (for a mask: in increasing index order).
     rows : {"all", "free"}
-        Residual rows in the energy (see :class:`Reconstructor`).
+        Residual rows in the energy (see `Reconstructor`).
     backend : str
         Sparse solver backend.
 

@@ -1,6 +1,6 @@
 """A cotangent Laplacian that tolerates degenerate triangles (Sharp & Crane 2020, mollification).
 
-The plain :func:`~curvdetail.cotan_laplacian` refuses triangles of zero area: their cotangents
+The plain `cotan_laplacian` refuses triangles of zero area: their cotangents
 are infinite. Scans have them (a vertex on the opposite edge: a "cap"; two vertices at one point:
 a "needle"). The mollified Laplacian takes its cotangents from the edge lengths alone (an
 intrinsic metric), each lengthened by the smallest ``delta`` that leaves every triangle's
@@ -21,7 +21,7 @@ MOLLIFY = 1e-6
 def robust_laplacian(V, F, eps=MOLLIFY):
     """The mollified intrinsic cotangent Laplacian ``L`` and its lumped mass ``M``.
 
-    Same convention as :func:`~curvdetail.cotan_laplacian`: symmetric positive semi-definite,
+    Same convention as `cotan_laplacian`: symmetric positive semi-definite,
     ``(L X)_i = 1/2 sum_j (cot a_ij + cot b_ij)(x_i - x_j)``, rows summing to zero, the cotangents
     those of the triangles with edge lengths ``l + delta`` (``delta`` as in the module's text).
     A sum of one positive semi-definite energy per triangle, so PSD whatever the mesh.

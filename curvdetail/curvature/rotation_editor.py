@@ -12,7 +12,7 @@ from .sparse_solver import factorize, resolve_backend
 
 #: Default stopping tolerance: the largest vertex move of an iteration over the bbox diagonal.
 DEFAULT_TOL = 1e-4
-#: Default cap on the number of iterations of :meth:`RotationAwareEditor.solve`.
+#: Default cap on the number of iterations of `RotationAwareEditor.solve`.
 DEFAULT_MAX_ITERATIONS = 500
 
 
@@ -27,7 +27,7 @@ class RotationAwareEditor:
     with ``w_ij = max(-L_ij, 0)`` the cotangent weights of the rest mesh ``V`` clamped at zero (a
     negative weight makes ``E`` unbounded below) and ``S`` the vertices with a free vertex in
     their closed one-ring (the as-rigid-as-possible energy of Sorkine & Alexa 2007).
-    :meth:`solve` alternates two steps, each minimizing ``E`` exactly over its variables:
+    `solve` alternates two steps, each minimizing ``E`` exactly over its variables:
 
     - local: every ``R_i`` in closed form, the rotation nearest the 3x3 covariance
       ``sum_j w_ij (x_i - x_j) (v_i - v_j)^T`` (all vertices at once, reflections excluded);
@@ -35,14 +35,14 @@ class RotationAwareEditor:
       weights ``w``), with the turned rest details ``B_i = sum_j w_ij (s_i R_i + s_j R_j) / 2
       (v_i - v_j)``; where the neighbourhood turns as one, ``B_i = s R D_i``.
 
-    Steps are Anderson-accelerated (:attr:`anderson_memory`); an accelerated step is kept only
+    Steps are Anderson-accelerated (`anderson_memory`); an accelerated step is kept only
     where it lowers ``E``, so ``E`` never increases from one iteration to the next
     (``energies``). The rotations start at the best-fit rotation of the handles (rest to given
     positions), blended towards the identity at the fixed part by a harmonic weight, so a rigid
     motion of every handle with ``roi=None`` is reproduced in the first iteration. The
     iterations stop when the plain step would move no vertex more than ``tol`` times the bbox
     diagonal, or after ``max_iterations``. The constructor does all factoring; an iteration of
-    :meth:`solve` is one back-substitution plus the batched local fits.
+    `solve` is one back-substitution plus the batched local fits.
 
     Parameters
     ----------
@@ -51,7 +51,7 @@ class RotationAwareEditor:
     F : (m, 3) int array
         Triangles.
     handles : (p,) int array or (n,) bool mask
-        Vertices whose positions are given to :meth:`solve`, inside ``roi``.
+        Vertices whose positions are given to `solve`, inside ``roi``.
     roi : (r,) int array or (n,) bool mask, optional
         Region of interest; vertices outside keep their rest positions. None: the whole mesh.
     scaling : bool
@@ -59,9 +59,9 @@ class RotationAwareEditor:
     tol : float
         Stopping tolerance, over the bbox diagonal of ``V``.
     max_iterations : int
-        Most iterations of :meth:`solve`.
+        Most iterations of `solve`.
     backend : str
-        Sparse solver backend ("auto" or one of :func:`available_backends`).
+        Sparse solver backend ("auto" or one of `available_backends`).
 
     Attributes
     ----------
@@ -69,11 +69,11 @@ class RotationAwareEditor:
         Rest detail ``D_i = sum_j w_ij (v_i - v_j)``: the curvature detail ``L V`` wherever no
         weight was clamped.
     iterations : int
-        Iterations of the last :meth:`solve` (global steps).
+        Iterations of the last `solve` (global steps).
     converged : bool
-        Whether the last :meth:`solve` met ``tol`` within ``max_iterations``.
+        Whether the last `solve` met ``tol`` within ``max_iterations``.
     energies : list of float
-        ``E`` after each local step of the last :meth:`solve`; non-increasing up to rounding.
+        ``E`` after each local step of the last `solve`; non-increasing up to rounding.
     backend : str
         Solver backend of the embedding.
 
@@ -284,7 +284,7 @@ def _closest_rotations(C, steps=8):
     s3 + d s1 s2) W^T``: where its first two entries are positive and the third has the sign of
     ``d`` (always for ``d = 1``, rank 2 included), its orthogonal polar factor is the answer,
     found by ``steps`` scaled Newton steps ``X <- (g X + X^-T / g) / 2``. The rest (a factor
-    that is no rotation to 1e-12) goes through :func:`_closest_rotations_eigh`."""
+    that is no rotation to 1e-12) goes through `_closest_rotations_eigh`."""
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         X = C / np.sqrt(np.einsum("kij,kij->k", C, C))[:, None, None]
         X = X + _cofactor(X)
@@ -307,7 +307,7 @@ def _cofactor(A):
 
 
 def _closest_rotations_eigh(C):
-    """:func:`_closest_rotations` from the eigenvectors of ``C^T C`` (rank 2 included)."""
+    """`_closest_rotations` from the eigenvectors of ``C^T C`` (rank 2 included)."""
     _, W = np.linalg.eigh(np.swapaxes(C, 1, 2) @ C)          # ascending: W[..., 2] the largest
     w1, w2 = W[..., 2], W[..., 1]
     u1 = np.einsum("kij,kj->ki", C, w1)

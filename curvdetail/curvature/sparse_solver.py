@@ -54,7 +54,7 @@ def _installed(module):
 
 
 def available_backends():
-    """Names of the installed backends, in :data:`BACKENDS` order; ``"splu"`` is always there.
+    """Names of the installed backends, in `BACKENDS` order; ``"splu"`` is always there.
 
     Examples
     --------
@@ -124,7 +124,7 @@ def _release(solver):
 
 
 class Factorization:
-    """A factored square sparse matrix; :meth:`solve` back-substitutes only. See :func:`factorize`.
+    """A factored square sparse matrix; `solve` back-substitutes only. See `factorize`.
 
     Attributes
     ----------

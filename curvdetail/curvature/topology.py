@@ -154,7 +154,7 @@ def misoriented_edges(F):
 
 def check_oriented(F, what="the mesh", error=MeshError):
     """Raise ``error`` if triangles of ``F`` are wound against their neighbours (see
-    :func:`misoriented_edges`), naming ``what``."""
+    `misoriented_edges`), naming ``what``."""
     E = misoriented_edges(F)
     if E.shape[0]:
         pairs = ", ".join(f"({a}, {b})" for a, b in E[:3])
@@ -180,7 +180,7 @@ def boundary_vertices(F):
     Parameters
     ----------
     F : (m, 3) int array
-        Triangles, as for :func:`boundary_edges`.
+        Triangles, as for `boundary_edges`.
 
     Returns
     -------
@@ -190,7 +190,7 @@ def boundary_vertices(F):
     Raises
     ------
     MeshError
-        As :func:`boundary_edges`.
+        As `boundary_edges`.
 
     Examples
     --------
@@ -227,7 +227,7 @@ def vertex_components(F, n, adjacency=None):
 
 def check_every_component_fixed(F, n, fixed, adjacency=None):
     """Raise ConstraintError if a connected component has no fixed vertex (``first``: a vertex of
-    each such piece). ``adjacency``: see :func:`vertex_components`."""
+    each such piece). ``adjacency``: see `vertex_components`."""
     labels, count = vertex_components(F, n, adjacency)
     has = np.zeros(count, dtype=bool)
     has[labels[fixed]] = True

@@ -1,10 +1,10 @@
 """Comparative evaluation at scale: mesh collections x remeshing configurations, on Dask.
 
-A :class:`Study` (grids of :func:`~curvdetail.remesh.remesh_experiment` options, from arguments
-or a TOML/JSON file, :func:`load_study`) times the meshes of a collection gives cells;
-:func:`run_study` runs those not yet in a results folder as Dask tasks, each in a child process
+A `Study` (grids of `remesh_experiment` options, from arguments
+or a TOML/JSON file, `load_study`) times the meshes of a collection gives cells;
+`run_study` runs those not yet in a results folder as Dask tasks, each in a child process
 of its worker that a time limit can stop, and writes one table row per cell as it finishes
-(:mod:`.table`: Parquet and CSV); :func:`write_summary` writes a Markdown summary and plots.
+(`table`: Parquet and CSV); `write_summary` writes a Markdown summary and plots.
 ``curvdetail evaluate`` is the command line; docs/guide/evaluate.md the guide.
 """
 

@@ -1,5 +1,5 @@
-"""One cell of a study: read the mesh, run :func:`~curvdetail.remesh.remesh_experiment`, and
-make the table row (:data:`~curvdetail.evaluate.table.COLUMNS`) of its figures or its error."""
+"""One cell of a study: read the mesh, run `remesh_experiment`, and
+make the table row (`COLUMNS`) of its figures or its error."""
 
 import os
 import resource
@@ -18,7 +18,7 @@ _STAGES = ("retriangulate", "parameterize", "transfer", "reconstruct", "evaluate
 
 
 def base_row(task):
-    """The row's mesh identity and configuration, from a cell's task dict (:meth:`Cell.task`)."""
+    """The row's mesh identity and configuration, from a cell's task dict (`Cell.task`)."""
     return {"cell_key": task["key"], "mesh_name": task["name"], "mesh_path": task["path"],
             "mesh_blake2b": task["blake2b"], **{k: task[k] for k in CONFIG_KEYS}}
 
@@ -43,7 +43,7 @@ def _reset_peak_memory():
 
 
 def _peak_memory_mib():
-    """Peak resident memory since :func:`_reset_peak_memory` (Linux), else of the process's life."""
+    """Peak resident memory since `_reset_peak_memory` (Linux), else of the process's life."""
     try:
         with open("/proc/self/status") as fh:
             for line in fh:
@@ -86,7 +86,7 @@ def run_cell(task):
     Parameters
     ----------
     task : dict
-        :meth:`~curvdetail.evaluate.study.Cell.task`: ``path``, ``name``, ``blake2b``, ``key``
+        `task`: ``path``, ``name``, ``blake2b``, ``key``
         and the configuration (``method``, ``target_edge`` as ``"1%"``, ...).
     """
     t0 = time.perf_counter()

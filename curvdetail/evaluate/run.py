@@ -56,7 +56,7 @@ def run_study(study, inputs, results, *, workers=None, scheduler=None, cell_time
 
     Each finished cell's row is written at once (``results/parts/<cell key>.parquet``);
     ``results/results.parquet`` and ``results/results.csv`` are rebuilt from the parts every
-    :data:`REBUILD_EVERY` seconds and at the end (also after Ctrl-C). A failed cell is a row
+    `REBUILD_EVERY` seconds and at the end (also after Ctrl-C). A failed cell is a row
     with ``status`` "failed" and its error, one stopped at ``cell_timeout`` or ``cell_memory`` a
     row with "timeout" or "memory".
 
@@ -64,7 +64,7 @@ def run_study(study, inputs, results, *, workers=None, scheduler=None, cell_time
     ----------
     study : Study
     inputs : str or list of str
-        Mesh files, folders or glob patterns (:func:`~curvdetail.evaluate.study.find_meshes`),
+        Mesh files, folders or glob patterns (`find_meshes`),
         read by the workers from these paths (a path they share).
     results : str
         The results folder (created; a study's folder is continued).

@@ -30,7 +30,7 @@ ONE_THREAD = {name: "1" for name in ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPEN
 
 
 class Runner:
-    """A child process that runs cells (:func:`~curvdetail.evaluate.cell.run_cell`) one at a time.
+    """A child process that runs cells (`run_cell`) one at a time.
 
     Raises
     ------
@@ -96,7 +96,7 @@ _local = threading.local()
 
 
 def evaluate_cell(task, timeout=None, memory=None):
-    """Dask task: the row of one cell, run in this worker thread's :class:`Runner` (started on
+    """Dask task: the row of one cell, run in this worker thread's `Runner` (started on
     first use, again after a limit or a crash; ``timeout`` seconds, ``memory`` MiB); never
     raises for the cell's failure."""
     runner = getattr(_local, "runner", None)

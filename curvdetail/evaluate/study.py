@@ -1,4 +1,4 @@
-"""A study: mesh files x a grid of :func:`~curvdetail.remesh.remesh_experiment` configurations.
+"""A study: mesh files x a grid of `remesh_experiment` configurations.
 
 A study is one or more grids. A grid gives each option of the experiment as one value or a
 list (``method``, ``target_edge``, ``transfer``, ``rows``, ``location``, ``parameterization``)
@@ -29,7 +29,7 @@ from ..remesh.retriangulate import METHODS as RETRIANGULATIONS
 from ..remesh.transfer import LOCATIONS
 from ..remesh.transfer import METHODS as TRANSFERS
 
-#: The options of a grid with their choices (``target_edge`` takes sizes, see :func:`target_size`).
+#: The options of a grid with their choices (``target_edge`` takes sizes, see `target_size`).
 CHOICES = {"method": RETRIANGULATIONS, "transfer": TRANSFERS, "rows": ROW_MODES, "location": LOCATIONS,
            "parameterization": PARAMETERIZATIONS}
 #: What a grid that leaves an option out runs (remesh_experiment's defaults).
@@ -65,14 +65,14 @@ def target_size(value):
 
 
 def experiment_target_edge(size):
-    """The ``target_edge`` argument of :func:`~curvdetail.remesh.remesh_experiment` for a
-    normalized size of :func:`target_size`: ``"1%"`` as it is, a plain number in model units."""
+    """The ``target_edge`` argument of `remesh_experiment` for a
+    normalized size of `target_size`: ``"1%"`` as it is, a plain number in model units."""
     return size if size.endswith("%") else float(size)
 
 
 @dataclass(frozen=True)
 class Cell:
-    """One run of a study: a mesh file and a configuration (``config``: :data:`CONFIG_KEYS`).
+    """One run of a study: a mesh file and a configuration (``config``: `CONFIG_KEYS`).
     ``key`` identifies it across runs: a hash of the file's content and the configuration."""
     path: str
     name: str
@@ -142,11 +142,11 @@ class Study:
     Parameters
     ----------
     grids : list of dict
-        Each: option -> value or list of values (:data:`CHOICES`, ``target_edge`` sizes such as
+        Each: option -> value or list of values (`CHOICES`, ``target_edge`` sizes such as
         ``"1%"``), optional ``meshes`` (file-name patterns); a left-out option takes
-        :data:`DEFAULTS`.
+        `DEFAULTS`.
     baselines : list of str
-        Names of :data:`BASELINES`.
+        Names of `BASELINES`.
 
     Raises
     ------
@@ -204,7 +204,7 @@ class Study:
         return list(dict.fromkeys(out))
 
     def cells(self, inputs):
-        """The cells for the mesh files ``inputs`` names (:func:`find_meshes`), each once; a
+        """The cells for the mesh files ``inputs`` names (`find_meshes`), each once; a
         grid's ``meshes`` patterns are matched against the files' names (StudyError where one
         matches none)."""
         paths = find_meshes(inputs)
@@ -229,7 +229,7 @@ def _as_list(value):
 
 
 def load_study(path):
-    """A :class:`Study` from a TOML (``.toml``) or JSON file; StudyError where it cannot be read
+    """A `Study` from a TOML (``.toml``) or JSON file; StudyError where it cannot be read
     or parsed (``e.value`` is the file)."""
     path = os.fspath(path)
     try:

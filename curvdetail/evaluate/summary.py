@@ -7,7 +7,7 @@ import numpy as np
 from ..io.atomic import atomic_write, check_output_path
 from .plots import label, plot_ratio_to_floor, plot_rms_against_target, plot_time_against_vertices
 
-#: The files :func:`write_summary` writes into its folder.
+#: The files `write_summary` writes into its folder.
 FILES = ("summary.md", "rms_against_target.png", "ratio_to_floor.png", "time_against_vertices.png")
 
 
@@ -55,14 +55,14 @@ def summary_markdown(rows):
 
 
 def write_summary(table, folder, *, overwrite=False):
-    """Write ``summary.md`` (:func:`summary_markdown`) and the plots (RMS against target edge per
+    """Write ``summary.md`` (`summary_markdown`) and the plots (RMS against target edge per
     configuration, RMS/floor per mesh and configuration, seconds against vertex count) into
     ``folder`` (created), each atomically.
 
     Parameters
     ----------
     table : pyarrow.Table
-        A study's table (:func:`~curvdetail.evaluate.read_results`).
+        A study's table (`read_results`).
     folder : str
     overwrite : bool
         Replace the files of an earlier summary.
@@ -70,12 +70,12 @@ def write_summary(table, folder, *, overwrite=False):
     Returns
     -------
     list of str
-        The paths written (:data:`FILES`).
+        The paths written (`FILES`).
 
     Raises
     ------
     FileExistsError
-        A file of :data:`FILES` exists and ``overwrite`` is False (before any is written).
+        A file of `FILES` exists and ``overwrite`` is False (before any is written).
     """
     os.makedirs(folder, exist_ok=True)
     paths = [check_output_path(os.path.join(folder, name), overwrite) for name in FILES]

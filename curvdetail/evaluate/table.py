@@ -88,7 +88,7 @@ def write_part(folder, row):
 
 
 def read_parts(folder):
-    """The rows of every part in ``folder/parts`` as one table (:data:`SCHEMA`; empty if none)."""
+    """The rows of every part in ``folder/parts`` as one table (`SCHEMA`; empty if none)."""
     files = sorted(glob.glob(os.path.join(folder, "parts", "*.parquet")))    # not the hidden temporary files
     if not files:
         return SCHEMA.empty_table()

@@ -15,7 +15,7 @@ runs its filters on a MeshSet the way pymeshlab runs its own::
     filters.save_script(ms, "recorded.mlx")                  # every step above, for `curvdetail run`
 
 Every filter lives in its own module named as the filter and is declared with
-:func:`~curvdetail.filters.registry.filter`; importing this package registers them all.
+`filter`; importing this package registers them all.
 """
 
 import importlib

@@ -38,13 +38,13 @@ def apply(ms, name, **params):
     (``sourcemesh``, ``targetmesh``, ...). Parameters left out take their defaults (never values
     from an earlier call). A filter that creates a mesh adds it as a new layer and makes it
     current, as pymeshlab's ``generate_*`` filters do. The step is recorded on ``ms`` for
-    :func:`~curvdetail.filters.save_script` (with every parameter, the defaults included).
+    `save_script` (with every parameter, the defaults included).
 
     Parameters
     ----------
     ms : pymeshlab.MeshSet
     name : str
-        A registered filter (see :func:`list_filters`)
+        A registered filter (see `list_filters`)
     **params         the filter's parameters by name
 
     Returns

@@ -28,9 +28,9 @@ AMPLIFICATION_LIMIT = 3.0
 
 class AmplifiedEditWarning(UserWarning):
     """Said by ``apply_curvature_editing`` when its result moved more than
-    :data:`AMPLIFICATION_LIMIT` times as far as the handles, or its details changed more than that
+    `AMPLIFICATION_LIMIT` times as far as the handles, or its details changed more than that
     many times as much as the edit asks, without folding triangles (folds are said with
-    :class:`~curvdetail.curvature.errors.FoldedTrianglesWarning`): the edit ran and the mesh is
+    `FoldedTrianglesWarning`): the edit ran and the mesh is
     changed, but the curvature stage amplified the handles' change. The message gives the figures
     and what to try; the same figures are in the filter's dict. Turn it into an error with
     ``warnings.simplefilter("error", AmplifiedEditWarning)``."""
@@ -82,7 +82,7 @@ def _indices(text, n):
 
 
 def _handles_without_a_mesh(text):
-    """The checks of :func:`_indices` that need no mesh (numbers, whole, not negative, each once),
+    """The checks of `_indices` that need no mesh (numbers, whole, not negative, each once),
     run on the parameter's value (``Parameter.validate``), so that a script's check and the
     command line refuse a malformed ``handles`` before any step runs. The empty default passes
     here; the filter names it."""
@@ -320,7 +320,7 @@ def _region_ring_counts(V, F, roi, editor):
 
 def _warn_if_amplified(figures, folded, m, moved, D, D0, options):
     """A FoldedTrianglesWarning where triangles folded, else an AmplifiedEditWarning where
-    ``amplification`` or ``detail_amplification`` is above :data:`AMPLIFICATION_LIMIT` (the
+    ``amplification`` or ``detail_amplification`` is above `AMPLIFICATION_LIMIT` (the
     rule of curvdetail edit's warning); nothing otherwise. The message names the figures, the
     first folded triangles and the vertices that moved and changed most, and what to try."""
     ratio, detail_ratio = figures["amplification"], figures["detail_amplification"]

@@ -1,6 +1,6 @@
 """Exceptions raised by the filter suite.
 
-All derive from :class:`curvdetail.curvature.errors.CurvdetailError` (a ``ValueError``), so they
+All derive from `curvdetail.curvature.errors.CurvdetailError` (a ``ValueError``), so they
 carry ``parameter``, ``value`` and ``hint`` as fields: a front end (the CLI) names the
 parameter in its own terms.
 """
@@ -25,6 +25,6 @@ class ScriptError(FilterError):
 
 
 class ScaleWarning(UserWarning):
-    """Said by :func:`~curvdetail.filters.run_script` (``curvdetail run`` says it as a note) when a
+    """Said by `run_script` (``curvdetail run`` says it as a note) when a
     script gives a length in model units far from the mesh's size: likely sized for another mesh
     (the message names the ratio to the bbox diagonal). Write such lengths as percentages."""

@@ -1,11 +1,11 @@
 """Load mesh files into a MeshSet and save its current mesh with the filters' results.
 
-PLY is read and written with plyfile (:mod:`curvdetail.io.ply`): double coordinates, the vertex
+PLY is read and written with plyfile (`curvdetail.io.ply`): double coordinates, the vertex
 quality, colours and selection (in MeshLab's vertex flags), and every custom per-vertex
 attribute a filter stored (``curvature_detail``, ``curvature_area``, ...; a point attribute as
 the properties ``<name>_x``, ``<name>_y``, ``<name>_z``), so one step's output is the next one's
-input. Other formats are loaded by pymeshlab (:func:`curvdetail.io.mesh.load_new_mesh`) and
-saved as :func:`curvdetail.write_mesh` writes them: the geometry. Saves are atomic and replace
+input. Other formats are loaded by pymeshlab (`curvdetail.io.mesh.load_new_mesh`) and
+saved as `curvdetail.write_mesh` writes them: the geometry. Saves are atomic and replace
 an existing file only with ``overwrite=True``.
 """
 
@@ -27,7 +27,7 @@ _OWN = ("quality", "flags") + _RGBA
 #: The checks of an output path, before any work (the CLI's ``apply`` and ``run`` use it).
 check_output_path = check_mesh_output
 
-#: the absolute path each layer of a MeshSet made by :func:`load_meshset` was read from, with a
+#: the absolute path each layer of a MeshSet made by `load_meshset` was read from, with a
 #: digest of its geometry then (pymeshlab gives Python only the bare file name, ``Mesh.label()``)
 _LOADED_FROM = weakref.WeakKeyDictionary()
 
@@ -37,7 +37,7 @@ def load_meshset(path, *more):
     ``more`` as layers 1, 2, ... (the last one current, as with ``load_new_mesh``).
 
     A PLY file's quality, colours, selection and other per-vertex properties come with it (the
-    others as custom attributes). Raises as :func:`curvdetail.read_mesh`.
+    others as custom attributes). Raises as `curvdetail.read_mesh`.
     """
     import pymeshlab
 
@@ -72,7 +72,7 @@ def _add_ply_layer(ms, path):
 
 
 def loaded_from(ms, mesh_id):
-    """The absolute path of the file :func:`load_meshset` read layer ``mesh_id`` of ``ms`` from,
+    """The absolute path of the file `load_meshset` read layer ``mesh_id`` of ``ms`` from,
     or None: a layer pymeshlab loaded itself, one made in memory, or one whose vertices or
     triangles changed since (a filter in a script smoothed it: the file is no longer its source)."""
     path, digest = _LOADED_FROM.get(ms, {}).get(mesh_id, (None, None))
@@ -109,7 +109,7 @@ def attributes_lost_in(ms, path):
 
 
 def vertex_colours_kept_in(ms, path):
-    """Whether :func:`save_current_mesh` writes the current mesh's vertex colours to ``path``:
+    """Whether `save_current_mesh` writes the current mesh's vertex colours to ``path``:
     PLY, and colours other than the opaque white pymeshlab gives every mesh built from arrays."""
     mesh = ms.current_mesh()
     return _is_ply(path) and mesh.has_vertex_color() and not bool(np.all(mesh.vertex_color_matrix() == 1.0))
@@ -117,8 +117,8 @@ def vertex_colours_kept_in(ms, path):
 
 def save_current_mesh(ms, path, *, overwrite=False):
     """Atomically save the current mesh of ``ms``: to PLY with its quality, colours (see
-    :func:`vertex_colours_kept_in`), selection and custom attributes; to other formats its
-    geometry, as :func:`curvdetail.write_mesh` writes it. The layer is left as it is.
+    `vertex_colours_kept_in`), selection and custom attributes; to other formats its
+    geometry, as `curvdetail.write_mesh` writes it. The layer is left as it is.
 
     Raises FileExistsError (``path`` exists, ``overwrite`` False), MeshError (``path`` cannot
     be written), MeshFileError (the write failed; nothing is left behind).

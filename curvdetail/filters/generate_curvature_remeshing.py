@@ -114,7 +114,7 @@ def generate_curvature_remeshing(ms, *, method, target_edge, transfer, rows, loc
 
 
 def _add_layer_without_quality(ms, V, F, label, *, quality=None, attributes=None):
-    """:func:`~curvdetail.filters.meshset.add_layer` of a layer that has no vertex quality
+    """`add_layer` of a layer that has no vertex quality
     (``quality`` must be None). A ``pymeshlab.Mesh`` made from arrays always has one, all 0,
     which a PLY of the layer would carry as if it were measured; a layer loaded from a file
     without one has none. So the layer is loaded from a temporary binary PLY (doubles: exact)."""

@@ -23,7 +23,7 @@ from .errors import FilterError
 _scratch_ids = itertools.count()
 
 #: ``{name: "point" | "scalar"}`` for every custom attribute a filter stored with
-#: :func:`set_vertex_attribute` or :func:`add_layer`; saving to PLY keeps these.
+#: `set_vertex_attribute` or `add_layer`; saving to PLY keeps these.
 WRITTEN_ATTRIBUTES = {}
 
 
@@ -99,9 +99,9 @@ KEEP_ATTRIBUTES = ("if the layer came from a PLY file written with them, load it
 
 
 def require_vertex_attribute(ms, mesh_id, name, kind, hint):
-    """Like :func:`vertex_attribute` but raises FilterError (``value``: the attribute's name)
+    """Like `vertex_attribute` but raises FilterError (``value``: the attribute's name)
     naming the attribute, ``hint`` and how to keep attributes through a file
-    (:data:`KEEP_ATTRIBUTES`)."""
+    (`KEEP_ATTRIBUTES`)."""
     values = vertex_attribute(ms, mesh_id, name, kind)
     if values is None:
         label = get_mesh(ms, mesh_id).label()
@@ -166,7 +166,7 @@ def set_vertex_attribute(ms, mesh_id, name, values):
 
 def set_vertex_quality(ms, mesh_id, quality):
     """Set a layer's per-vertex quality in place, and its vertex colours from it
-    (:func:`colour_by_quality`); returns the colour range ``(lo, hi)``."""
+    (`colour_by_quality`); returns the colour range ``(lo, hi)``."""
     mesh = get_mesh(ms, mesh_id)
     q = _as_columns(mesh, quality, 1, "vertex quality")
     with _current(ms, mesh_id):
@@ -181,7 +181,7 @@ COLOUR_MAP = "Viridis"
 
 def colour_by_quality(ms, mesh_id, quality):
     """Colour a layer's vertices by its quality, which MeshLab shows on open and a PLY keeps:
-    :data:`COLOUR_MAP` over [0, max] for a quality of one sign (a distance), over [-m, m], m the
+    `COLOUR_MAP` over [0, max] for a quality of one sign (a distance), over [-m, m], m the
     largest magnitude, for a signed one (a mean curvature), so that 0 is the middle colour.
     Returns ``(lo, hi)``, in the quality's units."""
     q = np.asarray(quality, dtype=np.float64)
@@ -205,7 +205,7 @@ def set_vertex_positions(ms, mesh_id, X):
 def add_layer(ms, V, F, label, *, quality=None, attributes=None):
     """Add ``(V, F)`` as a new layer called ``label`` and make it current; return its id.
 
-    ``quality`` (n,) becomes the vertex quality and the vertex colours (:func:`colour_by_quality`);
+    ``quality`` (n,) becomes the vertex quality and the vertex colours (`colour_by_quality`);
     ``attributes`` maps names to (n, 3) point or
     (n,) scalar custom attributes."""
     import pymeshlab

@@ -15,7 +15,7 @@ The format is MeshLab's (and pymeshlab's ``save_filter_script``)::
     </FilterScript>
 
 A ``<filter>`` whose name is one of ours (the snake_case name of
-:func:`~curvdetail.filters.list_filters`) runs through :func:`~curvdetail.filters.apply` with
+`list_filters`) runs through `apply` with
 the ``<Param name= value=>`` pairs converted by the parameter types (an enum's value is its index,
 as MeshLab writes it, read through the element's ``enum_val<i>`` where it has them, or its
 text; a ``PercentageValue`` is absolute, as MeshLab writes it, or ``"1.5%"`` of the bbox
@@ -130,7 +130,7 @@ def run_script(ms, path, *, progress=None):
         unknown or of the wrong type or range, a parameter of a MeshLab step that MeshLab would
         misread without a word (a bool other than 'true'/'false', a number that does not parse, a
         RichAbsPerc without min and max, a name the filter does not have): all these found before
-        any step runs (:func:`check_script`), except a MeshLab parameter name right but for its
+        any step runs (`check_script`), except a MeshLab parameter name right but for its
         capitals, found after its step; then, as the steps run, a MeshLab filter that needs a mesh
         on an empty MeshSet, or a step failed (the message names the step number and filter, then
         the reason), or the last step left the MeshSet with no mesh
@@ -177,12 +177,12 @@ def run_script(ms, path, *, progress=None):
 
 def check_script(path):
     """Read a MeshLab filter script (.mlx) and check every step without running any: the
-    checks of :func:`run_script` that need no mesh, so that a typo in its last step is found
+    checks of `run_script` that need no mesh, so that a typo in its last step is found
     before its first one has taken minutes.
 
     Of our filters: the name (a typo of one of ours gets the close matches), each parameter's
-    name and value (parsed by its type, checked as :func:`~curvdetail.filters.apply` checks
-    it); of MeshLab's: what MeshLab would misread without a word (see :func:`run_script`).
+    name and value (parsed by its type, checked as `apply` checks
+    it); of MeshLab's: what MeshLab would misread without a word (see `run_script`).
     What needs the meshes (layer ids that exist, attributes, a mesh for a native step) is
     checked as each step runs.
 
@@ -200,7 +200,7 @@ def check_script(path):
 
     Raises
     ------
-    FileNotFoundError, ScriptError   as :func:`run_script`
+    FileNotFoundError, ScriptError   as `run_script`
     """
     from .dispatch import complete_parameters
 
@@ -225,12 +225,12 @@ def check_script(path):
 
 
 def save_script(path, steps, *, overwrite=False):
-    """Write a MeshLab filter script that :func:`run_script` runs: the pipeline run on a MeshSet
+    """Write a MeshLab filter script that `run_script` runs: the pipeline run on a MeshSet
     (``save_script(ms, path)``), or our filters named in a list (``save_script(path, steps)``).
 
     ``save_script(ms, path)`` writes every step run on ``ms`` from Python, in order: ours (run by
-    :func:`~curvdetail.filters.apply`) and pymeshlab's (run by
-    :func:`~curvdetail.filters.apply_native`, whose lengths and floats replay to the last digit,
+    `apply`) and pymeshlab's (run by
+    `apply_native`, whose lengths and floats replay to the last digit,
     or on the MeshSet directly, as pymeshlab recorded them). ``curvdetail run`` replays it on the
     same input to the same result.
 
@@ -255,7 +255,7 @@ def save_script(path, steps, *, overwrite=False):
     ScriptError
         ``steps`` is not a list of names or (name, parameters) pairs; a MeshSet on which no filter
         has run
-    UnknownFilterError, FilterParameterError   as :func:`~curvdetail.filters.apply`
+    UnknownFilterError, FilterParameterError   as `apply`
 
     Examples
     --------
@@ -304,8 +304,8 @@ def _write(path, elements, overwrite):
 
 
 def _note_far_lengths(ms, where, element, params):
-    """A :class:`ScaleWarning` for each length of a step given in model units far from the
-    current mesh's size (see :data:`~.native.FAR_LENGTH`): likely sized for another mesh."""
+    """A `ScaleWarning` for each length of a step given in model units far from the
+    current mesh's size (see `FAR_LENGTH`): likely sized for another mesh."""
     from ..curvature.errors import warn
     from ..curvature.geometry import bbox_diagonal
     from .native import FAR_LENGTH

@@ -198,7 +198,7 @@ def _unknown_native_step(name):
 def percentages_resolved(ms, element):
     """A copy of a native step whose ``RichAbsPerc`` values given as ``"2%"`` (MeshLab takes
     lengths in model units only) are resolved against the current mesh's bbox diagonal, with
-    every digit (as :func:`~.recording.apply_native` resolves a ``PercentageValue``)."""
+    every digit (as `apply_native` resolves a ``PercentageValue``)."""
     import copy
 
     from ..curvature.geometry import bbox_diagonal
@@ -229,7 +229,7 @@ def far_lengths(ms, element):
 
 def percent_length(percent, diagonal):
     """A percentage of ``diagonal`` in model units: one formula for recording
-    (:func:`~.recording.apply_native`) and replay."""
+    (`apply_native`) and replay."""
     return float(percent) / 100.0 * float(diagonal)
 
 

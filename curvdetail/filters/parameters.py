@@ -1,6 +1,6 @@
 """Typed filter parameters, as pymeshlab's: declaration, checking and parsing from text.
 
-A :class:`Parameter` has a ``name``, a ``type`` (one of :data:`TYPES`), a ``default``, a
+A `Parameter` has a ``name``, a ``type`` (one of `TYPES`), a ``default``, a
 ``description`` and, where they apply, ``choices`` (for ``str``) and ``min`` / ``max`` (for
 ``int``, ``float`` and ``PercentageValue``; ``positive=True`` asks for a value above 0).
 
@@ -17,7 +17,7 @@ Types, as pymeshlab names them:
     a length given either as a percentage of the bounding-box diagonal
     (``pymeshlab.PercentageValue(1.0)``, ``"1%"`` on the command line) or as an absolute value
     (``pymeshlab.PureValue(0.01)``, a plain number, ``"0.01"``). The filter receives a
-    :class:`BBoxLength` and calls ``.resolve(diagonal)``.
+    `BBoxLength` and calls ``.resolve(diagonal)``.
 ``mesh``
     a layer id of the MeshSet (pymeshlab shows these as ``int``); the default ``None`` means the
     current mesh.
@@ -298,7 +298,7 @@ class Parameter:
 
         ``bool``: true/false/1/0/yes/no; ``PercentageValue``: ``"1.5%"`` (percent of the bbox
         diagonal) or ``"0.01"`` (absolute); ``mesh``: a layer id, or ``""`` / ``"current"`` for
-        the current mesh (how :meth:`format` writes None); ``str`` with choices: the choice,
+        the current mesh (how `format` writes None); ``str`` with choices: the choice,
         case-insensitive, or its 0-based index (how MeshLab writes a RichEnum).
         """
         s = str(text).strip()
@@ -336,7 +336,7 @@ class Parameter:
                                        parameter=self.name) from None
 
     def format(self, value):
-        """``value`` as text that :meth:`parse` reads back exactly."""
+        """``value`` as text that `parse` reads back exactly."""
         if value is None:
             return ""
         if self.type == "bool":

@@ -2,11 +2,11 @@
 
 pymeshlab records every filter it runs on a MeshSet (``ms.save_filter_script``), ours included
 in the form of the internal steps they use to write attributes (``curvdetail_scratch_<k>``),
-which no script can replay. So :func:`~curvdetail.filters.apply` records each of our filters as
+which no script can replay. So `apply` records each of our filters as
 its own ``<filter>`` step, with the range of pymeshlab's history it covers, and
-:func:`apply_native` does the same for one of pymeshlab's filters, with the lengths and numbers
+`apply_native` does the same for one of pymeshlab's filters, with the lengths and numbers
 given as written (a ``PercentageValue`` as ``"1%"``, a float with every digit: pymeshlab's own
-history keeps 6). :func:`recorded_steps` puts them together with the steps run on the MeshSet
+history keeps 6). `recorded_steps` puts them together with the steps run on the MeshSet
 directly (``ms.meshing_...``), as pymeshlab recorded those.
 """
 
@@ -70,7 +70,7 @@ def record(ms, start, element):
 
 
 def recorded_steps(ms):
-    """Every step run on ``ms``, in order: ours and those of :func:`apply_native` as recorded,
+    """Every step run on ``ms``, in order: ours and those of `apply_native` as recorded,
     the native filters run on it directly as pymeshlab recorded them (our internal steps left
     out)."""
     steps, done = [], 0
@@ -85,7 +85,7 @@ def recorded_steps(ms):
 
 def apply_native(ms, name, **params):
     """Run pymeshlab's filter ``name`` (its Python name, e.g. ``"meshing_isotropic_explicit_remeshing"``)
-    on ``ms`` and record it for :func:`~curvdetail.filters.save_script`.
+    on ``ms`` and record it for `save_script`.
 
     As ``ms.apply_filter(name, **params)``, except that a ``pymeshlab.PercentageValue`` is
     resolved here against the current mesh's bbox diagonal (as a script's ``"1%"`` is when it is

@@ -1,4 +1,4 @@
-"""The filter registry: every filter is declared once, next to its code, with :func:`filter`.
+"""The filter registry: every filter is declared once, next to its code, with `filter`.
 
 A filter is a function ``f(ms, *, p1, p2, ...) -> dict`` that reads a ``pymeshlab.MeshSet``,
 calls the package's numeric code and writes custom attributes, vertex quality or a new layer.
@@ -17,7 +17,7 @@ Its declaration gives everything a user needs to call it without reading the cod
         return {"max_displacement": ...}
 
 and the module is imported by ``curvdetail/filters/__init__.py`` so that registration happens.
-Users call it through :func:`curvdetail.filters.apply`, which checks and completes the
+Users call it through `curvdetail.filters.apply`, which checks and completes the
 parameters first.
 """
 
@@ -40,7 +40,7 @@ _REGISTRY = {}
 @dataclass(frozen=True)
 class FilterSpec:
     """A registered filter: ``name``, ``category``, ``description``, ``parameters`` (a tuple of
-    :class:`~curvdetail.filters.parameters.Parameter`) and the ``function`` that runs it."""
+    `Parameter`) and the ``function`` that runs it."""
 
     name: str
     category: str
@@ -49,7 +49,7 @@ class FilterSpec:
     function: object
 
     def parameter(self, name):
-        """The :class:`Parameter` called ``name`` (KeyError if there is none)."""
+        """The `Parameter` called ``name`` (KeyError if there is none)."""
         for p in self.parameters:
             if p.name == name:
                 return p
@@ -65,7 +65,7 @@ class FilterSpec:
 
     def to_dict(self):
         """The filter as JSON-ready values (``json.dumps`` takes it): ``name``, ``category``,
-        ``description`` (one line) and ``parameters`` (each :meth:`Parameter.to_dict`)."""
+        ``description`` (one line) and ``parameters`` (each `Parameter.to_dict`)."""
         return {"name": self.name, "category": self.category,
                 "description": " ".join(self.description.split()),
                 "parameters": [p.to_dict() for p in self.parameters]}
@@ -77,7 +77,7 @@ def filter(*, name, category, description, parameters=()):  # noqa: A001 (pymesh
     Parameters
     ----------
     name : str
-        snake_case, starting with a verb family (:data:`FAMILIES`).
+        snake_case, starting with a verb family (`FAMILIES`).
     category : str
         MeshLab menu-style category, e.g. ``"Curvature detail"``.
     description : str
@@ -89,7 +89,7 @@ def filter(*, name, category, description, parameters=()):  # noqa: A001 (pymesh
     Returns
     -------
     register : callable
-        The decorator: it registers a :class:`FilterSpec` under ``name`` (the description with
+        The decorator: it registers a `FilterSpec` under ``name`` (the description with
         its whitespace collapsed to single spaces), sets ``function.spec``, gives a function
         without a docstring one built from the declaration, and returns the same function. The
         decorated function keeps working as a plain function.
@@ -98,7 +98,7 @@ def filter(*, name, category, description, parameters=()):  # noqa: A001 (pymesh
     ------
     TypeError
         When the decorator is applied: ``name`` not snake_case or not starting with one of
-        :data:`FAMILIES`, already registered, an empty ``category`` or ``description``, a
+        `FAMILIES`, already registered, an empty ``category`` or ``description``, a
         parameter declared twice, or declared parameters that differ from the function's
         keyword-only arguments.
 
@@ -157,9 +157,9 @@ def _docstring(spec):
 
 
 def list_filters():
-    """Every registered filter's :class:`FilterSpec`, sorted by name.
+    """Every registered filter's `FilterSpec`, sorted by name.
 
-    Takes no parameters; importing :mod:`curvdetail.filters` registers the package's filters.
+    Takes no parameters; importing `curvdetail.filters` registers the package's filters.
 
     Returns
     -------
@@ -182,7 +182,7 @@ def close_matches(word, candidates, cutoff=0.5):
 
 
 def get_filter(name):
-    """The :class:`FilterSpec` called ``name``, or UnknownFilterError listing the close matches.
+    """The `FilterSpec` called ``name``, or UnknownFilterError listing the close matches.
 
     Parameters
     ----------
@@ -224,7 +224,7 @@ def print_filter_list():
     """Print the filter names, as ``pymeshlab.print_filter_list()`` does.
 
     Takes no parameters and returns None: prints a header line, then each registered name on a
-    line of its own, indented by a tab, sorted by name (as :func:`list_filters`).
+    line of its own, indented by a tab, sorted by name (as `list_filters`).
 
     Examples
     --------
@@ -255,7 +255,7 @@ def print_filter_parameter_list(name):
     Raises
     ------
     UnknownFilterError
-        No filter of that name (as :func:`get_filter`)
+        No filter of that name (as `get_filter`)
 
     Examples
     --------

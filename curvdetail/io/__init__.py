@@ -1,5 +1,5 @@
-"""Files: meshes (:mod:`.mesh`; PLY through plyfile, :mod:`.ply`) and the one atomic writer every
-output goes through (:mod:`.atomic`)."""
+"""Files: meshes (`mesh`; PLY through plyfile, `ply`) and the one atomic writer every
+output goes through (`atomic`)."""
 
 from .atomic import atomic_write, check_output_path
 from .mesh import MeshFileError, read_mesh, write_mesh

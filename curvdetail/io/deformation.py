@@ -168,7 +168,7 @@ def write_transform(path, T, *, overwrite=False):
     Raises
     ------
     DeformationFileError
-        If ``T`` is a matrix :func:`read_transform` would refuse.
+        If ``T`` is a matrix `read_transform` would refuse.
     FileExistsError
         If ``path`` exists and ``overwrite`` is False.
     """
@@ -179,7 +179,7 @@ def write_transform(path, T, *, overwrite=False):
 
 
 def _as_transform(T, error):
-    """``T`` as a (4, 4) float array that :func:`read_transform` would accept, else ``error``."""
+    """``T`` as a (4, 4) float array that `read_transform` would accept, else ``error``."""
     try:
         T = np.asarray(T, dtype=np.float64)
         problem = None if T.shape == (4, 4) and np.isfinite(T).all() else f"T has shape {T.shape} or is not finite"
@@ -211,18 +211,18 @@ def edit_with_selection(V, F, status, T, *, method="rotation", handle_detail=Non
     F : (m, 3) int array
         Triangles.
     status : (n,) int array
-        0 fixed, 1 free, 2 handle (see :func:`read_selection`).
+        0 fixed, 1 free, 2 handle (see `read_selection`).
     T : (4, 4) float array
-        Affine handle transform with an invertible linear part (see :func:`read_transform`).
+        Affine handle transform with an invertible linear part (see `read_transform`).
     method : {"rotation", "paper"}
-        ``"rotation"``: a :class:`~curvdetail.curvature.rotation_editor.RotationAwareEditor`
+        ``"rotation"``: a `RotationAwareEditor`
         (the rest details turn with their neighbourhoods; fold-free on the benchmark cases);
-        ``"paper"``: the paper's linear two-stage :class:`~curvdetail.curvature.CurvatureEditor`.
+        ``"paper"``: the paper's linear two-stage `CurvatureEditor`.
     handle_detail : {"transform", "free"}, optional
         ``method="paper"`` only (default "transform"): the handles' details constrained to
         ``T[:3, :3] @ D`` (exact for a similarity), or solved like the free ones.
     relations, rcond
-        ``method="paper"`` only, as for :class:`~curvdetail.curvature.CurvatureEditor`
+        ``method="paper"`` only, as for `CurvatureEditor`
         (``relations`` default "one-ring").
     scaling, tol, max_iterations
         ``method="rotation"`` only, as for ``RotationAwareEditor``.

@@ -1,11 +1,11 @@
-"""Mesh files as ``(V, F)`` arrays: :func:`read_mesh`, :func:`write_mesh`.
+"""Mesh files as ``(V, F)`` arrays: `read_mesh`, `write_mesh`.
 
-PLY goes through plyfile (:mod:`.ply`, doubles kept), every other format is read by pymeshlab.
+PLY goes through plyfile (`ply`, doubles kept), every other format is read by pymeshlab.
 What a file yields then passes the checks any array input passes (finite coordinates, face
 indices in range, no repeated corner), and the counts the file states must be those loaded:
 PLY element counts (plyfile reads exactly those), the OFF header's, and an OBJ file's ``v`` and
 ``f`` lines. OBJ and OFF are written as exact decimals (``%.17g``); every write goes through
-:func:`.atomic.atomic_write`.
+`atomic.atomic_write`.
 """
 
 import contextlib
@@ -39,8 +39,8 @@ MESH_FORMATS = (".ply", ".obj", ".off", ".stl", ".wrl", ".dae", ".ctm", ".3ds", 
 
 
 def check_mesh_output(path, overwrite=False):
-    """:func:`.atomic.check_output_path` for a mesh file, before any work: also refuses an
-    extension not in :data:`MESH_FORMATS`. Returns ``path`` as a str; raises MeshFileError
+    """`atomic.check_output_path` for a mesh file, before any work: also refuses an
+    extension not in `MESH_FORMATS`. Returns ``path`` as a str; raises MeshFileError
     (FileExistsError for an existing file without ``overwrite``)."""
     try:
         path = os.fsdecode(check_output_path(path, overwrite))
@@ -73,7 +73,7 @@ def read_mesh(path, *, fields=False):
         Triangles; polygons are fanned from their first corner (a polygon of corners
         a, b, c, d gives (a, b, c), (a, c, d)), whatever the format.
     fields : dict of str to array
-        With ``fields=True``: (n,) arrays, and (n, 3) for points (see :mod:`curvdetail.io.ply`).
+        With ``fields=True``: (n,) arrays, and (n, 3) for points (see `curvdetail.io.ply`).
 
     Raises
     ------
@@ -110,14 +110,14 @@ def read_mesh(path, *, fields=False):
 
 def load_new_mesh(ms, path):
     """Load a mesh file into the ``pymeshlab.MeshSet`` ``ms`` as its new current layer, checked
-    as :func:`read_mesh` checks it; return the layer's ``(V, F)``.
+    as `read_mesh` checks it; return the layer's ``(V, F)``.
 
-    pymeshlab's loader reads the file (PLY too: read those with :func:`read_mesh` to keep their
+    pymeshlab's loader reads the file (PLY too: read those with `read_mesh` to keep their
     doubles and custom properties). An OFF file's polygons are fanned from their first corner
-    here, as pymeshlab fans an OBJ file's and :func:`read_mesh` a PLY file's (its OFF loader
+    here, as pymeshlab fans an OBJ file's and `read_mesh` a PLY file's (its OFF loader
     cuts a quad along the other diagonal, a larger polygon into triangles of the wrong
     vertices); such a layer is built from the arrays (its normals recomputed). Raises as
-    :func:`read_mesh`.
+    `read_mesh`.
     """
     import pymeshlab
 
@@ -336,9 +336,9 @@ def write_mesh(path, V, F, *, quality=None, overwrite=False):
 def write_mesh_fields(path, V, F, fields=None, *, overwrite=False):
     """Write ``V``, ``F`` and per-vertex ``fields`` as they are (no checks), atomically.
 
-    PLY keeps every field (:func:`curvdetail.io.ply.write_ply`); other formats as
-    :func:`write_mesh` writes them, with the field ``quality`` alone. For callers whose arrays
-    come from a mesh already held (a MeshSet layer). Raises as :func:`write_mesh`.
+    PLY keeps every field (`curvdetail.io.ply.write_ply`); other formats as
+    `write_mesh` writes them, with the field ``quality`` alone. For callers whose arrays
+    come from a mesh already held (a MeshSet layer). Raises as `write_mesh`.
     """
     extension = _extension(path)
     fields = fields or {}
@@ -353,7 +353,7 @@ def write_mesh_fields(path, V, F, fields=None, *, overwrite=False):
 
 @contextlib.contextmanager
 def _writing(path, overwrite):
-    """:func:`.atomic.atomic_write`, a failure of the writer raised as MeshFileError naming ``path``."""
+    """`atomic.atomic_write`, a failure of the writer raised as MeshFileError naming ``path``."""
     with atomic_write(path, overwrite=overwrite) as tmp:
         try:
             yield tmp

@@ -3,7 +3,7 @@
 A per-vertex property is a field: a scalar property is an (n,) array; a point (three values per
 vertex) is written as the three properties ``<name>_x``, ``<name>_y``, ``<name>_z`` and read back
 as one (n, 3) array, as is a list property of three values per vertex (MeshLab's ``__ca_vp__``
-export). :func:`curvdetail.io.read_mesh` and :func:`curvdetail.io.write_mesh` use these; the
+export). `curvdetail.io.read_mesh` and `curvdetail.io.write_mesh` use these; the
 arrays read here are not checked yet.
 """
 
@@ -102,7 +102,7 @@ def write_ply(path, V, F, fields=None):
     Parameters
     ----------
     path : str
-        The file (written as it is: callers go through :func:`curvdetail.io.atomic_write`).
+        The file (written as it is: callers go through `curvdetail.io.atomic_write`).
     V : (n, 3) float64 array
     F : (m, 3) int array
     fields : dict of str to array, optional

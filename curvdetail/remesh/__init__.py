@@ -1,7 +1,7 @@
 """The remeshing experiment of the paper's Fig. 3: retriangulate a surface (closed, holes, pieces), carry its
 curvature detail to the new triangulation, rebuild it from that detail, and measure.
 
-Depends on :mod:`curvdetail.curvature` (operators and solvers), pymeshlab (isotropic remeshing,
+Depends on `curvdetail.curvature` (operators and solvers), pymeshlab (isotropic remeshing,
 Hausdorff distance), libigl (closest points) and fast-simplification (decimation).
 """
 

@@ -1,6 +1,6 @@
 """Surface checks (any topology, and disks) and projection onto boundary polylines.
 
-Used across :mod:`curvdetail.remesh`, which exports ``check_surface``, ``check_disk``,
+Used across `curvdetail.remesh`, which exports ``check_surface``, ``check_disk``,
 ``NotADiskError`` and ``RemeshError`` from here. A *surface* is an edge- and vertex-manifold,
 consistently oriented triangle mesh: closed or with any number of boundary loops, pieces and
 handles. A *disk* is one connected piece with exactly one boundary loop and Euler
@@ -37,7 +37,7 @@ def check_disk(V, F, what="the source"):
     Parameters
     ----------
     V : (n, 3) float array
-        Vertex positions (checked as in :func:`check_mesh`)
+        Vertex positions (checked as in `check_mesh`)
     F : (m, 3) int array
         Triangles, consistently oriented; every vertex used
     what : str
@@ -114,7 +114,7 @@ def check_disk(V, F, what="the source"):
 
 
 def _checked(V, F, what, error=MeshError):
-    """:func:`check_mesh`, with edges shared by more than two triangles named as ``error``
+    """`check_mesh`, with edges shared by more than two triangles named as ``error``
     (``count``, ``first`` set) with the repair to make."""
     try:
         return check_mesh(V, F)
@@ -142,7 +142,7 @@ def check_surface(V, F, what="the source"):
     Parameters
     ----------
     V : (n, 3) float array
-        Vertex positions (checked as in :func:`check_mesh`)
+        Vertex positions (checked as in `check_mesh`)
     F : (m, 3) int array
         Triangles, consistently oriented; every vertex used
     what : str
@@ -174,7 +174,7 @@ def check_surface(V, F, what="the source"):
 
 
 def boundary_loops(F, n, what="the mesh"):
-    """The boundary loops of the manifold ``F`` (n vertices), as in :func:`check_surface`."""
+    """The boundary loops of the manifold ``F`` (n vertices), as in `check_surface`."""
     B = boundary_edges(F)
     if B.shape[0] == 0:
         return []
@@ -223,7 +223,7 @@ def _refuse(problem, advice, **fields):
     return exc
 
 
-#: Most point-segment pairs :meth:`Polyline.project` holds at once where it projects points
+#: Most point-segment pairs `Polyline.project` holds at once where it projects points
 #: onto more segments than their nearest (~200 bytes each while held).
 PROJECT_PAIRS = 500_000
 

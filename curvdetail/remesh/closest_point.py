@@ -45,7 +45,7 @@ def closest_points(P, V, F):
     Raises
     ------
     MeshError
-        Malformed input (see :func:`check_points_and_mesh`).
+        Malformed input (see `check_points_and_mesh`).
 
     Examples
     --------
@@ -62,7 +62,7 @@ def closest_points(P, V, F):
 
 
 def closest_in_frame(P, V, F, bary=True):
-    """:func:`closest_points` on arrays that passed :func:`check_points_and_mesh`, in the frame
+    """`closest_points` on arrays that passed `check_points_and_mesh`, in the frame
     given (no rescaling): ``(sqrD, face, C, bary)``; ``bary=False``: None for the barycentrics."""
     if P.shape[0] == 0:
         return np.empty(0), np.empty(0, dtype=np.int64), np.empty((0, V.shape[1])), np.empty((0, 3))
@@ -84,7 +84,7 @@ def _barycentric(X, T):
 
 def check_points_and_mesh(points, V, F, names=("points", "V", "F")):
     """``(P, V, F)`` as C-contiguous float64 / float64 / int64 arrays, or MeshError: dtypes and
-    shapes as :func:`~curvdetail.curvature.check_mesh` takes them (``V`` and ``points`` both
+    shapes as `check_mesh` takes them (``V`` and ``points`` both
     (k, 2) or both (k, 3)), NaN or infinite coordinates, triangle indices outside ``V``,
     zero-area triangles or a mesh of zero extent, coordinates beyond 1e150 and points further
     than ``MAX_RELATIVE_DISTANCE`` (1e100) bbox diagonals. ``names``: the three arguments as

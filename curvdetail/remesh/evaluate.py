@@ -34,7 +34,7 @@ def hausdorff(Va, Fa, Vb, Fb, *, samples=None, engine="exact", seed=0, a_vertex_
       means of the face samples.
 
     Engines: ``"exact"`` samples from numpy's ``default_rng(seed)``, the same in any process,
-    each measured exactly (libigl's AABB tree, :func:`~.closest_point.closest_points`).
+    each measured exactly (libigl's AABB tree, `closest_points`).
     ``"meshlab"``: pymeshlab's ``get_hausdorff_distance`` (Monte Carlo samples, closest points
     in single precision), for figures comparable with MeshLab's; its random state carries over
     within a process, so repeated calls give other samples. Meshes more than ``FAR_APART``
@@ -66,7 +66,7 @@ def hausdorff(Va, Fa, Vb, Fb, *, samples=None, engine="exact", seed=0, a_vertex_
     Raises
     ------
     MeshError
-        Malformed meshes (see :func:`~.closest_point.check_points_and_mesh`).
+        Malformed meshes (see `check_points_and_mesh`).
     ValueError
         Unknown ``engine``; ``samples`` not a whole number from 1 to 10,000,000; ``seed`` not a
         whole number >= 0; ``a_vertex_distance`` not (n_a,) finite distances >= 0.
@@ -108,7 +108,7 @@ def hausdorff(Va, Fa, Vb, Fb, *, samples=None, engine="exact", seed=0, a_vertex_
 
 
 def _check_vertex_distance(d, n):
-    """``a_vertex_distance`` of :func:`hausdorff` as a (n,) float64 array (None stays None), or
+    """``a_vertex_distance`` of `hausdorff` as a (n,) float64 array (None stays None), or
     CurvdetailError (a ValueError) with ``parameter="a_vertex_distance"``."""
     if d is None:
         return None
@@ -131,7 +131,7 @@ def _check_vertex_distance(d, n):
 
 
 def _check_samples(samples):
-    """``samples`` of :func:`hausdorff` as an int from 1 to ``MAX_SAMPLE_COUNT`` (None stays None)."""
+    """``samples`` of `hausdorff` as an int from 1 to ``MAX_SAMPLE_COUNT`` (None stays None)."""
     if samples is None:
         return None
     try:
@@ -191,7 +191,7 @@ def vertex_distance(V, Vs, Fs):
     """Exact distance from each point of ``V`` to the surface ``(Vs, Fs)`` (e.g. the per-vertex
     error of a rebuilt mesh against its source).
 
-    Measured in :func:`hausdorff`'s frame (the points and the surface together of unit size), so
+    Measured in `hausdorff`'s frame (the points and the surface together of unit size), so
     ``vertex_distance(Va, Vb, Fb)`` is bit for bit what ``hausdorff(Va, Fa, Vb, Fb)`` measures
     for a's vertices and can be passed to it as ``a_vertex_distance``.
 
@@ -212,8 +212,8 @@ def vertex_distance(V, Vs, Fs):
     Raises
     ------
     MeshError
-        Malformed points or surface, as :func:`~.locate.locate` refuses them (naming ``V``,
-        ``Vs`` and ``Fs``); vertices of ``Vs`` used by no triangle, as :func:`hausdorff` refuses them.
+        Malformed points or surface, as `locate` refuses them (naming ``V``,
+        ``Vs`` and ``Fs``); vertices of ``Vs`` used by no triangle, as `hausdorff` refuses them.
 
     Examples
     --------

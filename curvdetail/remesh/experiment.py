@@ -32,12 +32,12 @@ from .units import as_bbox_length, length_figures
 BASELINE_SAMPLES = 20000
 
 #: A rebuilt surface with a vertex further than this (x bbox diagonal) from the source is measured
-#: with the exact engine as well (see :func:`hausdorff`).
+#: with the exact engine as well (see `hausdorff`).
 FAR_SURFACE = 0.02
 
 #: RMS distances (in the report's unit, % of the source's bbox diagonal; the figures below are
 #: fractions of it) below which a figure is rounding, not
-#: a measurement, by the engine that measured it (see :func:`hausdorff`): pymeshlab's works in
+#: a measurement, by the engine that measured it (see `hausdorff`): pymeshlab's works in
 #: single precision (a flat square against its retriangulation: RMS 3e-11 to 1.6e-10, max up
 #: to 5e-8, where the distances are 0), the exact engine in double (1e-17 to 1e-16). On a
 #: flat patch the rebuilt, zero-detail and retriangulated surfaces all lie on the source, and a
@@ -54,7 +54,7 @@ RMS, MAX = "hausdorff_rms_percent_of_diagonal", "hausdorff_max_percent_of_diagon
 EVALUATION_STEPS = 5
 
 #: The source's Laplacian (its detail D = L V): "auto" uses "cotan" unless the plain checks
-#: refuse the source's zero-area triangles, then "robust" (:func:`_source`).
+#: refuse the source's zero-area triangles, then "robust" (`_source`).
 LAPLACIANS = ("auto", "cotan", "robust")
 
 STAGES = ("retriangulate", "parameterize", "transfer", "reconstruct", "evaluate")
@@ -65,12 +65,12 @@ DEFAULTS = {"method": "isotropic", "target_edge": "1%", "transfer": "conservativ
 
 
 class WorseThanZeroDetailWarning(UserWarning):
-    """Said by :func:`remesh_experiment` (and so by the ``generate_curvature_remeshing`` filter;
+    """Said by `remesh_experiment` (and so by the ``generate_curvature_remeshing`` filter;
     ``curvdetail remesh`` says it as a note) when the rebuilt surface is farther from the source
     than the zero-detail surface (two-sided Hausdorff RMS): the transferred detail made the
     rebuild worse than no detail at all, so the configuration failed on this patch (the paper's
     pointwise transfer does on camelhead, 36 % RMS against 21 %). The message says what to try
-    (:func:`worse_than_zero_detail`); the figures are in the report. Turn it into an error with
+    (`worse_than_zero_detail`); the figures are in the report. Turn it into an error with
     ``warnings.simplefilter("error", WorseThanZeroDetailWarning)``."""
 
 
@@ -80,8 +80,8 @@ def _option(name, value, cli):
 
 
 def worse_than_zero_detail(report, cli=False):
-    """The message of a :class:`WorseThanZeroDetailWarning` for an evaluated ``report`` of
-    :func:`remesh_experiment`, or None where the rebuild is no farther from the source than the
+    """The message of a `WorseThanZeroDetailWarning` for an evaluated ``report`` of
+    `remesh_experiment`, or None where the rebuild is no farther from the source than the
     zero-detail surface (RMS), lies on the source to rounding (RMS below its engine's
     ``ROUNDING_RMS``) or was not measured. ``cli``: naming the options of ``curvdetail remesh``
     instead of the function's parameters."""
@@ -117,14 +117,14 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="c
                       laplacian="auto"):
     """Retriangulate a surface, carry its curvature detail over, rebuild it, and measure.
 
-    Stages (timed): retriangulate (:func:`retriangulate`), parameterize (only for
-    ``location="uv"``: :func:`parameterize`), transfer (:func:`transfer_curvature`, location
+    Stages (timed): retriangulate (`retriangulate`), parameterize (only for
+    ``location="uv"``: `parameterize`), transfer (`transfer_curvature`, location
     included), reconstruct (target positions from the transferred detail with the target's
     boundary loops fixed and ``anchors`` vertices on each closed piece, see
-    :func:`~curvdetail.anchor_vertices`: one :class:`~curvdetail.Reconstructor` factorization,
+    `anchor_vertices`: one `Reconstructor` factorization,
     solved for the detail
     and for the zero-detail baseline, the harmonic surface ``(L Z)_free = 0``: with
-    ``rows="all"`` a second, free-row factorization gives it), evaluate (:func:`hausdorff` for
+    ``rows="all"`` a second, free-row factorization gives it), evaluate (`hausdorff` for
     the rebuilt mesh, the zero-detail baseline and the retriangulated surface itself, the
     floor).
 
@@ -137,7 +137,7 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="c
         Retriangulation
     target_edge : float or str
         Target edge length: model units, or a percentage of the bbox diagonal ("1%",
-        PercentageValue(1); see :func:`~.units.as_length`)
+        PercentageValue(1); see `as_length`)
     transfer : {"conservative", "pointwise"}
         How detail is carried over (conservative: measured better)
     rows : {"free", "all"}
@@ -151,7 +151,7 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="c
         Sparse solver backend
     evaluate : bool
         Measure distances (the costly part on big meshes). The error and the floor are measured with
-        pymeshlab's engine (see :func:`hausdorff`): a fresh process repeats their figures exactly, a
+        pymeshlab's engine (see `hausdorff`): a fresh process repeats their figures exactly, a
         second call in the same process draws other face samples (the bundled example's RMS: up to
         1.1e-6 of the diagonal, 0.8 %, apart over three calls; the maxima, at vertices, stay the
         same)
@@ -169,7 +169,7 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="c
         ``seconds.retriangulate`` is 0
     surface_check : bool
         Isotropic retriangulation: check the distance an edge collapse or flip moves the surface
-        (pymeshlab's ``checksurfdist``; see :func:`retriangulate`). ``False`` is faster on large
+        (pymeshlab's ``checksurfdist``; see `retriangulate`). ``False`` is faster on large
         patches (terrainA_100k at 100k targets 26.1 s -> 19.9 s) and may change the retriangulation;
         recorded in ``options.surface_check`` (None for a given ``target`` or ``"decimate"``)
     anchors : int
@@ -178,9 +178,9 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="c
     laplacian : {"auto", "cotan", "robust"}
         The source's detail ``D = L V``: "cotan" the plain cotangent Laplacian (refuses zero-area
         triangles); "robust" the mollified one
-        (:func:`~curvdetail.curvature.robust_laplacian.robust_laplacian`), and the geometric stages
+        (`robust_laplacian`), and the geometric stages
         see the source with its zero-area caps flipped away
-        (:func:`~curvdetail.curvature.robust_laplacian.flip_caps`: the same surface); "auto" "cotan"
+        (`flip_caps`: the same surface); "auto" "cotan"
         unless the plain checks refuse the source's zero-area triangles. The rebuild on the target
         uses the plain one always
 
@@ -256,7 +256,7 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="c
 
 def _check_planar_map(UV, F, which, parameterization):
     """RemeshError where the planar map ``UV`` of the ``which`` mesh collapses triangles of ``F``
-    (:func:`~.transfer.squashed_in_plane`), named as the parameterization's doing with the
+    (`squashed_in_plane`), named as the parameterization's doing with the
     experiment's options (pymeshlab's float32 LSCM of camelhead decimated at 5 % collapsed one
     whose 3D area is ordinary; the transfer called it a zero-area triangle of the mesh)."""
     other = ('parameterization "harmonic" (the default for location "uv") or '
@@ -310,7 +310,7 @@ def _check_choice(name, value, choices):
 def _source(V, F, laplacian):
     """The checked source ``(V, F, loops)`` for the geometric stages, its detail (None: the plain
     cotan one, which the transfer computes itself) and the report's ``laplacian`` and
-    ``laplacian_reason``. "auto" falls back to "robust" only where :func:`check_surface` refuses
+    ``laplacian_reason``. "auto" falls back to "robust" only where `check_surface` refuses
     zero-area triangles; the robust path flips the zero-area caps away (a needle, two vertices at
     one point, is still refused, by the same checks, naming it)."""
     if laplacian != "robust":
@@ -339,7 +339,7 @@ def run_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="cons
                    location="closest", parameterization=None, backend="auto", evaluate=True,
                    source_path=None, progress=None, target=None, surface_check=True, anchors=1,
                    laplacian="auto"):
-    """:func:`remesh_experiment` returning everything as a dict: ``X``, ``Ft``, ``Vt`` (the
+    """`remesh_experiment` returning everything as a dict: ``X``, ``Ft``, ``Vt`` (the
     retriangulated surface), ``Z`` (zero-detail baseline; None where the target has a closed
     piece), ``Dt``, ``distance`` and
     ``zero_distance`` (the exact distance of each vertex of ``X``, of ``Z``, to the source: the

@@ -21,7 +21,7 @@ def locate(points, V, F):
     In the plane (a parameter domain, ``V`` of shape (n, 2)) a point inside a triangle gets
     that triangle at distance 0, one outside the domain the closest point of its boundary; in
     space ((n, 3)) the closest point of the surface. Exact to rounding, at any distance
-    (:func:`~.closest_point.closest_points`, libigl's AABB tree); of several triangles at the
+    (`closest_points`, libigl's AABB tree); of several triangles at the
     same distance (a point on an edge), any one.
 
     Parameters
@@ -45,7 +45,7 @@ def locate(points, V, F):
     Raises
     ------
     MeshError
-        Malformed input (see :func:`~.closest_point.check_points_and_mesh`): mismatched
+        Malformed input (see `check_points_and_mesh`): mismatched
         dimensions, dtypes that are not real numbers / integers, NaN or infinite coordinates,
         triangle indices outside ``V``, zero-area triangles, a mesh of zero extent, coordinates
         beyond 1e150 or points more than 1e100 bbox diagonals away.
@@ -61,7 +61,7 @@ def locate(points, V, F):
 
 
 def _locate(P, V, F):
-    """:func:`locate` on arrays that passed :func:`~.closest_point.check_points_and_mesh`, in
+    """`locate` on arrays that passed `check_points_and_mesh`, in
     the frame where the mesh has unit size."""
     P, V, scale = unit_frame(P, V)
     sqrD, face, _, bary = closest_in_frame(P, V, F)
@@ -134,7 +134,7 @@ def interpolate(values, F, face, bary):
     F : (m, 3) int array
         Triangles.
     face : (k,) int array
-        Triangle of each point, as :func:`locate` returns it.
+        Triangle of each point, as `locate` returns it.
     bary : (k, 3) float array
         Barycentric coordinates in that triangle (rows in [0, 1] summing to 1, within
         ``BARY_TOLERANCE``).
@@ -170,7 +170,7 @@ def interpolate(values, F, face, bary):
 
 
 def spread(values, F, face, bary, n):
-    """Adjoint of :func:`interpolate`: each point's value split over the 3 corners of its
+    """Adjoint of `interpolate`: each point's value split over the 3 corners of its
     triangle by its barycentric weights and summed per vertex (the total is kept, to rounding).
 
     Parameters
@@ -178,7 +178,7 @@ def spread(values, F, face, bary, n):
     values : (k,) or (k, c) float array
         Finite, one value (or row) per located point.
     F, face, bary
-        As for :func:`interpolate`.
+        As for `interpolate`.
     n : int
         Vertex count of the result: at least ``F.max() + 1``, at most ``MAX_SPREAD_VERTICES``.
 

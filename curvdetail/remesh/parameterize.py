@@ -84,7 +84,7 @@ def harmonic_map(V, F, boundary, boundary_uv, *, backend="auto"):
     Raises
     ------
     MeshError
-        Malformed mesh (as :func:`check_mesh` names it)
+        Malformed mesh (as `check_mesh` names it)
     ConstraintError
         ``boundary`` empty, out of range or repeated, a piece of the mesh without a pinned vertex
         (the map is undetermined there), or ``boundary_uv`` not a finite (k, 2) array
@@ -113,7 +113,7 @@ def harmonic_map(V, F, boundary, boundary_uv, *, backend="auto"):
 
 
 def _harmonic_map(V, F, boundary, boundary_uv, backend="auto"):
-    """:func:`harmonic_map` on checked input."""
+    """`harmonic_map` on checked input."""
     n = V.shape[0]
     L = cotan_laplacian(V, F).tocsr()
     is_b = np.zeros(n, dtype=bool)

@@ -21,14 +21,14 @@ MAX_ITERATIONS = 1000
 MIN_VERTICES, MAX_VERTICES = 50, 5_000_000
 #: From this many estimated target vertices the experiment takes minutes and says so beforehand
 #: (measured: 199k-263k target vertices 61-104 s, about half of it or more the isotropic
-#: remeshing; 2.25M vertices: the remeshing alone 554 s; see :func:`long_run_reason`).
+#: remeshing; 2.25M vertices: the remeshing alone 554 s; see `long_run_reason`).
 BIG_TARGET = 200_000
 
 
 class LongRunWarning(UserWarning):
     """Said by the ``generate_curvature_remeshing`` filter before a run that will take minutes
     (a retriangulation of more than ``BIG_TARGET`` estimated vertices, see
-    :func:`long_run_vertices`), with what takes the time; silence it with
+    `long_run_vertices`), with what takes the time; silence it with
     ``warnings.simplefilter("ignore", LongRunWarning)``."""
 
 #: Most triangles meeting at one vertex that the isotropic remeshing is given: pymeshlab's
@@ -56,7 +56,7 @@ def estimated_vertices(V, F, target_edge):
 
 
 def long_run_vertices(V, F, target_edge, method="isotropic", evaluate=True):
-    """The estimated target vertex count (:func:`estimated_vertices`) where a run of the
+    """The estimated target vertex count (`estimated_vertices`) where a run of the
     experiment with target edges ``target_edge`` (absolute) takes minutes; else None.
 
     That is above ``BIG_TARGET``, up to the ``MAX_VERTICES`` the remesher accepts; for
@@ -76,7 +76,7 @@ def long_run_vertices(V, F, target_edge, method="isotropic", evaluate=True):
 
 
 def long_run_reason(method="isotropic", evaluate=True, cli=False):
-    """What takes the time of a run that :func:`long_run_vertices` announces and what shortens
+    """What takes the time of a run that `long_run_vertices` announces and what shortens
     it: a sentence for the note said beforehand (``cli``: naming the command line's options,
     else the filter's parameters). Isotropic remeshing grows faster than the vertex count, the
     measurements about with it; a decimation's time is mostly the measurements."""
@@ -93,7 +93,7 @@ def long_run_reason(method="isotropic", evaluate=True, cli=False):
 
 def edge_for_vertices(V, F, count):
     """The absolute edge length whose equilateral triangulation of the surface has ``count``
-    vertices (the inverse of :func:`estimated_vertices`)."""
+    vertices (the inverse of `estimated_vertices`)."""
     return float(np.sqrt(2.0 * 0.5 * face_double_areas(V, F).sum() / (np.sqrt(3.0) * count)))
 
 
@@ -126,7 +126,7 @@ def _decimation_refines(count, faces):
 def target_edge_range(V, F, method="isotropic"):
     """``(shortest, longest)`` target edge, as fractions of the bbox diagonal (the error
     messages say them in %), that
-    :func:`retriangulate` accepts for the patch ``(V, F)`` with ``method``: from
+    `retriangulate` accepts for the patch ``(V, F)`` with ``method``: from
     ``MAX_VERTICES`` to ``MIN_VERTICES`` estimated vertices; decimation, which only coarsens,
     from about the source's own edge length (fewer triangles than the source has) up. For a
     patch too small to decimate the shortest is longer than the longest. Decimation keeps every
@@ -195,7 +195,7 @@ def retriangulate(V, F, *, method="isotropic", target_edge="1%", iterations=10, 
         equilateral mesh with the target edge length; it can only coarsen.
     target_edge : float, str or pymeshlab.PercentageValue
         target edge length: a number in model units, or a percentage of the source's
-        bounding-box diagonal (``"1%"``, ``PercentageValue(1)``; see :func:`~.units.as_length`).
+        bounding-box diagonal (``"1%"``, ``PercentageValue(1)``; see `as_length`).
     iterations : int
         isotropic remeshing iterations, 1 to ``MAX_ITERATIONS`` (1,000).
     max_surface_distance : float, str, pymeshlab.PercentageValue or None
@@ -213,7 +213,7 @@ def retriangulate(V, F, *, method="isotropic", target_edge="1%", iterations=10, 
     aggressiveness : float
         decimation only: fast-simplification's ``agg``, the exponent of its collapse-threshold
         schedule. The patch is scaled so that the schedule always ends at a third of the bbox
-        diagonal (see :data:`DECIMATION_REACH`): every value reaches the target, and a higher
+        diagonal (see `DECIMATION_REACH`): every value reaches the target, and a higher
         one starts lower and so collapses in a more nearly greedy order (on the public patches
         5-7 keep the shape best; 1 gives 2-9x their distance to the source). If the result is
         not a disk it is retried at 3 and 1.
@@ -427,7 +427,7 @@ DECIMATION_SHORTFALL = 1.25
 def _decimate(V, F, h, agg, boundary, topology):
     """Decimate the unit-frame surface ``V`` to an equilateral target edge ``h`` (``boundary``: the
     number of its boundary vertices, which the decimation keeps; ``topology``: what the result
-    must keep, see :func:`_topology`)."""
+    must keep, see `_topology`)."""
     import fast_simplification
 
     area = 0.5 * face_double_areas(V, F).sum()

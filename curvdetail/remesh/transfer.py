@@ -47,7 +47,7 @@ def edge_curvature_measure(V, F):
     Raises
     ------
     MeshError
-        Malformed ``V`` or ``F`` or a zero-area triangle (as :func:`check_mesh` names them)
+        Malformed ``V`` or ``F`` or a zero-area triangle (as `check_mesh` names them)
 
     Examples
     --------
@@ -97,7 +97,7 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     mixed Voronoi area: ``D_t = K(x_t) A_t``.
 
     ``method="conservative"``: the extensive detail is moved as a measure. The source's detail
-    lives on its edges (:func:`edge_curvature_measure`, with ``D_i = 1/2 sum c_e`` exactly); each
+    lives on its edges (`edge_curvature_measure`, with ``D_i = 1/2 sum c_e`` exactly); each
     edge's measure is split evenly over sample points along the edge, every sample is located in
     a target triangle and split over its three corners by barycentric weights. Totals are kept
     exactly over any union of target stars, in particular ``sum_t D_t = sum_s D_s`` (to rounding),
@@ -111,7 +111,7 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     two triangulations of one surface; a conservative sample whose closest target triangle
     faces away from its source edge, the other sheet where two lie close, is put on the nearest
     one that faces its way); ``"uv"`` = point location in a shared planar domain
-    given as ``uv=(UVs, UVt)`` (see :func:`parameterize`).
+    given as ``uv=(UVs, UVt)`` (see `parameterize`).
 
     Parameters
     ----------
@@ -207,7 +207,7 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     return spread(c[edge] / q[edge, None], Ft, face, bary, Vt.shape[0])
 
 
-#: Most samples :func:`_facing_side` relocates one by one; more (a target wound against the
+#: Most samples `_facing_side` relocates one by one; more (a target wound against the
 #: source) are left where they are.
 MAX_RELOCATED = 10_000
 
@@ -277,7 +277,7 @@ def _check_same_surface(dist, Vs, location):
 
 def squashed_in_plane(UV, F, what, advice, error):
     """``error`` where the planar map ``UV`` (n, 2) collapses triangles of ``F`` to zero area (as
-    :func:`~.locate.locate` counts it: below ``ZERO_AREA_RELATIVE`` of the map's bbox diagonal
+    `locate` counts it: below ``ZERO_AREA_RELATIVE`` of the map's bbox diagonal
     squared), where no point can be located; ``what`` names the map, ``advice`` ends the message.
     Said as the map's doing: the mesh may be fine there, and locate's own refusal names the
     mesh's triangles with advice to repair it."""

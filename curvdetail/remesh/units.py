@@ -2,7 +2,7 @@
 the bounding-box diagonal (``"1%"``, ``"0.5 %"``, ``pymeshlab.PercentageValue(1)``).
 
 The remeshing functions, the filters' length parameters, the command line's ``--target-edge``
-and the ``.mlx`` scripts all read lengths through :func:`as_bbox_length`; reports store both
+and the ``.mlx`` scripts all read lengths through `as_bbox_length`; reports store both
 forms with the unit in the key (``target_edge_model_units``, ``target_edge_percent_of_diagonal``).
 """
 
@@ -43,7 +43,7 @@ class BBoxLength:
 
 
 def as_bbox_length(value, name="length"):
-    """``value`` as a :class:`BBoxLength`: a real number is model units; ``"1%"``, ``"0.5 %"``,
+    """``value`` as a `BBoxLength`: a real number is model units; ``"1%"``, ``"0.5 %"``,
     ``pymeshlab.PercentageValue(1)`` a percentage of the bbox diagonal; ``pymeshlab.PureValue``
     model units. Refuses anything else, and a length that is not positive and finite, with a
     CurvdetailError whose ``parameter`` is ``name``."""
@@ -99,7 +99,7 @@ def as_length(value, diagonal, name="length"):
 
 
 def length_figures(length, diagonal, name):
-    """``{name_model_units, name_percent_of_diagonal}`` of a :class:`BBoxLength`, for a report."""
+    """``{name_model_units, name_percent_of_diagonal}`` of a `BBoxLength`, for a report."""
     return {f"{name}_model_units": float(length.resolve(diagonal)),
             f"{name}_percent_of_diagonal": float(100.0 * length.fraction(diagonal))}
 
