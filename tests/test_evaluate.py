@@ -151,15 +151,58 @@ def test_a_study_writes_a_row_per_cell_with_units_and_resumes(tmp_path, meshes, 
         bad = rows["bad.obj", size]
         assert (bad["status"], bad["error_class"], bad["mesh_vertices"]) == ("failed", "MeshFileError", None)
 
-    parts = {p: p.stat().st_mtime_ns for p in (results / "parts").iterdir()}
+    # the parts are folded into results.parquet: a rerun skips its cells and writes nothing
+    assert list((results / "parts").iterdir()) == [] and {r["mesh_shipped"] for r in rows.values()} == {False}
+    written = (results / "results.parquet").stat().st_mtime_ns
     again = run_study(study, meshes, results, scheduler=client, progress=None)
-    assert (again["skipped"], again["ran"]) == (6, 0)
-    assert {p: p.stat().st_mtime_ns for p in (results / "parts").iterdir()} == parts
+    assert (again["skipped"], again["ran"]) == (6, 0) and again["table"].num_rows == 6
+    assert (results / "results.parquet").stat().st_mtime_ns == written
 
     more = run_study(Study([{"target_edge": ["5%", "8%", "9%"]}]), meshes, results, scheduler=client, progress=None)
     assert (more["skipped"], more["ran"]) == (6, 3) and read_results(results).num_rows == 9
     retry = run_study(study, meshes, results, scheduler=client, retry_failed=True, progress=None)
     assert (retry["ran"], retry["failed"]) == (2, 2) and read_results(results).num_rows == 9    # bad.obj again
+
+
+@pytest.mark.slow
+def test_shipped_meshes_run_where_the_workers_cannot_read_the_path(tmp_path, meshes, client, monkeypatch):
+    import curvdetail.evaluate.run as run
+
+    source = tmp_path / "in" / "bump4.obj"
+    source.parent.mkdir()
+    source.write_bytes((meshes / "bump4.obj").read_bytes())
+    read = run._mesh_bytes
+
+    def read_then_hide(cells):          # the file is gone once read: no worker can open its path
+        data = read(cells)
+        source.rename(tmp_path / "hidden.obj")
+        return data
+
+    monkeypatch.setattr(run, "_mesh_bytes", read_then_hide)
+    out = run_study(Study([{"target_edge": "8%"}]), source, tmp_path / "r", scheduler=client, ship_meshes=True,
+                    progress=None)
+    (row,) = out["table"].to_pylist()
+    assert (row["status"], row["mesh_shipped"], row["mesh_vertices"], row["mesh_path"]) == ("ok", True, 61,
+                                                                                            str(source))
+    assert not source.exists()
+
+
+@pytest.mark.slow
+def test_auto_ships_only_where_a_worker_does_not_see_the_path(tmp_path, meshes, client, monkeypatch):
+    import curvdetail.evaluate.run as run
+
+    study = Study([{"target_edge": "8%"}])
+    out = run_study(study, meshes / "bump4.obj", tmp_path / "a", scheduler=client, progress=None)
+    assert out["table"].column("mesh_shipped").to_pylist() == [False]      # a local cluster sees the file
+    monkeypatch.setattr(run, "_workers_see", lambda client, path: False)
+    out = run_study(study, meshes / "bump4.obj", tmp_path / "b", scheduler=client, progress=None)
+    assert out["table"].column("mesh_shipped").to_pylist() == [True]
+
+
+def test_a_bad_ship_meshes_is_refused(tmp_path, meshes):
+    with pytest.raises(StudyError) as e:
+        run_study(Study([{}]), meshes, tmp_path / "r", ship_meshes="always")
+    assert e.value.parameter == "ship_meshes"
 
 
 @pytest.mark.slow
@@ -200,6 +243,7 @@ def test_the_command_runs_a_study_on_a_local_cluster_and_writes_a_summary(tmp_pa
     assert main(args) == 0         # failed cells included (decimation cannot refine bump4; bad.obj)
     table = read_results(tmp_path / "r")
     assert sorted(table.column("status").to_pylist()) == ["failed", "failed", "failed", "ok"]
+    assert table.column("mesh_shipped").to_pylist() == [False] * 4     # auto: a local cluster reads the paths
     text = (tmp_path / "s" / "summary.md").read_text()
     assert "| isotropic conservative free closest 8% | 1 / 2 |" in text
     for name in ("rms_against_target.png", "ratio_to_floor.png", "time_against_vertices.png"):

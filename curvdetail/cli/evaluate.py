@@ -29,6 +29,9 @@ def add_arguments(parser):
     where.add_argument("--workers", type=whole_number_from_one, metavar="N",
                        help="worker processes of a local Dask cluster (default: one per core)")
     where.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask cluster, e.g. tcp://HOST:8786")
+    parser.add_argument("--ship-meshes", choices=("auto", "yes", "no"), default="auto",
+                        help="send the mesh files' bytes to the workers (yes), let them read the paths (no), or "
+                             "send them where a --scheduler's worker does not see the paths (auto, the default)")
     parser.add_argument("--cell-timeout", type=positive_number, metavar="S",
                         help="stop a cell after S seconds and record it as timed out")
     parser.add_argument("--cell-memory", type=positive_number, metavar="MIB",
@@ -58,7 +61,8 @@ def run(args):
         for name in FILES:
             check_output_path(os.path.join(args.summary, name), args.overwrite)
     out = run_study(study, args.inputs, args.results, workers=args.workers, scheduler=args.scheduler,
-                    cell_timeout=args.cell_timeout, cell_memory=args.cell_memory, retry_failed=args.retry_failed)
+                    cell_timeout=args.cell_timeout, cell_memory=args.cell_memory, retry_failed=args.retry_failed,
+                    ship_meshes={"auto": "auto", "yes": True, "no": False}[args.ship_meshes])
     table = out["table"]
     status = table.column("status").to_pylist()
     say(f"curvdetail evaluate: {out['ran']} cells run, {out['skipped']} already in {args.results}; the table holds "

@@ -20,7 +20,7 @@ _STAGES = ("retriangulate", "parameterize", "transfer", "reconstruct", "evaluate
 def base_row(task):
     """The row's mesh identity and configuration, from a cell's task dict (`Cell.task`)."""
     return {"cell_key": task["key"], "mesh_name": task["name"], "mesh_path": task["path"],
-            "mesh_blake2b": task["blake2b"], **{k: task[k] for k in CONFIG_KEYS}}
+            "mesh_blake2b": task["blake2b"], "mesh_shipped": task.get("shipped", False), **{k: task[k] for k in CONFIG_KEYS}}
 
 
 def failed_row(task, exc=None, *, status="failed", error_class=None, message=None):
@@ -86,14 +86,14 @@ def run_cell(task):
     Parameters
     ----------
     task : dict
-        `task`: ``path``, ``name``, ``blake2b``, ``key``
-        and the configuration (``method``, ``target_edge`` as ``"1%"``, ...).
+        `task`: ``path``, ``name``, ``blake2b``, ``key``, ``shipped``, optional ``read_path`` (the
+        file to read where not ``path``) and the configuration (``method``, ``target_edge`` as ``"1%"``, ...).
     """
     t0 = time.perf_counter()
     _reset_peak_memory()
     row = base_row(task)
     try:
-        V, F = read_mesh(task["path"])
+        V, F = read_mesh(task.get("read_path", task["path"]))     # a shipped file's copy on this worker
         row.update(mesh_vertices=int(V.shape[0]), mesh_faces=int(F.shape[0]),
                    mesh_closed=bool(boundary_edges(F).shape[0] == 0),
                    mesh_bbox_diagonal_model_units=float(bbox_diagonal(V)), read_s=time.perf_counter() - t0)

@@ -8,7 +8,7 @@ import time
 
 from .cell import failed_row
 from .study import StudyError
-from .table import read_parts, write_part, write_results
+from .table import compact, read_results, write_part, write_results
 
 #: Seconds between rebuilds of results.parquet / results.csv while a study runs.
 REBUILD_EVERY = 60.0
@@ -51,12 +51,13 @@ def _check_folder(results):
 
 
 def run_study(study, inputs, results, *, workers=None, scheduler=None, cell_timeout=None, cell_memory=None,
-              retry_failed=False, progress=sys.stderr):
+              retry_failed=False, ship_meshes="auto", progress=sys.stderr):
     """Run every cell of ``study`` on the meshes ``inputs`` names that ``results`` does not hold yet.
 
     Each finished cell's row is written at once (``results/parts/<cell key>.parquet``);
-    ``results/results.parquet`` and ``results/results.csv`` are rebuilt from the parts every
-    `REBUILD_EVERY` seconds and at the end (also after Ctrl-C). A failed cell is a row
+    ``results/results.parquet`` and ``results/results.csv`` are rebuilt with the parts every
+    `REBUILD_EVERY` seconds, and at the end (also after Ctrl-C) the parts are folded into them
+    and removed. A failed cell is a row
     with ``status`` "failed" and its error, one stopped at ``cell_timeout`` or ``cell_memory`` a
     row with "timeout" or "memory".
 
@@ -64,8 +65,7 @@ def run_study(study, inputs, results, *, workers=None, scheduler=None, cell_time
     ----------
     study : Study
     inputs : str or list of str
-        Mesh files, folders or glob patterns (`find_meshes`),
-        read by the workers from these paths (a path they share).
+        Mesh files, folders or glob patterns (`find_meshes`).
     results : str
         The results folder (created; a study's folder is continued).
     workers : int or None
@@ -80,6 +80,10 @@ def run_study(study, inputs, results, *, workers=None, scheduler=None, cell_time
         every 0.1 s).
     retry_failed : bool
         Run the table's cells that did not end "ok" again.
+    ship_meshes : "auto", True or False
+        True: read each mesh file here once and send its bytes to the workers (no shared path);
+        False: the workers read the paths; "auto": ship where ``scheduler`` is given and one
+        of its workers does not see the first mesh's path. The ``mesh_shipped`` column says which.
     progress : file or None
         Where progress lines go (cells done / failed / running, rate, time left).
 
@@ -97,13 +101,16 @@ def run_study(study, inputs, results, *, workers=None, scheduler=None, cell_time
     if workers is not None and scheduler is not None:
         raise StudyError("workers and scheduler both given", parameter="workers",
                          hint="the scheduler's cluster has its own workers; give one of them")
+    if ship_meshes not in ("auto", True, False):
+        raise StudyError(f"ship_meshes {ship_meshes!r} is not auto, True or False", parameter="ship_meshes",
+                         value=ship_meshes)
     for name, limit in (("cell_timeout", cell_timeout), ("cell_memory", cell_memory)):
         if limit is not None and not limit > 0:
             raise StudyError(f"{name} {limit!r} is not a positive number", parameter=name, value=limit)
     results = os.fspath(results)
     cells = study.cells(inputs)
     _check_folder(results)
-    table = read_parts(results)
+    table = read_results(results)
     done = {key for key, status in zip(table.column("cell_key").to_pylist(), table.column("status").to_pylist())
             if status == "ok" or not retry_failed}
     todo = [c for c in cells if c.key not in done]
@@ -112,22 +119,48 @@ def run_study(study, inputs, results, *, workers=None, scheduler=None, cell_time
         if todo:
             _say(progress, f"curvdetail evaluate: {len(todo)} of {len(cells)} cells to run"
                            + (f" ({summary['skipped']} already in {results})" if summary["skipped"] else ""))
-            _run(todo, results, workers, scheduler, (cell_timeout, cell_memory), progress, summary)
+            _run(todo, results, workers, scheduler, (cell_timeout, cell_memory), ship_meshes, progress, summary)
     finally:
-        summary["table"] = read_parts(results)
-        write_results(results, summary["table"])
+        summary["table"] = compact(results)
     return summary
 
 
-def _run(cells, results, workers, scheduler, limits, progress, summary):
+def _workers_see(client, path):
+    """Whether a worker of ``client`` sees the file ``path``."""
+    client.wait_for_workers(1)
+    worker = next(iter(client.scheduler_info()["workers"]))
+    return client.run(os.path.exists, path, workers=[worker])[worker]
+
+
+def _mesh_bytes(cells):
+    """The bytes of each readable mesh file of ``cells``, read once: {path: bytes}."""
+    data = {}
+    for path in dict.fromkeys(cell.path for cell in cells):
+        try:
+            with open(path, "rb") as fh:
+                data[path] = fh.read()
+        except OSError:         # the worker then fails to read it too, and its row says why
+            pass
+    return data
+
+
+def _run(cells, results, workers, scheduler, limits, ship, progress, summary):
     from distributed import as_completed
 
     from .runner import evaluate_cell
 
     with _client(workers, scheduler) as client:
+        if ship == "auto":
+            ship = scheduler is not None and not _workers_see(client, cells[0].path)
+        shipped = {}
+        if ship:
+            data = _mesh_bytes(cells)
+            _say(progress, f"curvdetail evaluate: sending {len(data)} mesh files to the workers")
+            shipped = dict(zip(data, client.scatter(list(data.values()), broadcast=False)))
         t0 = last_said = last_rebuild = time.monotonic()        # the rate from here: not the cluster's start
-        futures = {client.submit(evaluate_cell, cell.task(), *limits, key=f"curvdetail-cell-{cell.key}",
-                                 pure=False): cell for cell in cells}
+        futures = {client.submit(evaluate_cell, dict(cell.task(), shipped=cell.path in shipped), *limits,
+                                 shipped.get(cell.path), key=f"curvdetail-cell-{cell.key}", pure=False): cell
+                   for cell in cells}
         for future in as_completed(futures):
             cell = futures[future]
             try:
@@ -152,5 +185,5 @@ def _run(cells, results, workers, scheduler, limits, progress, summary):
                                f"{running} running; {rate:.2f} cells/s, about {left / rate:.0f} s left")
             if now - last_rebuild >= REBUILD_EVERY:
                 last_rebuild = now
-                write_results(results, read_parts(results))
+                write_results(results, read_results(results))
 

@@ -12,6 +12,7 @@ import signal
 import socket
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 from multiprocessing.connection import Connection
@@ -95,17 +96,27 @@ class Runner:
 _local = threading.local()
 
 
-def evaluate_cell(task, timeout=None, memory=None):
+def evaluate_cell(task, timeout=None, memory=None, data=None):
     """Dask task: the row of one cell, run in this worker thread's `Runner` (started on
     first use, again after a limit or a crash; ``timeout`` seconds, ``memory`` MiB); never
-    raises for the cell's failure."""
+    raises for the cell's failure. ``data``: the mesh file's bytes where they were shipped,
+    read from a temporary copy with the file's extension."""
     runner = getattr(_local, "runner", None)
+    copy = None
     try:
+        if data is not None:
+            fd, copy = tempfile.mkstemp(suffix=os.path.splitext(task["path"])[1], prefix="curvdetail-mesh-")
+            with os.fdopen(fd, "wb") as fh:
+                fh.write(data)
+            task = dict(task, read_path=copy)
         if runner is None or not runner.alive():
             runner = _local.runner = Runner()
         row = runner.run(task, timeout, memory)
     except (RuntimeError, OSError, psutil.Error) as exc:
         row = failed_row(task, exc)
+    finally:
+        if copy is not None:
+            os.remove(copy)
     try:
         from distributed import get_worker
 

@@ -1,8 +1,8 @@
 """The results table of a study: one row per cell, its columns with their units, and its files.
 
-A results folder ``DIR`` holds ``DIR/parts/<cell key>.parquet`` (one file per finished cell,
-written atomically as the cell finishes) and ``DIR/results.parquet`` + ``DIR/results.csv``, the
-table rebuilt from the parts. Units are in the column names: ``_percent_of_diagonal`` a percentage
+A results folder ``DIR`` holds ``DIR/results.parquet`` + ``DIR/results.csv``, the table, and
+while a study runs ``DIR/parts/<cell key>.parquet`` (one file per finished cell, written
+atomically as the cell finishes); `compact` folds the parts into the table at the end of a study. Units are in the column names: ``_percent_of_diagonal`` a percentage
 of the source's bounding-box diagonal, ``_model_units`` the mesh's own length unit, ``_s``
 seconds, ``_mib`` MiB (2^20 bytes).
 """
@@ -11,6 +11,7 @@ import glob
 import os
 
 import pyarrow as pa
+import pyarrow.compute as pc
 import pyarrow.csv as pa_csv
 import pyarrow.dataset as ds
 import pyarrow.parquet as pq
@@ -26,6 +27,7 @@ COLUMNS = [
     ("mesh_name", _S, "file name"),
     ("mesh_path", _S, "absolute path the workers read"),
     ("mesh_blake2b", _S, "blake2b (128 bits, hex) of the file's bytes"),
+    ("mesh_shipped", _B, "the file's bytes were sent to the worker (no shared path), not read there"),
     ("mesh_vertices", _I, "vertices of the source"),
     ("mesh_faces", _I, "triangles of the source"),
     ("mesh_closed", _B, "the source has no boundary edge"),
@@ -87,12 +89,21 @@ def write_part(folder, row):
         pq.write_table(pa.Table.from_pylist([row], schema=SCHEMA), tmp)
 
 
-def read_parts(folder):
-    """The rows of every part in ``folder/parts`` as one table (`SCHEMA`; empty if none)."""
-    files = sorted(glob.glob(os.path.join(folder, "parts", "*.parquet")))    # not the hidden temporary files
-    if not files:
-        return SCHEMA.empty_table()
-    return ds.dataset(files, schema=SCHEMA, format="parquet").to_table()
+def _parts(folder):
+    return sorted(glob.glob(os.path.join(folder, "parts", "*.parquet")))    # not the hidden temporary files
+
+
+def read_results(folder):
+    """A study's table, also of one still running or stopped: ``folder/results.parquet`` with
+    the rows of ``folder/parts`` (a part replaces the row of its cell); `SCHEMA`, empty if neither exists."""
+    files = _parts(folder)
+    table = ds.dataset(files, schema=SCHEMA, format="parquet").to_table() if files else SCHEMA.empty_table()
+    compacted = os.path.join(folder, "results.parquet")
+    if os.path.isfile(compacted):
+        old = ds.dataset(compacted, schema=SCHEMA, format="parquet").to_table()
+        old = old.filter(pc.invert(pc.is_in(old.column("cell_key"), value_set=table.column("cell_key"))))
+        table = pa.concat_tables([old, table])
+    return table
 
 
 def write_results(folder, table):
@@ -104,10 +115,14 @@ def write_results(folder, table):
         pa_csv.write_csv(table, tmp)
 
 
-def read_results(folder):
-    """A study's table: its parts (every finished cell, also of a study still running or
-    stopped), or ``folder/results.parquet`` where the folder has no parts."""
-    table = read_parts(folder)
-    if table.num_rows == 0 and os.path.isfile(os.path.join(folder, "results.parquet")):
-        table = pq.read_table(os.path.join(folder, "results.parquet"), schema=SCHEMA)
+def compact(folder):
+    """Fold the parts into ``folder/results.parquet`` (and .csv) and remove them; the table
+    (`read_results`). Nothing is written where there is no part and the table exists."""
+    files = _parts(folder)
+    table = read_results(folder)
+    if files or not os.path.isfile(os.path.join(folder, "results.parquet")):
+        write_results(folder, table)
+        for path in files:
+            os.remove(path)
     return table
+
