@@ -4,7 +4,7 @@ import numpy as np
 
 from ..curvature.topology import boundary_vertices, check_oriented
 from ..curvature.curvature_detail import curvature_detail
-from ..curvature.mean_curvature_normal import mean_curvature_normal
+from ..curvature.mixed_voronoi_area import mixed_voronoi_area
 from .detail_attributes import AREA, DETAIL, NORMAL, store_detail  # noqa: F401  (names re-exported)
 from .meshset import layer_id, mesh_arrays, set_vertex_quality, vertex_normals
 from .registry import PAPER, filter
@@ -45,7 +45,8 @@ def compute_curvature_detail(ms):
     D = curvature_detail(V, F)
     # H's sign comes from the vertex normals: with reversed triangles it was +-H at random
     check_oriented(F, "the current mesh")
-    K, A = mean_curvature_normal(V, F)
+    A = mixed_voronoi_area(V, F)
+    K = D / A[:, None]                  # = mean_curvature_normal(V, F)[0], bit for bit; L built once
     H = signed_mean_curvature(V, F, K)
     store_detail(ms, mid, F, D, K, A)
     set_vertex_quality(ms, mid, H)
