@@ -1,6 +1,7 @@
-"""The remeshing experiment on the closed public models: RMS and max against the retriangulated floor.
+"""The remeshing experiment on the public models and disk patches: RMS and max against the retriangulated floor.
 
-For each closed model (spot, bunny, cow, mannequin, elephant: those present in the mesh folder)
+For each closed model (spot, bunny, cow, mannequin, elephant) and each disk patch (the Fig. 3
+patches, the terrains and the mannequin opened at the neck), those present in the mesh folder,
 and each target edge (isotropic, 1 % of the bbox diagonal by default), runs
 :func:`curvdetail.remesh.remesh_experiment` with its defaults (conservative transfer, free rows,
 closest-point location, one anchor per closed piece) and records the rebuilt surface's Hausdorff
@@ -8,7 +9,7 @@ RMS and max, the floor's (the retriangulated surface itself), their ratios, the 
 and the seconds. The issue's target: RMS within 1.5x of the floor, max within 1.5x of the floor's max.
 
 Usage: python scripts/reproduce_closed.py [--meshes DIR] [--target-edge 1 [0.5 ...]]
-                                          [--out docs/results] [--force]
+                                          [--models NAME ...] [--out docs/results] [--force]
 (DIR defaults to $CURVDETAIL_MESHES, else ../shared/meshes beside the repository.) Writes
 OUT/closed_models.json (every report) and OUT/closed_models.md (the table); an existing file is
 refused before any work unless --force is given.
@@ -29,6 +30,9 @@ from curvdetail.remesh.experiment import MAX, RMS  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 MODELS = ["spot.obj", "bunny.off", "cow.off", "mannequin.off", "elephant.obj"]
+#: the public disk patches (one boundary loop): Fig. 3's, the terrains, the mannequin open at the neck
+DISKS = ["mannequin_nose.obj", "mannequin_ear.obj", "elephant_trunk.obj", "camelhead.off", "mannequin_disk_1k.obj",
+         "terrainA_1k.obj", "terrainA_10k.obj", "terrainA_100k.ply"]
 #: the issue's target: RMS and max within this factor of the floor's
 TARGET_RATIO = 1.5
 
@@ -73,6 +77,8 @@ def main(argv=None):
     parser.add_argument("--meshes", default=MESHES, help="folder of the public meshes")
     parser.add_argument("--target-edge", type=float, nargs="+", default=[1.0], metavar="PCT",
                         help="target edges in %% of the bbox diagonal (default: 1)")
+    parser.add_argument("--models", nargs="+", default=MODELS + DISKS, metavar="NAME",
+                        help="mesh files to run (default: the closed models and the disk patches)")
     parser.add_argument("--anchors", type=int, default=1, metavar="K", help="anchors per closed piece (default: 1)")
     parser.add_argument("--out", default=os.path.join(ROOT, "docs", "results"), help="output folder")
     parser.add_argument("--force", action="store_true", help="replace existing outputs")
@@ -84,9 +90,9 @@ def main(argv=None):
     json_path = os.path.join(args.out, "closed_models.json")
     md_path = os.path.join(args.out, "closed_models.md")
     _files.check_outputs(parser, [json_path, md_path], args.force)
-    models = [m for m in MODELS if os.path.exists(os.path.join(args.meshes, m))]
+    models = [m for m in args.models if os.path.exists(os.path.join(args.meshes, m))]
     if not models:
-        sys.exit(f"{args.meshes!r} holds none of {', '.join(MODELS)}; pass --meshes or set CURVDETAIL_MESHES.")
+        sys.exit(f"{args.meshes!r} holds none of {', '.join(args.models)}; pass --meshes or set CURVDETAIL_MESHES.")
     rows = []
     for pct in args.target_edge:
         for model in models:
@@ -98,9 +104,10 @@ def main(argv=None):
             print(f"{model} {pct:g} %: RMS {row['rms_percent']:.4f} % (floor {row['floor_rms_percent']:.4f} %, "
                   f"{row['ratio_rms']:.2f}x), max {row['max_percent']:.3f} % ({row['ratio_max']:.2f}x), "
                   f"{row['anchors']} anchor(s), {row['seconds']:.1f} s", file=sys.stderr)
-    heading = ("# The remeshing experiment on closed models\n\nIsotropic retriangulation, conservative transfer, "
-               f"free rows, closest-point location, {args.anchors} anchor(s) per closed piece (farthest-point sampled "
-               "from its flattest vertex). Figures are "
+    heading = ("# The remeshing experiment on closed models and disk patches\n\nIsotropic retriangulation, "
+               "conservative transfer, free rows, closest-point location; a disk patch keeps its boundary loop fixed, "
+               f"a closed model gets {args.anchors} anchor(s) (farthest-point sampled from its flattest vertex). "
+               "Figures are "
                "two-sided Hausdorff distances in % of the bbox diagonal; the floor is the retriangulated surface "
                f"itself. Target: both ratios within {TARGET_RATIO}x. Written by scripts/reproduce_closed.py.\n\n")
     _files.write_json(json_path, {"target_ratio": TARGET_RATIO, "anchors": args.anchors, "runs": rows}, args.force,

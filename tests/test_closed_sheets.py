@@ -1,0 +1,34 @@
+"""Two sheets of a surface closer than the retriangulation's error (cow.off: the tail along its rear):
+the conservative transfer keeps each sheet's detail on its own sheet."""
+
+import numpy as np
+
+from curvdetail.curvature import curvature_detail
+from curvdetail.curvature.testing import grid
+from curvdetail.remesh.transfer import transfer_curvature
+
+GAP = 0.05          # between the two source sheets (the grids are 1 x 1)
+
+
+def facing_sheets(offset_a):
+    """Sheet A (z = offset_a, normal +z) under sheet B (z = GAP, normal -z): they face each other."""
+    V, F = grid(9, 9)
+    A = V.copy()
+    A[:, 2] = offset_a
+    B = V.copy()
+    B[:, 2] = GAP
+    return np.vstack([A, B]), np.vstack([F, F[:, ::-1] + len(V)]), len(V)
+
+
+def test_detail_stays_on_its_own_sheet_when_the_other_is_closer():
+    # target: sheet A moved 1.5 gaps away from B, so every sample of source A is closer to target B
+    # (1 gap) than to target A (1.5 gaps); target B faces the other way and must not take A's detail
+    Vs, Fs, n = facing_sheets(0.0)
+    Vt, Ft, _ = facing_sheets(-1.5 * GAP)
+    Ds = curvature_detail(Vs, Fs)
+    Dt = transfer_curvature(Vs, Fs, Vt, Ft)
+    # each target sheet is its source sheet moved along its normal: the closest point below a flat
+    # sheet is the point straight below, so each sheet gets its own detail back, to rounding
+    assert np.abs(Ds[:n]).max() > 0.1                     # the boundary's in-plane detail: something to carry
+    np.testing.assert_allclose(Dt[:n], Ds[:n], atol=1e-12)
+    np.testing.assert_allclose(Dt[n:], Ds[n:], atol=1e-12)
