@@ -12,7 +12,7 @@ from ..curvature.mixed_voronoi_area import mixed_voronoi_area
 from ..curvature.sparse_solver import factorize
 from .closest_point import as_coordinates, check_points_and_mesh, unit_frame
 from .closest_point import _barycentric
-from .locate import _locate, interpolate, spread
+from .locate import _locate, interpolate, own_side, spread
 
 METHODS = ("conservative", "pointwise")
 LOCATIONS = ("closest", "uv")
@@ -64,7 +64,8 @@ def edge_curvature_measure(V, F):
 
 
 def _edge_curvature_measure(V, F, normals=False):
-    """``(E, c)``, and with ``normals`` also each edge's normal: the sum of its triangles' unit normals."""
+    """``(E, c)``, and with ``normals`` also each edge's normal (the sum of its triangles' unit normals)
+    and a point on the side of its triangles (the mean of the corners they hold opposite it)."""
     a, b, c = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
     n = np.cross(b - a, c - a)
     n /= np.linalg.norm(n, axis=1, keepdims=True)
@@ -80,8 +81,10 @@ def _edge_curvature_measure(V, F, normals=False):
     meas = np.column_stack([np.bincount(inverse, weights=g[:, j], minlength=keys.size) for j in range(3)])
     if not normals:
         return E, meas
-    n3 = np.repeat(n, 3, axis=0)
-    return E, meas, np.column_stack([np.bincount(inverse, weights=n3[:, j], minlength=keys.size) for j in range(3)])
+    n3, opposite = np.repeat(n, 3, axis=0), V[F.ravel()]          # half-edge k of a face faces its corner k
+    count = np.bincount(inverse, minlength=keys.size)[:, None]
+    return E, meas, *(np.column_stack([np.bincount(inverse, weights=X[:, j], minlength=keys.size) for j in range(3)])
+                      for X in (n3, opposite / count[inverse]))
 
 
 def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="closest", uv=None,
@@ -192,7 +195,7 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
         face, bary, dist = _locate(*check_points_and_mesh(tgt_dom, src_dom, Fs, names=(names[1], names[0], "Fs")))
         _check_same_surface(dist, Vs, location)
         return interpolate(K, Fs, face, bary) * mixed_voronoi_area(Vt, Ft)[:, None]
-    E, c, normal = _edge_curvature_measure(Vs, Fs, normals=True)
+    E, c, normal, inner = _edge_curvature_measure(Vs, Fs, normals=True)
     if detail is not None:
         c = _carrying(E, c, detail)
     q = _samples_per_edge(Vs, E, Vt, Ft, samples_per_edge)
@@ -203,6 +206,7 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     face, bary, dist = _locate(*check_points_and_mesh(pts, tgt_dom, Ft, names=("edge samples", names[1], "Ft")))
     _check_same_surface(dist, Vs, location)
     if location == "closest":
+        own_side(pts, inner[edge], Vt, Ft, face, bary, dist)
         _facing_side(pts, normal[edge], Vt, Ft, face, bary, dist)
     return spread(c[edge] / q[edge, None], Ft, face, bary, Vt.shape[0])
 
