@@ -77,9 +77,9 @@ SIDE_STEP = 0.1
 def own_side(P, inner, V, F, face, bary, dist):
     """Keep samples of a source edge on the side its triangles lie on, in place.
 
-    A sample whose closest triangle (``face``) is neither the triangle nor an edge-neighbour of
-    the one closest to the sample stepped toward ``inner`` is located again on those four
-    triangles alone (``face``, ``bary`` and ``dist`` rewritten). Where two sheets of the source touch (cow.off: two
+    A sample whose closest triangle (``face``) shares no vertex with the one closest to the sample
+    stepped toward ``inner`` is located again on the triangles around that one's corners alone
+    (``face``, ``bary`` and ``dist`` rewritten). Where two sheets of the source touch (cow.off: two
     vertices at one point on an unwelded seam) a sample on the touching edge is at distance 0 from
     both sheets, and only the side its triangles lie on tells them apart; elsewhere the two
     locations agree (a target equal to the source: always).
@@ -108,11 +108,13 @@ def own_side(P, inner, V, F, face, bary, dist):
     length = np.linalg.norm(d, axis=1, keepdims=True)
     Q = P + d * np.minimum(step / np.maximum(length, np.finfo(float).tiny), 0.5)
     f_q = _locate(Q, V, F)[0]
-    neighbours, _ = igl.triangle_triangle_adjacency(F)
-    near = np.column_stack([f_q, neighbours[f_q]])              # -1: no neighbour (a boundary edge)
-    off = np.flatnonzero(~(near == face[:, None]).any(axis=1))
+    off = np.flatnonzero(~(F[face][:, :, None] == F[f_q][:, None, :]).any(axis=(1, 2)))
+    if off.size == 0:
+        return 0
+    around = sp.csr_matrix((np.ones(F.size), (F.ravel(), np.repeat(np.arange(F.shape[0]), 3))),
+                           shape=(V.shape[0], F.shape[0]))      # vertex -> its triangles
     for i in off:                                               # few: where two sheets touch
-        candidates = near[i][near[i] >= 0]
+        candidates = np.unique(around[F[f_q[i]]].indices)
         sq, at, C = igl.point_mesh_squared_distance(P[i:i + 1], V, F[candidates])
         face[i] = candidates[at[0]]
         bary[i] = _barycentric(C, V[F[face[i:i + 1]]])[0]
