@@ -44,29 +44,30 @@ The reconstruction is exact given the target's own detail (rebuilt from `L Vt`, 
 elephant_trunk and camelhead return `Vt` to 1e-14 of the diagonal): the error is all in the
 transferred detail.
 
-- **cow.off, 1 %**: the max sits at the tail's tip, and the rebuilt tail is stretched along its axis
-  (the displacement grows linearly from 0 at the root to 0.66 % at the tip, about 2 % strain). The
-  tail is about 2 % of the diagonal across, some six target edges round; the transferred detail's
-  sum over the tail beyond a cut exceeds the target's own by 1-4 %, and a long thin appendage is
-  the softest direction of the rebuild, so the mismatch adds up along it (the tail's detail error
-  alone moves the tip 0.78 %, the rest of the body's 0.03 %).
-- **cow.off, 0.5 %**: the max is at the source's vertices 621 and 2761, two vertices at one point (an
-  unwelded seam vertex where two cone tips touch; the target keeps the pair). Not a location error:
-  relocating every sample near them onto its own side moves none. The conservative transfer spreads
-  each source edge's measure evenly along the edge, so a cone tip's detail, concentrated at one
-  source vertex (z: 0.026), is shared with the target vertices along its edges: the target's tip
-  gets 0.006 where its own is 0.013 (at 1 %: 0.012 against 0.026), and the two tips are rebuilt
-  blunter, each receding 0.7 % from the other.
+- **cow.off** at both edges: the max sits at the tail's tip, and the rebuilt tail is stretched
+  along its axis (at 1 % the displacement grows linearly from 0 at the root to 0.66 % at the tip,
+  about 2 % strain; at 0.5 % the tip's vertices are 0.30 % off). The tail is about 2 % of the
+  diagonal across, some six target edges round at 1 %; the transferred detail's sum over the tail
+  beyond a cut exceeds the target's own by 1-4 %, and a long thin appendage is the softest
+  direction of the rebuild, so the mismatch adds up along it (the tail's detail error alone moves
+  the tip 0.78 %, the rest of the body's 0.03 %). Not a location error: relocating every tail
+  sample found on the body's triangles (or the reverse) onto its own part moves none.
+- **cow.off, 0.5 %, fixed**: the source has two vertices at one point (621 and 2761, an unwelded seam
+  vertex where two cone tips touch) and the target keeps the pair. A sample on the seam lies at
+  distance 0 from both sheets, whose facing normals agree (cos 0.72-0.98), so half of each tip's
+  detail went to the other tip and the rebuilt tips opened by 0.7 % (max 0.71-0.73 %).
+  A sample is now kept on the side its own triangles lie on (`remesh.locate.own_side`): max 0.30-0.32 %,
+  RMS 2.42x -> 2.13x the floor; no other model's figures move.
 - **Disk patches at 0.5 %** (mannequin_ear, elephant_trunk, camelhead; the max is within target
   everywhere): the rebuild's error is a smooth deformation (95 % of it survives 20 one-ring
   averaging steps), does not change with 4x the edge samples, and is a slightly flattened surface:
   scaling the transferred detail by 1.001 lowers mannequin_ear's ratio from 1.44x to 1.32x at 1 %
   and from 1.85x to 1.69x at 0.5 %. A systematic discretization error, not a location error.
 
-Tried on the cow, not adopted: a stricter normal test (cos > 0.5: 25x RMS at 1 %), 2 or 3 anchors
-(no change), samples moved 0.1-0.25 target edges inward along their normal (the tips unchanged,
-RMS worse), the detail rescaled by the target/source area ratio (worse everywhere), the pointwise
-transfer (60-136x). The floor's max is measured on pymeshlab's samples and moves between runs
+Tried for the tail, not adopted: a stricter normal test (cos > 0.5: 25x RMS at 1 %), 2 or 3
+anchors (no change), samples moved 0.1-0.25 target edges inward along their normal (RMS worse),
+the detail rescaled by the target/source area ratio (worse everywhere), the pointwise transfer
+(60-136x). The floor's max is measured on pymeshlab's samples and moves between runs
 (cow at 0.5 %: 0.10-0.19 % over six runs), and the max ratio with it.
 """
 

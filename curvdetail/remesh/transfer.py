@@ -113,7 +113,8 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     Location: ``"closest"`` = the closest point on the other surface in space (the meshes are
     two triangulations of one surface; a conservative sample whose closest target triangle
     faces away from its source edge, the other sheet where two lie close, is put on the nearest
-    one that faces its way); ``"uv"`` = point location in a shared planar domain
+    one that faces its way, and one on a seam where two sheets touch stays on the side its own
+    triangles lie on, see `own_side`); ``"uv"`` = point location in a shared planar domain
     given as ``uv=(UVs, UVt)`` (see `parameterize`).
 
     Parameters
