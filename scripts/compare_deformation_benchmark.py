@@ -1,16 +1,16 @@
 """Compare curvature-detail editing with libigl and the survey on the Botsch-Sorkine benchmark.
 
 For each of the four cases (bar, cactus, cylinder, plane) run, with the files' selection and
-transform: ours rotation-aware (``edit_with_selection``'s default), the paper's linear edit
-(handle details transformed, one-ring relations) and its one- plus two-ring variant, libigl's
-ARAP (spokes-and-rims energy, ``MAX_ITER`` iterations from the rest shape, fixed and handle
-vertices constrained) and libigl's biharmonic deformation (``igl.harmonic`` with k = 2 on the
-displacements). Each result is measured against the survey's ``NAME-laplacian_editing.off``
-(same connectivity: vertex-to-vertex distance, mean and max over the bbox diagonal), for folded
-triangles (normal against both its rest normal and the handle-turned one), the mean relative
-edge-length change over the edges with a non-fixed end, and the area kept by the free region
-(status 1) and by the handles' triangles, and the warnings each run raised. Times: setup
-(factoring), one iteration (the iterative methods), and a re-solve (ours: a solve warm-started from the result; paper: a
+transform: ours rotation-aware (``edit_with_selection``'s default), the paper's linear edit (handle
+details transformed, one-ring relations) and its one- plus two-ring variant, libigl's ARAP
+(spokes-and-rims energy, ``MAX_ITER`` iterations from the rest shape, fixed and handle vertices
+constrained) and libigl's biharmonic deformation (``igl.harmonic`` with k = 2 on the
+displacements). Each result is measured against the survey's ``NAME-laplacian_editing.off`` (same
+connectivity: vertex-to-vertex distance, mean and max over the bbox diagonal), for folded triangles
+(normal against both its rest normal and the handle-turned one), the mean relative edge-length
+change over the edges with a non-fixed end, and the area kept by the free region (status 1) and by
+the handles' triangles, and the warnings each run raised. Times: setup (factoring), one iteration
+(the iterative methods), and a re-solve (ours: a solve warm-started from the result; paper: a
 back-substitution; ARAP: one more iteration from its result); "per iteration / ARAP" is the
 per-iteration time over libigl ARAP's on the same case and run.
 
