@@ -185,7 +185,8 @@ def main(argv=None):
                       "boundary values to free positions, median of "
                       f"{args.repeats}, arms interleaved; factor: best of 3. \"busy\": {args.busy} processes "
                       "spinning on the CPU, started by the script. The machine's own load is in the last column "
-                      "(1-minute load average).\n\n" + _files.environment_line(env) + "\n\n" + text + "\n",
+                      f"(1-minute load average). The rule measured: `\"auto\"` takes SuperLU (one thread) below "
+                      f"{sparse_solver.SMALL_SYSTEM_NNZ:,} stored entries, else PARDISO.\n\n" + _files.environment_line(env) + "\n\n" + text + "\n",
                       args.force)
     return 0
 

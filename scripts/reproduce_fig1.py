@@ -290,7 +290,7 @@ def main(argv=None):
         V, F, X, info, y_up = make()
         extra = info.pop("extra_panel", None)
         default = info.pop("default_panel", None)
-        label = info.pop("edited_label", "edited (colour: distance moved)")
+        label = info.pop("edited_label", "the paper's edit (colour: distance moved)")
         report.append(info)
         show = (lambda P: P @ Y_UP.T) if y_up else (lambda P: P)
         moved = np.linalg.norm(X - V, axis=1)
