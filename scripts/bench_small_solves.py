@@ -94,7 +94,8 @@ class BusyProcesses:
         self.count, self.children = count, []
 
     def __enter__(self):
-        code = "while True: pass"
+        # spins while the parent lives: a parent killed outright (SIGKILL) leaves no spinner behind
+        code = "import os\nparent = os.getppid()\nwhile os.getppid() == parent: pass"
         self.children = [subprocess.Popen([sys.executable, "-c", code]) for _ in range(self.count)]
         time.sleep(2.0)                             # let the scheduler see them
         return self
@@ -166,6 +167,7 @@ def main(argv=None):
     json_path, md_path = (os.path.join(args.out, "small_solves" + ext) for ext in (".json", ".md"))
     _files.check_outputs(ap, [json_path, md_path], args.force)
     signal.signal(signal.SIGTERM, _stop)
+    signal.signal(signal.SIGINT, signal.default_int_handler)   # Ctrl-C also where a shell ignored it
     sizes = [int(s) for s in args.sizes.split(",")]
     started = time.perf_counter()
     rows = measure(sizes, args.repeats, 0)
