@@ -9,7 +9,7 @@ from ..curvature.errors import CurvdetailError, MeshError, warn
 from ..curvature.checks import as_count, check_bool, check_choice
 from ..curvature.geometry import bbox_diagonal
 from ..curvature.anchors import anchor_vertices
-from ..curvature.robust_laplacian import degenerate_triangles, flip_caps, robust_laplacian
+from ..curvature.robust_laplacian import LAPLACIANS, source_detail
 from ..curvature.topology import boundary_vertices
 from ..curvature.reconstruct import ROW_MODES, Reconstructor
 from ..curvature.sparse_solver import resolve_backend
@@ -52,10 +52,6 @@ RMS, MAX = "hausdorff_rms_percent_of_diagonal", "hausdorff_max_percent_of_diagon
 
 #: Measurements of the evaluate stage, reported one by one as ``progress("evaluate", done, total)``.
 EVALUATION_STEPS = 5
-
-#: The source's Laplacian (its detail D = L V): "auto" uses "cotan" unless the plain checks
-#: refuse the source's zero-area triangles, then "robust" (`_source`).
-LAPLACIANS = ("auto", "cotan", "robust")
 
 STAGES = ("retriangulate", "parameterize", "transfer", "reconstruct", "evaluate")
 
@@ -310,29 +306,11 @@ def _check_choice(name, value, choices):
 def _source(V, F, laplacian):
     """The checked source ``(V, F, loops)`` for the geometric stages, its detail (None: the plain
     cotan one, which the transfer computes itself) and the report's ``laplacian`` and
-    ``laplacian_reason``. "auto" falls back to "robust" only where `check_surface` refuses
-    zero-area triangles; the robust path flips the zero-area caps away (a needle, two vertices at
-    one point, is still refused, by the same checks, naming it)."""
-    if laplacian != "robust":
-        try:
-            return (*check_surface(V, F, "the source"), None,
-                    {"laplacian": "cotan", "laplacian_reason": f"laplacian={laplacian!r}: the plain "
-                     "cotangent Laplacian (the source has no zero-area triangle)"})
-        except MeshError:
-            if laplacian == "cotan" or not degenerate_triangles(V, F).size:
-                raise
-    zero = degenerate_triangles(V, F)
-    flipped = flip_caps(V, F)
-    V, F_geometric, loops = check_surface(V, flipped, "the source (its zero-area caps flipped)")
-    L, _, delta = robust_laplacian(V, F)
-    why = ("asked for (laplacian='robust')" if laplacian == "robust" else
-           "laplacian='auto': the plain cotangent Laplacian refuses them")
-    return V, F_geometric, loops, L @ V, {
-        "laplacian": "robust",
-        "laplacian_reason": f"{zero.size} zero-area source triangles (first: {zero[:3].tolist()}), {why}; "
-                            f"mollified (every edge + {delta:.3g}), and for the other stages "
-                            f"{int((flipped != np.asarray(F)).any(axis=1).sum())} triangles re-cut by "
-                            "flipping the caps' long edges (the same surface)"}
+    ``laplacian_reason``, by `source_detail` (its zero-area caps flipped away where the robust
+    Laplacian runs; a needle, two vertices at one point, is still refused, naming it)."""
+    F_located, detail, used = source_detail(V, F, laplacian)
+    what = "the source" if detail is None else "the source (its zero-area caps flipped)"
+    return (*check_surface(V, F_located, what), detail, used)
 
 
 def run_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="conservative", rows="free",
