@@ -78,7 +78,7 @@ def choose_laplacian(V, F, laplacian="auto"):
     if laplacian == "cotan":
         raise MeshError(f"{found}, which the plain cotangent Laplacian (laplacian='cotan') refuses",
                         parameter="laplacian", value="cotan", count=int(zero.size), first=zero[:3].tolist(),
-                        hint="use laplacian='auto' or 'robust' (the mollified Laplacian takes them), or "
+                        hint="ask for 'auto' or 'robust' (the mollified Laplacian takes them), or "
                              + ZERO_AREA_ADVICE)
     return {"laplacian": "robust", "laplacian_reason": f"laplacian='auto': {found}, which the plain cotangent "
             "Laplacian refuses"}
