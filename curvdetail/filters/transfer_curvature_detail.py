@@ -24,23 +24,20 @@ def planar_map(location, parameterization, default="harmonic"):
     return None
 
 
-def check_retriangulation(Vs, loops_s, Vt, loops_t, source, target):
-    """FilterError (``parameter`` 'targetmesh', ``value`` the largest distance as a fraction of
-    the source's diagonal, ``first`` target vertices) unless the target's boundary vertices lie
-    on the source's boundary within ``RETRIANGULATION_TOLERANCE``, as ``remesh_experiment``
-    asks of a given target: another surface gives a result that measures nothing."""
-    from ..curvature.geometry import bbox_diagonal
-    from ..remesh import RETRIANGULATION_TOLERANCE, RemeshError, check_target_boundary
+def check_retriangulation(Vs, Fs, Vt, Ft, source, target):
+    """`curvdetail.remesh.check_retriangulation` (boundary within ``RETRIANGULATION_TOLERANCE``,
+    every vertex within ``SURFACE_TOLERANCE`` of the source) in the filter's words: FilterError
+    with ``parameter`` 'targetmesh' and the check's ``value``, ``count`` and ``first`` (target
+    vertices)."""
+    from ..remesh import RemeshError
+    from ..remesh import check_retriangulation as check
 
-    given = np.concatenate(loops_t) if loops_t else np.zeros(0, dtype=np.int64)
     try:
-        check_target_boundary([Vs[loop] for loop in loops_s], Vt[given], bbox_diagonal(Vs),
-                              f"pass a retriangulation of layer {source} as the target (e.g. from "
-                              "generate_curvature_remeshing)", tolerance=RETRIANGULATION_TOLERANCE)
+        check(Vs, Fs, Vt, Ft, advice=f"pass a retriangulation of layer {source} as the target (e.g. from "
+                                     "generate_curvature_remeshing)")
     except RemeshError as exc:
-        first = None if exc.first is None else given[exc.first].tolist()
         raise FilterError(f"layer {target}: {exc.problem}", parameter="targetmesh", value=exc.value,
-                          hint=exc.hint, count=exc.count, first=first) from None
+                          hint=exc.hint, count=exc.count, first=exc.first) from None
 
 
 @filter(
@@ -48,8 +45,9 @@ def check_retriangulation(Vs, loops_s, Vt, loops_t, source, target):
     category="Curvature detail",
     description=f"""
         Carry the curvature detail of the source layer (a manifold surface; a disk-topology
-        patch for location 'uv') over to the target layer (a retriangulation of it: its boundary
-        vertices within 0.1 % of the diagonal of the source's boundary, else refused), the transfer
+        patch for location 'uv') over to the target layer (a retriangulation of it: as many
+        boundary loops, its boundary vertices within 0.1 % of the diagonal of the source's
+        boundary and every vertex within 3 % of the source's surface, else refused), the transfer
         step of the paper's remeshing experiment. The detail carried is the source's stored 'curvature_detail' where it holds
         one (from compute_curvature_detail, kept while its vertices were moved; refused if the
         source was retriangulated since, as apply_curvature_reconstruction refuses it), else the
@@ -99,9 +97,9 @@ def transfer_curvature_detail(ms, *, sourcemesh, targetmesh, method, location, p
     Vt, Ft = mesh_arrays(ms, target)
     # zero-area caps (scans): the robust detail, and the caps flipped away for locating points
     Fl, Dr, used = source_detail(Vs, Fs, laplacian)
-    _, _, loops_s = check_surface(Vs, Fl, f"the source (layer {source})")   # 'uv': parameterize asks for disks
-    _, _, loops_t = check_surface(Vt, Ft, f"the target (layer {target})")
-    check_retriangulation(Vs, loops_s, Vt, loops_t, source, target)
+    Vs, Fl, _ = check_surface(Vs, Fl, f"the source (layer {source})")   # 'uv': parameterize asks for disks
+    Vt, Ft, _ = check_surface(Vt, Ft, f"the target (layer {target})")
+    check_retriangulation(Vs, Fl, Vt, Ft, source, target)
     # stored detail outlives moved vertices (the editing use); a broken stamp is refused in load_detail
     stored = vertex_attribute(ms, source, DETAIL, "point") is not None
     Ds = load_detail(ms, source, Fs) if stored else curvature_detail(Vs, Fs) if Dr is None else Dr

@@ -14,7 +14,7 @@ from ..curvature.topology import boundary_vertices
 from ..curvature.reconstruct import ROW_MODES, Reconstructor
 from ..curvature.sparse_solver import resolve_backend
 from ._disk import TARGET_BOUNDARY_TOLERANCE, RemeshError  # noqa: F401 (their home before)
-from ._disk import check_disk, check_surface, check_target_boundary
+from ._disk import check_disk, check_retriangulation, check_surface
 from .evaluate import hausdorff, vertex_distance
 from .parameterize import METHODS as PARAMETERIZATIONS
 from .parameterize import parameterize
@@ -217,8 +217,10 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="c
     CurvdetailError
         ``target_edge`` not a positive length (even with a ``target``)
     RemeshError
-        Absurd target edge (with the numbers), a failed retriangulation, or a ``target`` with
-        boundary vertices off the source's boundary polyline (by more than
+        Absurd target edge (with the numbers), a failed retriangulation, or a ``target`` that is
+        not a retriangulation of the source (`check_retriangulation`: other boundary loops,
+        vertices more than ``SURFACE_TOLERANCE`` off its surface, or boundary vertices off the
+        source's boundary polyline by more than
         ``TARGET_BOUNDARY_TOLERANCE`` = 1e-6 of the larger of the bbox diagonal and the largest
         coordinate)
     ValueError
@@ -369,10 +371,9 @@ def run_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="cons
         Vt, Ft = retriangulate(V, F, method=method, target_edge=length, surface_check=surface_check)
         seconds["retriangulate"] = time.perf_counter() - t
     else:
-        Vt, Ft, loops_given = check_surface(*target, "the target")
-        given = np.concatenate(loops_given) if loops_given else np.zeros(0, dtype=np.int64)
-        check_target_boundary([V[loop] for loop in loops_s], Vt[given], d, "Pass one made by "
-                              "curvdetail.remesh.retriangulate, or target=None to make it here.")
+        Vt, Ft, _ = check_surface(*target, "the target")
+        check_retriangulation(V, F, Vt, Ft, boundary_tolerance=TARGET_BOUNDARY_TOLERANCE, advice="Pass one made "
+                              "by curvdetail.remesh.retriangulate, or target=None to make it here.")
 
     uv, param_info = None, None
     if location == "uv":
