@@ -18,10 +18,10 @@ the terrain's sines), the meshes' vertex and face counts, and the run's time, lo
 memory.
 
 The figure's edits are the paper's linear one (``CurvatureEditor`` /
-``edit_with_selection(method="paper")`` / ``edit_boundary``). Each sub-figure also runs the
-default settings: the cow's moved handles through ``edit_with_selection(V, F, status, T)``
-(rotation-aware), the terrain's sines through ``edit_boundary(V, F, displacement)`` with no
-option. Every edit reports its folded triangles, its amplification (largest move over the
+``edit_with_selection(method="paper")`` / ``edit_boundary(method="paper")``). Each sub-figure
+also runs the default settings: the cow's moved handles through ``edit_with_selection(V, F,
+status, T)``, the terrain's sines through ``edit_boundary(V, F, displacement)`` with no option
+(both rotation-aware). Every edit reports its folded triangles, its amplification (largest move over the
 handles' or the boundary's largest move; the editing filter and ``curvdetail edit`` warn above
 ``AMPLIFICATION_LIMIT``) and the warnings it raised (the default ones are not silenced).
 
@@ -158,7 +158,7 @@ def terrain():
                 else:
                     # the paper's one-ring cases fold on purpose here: counted below, not warned
                     warnings.simplefilter("ignore", FoldedTrianglesWarning)
-                    X, info = edit_boundary(V, F, displacement, boundary_detail=mode, relations=relations,
+                    X, info = edit_boundary(V, F, displacement, method="paper", boundary_detail=mode, relations=relations,
                                             return_info=True)
             b = info["boundary"]
             variant = f"{mode}/{relations}"
@@ -209,7 +209,7 @@ def markdown(cow_, terrain_, env):
     lines += ["", f"(b) {terrain_['model']} ({terrain_['vertices']} vertices, {terrain_['faces']} triangles): "
               f"the boundary moved by {terrain_['config']['periods']} periods of a sine; folded = normals "
               "pointing down (at rest: " + str(terrain_["rest_folded"]) + "); \"default\": `edit_boundary` with no "
-              "option (the others silence its FoldedTrianglesWarning); amplification: largest move over the "
+              "option, rotation-aware (the paper's rows silence its FoldedTrianglesWarning); amplification: largest move over the "
               "boundary's largest move.", "",
               "| sine | amplitude | boundary detail | relations | largest move (%) | height range | folded | "
               "folded against rest normals | amplification | warnings | seconds |",
@@ -217,7 +217,9 @@ def markdown(cow_, terrain_, env):
     for key, r in terrain_.items():
         if isinstance(r, dict) and "boundary_detail" in r:
             lines.append(f"| {key.split('_')[0] + '_' + key.split('_')[1]} | {r['amplitude']:.3g} | "
-                         f"{r['boundary_detail']} | {r['relations']} | {100 * r['max_move_fraction']:.1f} | "
+                         + ("default (rotation-aware) | - | " if r["boundary_detail"] == "default" else
+                            f"{r['boundary_detail']} | {r['relations']} | ")
+                         + f"{100 * r['max_move_fraction']:.1f} | "
                          f"x{r['height_range_ratio']:.2f} | {r['folded_triangles']} | {r['folded_against_rest']} | "
                          f"{_cell(r['amplification'])} | {_said(r['warnings'])} | {r['seconds']:.2f} |")
     lines += ["", "![Fig. 2](fig2.png)", ""]
