@@ -6,7 +6,12 @@ import scipy.sparse as sp
 
 from ..curvature.checks import as_count
 from ..curvature.errors import CurvdetailError, MeshError, first_indices
-from .closest_point import _barycentric, check_points_and_mesh, closest_in_frame, unit_frame
+from .closest_point import (
+    _barycentric,
+    check_points_and_mesh,
+    closest_in_frame,
+    unit_frame,
+)
 
 #: Barycentric coordinates taken by interpolate / spread: entries in [-tol, 1 + tol], rows summing
 #: to 1 within tol. locate() clips and normalizes its coordinates, so they are off by rounding only.
