@@ -49,9 +49,10 @@ transferred detail.
   about 2 % strain; at 0.5 % the tip's vertices are 0.30 % off). The tail is about 2 % of the
   diagonal across, some six target edges round at 1 %; the transferred detail's sum over the tail
   beyond a cut exceeds the target's own by 1-4 %, and a long thin appendage is the softest
-  direction of the rebuild, so the mismatch adds up along it (the tail's detail error alone moves
-  the tip 0.78 %, the rest of the body's 0.03 %). Not a location error: relocating every tail
-  sample found on the body's triangles (or the reverse) onto its own part moves none.
+  direction of the rebuild, so the mismatch adds up along it (the detail error of the tail and the
+  rear, x < -0.43, alone moves the tip 0.78 %, that of the rest 0.03 %). Not a location error:
+  relocating every tail sample found on the body's triangles (or the reverse) onto its own part
+  moves none.
 - **cow.off, 0.5 %, fixed**: the source has two vertices at one point (621 and 2761, an unwelded seam
   vertex where two cone tips touch) and the target keeps the pair. A sample on the seam lies at
   distance 0 from both sheets, whose facing normals agree (cos 0.72-0.98), so half of each tip's
