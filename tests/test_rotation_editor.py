@@ -148,6 +148,6 @@ def test_the_local_fit_is_the_svd_s_nearest_rotation():
                         0.5 * Q @ np.diag([1.0, 1.0, -1.0]) + 1e-3 * rng.normal(size=(3000, 3, 3))])
     U, _, Wt = np.linalg.svd(C)
     U[:, :, 2] *= np.sign(np.linalg.det(U) * np.linalg.det(Wt))[:, None]
-    R = _closest_rotations(C)
+    R = _closest_rotations(np.ascontiguousarray(C.transpose(1, 2, 0))).transpose(2, 0, 1)   # matrix index first
     assert np.abs(R - U @ Wt).max() < 1e-9
     assert np.abs(np.linalg.det(R) - 1).max() < 1e-12

@@ -148,17 +148,25 @@ class RotationAwareEditor:
         ei, ej, we = rows[k], cols[k], w[k]
         rest_e = V[ei] - V[ej]
         at_rows = at_s[ei]
-        self._W = sp.csr_matrix((we, (at_rows, ej)), shape=(s_idx.size, n))
-        self._We = [sp.csr_matrix((we * rest_e[:, c], (at_rows, ej)), shape=(s_idx.size, n)) for c in range(3)]
-        self._wsum = np.asarray(self._W.sum(axis=1)).ravel()
-        self._rest_sq = np.bincount(at_rows, weights=we * np.einsum("ij,ij->i", rest_e, rest_e),
-                                    minlength=s_idx.size)
-        # the global step's rows: free i, columns j in S (every neighbour of a free vertex is)
+        # one product with X gives, per vertex i of S, sum_j w_ij (v_i - v_j)[c] x_j (row c s + i)
+        ns = s_idx.size
+        self._cov_rows = sp.csr_matrix((np.concatenate([we * rest_e[:, c] for c in range(3)]),
+                                        (np.concatenate([at_rows + c * ns for c in range(3)]), np.tile(ej, 3))),
+                                       shape=(3 * ns, n))
+        self._detail_s = np.ascontiguousarray(self.detail[s_idx].T)    # (3, s)
+        # the edges i < j of E, weighted w_ij times how many of i, j are in S
+        times = np.where(rows < cols, in_s[rows].astype(float) + in_s[cols], 0.0)
+        half = times > 0
+        self._edges = (rows[half], cols[half], w[half] * times[half])
+        self._rest_sq = np.bincount(at_rows, weights=we * np.einsum("ij,ij->i", rest_e, rest_e), minlength=ns)
+        # the global step's rows: free i, columns c s + j for j in S (every neighbour of a free
+        # vertex is): w_ij (v_i - v_j)[c]
         kf = free[ei]
         at_f = np.full(n, -1, dtype=np.int64)
         at_f[fp] = np.arange(fp.size)
-        self._Wf = [sp.csr_matrix((we[kf] * rest_e[kf, c], (at_f[ei[kf]], at_s[ej[kf]])), shape=(fp.size, s_idx.size))
-                    for c in range(3)]
+        self._Wf = sp.csr_matrix((np.concatenate([we[kf] * rest_e[kf, c] for c in range(3)]),
+                                  (np.tile(at_f[ei[kf]], 3), np.concatenate([at_s[ej[kf]] + c * ns for c in range(3)]))),
+                                 shape=(fp.size, 3 * ns))
         self._fp_s = at_s[fp]
         L_free = L[fp]
         self._L_pc = L_free[:, pc].tocsr()
@@ -206,7 +214,7 @@ class RotationAwareEditor:
             X[self._fp] = as_values(initial, self.n, "initial")[self._fp] - centre
             R, energy = self._local(X)
         else:
-            R = _blended_rotations(_best_rotation(self.V[self._pc], Xk), self._blend)
+            R = _blended_rotations(_best_rotation(self.V[self._pc], Xk), self._blend).transpose(1, 2, 0)
             energy = None
         self.energies = [] if energy is None else [energy]
         self.iterations, self.converged = 0, self._embed is None
@@ -240,29 +248,32 @@ class RotationAwareEditor:
         return X
 
     def _local(self, X):
-        """Rotations (scaled with ``scaling``) of every vertex of S fitted to X, and E(X, R).
-        ``X`` about a centre near the mesh (the sums below cancel large coordinates)."""
-        Xs = X[self._s]
-        # cov_i = sum_j w_ij (x_i - x_j) (v_i - v_j)^T, column c by column c
-        cov = np.stack([Xs * self.detail[self._s, c, None] - self._We[c] @ X for c in range(3)], axis=2)
+        """Rotations (scaled with ``scaling``), shape (3, 3, s), of every vertex of S fitted to X,
+        and E(X, R). ``X`` about a centre near the mesh (the sums below cancel large coordinates)."""
+        Xs = X[self._s].T                                    # (3, s)
+        P = self._cov_rows @ X                               # (3 s, 3)
+        ns = Xs.shape[1]
+        # cov[a, c, i] = sum_j w_ij (x_i - x_j)[a] (v_i - v_j)[c] = x_i[a] D_i[c] - sum_j w_ij (v_i - v_j)[c] x_j[a]
+        cov = np.multiply(Xs[:, None, :], self._detail_s, out=np.empty((3, 3, ns)))   # C order: rows contiguous
+        cov -= P.reshape(3, ns, 3).transpose(2, 0, 1)
         R = _closest_rotations(cov)
-        fit = np.einsum("kij,kij->k", R, cov)                # trace(R^T cov)
-        # sum_j w_ij |x_i - x_j|^2
-        def_sq = (self._wsum * np.einsum("ij,ij->i", Xs, Xs) - 2 * np.einsum("ij,ij->i", Xs, self._W @ X)
-                  + self._W @ np.einsum("ij,ij->i", X, X))
+        fit = np.einsum("ijk,ijk->k", R, cov)                # trace(R_i^T cov_i)
+        i, j, w = self._edges
+        d = X[i] - X[j]
+        def_sq = np.einsum("ij,ij,i->", d, d, w)             # sum_i sum_j w_ij |x_i - x_j|^2
         if self.scaling:
             s = np.maximum(fit, 0.0) / np.maximum(self._rest_sq, np.finfo(float).tiny)
-            R = R * s[:, None, None]
-            energy = def_sq - 2 * s * fit + s * s * self._rest_sq
+            R *= s
+            energy = def_sq - np.sum(2 * s * fit - s * s * self._rest_sq)
         else:
-            energy = def_sq - 2 * fit + self._rest_sq
-        return R, float(energy.sum())
+            energy = def_sq - np.sum(2 * fit - self._rest_sq)
+        return R, float(energy)
 
     def _turned_details(self, R):
-        """``B_f = sum_j w_ij (R_i + R_j) / 2 (v_i - v_j)`` over the free rows (R scaled):
+        """``B_f = sum_j w_ij (R_i + R_j) / 2 (v_i - v_j)`` over the free rows (R scaled, (3, 3, s)):
         ``(R_f D_f + sum_j R_j w_ij (v_i - v_j)) / 2``."""
-        own = np.einsum("kab,kb->ka", R[self._fp_s], self.detail[self._fp])
-        other = sum(self._Wf[c] @ np.ascontiguousarray(R[:, :, c]) for c in range(3))
+        own = np.einsum("abk,kb->ka", R[:, :, self._fp_s], self.detail[self._fp])
+        other = self._Wf @ R.transpose(1, 2, 0).reshape(-1, 3)   # rows c s + j: R_j[:, c]
         return 0.5 * (own + other)
 
 
@@ -276,34 +287,46 @@ def _anderson(history):
     return G[:, -1] - dG @ gamma
 
 
-def _closest_rotations(C, steps=8):
-    """The rotations ``R_k`` maximizing ``trace(R_k^T C_k)`` for (k, 3, 3) ``C``: the SVD
-    solution ``U diag(1, 1, d) W^T``, ``d = det(U) det(W)``.
+def _closest_rotations(C, tol=1e-7, max_steps=20):
+    """The rotations ``R_k`` maximizing ``trace(R_k^T C_k)``, for ``C`` of shape (3, 3, k)
+    (matrix index first, so that every entry is a contiguous row); the SVD solution
+    ``U diag(1, 1, d) W^T``, ``d = det(U) det(W)``. Returns shape (3, 3, k).
 
     ``C + cof(C)`` (``C`` scaled to unit Frobenius norm) is ``U diag(s1 + d s2 s3, s2 + d s1 s3,
     s3 + d s1 s2) W^T``: where its first two entries are positive and the third has the sign of
-    ``d`` (always for ``d = 1``, rank 2 included), its orthogonal polar factor is the answer,
-    found by ``steps`` scaled Newton steps ``X <- (g X + X^-T / g) / 2``. The rest (a factor
-    that is no rotation to 1e-12) goes through `_closest_rotations_eigh`."""
+    ``d`` (always for ``d = 1``, rank 2 included), its determinant is positive and its orthogonal
+    polar factor is the answer, found by scaled Newton steps ``X <- (g X + X^-T / g) / 2`` until
+    no entry moves more than ``tol`` (the error is then about ``tol^2``). The rest (a factor that
+    is no rotation) goes through `_closest_rotations_eigh`."""
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        X = C / np.sqrt(np.einsum("kij,kij->k", C, C))[:, None, None]
-        X = X + _cofactor(X)
-        for _ in range(steps):
-            inv_t = _cofactor(X)
-            inv_t /= np.einsum("ki,ki->k", X[..., 0], inv_t[..., 0])[:, None, None]       # X^-T
-            g = (np.einsum("kij,kij->k", inv_t, inv_t) / np.einsum("kij,kij->k", X, X)) ** 0.25
-            X = 0.5 * (g[:, None, None] * X + inv_t / g[:, None, None])
-        error = np.abs(np.swapaxes(X, 1, 2) @ X - np.eye(3)).max(axis=(1, 2))
-        bad = ~((error < 1e-12) & (np.einsum("ki,ki->k", X[..., 0], np.cross(X[..., 1], X[..., 2])) > 0))
+        X = C / np.sqrt(np.einsum("ijk,ijk->k", C, C))
+        X += _cofactor(X)
+        for _ in range(max_steps):
+            cof = _cofactor(X)                               # det(X) X^-T
+            det = np.einsum("ik,ik->k", X[:, 0], cof[:, 0])
+            g = np.sqrt(np.sqrt(np.einsum("ijk,ijk->k", cof, cof) / np.einsum("ijk,ijk->k", X, X)) / np.abs(det))
+            step = 0.5 * (g * X + cof / (g * det))
+            change = np.abs(step - X)
+            X = step
+            if np.fmax.reduce(change, axis=None) < tol:     # NaN (a singular X) ignored, caught by det
+                break
+        bad = ~(det > 0)
+        if not np.fmax.reduce(change, axis=None) < tol:
+            bad |= ~(change.reshape(9, -1).max(axis=0) < tol)
     if bad.any():
-        X[bad] = _closest_rotations_eigh(C[bad])
+        X[:, :, bad] = _closest_rotations_eigh(C[:, :, bad].transpose(2, 0, 1)).transpose(1, 2, 0)
     return X
 
 
 def _cofactor(A):
-    """Cofactor matrices ``det(A) A^-T`` of (k, 3, 3) ``A``: columns ``a1 x a2, a2 x a0, a0 x a1``."""
-    a0, a1, a2 = A[..., 0], A[..., 1], A[..., 2]
-    return np.stack([np.cross(a1, a2), np.cross(a2, a0), np.cross(a0, a1)], axis=2)
+    """Cofactor matrices ``det(A) A^-T`` of (3, 3, k) ``A``."""
+    out = np.empty_like(A)
+    for i in range(3):
+        i1, i2 = (i + 1) % 3, (i + 2) % 3
+        for j in range(3):
+            j1, j2 = (j + 1) % 3, (j + 2) % 3
+            np.subtract(A[i1, j1] * A[i2, j2], A[i1, j2] * A[i2, j1], out=out[i, j])
+    return out
 
 
 def _closest_rotations_eigh(C):
