@@ -219,22 +219,25 @@ class RotationAwareEditor:
         self.energies = [] if energy is None else [energy]
         self.iterations, self.converged = 0, self._embed is None
         const = -(self._L_pc @ X[self._pc]) - (self._L_out_V - self._L_out_sum[:, None] * centre)
-        fp, history = self._fp, []
+        fp, history, plain = self._fp, [], False
         while self._embed is not None and self.iterations < self.max_iterations:
             x = X[fp]
             g = self._embed.solve(self._turned_details(R) + const)
             self.iterations += 1
             change = np.abs(g - x).max() / self.diagonal      # the plain step's move: the residual
             step = g
-            if energy is not None and self.anderson_memory:
+            if energy is not None and self.anderson_memory:         # (g, g - x) a sample of the map x -> g
                 history = (history + [(g.ravel(), (g - x).ravel())])[-(self.anderson_memory + 1):]
-                step = _anderson(history).reshape(g.shape) if len(history) > 1 else g
+                if not plain and len(history) > 1:
+                    step = _anderson(history).reshape(g.shape)
             X[fp] = step
             R_step, E_step = self._local(X)
-            if step is not g and not E_step <= energy:       # the plain step never increases E
+            # the plain step never increases E; after it, the next step is plain too (an
+            # accelerated step right after a rejected one is mostly rejected again)
+            plain = step is not g and not E_step <= energy
+            if plain:
                 X[fp] = g
                 R_step, E_step = self._local(X)
-                history = history[-1:]
             R, energy = R_step, E_step
             self.energies.append(energy)
             if change < self.tol:
