@@ -282,12 +282,12 @@ class RotationAwareEditor:
 
 def _anderson(history):
     """Anderson-accelerated next iterate from ``(g_k, f_k = g_k - x_k)`` of the last steps:
-    ``g - dG gamma`` with ``gamma`` minimizing ``|f - dF gamma|`` (Walker & Ni 2011)."""
-    G = np.stack([g for g, _ in history], axis=1)
-    Fr = np.stack([f for _, f in history], axis=1)
-    dG, dF = np.diff(G, axis=1), np.diff(Fr, axis=1)
-    gamma = np.linalg.lstsq(dF, Fr[:, -1], rcond=None)[0]
-    return G[:, -1] - dG @ gamma
+    ``g - dG gamma`` with ``gamma`` minimizing ``|f - dF gamma|`` (Walker & Ni 2011), from the
+    normal equations (a few unknowns; a poor step is refused by the energy test)."""
+    G = np.stack([g for g, _ in history])
+    dG, dF = np.diff(G, axis=0), np.diff(np.stack([f for _, f in history]), axis=0)
+    gamma = np.linalg.lstsq(dF @ dF.T, dF @ history[-1][1], rcond=None)[0]
+    return G[-1] - gamma @ dG
 
 
 def _closest_rotations(C, tol=1e-7, max_steps=20):
