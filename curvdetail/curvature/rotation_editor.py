@@ -148,26 +148,28 @@ class RotationAwareEditor:
         ei, ej, we = rows[k], cols[k], w[k]
         rest_e = V[ei] - V[ej]
         at_rows = at_s[ei]
-        # one product with X gives, per vertex i of S, sum_j w_ij (v_i - v_j)[c] x_j (row c s + i)
+        # the covariances are one product with X: row c s + i holds D_i[c] at column i and
+        # -w_ij (v_i - v_j)[c] at j, so that it gives sum_j w_ij (v_i - v_j)[c] (x_i - x_j)
         ns = s_idx.size
-        self._cov_rows = sp.csr_matrix((np.concatenate([we * rest_e[:, c] for c in range(3)]),
-                                        (np.concatenate([at_rows + c * ns for c in range(3)]), np.tile(ej, 3))),
-                                       shape=(3 * ns, n))
-        self._detail_s = np.ascontiguousarray(self.detail[s_idx].T)    # (3, s)
+        c_rows = np.concatenate([at_rows, np.arange(ns)])
+        c_vals = np.concatenate([-we[:, None] * rest_e, self.detail[s_idx]])
+        self._cov_rows = sp.csr_matrix((c_vals.T.ravel(), (np.concatenate([c_rows + c * ns for c in range(3)]),
+                                                           np.tile(np.concatenate([ej, s_idx]), 3))), shape=(3 * ns, n))
         # the edges i < j of E, weighted w_ij times how many of i, j are in S
         times = np.where(rows < cols, in_s[rows].astype(float) + in_s[cols], 0.0)
         half = times > 0
         self._edges = (rows[half], cols[half], w[half] * times[half])
         self._rest_sq = np.bincount(at_rows, weights=we * np.einsum("ij,ij->i", rest_e, rest_e), minlength=ns)
-        # the global step's rows: free i, columns c s + j for j in S (every neighbour of a free
-        # vertex is): w_ij (v_i - v_j)[c]
+        # the global step's turned details: B = T R for R (3, 3, s) as rows c s + j: R_j[:, c]; row
+        # f of T holds w_fj (v_f - v_j)[c] / 2 at column c s + j and D_f[c] / 2 at c s + f
         kf = free[ei]
         at_f = np.full(n, -1, dtype=np.int64)
         at_f[fp] = np.arange(fp.size)
-        self._Wf = sp.csr_matrix((np.concatenate([we[kf] * rest_e[kf, c] for c in range(3)]),
-                                  (np.tile(at_f[ei[kf]], 3), np.concatenate([at_s[ej[kf]] + c * ns for c in range(3)]))),
-                                 shape=(fp.size, 3 * ns))
-        self._fp_s = at_s[fp]
+        t_rows = np.concatenate([at_f[ei[kf]], np.arange(fp.size)])
+        t_cols = np.concatenate([at_s[ej[kf]], at_s[fp]])
+        t_vals = np.concatenate([we[kf, None] * rest_e[kf], self.detail[fp]])
+        self._turn = sp.csr_matrix((0.5 * t_vals.T.ravel(), (np.tile(t_rows, 3), np.concatenate([t_cols + c * ns for c in range(3)]))),
+                                   shape=(fp.size, 3 * ns))
         L_free = L[fp]
         self._L_pc = L_free[:, pc].tocsr()
         outside = ~in_roi
@@ -253,16 +255,13 @@ class RotationAwareEditor:
     def _local(self, X):
         """Rotations (scaled with ``scaling``), shape (3, 3, s), of every vertex of S fitted to X,
         and E(X, R). ``X`` about a centre near the mesh (the sums below cancel large coordinates)."""
-        Xs = X[self._s].T                                    # (3, s)
-        P = self._cov_rows @ X                               # (3 s, 3)
-        ns = Xs.shape[1]
-        # cov[a, c, i] = sum_j w_ij (x_i - x_j)[a] (v_i - v_j)[c] = x_i[a] D_i[c] - sum_j w_ij (v_i - v_j)[c] x_j[a]
-        cov = np.multiply(Xs[:, None, :], self._detail_s, out=np.empty((3, 3, ns)))   # C order: rows contiguous
-        cov -= P.reshape(3, ns, 3).transpose(2, 0, 1)
+        ns = self._s.size
+        # cov[a, c, i] = sum_j w_ij (x_i - x_j)[a] (v_i - v_j)[c], C order (every entry a contiguous row)
+        cov = np.ascontiguousarray((self._cov_rows @ X).reshape(3, ns, 3).transpose(2, 0, 1))
         R = _closest_rotations(cov)
         fit = np.einsum("ijk,ijk->k", R, cov)                # trace(R_i^T cov_i)
         i, j, w = self._edges
-        d = X[i] - X[j]
+        d = np.take(X, i, axis=0) - np.take(X, j, axis=0)
         def_sq = np.einsum("ij,ij,i->", d, d, w)             # sum_i sum_j w_ij |x_i - x_j|^2
         if self.scaling:
             s = np.maximum(fit, 0.0) / np.maximum(self._rest_sq, np.finfo(float).tiny)
@@ -273,11 +272,9 @@ class RotationAwareEditor:
         return R, float(energy)
 
     def _turned_details(self, R):
-        """``B_f = sum_j w_ij (R_i + R_j) / 2 (v_i - v_j)`` over the free rows (R scaled, (3, 3, s)):
-        ``(R_f D_f + sum_j R_j w_ij (v_i - v_j)) / 2``."""
-        own = np.einsum("abk,kb->ka", R[:, :, self._fp_s], self.detail[self._fp])
-        other = self._Wf @ R.transpose(1, 2, 0).reshape(-1, 3)   # rows c s + j: R_j[:, c]
-        return 0.5 * (own + other)
+        """``B_f = sum_j w_fj (R_f + R_j) / 2 (v_f - v_j) = (R_f D_f + sum_j R_j w_fj (v_f - v_j)) / 2``
+        over the free rows, for R (3, 3, s) (scaled with ``scaling``)."""
+        return self._turn @ R.transpose(1, 2, 0).reshape(-1, 3)
 
 
 def _anderson(history):
