@@ -36,8 +36,8 @@ class RotationAwareEditor:
       (v_i - v_j)``; where the neighbourhood turns as one, ``B_i = s R D_i``.
 
     Steps are Anderson-accelerated (`anderson_memory`); an accelerated step is kept only
-    where it lowers ``E``, so ``E`` never increases from one iteration to the next
-    (``energies``). The rotations start at the best-fit rotation of the handles (rest to given
+    where it lowers ``E`` (else the plain step is taken, and the next step is plain too), so
+    ``E`` never increases from one iteration to the next (``energies``). The rotations start at the best-fit rotation of the handles (rest to given
     positions), blended towards the identity at the fixed part by a harmonic weight, so a rigid
     motion of every handle with ``roi=None`` is reproduced in the first iteration. The
     iterations stop when the plain step would move no vertex more than ``tol`` times the bbox
@@ -144,8 +144,7 @@ class RotationAwareEditor:
         k = in_s[rows]                                     # CSR order: sorted by row
         self._s, self._fp, self._pc = s_idx, fp, pc
         self.detail = laplacian_product(L, V)              # sum_j w_ij (v_i - v_j)
-        # per vertex i of S, sparse rows over its neighbours j: w_ij and w_ij (v_i - v_j)[c]
-        ei, ej, we = rows[k], cols[k], w[k]
+        ei, ej, we = rows[k], cols[k], w[k]                # the edges from S
         rest_e = V[ei] - V[ej]
         at_rows = at_s[ei]
         # the covariances are one product with X: row c s + i holds D_i[c] at column i and
@@ -168,7 +167,8 @@ class RotationAwareEditor:
         t_rows = np.concatenate([at_f[ei[kf]], np.arange(fp.size)])
         t_cols = np.concatenate([at_s[ej[kf]], at_s[fp]])
         t_vals = np.concatenate([we[kf, None] * rest_e[kf], self.detail[fp]])
-        self._turn = sp.csr_matrix((0.5 * t_vals.T.ravel(), (np.tile(t_rows, 3), np.concatenate([t_cols + c * ns for c in range(3)]))),
+        self._turn = sp.csr_matrix((0.5 * t_vals.T.ravel(),
+                                    (np.tile(t_rows, 3), np.concatenate([t_cols + c * ns for c in range(3)]))),
                                    shape=(fp.size, 3 * ns))
         L_free = L[fp]
         self._L_pc = L_free[:, pc].tocsr()
@@ -349,7 +349,7 @@ def _blended_rotations(R, t):
     if angle < 1e-12 or np.linalg.norm(axis) < 1e-12 * max(angle, 1.0):
         if angle < 1e-12:
             return np.broadcast_to(np.eye(3), (t.size, 3, 3))
-        w, v = np.linalg.eigh(R + R.T)                    # a half turn: the axis is R's eigenvector 1
+        _, v = np.linalg.eigh(R + R.T)                    # a half turn: the axis is R's eigenvector 1
         axis = v[:, -1]
     axis = axis / np.linalg.norm(axis)
     K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
