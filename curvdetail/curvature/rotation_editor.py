@@ -221,17 +221,17 @@ class RotationAwareEditor:
         self.energies = [] if energy is None else [energy]
         self.iterations, self.converged = 0, self._embed is None
         const = -(self._L_pc @ X[self._pc]) - (self._L_out_V - self._L_out_sum[:, None] * centre)
-        fp, history, plain = self._fp, [], False
+        fp, accel, plain = self._fp, _Anderson(self.anderson_memory), False
         while self._embed is not None and self.iterations < self.max_iterations:
             x = X[fp]
             g = self._embed.solve(self._turned_details(R) + const)
             self.iterations += 1
             change = np.abs(g - x).max() / self.diagonal      # the plain step's move: the residual
             step = g
-            if energy is not None and self.anderson_memory:         # (g, g - x) a sample of the map x -> g
-                history = (history + [(g.ravel(), (g - x).ravel())])[-(self.anderson_memory + 1):]
-                if not plain and len(history) > 1:
-                    step = _anderson(history).reshape(g.shape)
+            if energy is not None and self.anderson_memory:   # (g, g - x): a sample of the map x -> g
+                accel.add(g.ravel(), (g - x).ravel())
+                if not plain and accel.dF:
+                    step = accel.step().reshape(g.shape)
             X[fp] = step
             R_step, E_step = self._local(X)
             # the plain step never increases E; after it, the next step is plain too (an
@@ -277,14 +277,34 @@ class RotationAwareEditor:
         return self._turn @ R.transpose(1, 2, 0).reshape(-1, 3)
 
 
-def _anderson(history):
-    """Anderson-accelerated next iterate from ``(g_k, f_k = g_k - x_k)`` of the last steps:
-    ``g - dG gamma`` with ``gamma`` minimizing ``|f - dF gamma|`` (Walker & Ni 2011), from the
-    normal equations (a few unknowns; a poor step is refused by the energy test)."""
-    G = np.stack([g for g, _ in history])
-    dG, dF = np.diff(G, axis=0), np.diff(np.stack([f for _, f in history]), axis=0)
-    gamma = np.linalg.lstsq(dF @ dF.T, dF @ history[-1][1], rcond=None)[0]
-    return G[-1] - gamma @ dG
+class _Anderson:
+    """Anderson acceleration (Walker & Ni 2011) from the samples ``(g_k, f_k = g_k - x_k)`` of
+    the last ``memory + 1`` steps: `step` is ``g - dG gamma`` with ``gamma`` minimizing
+    ``|f - dF gamma|``, from the normal equations of its few unknowns (a poor step is refused by
+    the energy test). The differences and their Gram matrix are kept, one new row a sample."""
+
+    def __init__(self, memory):
+        self.memory, self.last, self.dG, self.dF, self.gram = memory, None, [], [], np.zeros((0, 0))
+
+    def add(self, g, f):
+        if self.last is not None:
+            self.dG = (self.dG + [g - self.last[0]])[-self.memory:]
+            self.dF = (self.dF + [f - self.last[1]])[-self.memory:]
+            row = np.array([np.einsum("i,i->", self.dF[-1], d) for d in self.dF])
+            k = row.size
+            gram = np.empty((k, k))
+            gram[:-1, :-1] = self.gram[1:, 1:] if self.gram.shape[0] == k else self.gram
+            gram[-1], gram[:, -1] = row, row
+            self.gram = gram
+        self.last = (g, f)
+
+    def step(self):
+        g, f = self.last
+        gamma = np.linalg.lstsq(self.gram, np.array([np.einsum("i,i->", d, f) for d in self.dF]), rcond=None)[0]
+        out = g.copy()
+        for c, d in zip(gamma, self.dG):
+            out -= c * d
+        return out
 
 
 def _closest_rotations(C, tol=1e-7, max_steps=20):
