@@ -37,11 +37,11 @@ class RotationAwareEditor:
 
     Steps are Anderson-accelerated (`anderson_memory`); an accelerated step is kept only
     where it lowers ``E`` (else the plain step is taken, and the next step is plain too), so
-    ``E`` never increases from one iteration to the next (``energies``). The rotations start at the best-fit rotation of the handles (rest to given
-    positions), blended towards the identity at the fixed part by a harmonic weight, so a rigid
-    motion of every handle with ``roi=None`` is reproduced in the first iteration. The
-    iterations stop when the plain step would move no vertex more than ``tol`` times the bbox
-    diagonal, or after ``max_iterations``. The constructor does all factoring; an iteration of
+    ``E`` never increases from one iteration to the next (``energies``). The rotations start
+    at the best-fit rotation of the handles (rest to given positions), blended towards the
+    identity at the fixed part by a harmonic weight, so a rigid motion of every handle with
+    ``roi=None`` is reproduced in the first iteration. The iterations stop when the plain step
+    would move no vertex more than ``tol`` times the bbox diagonal, or after ``max_iterations``. The constructor does all factoring; an iteration of
     `solve` is one back-substitution plus the batched local fits.
 
     Parameters
