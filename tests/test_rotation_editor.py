@@ -44,17 +44,16 @@ def test_a_rigid_motion_of_every_handle_moves_the_whole_mesh_rigidly():
     V = V * [1.0, 0.7, 1.3]
     handles = np.array([0, 5, 17, 40, 101])
     R, t = _rotation([1, 2, -0.5], 1.1), np.array([3.0, -1.0, 0.5])
-    ed = RotationAwareEditor(V, F, handles)
+    ed = RotationAwareEditor(V, F, handles, max_iterations=1)
     X = ed.solve(V[handles] @ R.T + t)
-    assert np.abs(X - (V @ R.T + t)).max() < 1e-8
-    assert ed.converged and ed.iterations <= 3
+    assert np.abs(X - (V @ R.T + t)).max() < 1e-8          # in the first iteration
 
 
 def test_a_bent_cylinder_keeps_its_radius():
     # a tube 20 radii long bent by 60 degrees (bend radius 19 tube radii): every ring stays a
-    # circle of the tube's radius to within 3 % (measured 1.6 %: the energy trades a little
-    # ovalization for the stretch of the outer side); the paper's linear edit, handle details
-    # turned, squashes the middle rings by more than half the radius
+    # circle of the tube's radius to within 3.5 % (3.05 % at the converged minimum: the energy
+    # trades a little ovalization for the stretch of the outer side); the paper's linear edit,
+    # handle details turned, squashes the middle rings by more than half the radius
     V, F, X, ed, ring, R, target = _bent_cylinder(np.pi / 3)
     assert ed.converged
 
@@ -62,7 +61,7 @@ def test_a_bent_cylinder_keeps_its_radius():
         return max(np.abs(np.linalg.norm(Y[ring == k] - Y[ring == k].mean(axis=0), axis=1) - RADIUS).max()
                    for k in range(ring.max() + 1)) / RADIUS
 
-    assert radius_error(X) < 0.03
+    assert radius_error(X) < 0.035
     assert folded_triangles(V, F, X, R).size == 0
     h = ed.position_constrained
     paper = CurvatureEditor(V, F, h, h, roi=ed.roi)
@@ -91,6 +90,26 @@ def test_stops_at_the_tolerance_and_reports_its_iterations():
     assert 1 <= loose.iterations < tight.iterations
     *_, capped = _bent_cylinder(1.0, tol=1e-12, max_iterations=5)[:4]
     assert capped.iterations == 5 and not capped.converged
+
+
+def test_the_default_stop_is_within_the_tolerance_of_the_converged_result(load_mesh):
+    # a slowly converging edit (the ear's tip turned by 30 degrees and lifted by 5 % of the
+    # diagonal): the default stop (no vertex moving more than 1e-4 of the diagonal over the last
+    # 10 iterations) is within 1e-4 of the diagonal of the result at tol 1e-10 (measured 3e-6,
+    # 86 iterations of 141); a stop on one step's move (stop_window 1) stops at 47 iterations,
+    # 1e-2 of the diagonal off
+    V, F = load_mesh("mannequin_ear.obj")
+    d = np.linalg.norm(V - V[0], axis=1)
+    h = np.flatnonzero(d < np.quantile(d, 0.05))
+    diagonal = np.linalg.norm(np.ptp(V, axis=0))
+    target = (V[h] - V[h].mean(0)) @ _rotation([0, 1, 0], np.pi / 6).T + V[h].mean(0) + [0, 0, 0.05 * diagonal]
+    ed = RotationAwareEditor(V, F, h, roi=np.flatnonzero(d < np.quantile(d, 0.6)))
+    X = ed.solve(target)
+    assert ed.converged and ed.tol == 1e-4
+    ed.tol, ed.max_iterations = 1e-10, 2000
+    X_tight = ed.solve(target)
+    assert ed.converged
+    assert np.abs(X - X_tight).max() < 1e-4 * diagonal
 
 
 def test_handles_and_the_exterior_are_exact():

@@ -1,5 +1,7 @@
 """Rotation-aware curvature-detail editing: the rest details turn with their neighbourhoods."""
 
+import collections
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -10,7 +12,8 @@ from .errors import ConstraintError
 from .geometry import bbox_centre, bbox_diagonal
 from .sparse_solver import factorize, resolve_backend
 
-#: Default stopping tolerance: the largest vertex move of an iteration over the bbox diagonal.
+#: Default stopping tolerance: the largest vertex move over the last `RotationAwareEditor.stop_window`
+#: iterations, over the bbox diagonal.
 DEFAULT_TOL = 1e-4
 #: Default cap on the number of iterations of `RotationAwareEditor.solve`.
 DEFAULT_MAX_ITERATIONS = 500
@@ -103,6 +106,8 @@ class RotationAwareEditor:
 
     #: Anderson acceleration of the iterations: how many earlier steps it combines (0: off)
     anderson_memory = 5
+    #: How many iterations back the stopping test measures the move (fewer at the start of a solve)
+    stop_window = 10
 
     def __init__(self, V, F, handles, *, roi=None, scaling=False, tol=DEFAULT_TOL,
                  max_iterations=DEFAULT_MAX_ITERATIONS, backend="auto"):
@@ -222,11 +227,12 @@ class RotationAwareEditor:
         self.iterations, self.converged = 0, self._embed is None
         const = -(self._L_pc @ X[self._pc]) - (self._L_out_V - self._L_out_sum[:, None] * centre)
         fp, accel, plain = self._fp, _Anderson(self.anderson_memory), False
+        # the start and the iterates since, the last stop_window + 1 kept: the stop tests the move over them
+        recent = collections.deque([X[fp]], maxlen=self.stop_window + 1)
         while self._embed is not None and self.iterations < self.max_iterations:
             x = X[fp]
             g = self._embed.solve(self._turned_details(R) + const)
             self.iterations += 1
-            change = np.abs(g - x).max() / self.diagonal      # the plain step's move: the residual
             step = g
             if energy is not None and self.anderson_memory:   # (g, g - x): a sample of the map x -> g
                 accel.add(g.ravel(), (g - x).ravel())
@@ -242,7 +248,8 @@ class RotationAwareEditor:
                 R_step, E_step = self._local(X)
             R, energy = R_step, E_step
             self.energies.append(energy)
-            if change < self.tol:
+            recent.append(X[fp])                              # a copy (fancy index)
+            if np.abs(recent[-1] - recent[0]).max() < self.tol * self.diagonal:
                 self.converged = True
                 break
         X += centre
