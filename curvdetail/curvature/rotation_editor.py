@@ -43,9 +43,14 @@ class RotationAwareEditor:
     ``E`` never increases from one iteration to the next (``energies``). The rotations start
     at the best-fit rotation of the handles (rest to given positions), blended towards the
     identity at the fixed part by a harmonic weight, so a rigid motion of every handle with
-    ``roi=None`` is reproduced in the first iteration. The iterations stop when the plain step
-    would move no vertex more than ``tol`` times the bbox diagonal, or after ``max_iterations``. The constructor does all factoring; an iteration of
-    `solve` is one back-substitution plus the batched local fits.
+    ``roi=None`` is reproduced in the first iteration. The iterations stop when no vertex has
+    moved more than ``tol`` times the bbox diagonal over the last `stop_window` (10) iterations
+    (since the start, in the first ones: a cold start takes at least 11), or after
+    ``max_iterations``. ``tol`` bounds that move, which is close to the distance to the minimum
+    where the iteration converges at a steady rate (one step's move is not, where the rate is
+    slow), but not along a nearly flat valley of ``E``, where the result can lie farther (see
+    docs/guide/editing.md). The constructor does all factoring; an iteration of `solve` is one
+    back-substitution plus the batched local fits.
 
     Parameters
     ----------
@@ -60,7 +65,8 @@ class RotationAwareEditor:
     scaling : bool
         Fit a uniform scale with each rotation (as-similar-as-possible), else rotations only.
     tol : float
-        Stopping tolerance, over the bbox diagonal of ``V``.
+        Stopping tolerance: the largest vertex move over the last `stop_window` iterations, over
+        the bbox diagonal of ``V``.
     max_iterations : int
         Most iterations of `solve`.
     backend : str
@@ -230,7 +236,7 @@ class RotationAwareEditor:
         # the start and the iterates since, the last stop_window + 1 kept: the stop tests the move over them
         recent = collections.deque([X[fp]], maxlen=self.stop_window + 1)
         while self._embed is not None and self.iterations < self.max_iterations:
-            x = X[fp]
+            x = recent[-1]                                    # X[fp]
             g = self._embed.solve(self._turned_details(R) + const)
             self.iterations += 1
             step = g
