@@ -1,17 +1,22 @@
 """Compare curvature-detail editing with libigl and the survey on the Botsch-Sorkine benchmark.
 
 For each of the four cases (bar, cactus, cylinder, plane) run, with the files' selection and
-transform: ours rotation-aware (``edit_with_selection``'s default), the paper's linear edit
-(handle details transformed, one-ring relations) and its one- plus two-ring variant, libigl's
-ARAP (spokes-and-rims energy, ``MAX_ITER`` iterations from the rest shape, fixed and handle
-vertices constrained) and libigl's biharmonic deformation (``igl.harmonic`` with k = 2 on the
-displacements). Each result is measured against the survey's ``NAME-laplacian_editing.off``
-(same connectivity: vertex-to-vertex distance, mean and max over the bbox diagonal), for folded
-triangles (normal against both its rest normal and the handle-turned one), the mean relative
-edge-length change over the edges with a non-fixed end, and the area kept by the free region
-(status 1) and by the handles' triangles. Times: setup (factoring), one iteration (the
-iterative methods), and a re-solve (ours: a solve warm-started from the result; paper: a
-back-substitution; ARAP: one more iteration from its result).
+transform: ours rotation-aware (``edit_with_selection``'s default), the paper's linear edit (handle
+details transformed, one-ring relations) and its one- plus two-ring variant, libigl's ARAP
+(spokes-and-rims energy, ``MAX_ITER`` iterations from the rest shape, fixed and handle vertices
+constrained) and libigl's biharmonic deformation (``igl.harmonic`` with k = 2 on the
+displacements). Each result is measured against the survey's ``NAME-laplacian_editing.off`` (same
+connectivity: vertex-to-vertex distance, mean and max over the bbox diagonal), for folded triangles
+(normal against both its rest normal and the handle-turned one), the mean relative edge-length
+change over the edges with a non-fixed end, and the area kept by the free region (status 1) and by
+the handles' triangles, and the warnings each run raised. Times: setup (factoring), one iteration
+(the iterative methods), and a re-solve (ours: a solve warm-started from the result; paper: a
+back-substitution; ARAP: one more iteration from its result); "per iteration / ARAP" is the
+per-iteration time over libigl ARAP's on the same case and run.
+
+On the cactus, the turn of the trunk above the arms and of the upper arm (best-fit rotation,
+rest to result) and the upper arm's area kept, the parts defined from the rest shape
+(`cactus_parts`; the table's caption states the definition).
 
 Usage: python scripts/compare_deformation_benchmark.py [--out docs/results] [--pictures DIR] [--force]
 Writes OUT/deformation.json and OUT/deformation.md (and DIR/deformation_NAME.png with --pictures),
@@ -22,6 +27,7 @@ import argparse
 import os
 import sys
 import time
+import warnings
 
 import numpy as np
 
@@ -107,6 +113,38 @@ def _igl(V, F, status, T, method):
                "backend": "libigl"}
 
 
+def cactus_parts(V, status):
+    """``{"trunk above the arms": mask, "upper arm": mask}`` of the rest cactus (z up, arms along y).
+
+    An arm: the vertices more than 1 % of the bbox diagonal beyond the fixed foot's y-extent on
+    its side; the upper arm: the arm whose lowest vertex is higher; its junction: its vertices
+    within 3 % of the diagonal of that side; the trunk above the arms: the free vertices within the
+    foot's y-extent above the junction's highest vertex.
+    """
+    foot = V[status == 0, 1]
+    margin = 0.01 * bbox_diagonal(V)
+    arms = [V[:, 1] < foot.min() - margin, V[:, 1] > foot.max() + margin]
+    upper, side = max(zip(arms, (foot.min(), foot.max())), key=lambda a: V[a[0], 2].min())
+    junction = upper & (np.abs(V[:, 1] - side) < 3 * margin)
+    trunk = (status == 1) & (V[:, 1] >= foot.min()) & (V[:, 1] <= foot.max()) & (V[:, 2] > V[junction, 2].max())
+    return {"trunk above the arms": trunk, "upper arm": upper}
+
+
+def turn_degrees(P, Q):
+    """Angle (degrees) of the rotation that best maps the points ``P`` to ``Q``, centroids removed."""
+    U, _, Wt = np.linalg.svd((Q - Q.mean(0)).T @ (P - P.mean(0)))
+    R = U @ np.diag([1.0, 1.0, np.sign(np.linalg.det(U @ Wt))]) @ Wt
+    return float(np.degrees(np.arccos(np.clip((np.trace(R) - 1) / 2, -1.0, 1.0))))
+
+
+def measure_parts(V, F, X, parts):
+    """Turn (degrees) of each part and the area kept by the upper arm's triangles."""
+    arm = parts["upper arm"][F].all(axis=1)
+    return {"turn_trunk": turn_degrees(V[parts["trunk above the arms"]], X[parts["trunk above the arms"]]),
+            "turn_upper_arm": turn_degrees(V[parts["upper arm"]], X[parts["upper arm"]]),
+            "area_upper_arm": float(face_double_areas(X, F[arm]).sum() / face_double_areas(V, F[arm]).sum())}
+
+
 def measure(V, F, status, T, X, ref, E):
     diag = bbox_diagonal(V)
     dist = np.linalg.norm(X - ref, axis=1) / diag
@@ -133,10 +171,20 @@ def run_case(name, folder):
     E = _edges(F)
     row = {"case": name, "vertices": int(V.shape[0]), "faces": int(F.shape[0]),
            "counts": np.bincount(status, minlength=3).tolist(), "survey": measure(V, F, status, T, ref, ref, E)}
+    parts = cactus_parts(V, status) if name == "cactus" else None
+    if parts:
+        row["parts"] = {k: int(v.sum()) for k, v in parts.items()}
+        row["handle_turn"] = turn_degrees(V[status == 2], apply_transform(T, V[status == 2]))
+        row["survey"].update(measure_parts(V, F, ref, parts))
     results = {}
     for method in METHODS:
-        X, times = (_igl if method.startswith("igl") else _ours)(V, F, status, T, method)
-        row[method] = {**measure(V, F, status, T, X, ref, E), **times}
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            X, times = (_igl if method.startswith("igl") else _ours)(V, F, status, T, method)
+        row[method] = {**measure(V, F, status, T, X, ref, E), **times,
+                       "warnings": [f"{w.category.__name__}: {w.message}" for w in caught]}
+        if parts:
+            row[method].update(measure_parts(V, F, X, parts))
         results[method] = X
         print(name, method, {k: (round(v, 4) if isinstance(v, float) else v) for k, v in row[method].items()},
               flush=True)
@@ -148,16 +196,35 @@ def _cell(value, fmt):
 
 
 def table(rows):
-    lines = ["| case | method | to survey mean / max (% diag) | folded | edge-length change | area free / handle "
-             "| setup (s) | iterations | per iteration (ms) | re-solve (ms) |",
-             "|---|---|---|---:|---:|---|---:|---:|---:|---:|"]
+    lines = ["| case | method | to survey mean / max (% diag) | folded | warnings | edge-length change "
+             "| area free / handle | setup (s) | iterations | per iteration (ms) | per iteration / ARAP | re-solve (ms) |",
+             "|---|---|---|---:|---|---:|---|---:|---:|---:|---:|---:|"]
     for r in rows:
+        arap = r["igl arap"]["iteration_s"]
         for m in METHODS:
             x = r[m]
             lines.append(f"| {r['case']} | {m} | {100 * x['mean']:.2f} / {100 * x['max']:.2f} | {x['folded']} | "
-                         f"{x['edge_change']:.4f} | {x['area_free']:.3f} / {x['area_handle']:.3f} | "
+                         f"{', '.join(sorted({w.split(':')[0] for w in x['warnings']})) or 'none'} | {x['edge_change']:.4f} | {x['area_free']:.3f} / {x['area_handle']:.3f} | "
                          f"{_cell(x['setup_s'], '.3f')} | {_cell(x['iterations'], 'd')} | "
-                         f"{_cell(x['iteration_s'] and 1e3 * x['iteration_s'], '.2f')} | {1e3 * x['resolve_s']:.1f} |")
+                         f"{_cell(x['iteration_s'] and 1e3 * x['iteration_s'], '.2f')} | "
+                         f"{_cell(x['iteration_s'] and x['iteration_s'] / arap, '.2f')} | {1e3 * x['resolve_s']:.1f} |")
+    return "\n".join(lines)
+
+
+def parts_table(row):
+    """The cactus's parts: turns against the handle's and the upper arm's area kept."""
+    lines = [f"Cactus parts (the handle turns {row['handle_turn']:.1f} degrees; targets: the trunk within 10 degrees "
+             "of it, the upper arm >= 0.90 of its area). The parts, from the rest shape: an arm is the vertices more "
+             "than 1 % of the bbox diagonal beyond the fixed foot's y-extent (the trunk's width) on its side; the "
+             "upper arm is the arm whose lowest vertex is higher; the trunk above the arms is the free vertices "
+             "within the foot's y-extent above the upper arm's junction (its vertices within 3 % of the diagonal "
+             f"of the trunk's side) ({row['parts']['trunk above the arms']} and {row['parts']['upper arm']} "
+             "vertices). Turn: angle of the best-fit rotation of the part, rest to result (Kabsch); area: over the "
+             "triangles with all three vertices in the arm.", "",
+             "| method | trunk turn (degrees) | upper arm turn (degrees) | upper arm area kept |", "|---|---:|---:|---:|"]
+    for m in ("survey", *METHODS):
+        x = row[m]
+        lines.append(f"| {m} | {x['turn_trunk']:.1f} | {x['turn_upper_arm']:.1f} | {x['area_upper_arm']:.3f} |")
     return "\n".join(lines)
 
 
@@ -185,7 +252,7 @@ def main(argv=None):
             panels.append((ref, F, "survey: Laplacian editing"))
             elev, azim = VIEWS[name]
             _files.render_panels(pictures[k], panels, args.force, elev=elev, azim=azim, panel_size=2.6)
-    text = table(rows)
+    text = table(rows) + "\n\n" + "".join(parts_table(r) for r in rows if "parts" in r)
     print(text)
     conditions = _files.measured_conditions()
     _files.write_json(json_path, {"methods": METHODS, "igl_arap_iterations": MAX_ITER, "rows": rows, **conditions},

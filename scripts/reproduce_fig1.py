@@ -18,7 +18,12 @@ fractions of the bounding-box diagonal), sizes, and the run's time, load and pea
 Every edit is one CurvatureEditor (constructor = all factoring) and one solve.
 
 Every edit is the paper's linear one (``CurvatureEditor``, one-ring relations), so the figure is
-the paper's; the rotation-aware editor is compared in the deformation benchmark.
+the paper's. (a) and (b) also run the default edit, rotation-aware (``RotationAwareEditor`` with
+its default settings, as ``edit_with_selection`` and ``apply_curvature_editing`` run it) with the
+same handles, region and moves; (c) scales details, which only the paper's edit does. Every edit
+reports its folded triangles (normal against its rest one), its amplification (largest move over
+the handles' largest move; ``apply_curvature_editing`` and ``curvdetail edit`` warn above
+``AMPLIFICATION_LIMIT``) and the warnings it raised.
 
 Usage: python scripts/reproduce_fig1.py [--out out/fig1] [--docs docs/results] [--force]
 Writes OUT/fig1.json, OUT/fig1.md, OUT/fig1a.png, OUT/fig1b.png, OUT/fig1c.png, and with --docs DIR
@@ -32,6 +37,7 @@ import json
 import os
 import sys
 import time
+import warnings
 
 import numpy as np
 
@@ -40,7 +46,9 @@ import _files  # noqa: E402
 from _meshes import MESHES, require  # noqa: E402
 
 from curvdetail import CurvatureEditor, boundary_vertices, mean_curvature_normal, read_mesh
-from curvdetail.curvature.geometry import bbox_diagonal
+from curvdetail.curvature.geometry import bbox_diagonal, folded_triangles
+from curvdetail.curvature.rotation_editor import RotationAwareEditor
+from curvdetail.filters.editing import AMPLIFICATION_LIMIT
 
 Y_UP = np.array([[1.0, 0, 0], [0, 0, -1.0], [0, 1.0, 0]])   # display y-up models with z up
 
@@ -57,6 +65,28 @@ DEVIL = {"horn_radius": 0.03, "base_ring": [0.05, 0.06], "detail_scales": [0.5, 
 
 def near(V, i, radius):
     return np.flatnonzero(np.linalg.norm(V - V[i], axis=1) < radius)
+
+
+def checks(V, F, X, handles, caught):
+    """Folded triangles, amplification (None for unmoved handles) and the warnings caught."""
+    moved = np.linalg.norm(X - V, axis=1)
+    on_handles = moved[handles].max() if handles.size else 0.0
+    amplification = float(moved.max() / on_handles) if on_handles > 1e-12 * bbox_diagonal(V) else None
+    return {"folded_triangles": int(folded_triangles(V, F, X, np.eye(3)).size), "amplification": amplification,
+            "amplified": amplification is not None and amplification > AMPLIFICATION_LIMIT,
+            "warnings": [f"{w.category.__name__}: {w.message}" for w in caught]}
+
+
+def default_edit(V, F, handles, roi, P):
+    """The default (rotation-aware) edit of the same handles, region and positions."""
+    t = time.perf_counter()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        ed = RotationAwareEditor(V, F, handles, roi=roi)
+        X = ed.solve(P)
+    return X, {"seconds": time.perf_counter() - t, "iterations": ed.iterations, "converged": ed.converged,
+               "max_move_fraction": float(np.linalg.norm(X - V, axis=1).max() / bbox_diagonal(V)),
+               **checks(V, F, X, handles, caught)}
 
 
 def summary(name, V, F, X, ed, seconds, config):
@@ -83,8 +113,14 @@ def elephant():
     P = V[handles].copy()
     P[:hl.size] += np.asarray(ELEPHANT["left_ear_move"]) * diag
     P[hl.size:] += np.asarray(ELEPHANT["right_ear_move"]) * diag
-    X = ed.solve(positions=P)
-    return V, F, X, summary("elephant", V, F, X, ed, time.perf_counter() - t, ELEPHANT), True
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        X = ed.solve(positions=P)
+    info = summary("elephant", V, F, X, ed, time.perf_counter() - t, ELEPHANT)
+    info.update(checks(V, F, X, handles, caught))
+    Xd, info["default"] = default_edit(V, F, handles, roi, P)
+    info["default_panel"] = (Xd, "default (rotation-aware)")
+    return V, F, X, info, True
 
 
 def cactus():
@@ -101,8 +137,14 @@ def cactus():
     for i, shift in zip(tips, CACTUS["tip_moves"].values()):
         sel = np.linalg.norm(P - V[i], axis=1) < radius
         P[sel] += np.asarray(shift) * diag
-    X = ed.solve(positions=P)
-    return V, F, X, summary("cactus", V, F, X, ed, time.perf_counter() - t, CACTUS), False
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        X = ed.solve(positions=P)
+    info = summary("cactus", V, F, X, ed, time.perf_counter() - t, CACTUS)
+    info.update(checks(V, F, X, handles, caught))
+    Xd, info["default"] = default_edit(V, F, handles, roi, P)
+    info["default_panel"] = (Xd, "default (rotation-aware)")
+    return V, F, X, info, False
 
 
 def horn_tips(V, F, K):
@@ -153,10 +195,12 @@ def devil():
     for scale in DEVIL["detail_scales"]:
         D = ed.detail[dc].copy()
         D[neck.size:] *= scale                                      # scale the horn's details
-        X = ed.solve(details=D)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            X = ed.solve(details=D)
         K, _ = mean_curvature_normal(X, F)
         results[scale] = {
-            "X": X,
+            "X": X, **checks(V, F, X, neck, caught),
             "horn_length_ratio": float(horn_length(X, tip) / horn_length(V, tip)),
             "other_horn_length_ratio": float(horn_length(X, other) / horn_length(V, other)),
             "head_height_ratio": float(np.ptp(X[:, 2]) / np.ptp(V[:, 2])),
@@ -171,6 +215,8 @@ def devil():
                 horn_vertices=int(horn.size), tip_curvature_over_median=float(curvature[tip] / np.median(curvature)))
     for scale, r in results.items():
         info[f"detail_x{scale}"] = {k: v for k, v in r.items() if k != "X"}
+    info.update({k: info[f"detail_x{high}"][k] for k in ("folded_triangles", "amplification", "amplified")})
+    info["warnings"] = sorted({w for r in results.values() for w in r["warnings"]})
     info["extra_panel"] = (results[low]["X"], f"horn detail x{low:g}: horn length "
                                               f"x{results[low]['horn_length_ratio']:.2f}")
     info["edited_label"] = (f"horn detail x{high:g}: horn length x{results[high]['horn_length_ratio']:.2f},\n"
@@ -178,19 +224,39 @@ def devil():
     return V, F, X, info, False
 
 
+def _said(messages):
+    """The warnings' categories, for a table cell (their messages are in the JSON)."""
+    return ", ".join(sorted({m.split(":")[0] for m in messages})) or "none"
+
+
 def markdown(report, env):
     """The Fig. 1 page: one table of the edits, one of the horn's detail scales."""
-    lines = ["# Fig. 1: mesh editing with curvature detail (the paper's edit, `CurvatureEditor`)", "",
+    lines = ["# Fig. 1: mesh editing with curvature detail (the paper's edit, `CurvatureEditor`, and the default)", "",
              "Written by `python scripts/reproduce_fig1.py --docs docs/results --force`; settings, counts and "
              "the run's load in [fig1.json](fig1.json). Moves in % of the bounding-box diagonal.", "",
              _files.environment_line(env), "",
-             "| edit | model | vertices | faces | region | position constrained | detail constrained | "
-             "largest move (%) | seconds |",
-             "|---|---|---:|---:|---:|---:|---:|---:|---:|"]
+             "Each edit also runs as the default, rotation-aware edit where it can (same handles, region and "
+             "moves; (c) scales details, which only the paper's edit does). Folded: triangles whose normal turned "
+             "against its rest one; amplification: largest move over the handles' largest move (the editing "
+             f"filter and `curvdetail edit` warn above {AMPLIFICATION_LIMIT:g}; - where the handles do not move); "
+             "warnings: the categories of those the edit raised (their messages in the JSON).", "",
+             "| edit | model | method | vertices | faces | region | position constrained | detail constrained | "
+             "largest move (%) | folded | amplification | warnings | iterations | seconds |",
+             "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|"]
+
+    def cells(x):
+        amp = "-" if x["amplification"] is None else f"{x['amplification']:.2f}"
+        return (f"{100 * x['max_move_fraction']:.1f} | {x['folded_triangles']} | {amp} | "
+                f"{_said(x['warnings'])}")
+
     for key, r in zip("abc", report):
-        lines.append(f"| ({key}) | {r['model']} | {r['vertices']} | {r['faces']} | {r['roi']} | "
-                     f"{r['position_constrained']} | {r['detail_constrained']} | "
-                     f"{100 * r['max_move_fraction']:.1f} | {r['seconds']:.2f} |")
+        lines.append(f"| ({key}) | {r['model']} | paper | {r['vertices']} | {r['faces']} | {r['roi']} | "
+                     f"{r['position_constrained']} | {r['detail_constrained']} | {cells(r)} | - | {r['seconds']:.2f} |")
+        if "default" in r:
+            d = r["default"]
+            lines.append(f"| ({key}) | {r['model']} | default (rotation-aware) | {r['vertices']} | {r['faces']} | "
+                         f"{r['roi']} | {r['position_constrained']} | - | {cells(d)} | {d['iterations']}"
+                         f"{'' if d['converged'] else ' (not converged)'} | {d['seconds']:.2f} |")
     devil_ = report[-1]
     lines += ["", f"(c) the horn's curvature detail `D = K A` scaled ({devil_['horn_vertices']} vertices; "
               "ratios to the rest shape):", "",
@@ -223,7 +289,8 @@ def main(argv=None):
     for key, make in (("fig1a", elephant), ("fig1b", cactus), ("fig1c", devil)):
         V, F, X, info, y_up = make()
         extra = info.pop("extra_panel", None)
-        label = info.pop("edited_label", "edited (colour: distance moved)")
+        default = info.pop("default_panel", None)
+        label = info.pop("edited_label", "the paper's edit (colour: distance moved)")
         report.append(info)
         show = (lambda P: P @ Y_UP.T) if y_up else (lambda P: P)
         moved = np.linalg.norm(X - V, axis=1)
@@ -232,6 +299,8 @@ def main(argv=None):
         if extra is not None:
             panels.append((show(extra[0]), F, extra[1], np.linalg.norm(extra[0] - V, axis=1)))
         panels.append((show(X), F, label, moved))
+        if default is not None:
+            panels.append((show(default[0]), F, default[1], np.linalg.norm(default[0] - V, axis=1)))
         _files.render_panels(os.path.join(args.out, key + ".png"), panels, args.force, elev=elev, azim=azim)
         print(json.dumps(info))
     env = _files.environment()

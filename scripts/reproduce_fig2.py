@@ -17,8 +17,13 @@ The JSON holds the settings (``config``: the thresholds, the turn, the offset, t
 the terrain's sines), the meshes' vertex and face counts, and the run's time, load and peak
 memory.
 
-Every edit is the paper's linear one (``CurvatureEditor`` / ``edit_with_selection(method="paper")``
-/ ``edit_boundary``), so the figure is the paper's.
+The figure's edits are the paper's linear one (``CurvatureEditor`` /
+``edit_with_selection(method="paper")`` / ``edit_boundary(method="paper")``). Each sub-figure
+also runs the default settings: the cow's moved handles through ``edit_with_selection(V, F,
+status, T)``, the terrain's sines through ``edit_boundary(V, F, displacement)`` with no option
+(both rotation-aware). Every edit reports its folded triangles, its amplification (largest move over the
+handles' or the boundary's largest move; the editing filter and ``curvdetail edit`` warn above
+``AMPLIFICATION_LIMIT``) and the warnings it raised (the default ones are not silenced).
 
 Usage: python scripts/reproduce_fig2.py [--out out/fig2] [--docs docs/results] [--force]
 Writes OUT/fig2.json, OUT/fig2.md, OUT/fig2a.png, OUT/fig2b.png, and with --docs DIR also
@@ -41,8 +46,9 @@ import _files  # noqa: E402
 from _meshes import MESHES, require  # noqa: E402
 
 from curvdetail import CurvatureEditor, edit_boundary, read_mesh, sine_displacement
-from curvdetail.curvature.geometry import bbox_diagonal
+from curvdetail.curvature.geometry import bbox_diagonal, folded_triangles
 from curvdetail.curvature.errors import FoldedTrianglesWarning
+from curvdetail.filters.editing import AMPLIFICATION_LIMIT
 from curvdetail.io.deformation import edit_with_selection
 from curvdetail.plot import view_direction
 
@@ -59,7 +65,18 @@ COW = {"region_x_above": 0.18, "handles_x_above": 0.42, "turn_degrees": 35.0, "p
 #: the handles are also placed where the turn and the offset take them (edit_with_selection)
 COW_VARIANTS = (("paper", "transform", "one-ring"), ("paper", "transform", "one+two-ring"),
                 ("moved", "transform", "one-ring"), ("moved", "transform", "one+two-ring"),
-                ("moved", "free", "one-ring"))
+                ("moved", "free", "one-ring"), ("moved", "default", "rotation-aware"))
+
+
+def _warnings(caught):
+    return [f"{w.category.__name__}: {w.message}" for w in caught]
+
+
+def _amplification(V, X, moved_part):
+    """Largest move over the largest move of ``moved_part`` (None where that part did not move)."""
+    moved = np.linalg.norm(X - V, axis=1)
+    on_part = moved[moved_part].max()
+    return float(moved.max() / on_part) if on_part > 1e-12 * bbox_diagonal(V) else None
 
 
 def cow():
@@ -83,12 +100,16 @@ def cow():
     meshes = {}
     for positions, handle_detail, relations in COW_VARIANTS:
         t = time.perf_counter()
-        if positions == "paper":
-            ed = CurvatureEditor(V, F, np.empty(0, dtype=np.int64), handles, roi=roi, relations=relations)
-            X = ed.solve(details=ed.detail[handles] @ R.T)
-        else:
-            X, ed = edit_with_selection(V, F, status, T, method="paper", handle_detail=handle_detail,
-                                        relations=relations, return_editor=True)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            if positions == "paper":
+                ed = CurvatureEditor(V, F, np.empty(0, dtype=np.int64), handles, roi=roi, relations=relations)
+                X = ed.solve(details=ed.detail[handles] @ R.T)
+            elif handle_detail == "default":
+                X, ed = edit_with_selection(V, F, status, T, return_editor=True)
+            else:
+                X, ed = edit_with_selection(V, F, status, T, method="paper", handle_detail=handle_detail,
+                                            relations=relations, return_editor=True)
         variant = f"{positions}/{handle_detail}/{relations}"
         moved = np.linalg.norm(X - V, axis=1)
         out[variant] = {"handle_positions": positions, "handle_detail": handle_detail, "relations": relations,
@@ -97,7 +118,12 @@ def cow():
                         "max_move_fraction": float(moved.max() / diag),
                         "handle_centroid_move_fraction": float(np.linalg.norm(X[handles].mean(0)
                                                                               - V[handles].mean(0)) / diag),
-                        "finite": bool(np.isfinite(X).all()), "rank_deficient": ed.rank_deficient}
+                        "finite": bool(np.isfinite(X).all()),
+                        "rank_deficient": getattr(ed, "rank_deficient", None),
+                        "iterations": getattr(ed, "iterations", None),
+                        "folded_triangles": int(folded_triangles(V, F, X, R).size),
+                        "amplification": _amplification(V, X, handles) if positions == "moved" else None,
+                        "warnings": _warnings(caught)}
         meshes[variant] = X
     return V, F, status, meshes, out
 
@@ -121,18 +147,24 @@ def terrain():
     meshes = {}
     for name, (axis, fraction) in TERRAIN["sines"].items():
         amp = fraction * extent
-        for mode, relations in (("deformed", "one-ring"), ("deformed", "one+two-ring"), ("rest", "one-ring")):
+        for mode, relations in (("deformed", "one-ring"), ("deformed", "one+two-ring"), ("rest", "one-ring"),
+                                ("default", "default")):
+            displacement = sine_displacement(amp, periods=TERRAIN["periods"], axis=axis)
             t = time.perf_counter()
-            with warnings.catch_warnings():
-                # the paper's one-ring cases fold on purpose here: counted below, not warned
-                warnings.simplefilter("ignore", FoldedTrianglesWarning)
-                X, info = edit_boundary(V, F, sine_displacement(amp, periods=TERRAIN["periods"], axis=axis),
-                                        boundary_detail=mode, relations=relations, return_info=True)
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                if mode == "default":             # every option at its default, every warning said
+                    X, info = edit_boundary(V, F, displacement, return_info=True)
+                else:
+                    # the paper's one-ring cases fold on purpose here: counted below, not warned
+                    warnings.simplefilter("ignore", FoldedTrianglesWarning)
+                    X, info = edit_boundary(V, F, displacement, method="paper", boundary_detail=mode, relations=relations,
+                                            return_info=True)
             b = info["boundary"]
             variant = f"{mode}/{relations}"
             out[f"{name}_{variant}"] = {
                 "amplitude": float(amp), "periods": TERRAIN["periods"], "boundary_detail": mode,
-                "relations": relations,
+                "relations": relations, "warnings": _warnings(caught),
                 "seconds": time.perf_counter() - t, "boundary_vertices": int(b.size),
                 "max_move_fraction": float(np.linalg.norm(X - V, axis=1).max() / bbox_diagonal(V)),
                 "height_range_ratio": float(np.ptp(X[:, 2]) / np.ptp(V[:, 2])),
@@ -142,9 +174,18 @@ def terrain():
     return V, F, meshes, out
 
 
+def _cell(value):
+    return "-" if value is None else f"{value:.2f}"
+
+
+def _said(messages):
+    """The warnings' categories, for a table cell (their messages are in the JSON)."""
+    return ", ".join(sorted({m.split(":")[0] for m in messages})) or "none"
+
+
 def markdown(cow_, terrain_, env):
     """The Fig. 2 page: one table per sub-figure."""
-    lines = ["# Fig. 2: shape editing (the paper's edit)", "",
+    lines = ["# Fig. 2: shape editing (the paper's edit, and the default)", "",
              "Written by `python scripts/reproduce_fig2.py --docs docs/results --force`; settings, counts and "
              "the run's load in [fig2.json](fig2.json). Moves in % of the bounding-box diagonal.", "",
              _files.environment_line(env), "",
@@ -152,24 +193,35 @@ def markdown(cow_, terrain_, env):
              f"turned by {cow_['config']['turn_degrees']:g} degrees. Handle positions \"paper\": only the "
              "handles' curvature normals turned; \"moved\": the handles also placed by the turn and a move of "
              f"{100 * cow_['config']['offset_towards_reader']:g} % towards the reader.", "",
-             "| handle positions | handle detail | relations | largest move (%) | handle centroid move (%) | seconds |",
-             "|---|---|---|---:|---:|---:|"]
+             "The last row is the default edit (`edit_with_selection(V, F, status, T)`, rotation-aware). Folded: "
+             "normal against both its rest one and the turned one; amplification: largest move over the "
+             f"handles' largest move (the editing filter and `curvdetail edit` warn above {AMPLIFICATION_LIMIT:g}; "
+             "- where the handles are not placed); warnings: the categories of those the edit raised (their "
+             "messages in the JSON).", "",
+             "| handle positions | handle detail | relations | largest move (%) | handle centroid move (%) | folded "
+             "| amplification | warnings | seconds |",
+             "|---|---|---|---:|---:|---:|---:|---|---:|"]
     for positions, detail, relations in COW_VARIANTS:
         r = cow_[f"{positions}/{detail}/{relations}"]
         lines.append(f"| {positions} | {detail} | {relations} | {100 * r['max_move_fraction']:.1f} | "
-                     f"{100 * r['handle_centroid_move_fraction']:.1f} | {r['seconds']:.2f} |")
+                     f"{100 * r['handle_centroid_move_fraction']:.1f} | {r['folded_triangles']} | "
+                     f"{_cell(r['amplification'])} | {_said(r['warnings'])} | {r['seconds']:.2f} |")
     lines += ["", f"(b) {terrain_['model']} ({terrain_['vertices']} vertices, {terrain_['faces']} triangles): "
               f"the boundary moved by {terrain_['config']['periods']} periods of a sine; folded = normals "
-              "pointing down (at rest: " + str(terrain_["rest_folded"]) + ").", "",
+              "pointing down (at rest: " + str(terrain_["rest_folded"]) + "); \"default\": `edit_boundary` with no "
+              "option, rotation-aware (the paper's rows silence its FoldedTrianglesWarning); amplification: largest move over the "
+              "boundary's largest move.", "",
               "| sine | amplitude | boundary detail | relations | largest move (%) | height range | folded | "
-              "folded against rest normals | seconds |",
-              "|---|---:|---|---|---:|---:|---:|---:|---:|"]
+              "folded against rest normals | amplification | warnings | seconds |",
+              "|---|---:|---|---|---:|---:|---:|---:|---:|---|---:|"]
     for key, r in terrain_.items():
         if isinstance(r, dict) and "boundary_detail" in r:
             lines.append(f"| {key.split('_')[0] + '_' + key.split('_')[1]} | {r['amplitude']:.3g} | "
-                         f"{r['boundary_detail']} | {r['relations']} | {100 * r['max_move_fraction']:.1f} | "
+                         + ("default (rotation-aware) | - | " if r["boundary_detail"] == "default" else
+                            f"{r['boundary_detail']} | {r['relations']} | ")
+                         + f"{100 * r['max_move_fraction']:.1f} | "
                          f"x{r['height_range_ratio']:.2f} | {r['folded_triangles']} | {r['folded_against_rest']} | "
-                         f"{r['seconds']:.2f} |")
+                         f"{_cell(r['amplification'])} | {_said(r['warnings'])} | {r['seconds']:.2f} |")
     lines += ["", "![Fig. 2](fig2.png)", ""]
     return "\n".join(lines)
 
@@ -193,7 +245,8 @@ def main(argv=None):
                            ("paper/transform/one+two-ring", "handle normals turned, positions\nfree, one+two-ring"),
                            ("moved/transform/one-ring", "handles moved,\ndetails turned"),
                            ("moved/transform/one+two-ring", "handles moved, details\nturned, one+two-ring"),
-                           ("moved/free/one-ring", "handles moved,\ndetails free")):
+                           ("moved/free/one-ring", "handles moved,\ndetails free"),
+                           ("moved/default/rotation-aware", "default: handles moved,\nrotation-aware")):
         X = meshes[variant]
         label += f"\nlargest move {100 * info_a[variant]['max_move_fraction']:.0f} %"
         panels.append((X @ Y_UP.T, F, label, np.linalg.norm(X - V, axis=1)))

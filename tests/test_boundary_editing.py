@@ -101,8 +101,8 @@ def test_displacement_array_of_the_wrong_shape_is_refused(load_mesh):
 
 def test_rest_boundary_detail_keeps_the_inside_detail(load_mesh):
     V, F = load_mesh("terrainA_1k.obj")
-    X, info = edit_boundary(V, F, sine_displacement(0.3, periods=2, axis=2), boundary_detail="rest",
-                            return_info=True)
+    X, info = edit_boundary(V, F, sine_displacement(0.3, periods=2, axis=2), method="paper",
+                            boundary_detail="rest", return_info=True)
     b, ed = info["boundary"], info["editor"]
     assert np.array_equal(info["boundary_detail"], ed.detail[b])
     # consistent detail constraints: the curvature stage gives back the rest detail everywhere
@@ -143,8 +143,9 @@ def test_stacked_relations_keep_a_large_boundary_sine_free_of_folds(load_mesh):
 
     assert folded(V) == 0
     with pytest.warns(FoldedTrianglesWarning):
-        assert folded(edit_boundary(V, F, f, relations="one-ring")) > 0
-    assert folded(edit_boundary(V, F, f, relations="one+two-ring")) == 0
+        assert folded(edit_boundary(V, F, f, method="paper", relations="one-ring")) > 0
+    assert folded(edit_boundary(V, F, f, method="paper", relations="one+two-ring")) == 0
+    assert folded(edit_boundary(V, F, f)) == 0          # the rotation-aware default
 
 
 def test_the_mesh_is_checked_and_its_laplacian_assembled_once(monkeypatch):
@@ -161,7 +162,7 @@ def test_the_mesh_is_checked_and_its_laplacian_assembled_once(monkeypatch):
     monkeypatch.setattr(module, "_assemble_upper", counting)
     V, F = grid(10, 10)
     V[:, 2] = 0.05 * np.sin(4 * V[:, 0])
-    X, info = edit_boundary(V, F, sine_displacement(0.1, axis=2), return_info=True)
+    X, info = edit_boundary(V, F, sine_displacement(0.1, axis=2), method="paper", return_info=True)
     assert calls.count(True) == 1               # the checked rest-shape L (the editor's)
     from curvdetail import cotan_laplacian
     monkeypatch.setattr(module, "_assemble_upper", real)
@@ -279,15 +280,25 @@ def test_a_displacement_that_collapses_the_boundary_is_refused_without_warnings(
     V, F = grid(10, 10)
     V[:, 2] = 0.1 * np.sin(3 * V[:, 0])
     with pytest.raises(ConstraintError, match=message or None) as e:
-        edit_boundary(V, F, displacement)
+        edit_boundary(V, F, displacement, method="paper")
     assert e.value.parameter == "displacement" and e.value.count >= 1
     # the advice: defined, no numpy warnings (a loop collapsed onto a point or a line does fold
     # the inside, and the fold warning says so)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        X = edit_boundary(V, F, displacement, boundary_detail="rest")
-    assert np.all(np.isfinite(X))
+        X = edit_boundary(V, F, displacement, method="paper", boundary_detail="rest")
+        Y = None if message else edit_boundary(V, F, displacement)      # the rotation-aware default
+    assert np.all(np.isfinite(X)) and (Y is None or np.all(np.isfinite(Y)))
     assert [w.category for w in caught if w.category is not FoldedTrianglesWarning] == []
+
+
+@pytest.mark.filterwarnings("error")
+def test_the_rotation_aware_default_refuses_a_boundary_moved_onto_one_point():
+    V, F = grid(10, 10)
+    V[:, 2] = 0.1 * np.sin(3 * V[:, 0])
+    with pytest.raises(ConstraintError) as e:
+        edit_boundary(V, F, lambda s, P: P.mean(axis=0) - P)
+    assert (e.value.parameter, e.value.count) == ("displacement", 36)
 
 
 @pytest.mark.filterwarnings("error")
@@ -382,7 +393,7 @@ def test_a_small_boundary_move_that_folds_the_inside_warns_with_the_count_and_th
     V, F = load_mesh("mannequin_nose.obj")
     f = sine_displacement(0.02 * _loop_extent(V, F), periods=2, axis=1)
     with pytest.warns(FoldedTrianglesWarning) as caught:
-        X, info = edit_boundary(V, F, f, return_info=True)
+        X, info = edit_boundary(V, F, f, method="paper", return_info=True)
     message = str(caught[-1].message)
     folds = info["folded_triangles"]
     # the boundary does not turn as a whole here (best-fitting rotation ~0): the count is the
@@ -400,7 +411,13 @@ def test_a_small_boundary_move_that_folds_the_inside_warns_with_the_count_and_th
     assert "relations='one+two-ring'" in message and "smaller displacement" in message
     # the advice names the other relations from the other side too
     with pytest.warns(FoldedTrianglesWarning, match="Try relations='one-ring'"):
-        edit_boundary(V, F, f, relations="one+two-ring")
+        edit_boundary(V, F, f, method="paper", relations="one+two-ring")
+    # the rotation-aware default folds nothing and does not amplify the move here
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        X, info = edit_boundary(V, F, f, return_info=True)
+    assert info["folded_triangles"] == 0 == _folded_against_rest(V, F, X)
+    assert info["amplification"] == pytest.approx(1.0)
 
 
 @pytest.mark.parametrize("scale, turn", [(1.0, False), (2.0, True)])
@@ -438,7 +455,7 @@ def test_a_small_smooth_edit_neither_folds_nor_warns(load_mesh):
     # base moves its far end further by leverage, with either relations, folded or not)
     V, F = load_mesh("mannequin_nose.obj")
     f = sine_displacement(0.005 * _loop_extent(V, F), periods=2, axis=1)
-    X, info = edit_boundary(V, F, f, return_info=True)
+    X, info = edit_boundary(V, F, f, method="paper", return_info=True)
     assert info["folded_triangles"] == 0 == _folded_against_rest(V, F, X)
     assert info["amplification"] > 3
     # the docstring's example and the one of docs/guide/editing.md (the package's terrain)

@@ -356,9 +356,11 @@ def test_auto_curvature_backend_follows_the_size_rule(monkeypatch):
     # SuperLU below CURVATURE_SPLU_MAX unknowns (faster back-substitution), the general choice
     # from it on (SuperLU's factorization grew 24 s at 1M against PARDISO's 8.5 s); same result
     import curvdetail.curvature.curvature_editor as editor_module
+    from curvdetail.curvature import sparse_solver
     from curvdetail.curvature.sparse_solver import resolve_backend
 
     monkeypatch.delenv("CURVDETAIL_SOLVER", raising=False)
+    monkeypatch.setattr(sparse_solver, "SMALL_SYSTEM_NNZ", 50_000)
     V, F = grid(100, 100)                  # ~70k entries: above the size "auto" gives SuperLU anyway
     V[:, 2] = 0.1 * np.sin(3 * V[:, 0]) * np.cos(2 * V[:, 1])
     b = boundary_vertices(F)

@@ -81,8 +81,12 @@ def test_print_filter_parameter_list_prints_like_pymeshlab(capsys):
     assert "\trows : str = 'all'" in out and "\tfix_boundary : bool = True" in out
 
 
-def test_filter_without_parameters_prints_none(capsys):
-    filters.print_filter_parameter_list("compute_curvature_detail")
+def test_filter_without_parameters_prints_none(capsys, monkeypatch):
+    from curvdetail.filters import registry
+
+    monkeypatch.setattr(registry, "_REGISTRY", dict(registry._REGISTRY))     # forgotten after the test
+    declare(name="get_nothing", category="c", description="d")(lambda ms: {})
+    filters.print_filter_parameter_list("get_nothing")
     assert capsys.readouterr().out.splitlines()[1] == "\tNone."
 
 

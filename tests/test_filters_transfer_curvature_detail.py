@@ -259,3 +259,21 @@ def test_pymeshlabs_own_retriangulation_of_a_curved_boundary_is_taken():
     ms.generate_copy_of_current_mesh()
     ms.meshing_isotropic_explicit_remeshing(iterations=10, targetlen=pymeshlab.PercentageValue(3.0))
     assert apply(ms, "transfer_curvature_detail", sourcemesh=0, targetmesh=1)["target_vertices"] > 0
+
+
+def test_a_closed_target_of_another_surface_is_refused_naming_its_vertices():
+    # not checked at all before: a sphere onto one 1.2 times its size (every vertex 5.8 % of the
+    # diagonal off)
+    from curvdetail.curvature.testing import icosphere
+
+    V, F = icosphere(subdivisions=3)
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(V, F))
+    ms.add_mesh(pymeshlab.Mesh(1.2 * V, F))
+    with pytest.raises(FilterError) as info:
+        apply(ms, "transfer_curvature_detail", sourcemesh=0, targetmesh=1)
+    e = info.value
+    assert e.parameter == "targetmesh" and e.count == V.shape[0] and e.first == [0, 1, 2]
+    assert vertex_attribute(ms, 1, "curvature_detail", "point") is None
+    ms.add_mesh(pymeshlab.Mesh(V, F))                                   # layer 2: the same sphere
+    assert apply(ms, "transfer_curvature_detail", sourcemesh=0, targetmesh=2)["target_vertices"] == V.shape[0]

@@ -6,7 +6,10 @@ import pytest
 from curvdetail.curvature import curvature_detail, mixed_voronoi_area
 from curvdetail.curvature.errors import ConstraintError, CurvdetailError, MeshError
 from curvdetail.curvature.testing import grid, icosphere
-from curvdetail.remesh import edge_curvature_measure, retriangulate, transfer_curvature
+from curvdetail.curvature.geometry import bbox_diagonal
+from curvdetail.curvature.topology import boundary_vertices
+from curvdetail.remesh import (SURFACE_TOLERANCE, RemeshError, check_retriangulation, closest_points,
+                               edge_curvature_measure, retriangulate, transfer_curvature)
 from curvdetail.curvature import boundary_loop
 
 
@@ -179,18 +182,86 @@ def test_a_planar_map_that_squashes_a_triangle_is_named_as_the_maps_doing(method
 
 
 @pytest.mark.parametrize("method", ["conservative", "pointwise"])
-def test_a_target_that_is_not_the_same_surface_is_refused(load_mesh, method):
+def test_a_target_far_from_the_source_is_refused(load_mesh, method):
     # the closest point of a far target would silently give it the wrong detail
     V, F = load_mesh("mannequin_nose.obj")
-    with pytest.raises(MeshError) as e:
+    with pytest.raises(RemeshError) as e:
         transfer_curvature(V, F, V + [0.0, 0.0, 1000.0], F, method=method)
-    assert e.value.parameter == "Vt" and e.value.value > 0.25        # in source diagonals
-    D = transfer_curvature(V, F, V + [0.0, 0.0, 1e-3], F, method=method)       # a slight offset is fine
+    assert e.value.count == boundary_vertices(F).size and e.value.value > 0.5
+    d = bbox_diagonal(V)
+    D = transfer_curvature(V, F, V + [0.0, 0.0, 1e-4 * d], F, method=method)   # a slight offset is fine
     # and gives the target the detail of the same surface: that of the identity transfer, up to
-    # the sampling's sensitivity to the 0.11 %-of-the-diagonal shift (measured 4.9 % and 4.8 %
-    # of max |D| for conservative and pointwise)
+    # the sampling's sensitivity to the shift
     same = transfer_curvature(V, F, V, F, method=method)
     assert np.abs(D - same).max() < 0.1 * np.abs(same).max()
+
+
+def _terrain_with_a_bump(load_mesh, height):
+    """terrainA_1k ``(V, F)`` and a copy whose vertices within 15 % of the diagonal of its centre
+    are raised by ``height`` x the diagonal, fading to 0 there (the boundary stays): ``(V, F, W, bumped)``."""
+    V, F = load_mesh("terrainA_1k.obj")
+    d = bbox_diagonal(V)
+    centre = 0.5 * (V.min(0) + V.max(0))
+    r = np.linalg.norm((V - centre)[:, :2], axis=1) / (0.15 * d)
+    W = V.copy()
+    W[:, 2] += height * d * np.clip(1 - r, 0, None) ** 2
+    return V, F, W, np.flatnonzero(r < 1)
+
+
+def test_a_disk_target_off_the_source_inside_its_boundary_is_refused_naming_the_vertices(load_mesh):
+    # the boundary matches, the inside is another terrain: up to 10 % of the diagonal off
+    V, F, W, bumped = _terrain_with_a_bump(load_mesh, 0.1)
+    d = bbox_diagonal(V)
+    off = np.flatnonzero(np.sqrt(closest_points(W, V, F)[0]) > SURFACE_TOLERANCE * d)
+    assert 0 < off.size < bumped.size and np.isin(off, bumped).all()
+    with pytest.raises(RemeshError) as e:
+        transfer_curvature(V, F, W, F)
+    assert e.value.count == off.size and e.value.first == off[:3].tolist()
+    assert e.value.value == pytest.approx(0.1, rel=0.2)
+    _, _, W, _ = _terrain_with_a_bump(load_mesh, 0.01)      # 1 %: a coarse retriangulation's error
+    transfer_curvature(V, F, W, F)
+
+
+def test_a_disk_target_whose_boundary_is_elsewhere_is_refused(load_mesh):
+    # terrainA_1k onto the same patch with its heights mirrored: rebuilt 16.6 % off, exit 0, before
+    V, F = load_mesh("terrainA_1k.obj")
+    W = V.copy()
+    W[:, 2] = V[:, 2].min() + V[:, 2].max() - V[:, 2]
+    with pytest.raises(RemeshError) as e:
+        transfer_curvature(V, F, W, F)
+    assert e.value.count > 0 and set(e.value.first) <= set(boundary_vertices(F).tolist())
+
+
+def test_a_closed_target_of_another_surface_is_refused():
+    # a sphere of radius 1 onto one of radius 1.2: every vertex 0.2 off (5.8 % of the diagonal;
+    # 1.1 would be 2.9 %, within SURFACE_TOLERANCE)
+    V, F = icosphere(subdivisions=3)
+    with pytest.raises(RemeshError) as e:
+        transfer_curvature(V, F, 1.2 * V, F)
+    assert e.value.count == V.shape[0] and e.value.first == [0, 1, 2]
+    assert e.value.value == pytest.approx(0.2 / bbox_diagonal(V), rel=1e-2)     # the chords sag below 1
+
+
+def test_a_closed_source_onto_a_disk_target_is_refused_by_its_loops():
+    V, F = icosphere(subdivisions=3)
+    Vt, Ft = _cap(radius=1.0)
+    with pytest.raises(RemeshError) as e:
+        transfer_curvature(V, F, Vt, Ft)
+    assert e.value.count == 1 and e.value.first == [int(boundary_vertices(Ft).min())]   # its loop's first vertex
+
+
+@pytest.mark.parametrize("closed", [True, False])
+def test_a_true_retriangulation_passes(load_mesh, closed):
+    # pymeshlab's isotropic remeshing, closed (a bumpy sphere) and a disk (the nose)
+    if closed:
+        V, F = icosphere(subdivisions=4)
+        V *= 1 + 0.1 * np.sin(3 * V[:, [0]])
+    else:
+        V, F = load_mesh("mannequin_nose.obj")
+    Vt, Ft = retriangulate(V, F, target_edge="3%")
+    assert check_retriangulation(V, F, Vt, Ft) is None
+    Dt = transfer_curvature(V, F, Vt, Ft)
+    assert np.abs(Dt.sum(0) - curvature_detail(V, F).sum(0)).max() < 1e-12 * np.abs(Dt).sum()
 
 
 def _located_on_grid():

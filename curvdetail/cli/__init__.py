@@ -20,7 +20,7 @@ import sys
 import time
 import warnings
 
-from .options import (AMPLIFIED, NOT_CONVERGED, Progress, add_backend, add_fix, add_input_output,
+from .options import (AMPLIFIED, NOT_CONVERGED, Progress, add_backend, add_fix, add_input_output, add_laplacian,
                           add_overwrite, check_outputs, choice, diagonal, figures_status, fixed_vertices,
                           error_line, input_output, length, note_dropped, positive_number, print_figures,
                           quality_for, read_checked, run_on_file, say, show_warning, whole_number_from_one,
@@ -55,6 +55,7 @@ def _reconstruct(parser):
     add_input_output(parser, "mesh file", "rebuilt mesh; quality = distance to INPUT (.ply keeps it)")
     choice(parser, "--rows", ("all", "free"), "all",
            "residual rows in E_Q: all vertices (the paper) or free ones only (default: %(default)s)")
+    add_laplacian(parser, "the mesh's Laplacian")
     add_fix(parser)
     add_backend(parser)
     add_overwrite(parser)
@@ -62,21 +63,31 @@ def _reconstruct(parser):
     def run(args):
         import numpy as np
 
-        from .. import Reconstructor, anchor_vertices, curvature_detail
+        from .. import Reconstructor, anchor_vertices
+        from ..curvature.cotan_laplacian import laplacian_product
+        from ..curvature.robust_laplacian import checked_laplacian, flip_caps
 
         inputs = input_output(args)
         check_outputs(args, [("OUTPUT", args.output, True)], **inputs)
-        V, F, extras = read_noting_extras(args.input)
-        # the boundary (or --fix), and an anchor on each piece with no fixed vertex (a closed one)
-        fixed = anchor_vertices(V, F, fixed=None if args.fix is None else fixed_vertices(args, V, F, purpose=""))
+        V, F, extras = read_noting_extras(args.input, check=False)
+        V, F, L, used = checked_laplacian(V, F, args.laplacian)
+        D = laplacian_product(L, V)
+        # the boundary (or --fix), and an anchor on each piece with no fixed vertex (a closed one),
+        # placed on the surface with its zero-area caps flipped away, where areas are defined
+        located = F if used["laplacian"] == "cotan" else flip_caps(V, F)
+        fixed = anchor_vertices(V, located, detail=D,
+                                fixed=None if args.fix is None else fixed_vertices(args, V, F, purpose=""))
         t = time.perf_counter()
-        rec = Reconstructor(V, F, fixed, rows=args.rows, backend=args.backend)
-        X = rec.solve(curvature_detail(V, F), V[rec.fixed])
+        rec = Reconstructor(V, F, fixed, rows=args.rows, backend=args.backend, laplacian=used["laplacian"])
+        X = rec.solve(D, V[rec.fixed])
         seconds = time.perf_counter() - t
         dist = np.linalg.norm(X - V, axis=1)
         write_measured(args.output, X, F, dist, diagonal_of=V, overwrite=args.overwrite)
         print_figures(f"max vertex error {dist.max() / diagonal(V):.3e} of the bbox diagonal ({V.shape[0]} "
-                      f"vertices, {fixed.size} fixed, rows={args.rows}, {seconds:.3f} s)")
+                      f"vertices, {fixed.size} fixed, rows={args.rows}, laplacian={used['laplacian']}, "
+                      f"{seconds:.3f} s)")
+        if used["laplacian"] == "robust":
+            say(f"note: the robust Laplacian: {used['laplacian_reason']}")
         note_dropped(args.output, quality=True)
         note_not_carried(args.input, args.output, extras)
         return 0
@@ -151,9 +162,7 @@ def _remesh(parser):
            "planar domain for --location uv (default: harmonic)")
     parser.add_argument("--no-surface-check", action="store_true",
                         help="isotropic remeshing without its surface-distance check (faster on big targets)")
-    choice(parser, "--laplacian", ("auto", "cotan", "robust"), "auto",
-           "the source's Laplacian for its detail: robust = mollified, for zero-area triangles; auto "
-           "uses it only where cotan refuses the source (the report says which)")
+    add_laplacian(parser, "the source's Laplacian for its detail")
     add_backend(parser)
     parser.add_argument("--report", metavar="R.json", help="write the JSON report here")
     parser.add_argument("--image", metavar="FIG.png", help="write a picture: source, rebuilt, zero-detail baseline")

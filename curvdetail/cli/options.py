@@ -62,6 +62,14 @@ def choice(parser, name, choices, default, help):
     parser.add_argument(name, type=str.lower, choices=choices, default=default, help=help)
 
 
+def add_laplacian(parser, what):
+    from ..curvature.robust_laplacian import LAPLACIANS
+
+    choice(parser, "--laplacian", LAPLACIANS, "auto",
+           f"{what}: cotan (refuses zero-area triangles), robust (mollified, for zero-area triangles) or "
+           "auto (robust only where cotan refuses the mesh; the output says which ran)")
+
+
 def add_backend(parser):
     from ..curvature.sparse_solver import BACKENDS
 
@@ -111,16 +119,16 @@ def read_checked(path):
     return check_mesh(*read_mesh(path))
 
 
-def read_noting_extras(path):
-    """``(V, F, extras)``: `read_checked`, and what else INPUT holds per vertex that a
-    command writing new geometry does not carry (``"vertex colours"``, ``"normals"``), for
-    `note_not_carried`."""
+def read_noting_extras(path, check=True):
+    """``(V, F, extras)``: `read_checked` (``check=False``: `read_mesh` alone, for a command
+    whose library call checks), and what else INPUT holds per vertex that a command writing new
+    geometry does not carry (``"vertex colours"``, ``"normals"``), for `note_not_carried`."""
     from .. import check_mesh, read_mesh
 
     V, F, fields = read_mesh(path, fields=True)
     extras = [what for what, names in (("vertex colours", ("red", "green", "blue")), ("normals", ("nx", "ny", "nz")))
               if set(names) <= set(fields)]
-    return (*check_mesh(V, F), extras)
+    return (*(check_mesh(V, F) if check else (V, F)), extras)
 
 
 def note_not_carried(input_path, output_path, extras):

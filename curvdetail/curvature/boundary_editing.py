@@ -15,20 +15,25 @@ from .topology import _compact_ids, boundary_edges, check_oriented, vertex_compo
 from .cotan_laplacian import _cotan_laplacian_unchecked, laplacian_product
 from .curvature_coefficients import DEFAULT_RCOND, check_rcond
 from .curvature_editor import CurvatureEditor, _check_relations
+from .rotation_editor import RotationAwareEditor
 from .errors import ConstraintError, CurvdetailError, FoldedTrianglesWarning, MeshError, counted, first_indices
 from .sparse_solver import factorize, resolve_backend
 
 
 @ignoring_underflow
-def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="one-ring",
+def edit_boundary(V, F, displacement, *, method="rotation", boundary_detail=None, relations=None,
                   rcond=DEFAULT_RCOND, backend="auto", return_info=False):
     """Move the boundary of a disk-topology patch and rebuild the surface from its detail.
 
-    The boundary loop is moved by ``displacement`` and its curvature detail updated (``"deformed"``,
-    the paper: the details of a provisional surface, the boundary's best-fitting similarity applied
-    to the patch and the rest of the move spread harmonically inside; ``"rest"``: kept); then a
-    `CurvatureEditor` with the boundary's positions and details constrained rebuilds the
-    interior. See docs/guide/editing.md, "Shape editing of a boundary".
+    The boundary loop is moved by ``displacement``; the interior is rebuilt with the boundary's
+    new positions constrained. ``method="rotation"`` (the default): the patch is moved by the
+    boundary's best-fitting similarity, then a `RotationAwareEditor` turns each detail with its
+    neighbourhood. ``method="paper"``: the boundary's curvature detail is
+    updated (``boundary_detail="deformed"``, the paper: the details of a provisional surface, the
+    boundary's best-fitting similarity applied to the patch and the rest of the move spread
+    harmonically inside; ``"rest"``: kept), then a `CurvatureEditor` with the boundary's positions
+    and details constrained rebuilds the interior. See docs/guide/editing.md, "Shape editing of a
+    boundary".
 
     Parameters
     ----------
@@ -41,17 +46,19 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
         boundary vertex along the loop and ``P`` their (b, 3) positions; or the displacements
         themselves, row r for ``info["boundary"][r]``. `sine_displacement` builds the
         paper's sine.
-    boundary_detail : {"deformed", "rest"}
-        How the boundary's detail is updated.
-    relations : {"one-ring", "one+two-ring"}
-        Curvature-stage relations of `CurvatureEditor`.
+    method : {"rotation", "paper"}
+        Rotation-aware edit (no fold on the paper's Fig. 2b sines) or the paper's linear edit.
+    boundary_detail : {"deformed", "rest"} or None
+        ``"paper"`` only (None: ``"deformed"``): how the boundary's detail is updated.
+    relations : {"one-ring", "one+two-ring"} or None
+        ``"paper"`` only (None: ``"one-ring"``): curvature-stage relations of `CurvatureEditor`.
     rcond : float
         Threshold of `curvature_coefficients`.
     backend : str
         Sparse solver backend.
     return_info : bool
-        Also return a dict: ``boundary`` (loop order), ``arc_length``, ``boundary_detail`` (b, 3),
-        ``editor`` (for re-solves), ``folded_triangles`` (normal against the rest one, the
+        Also return a dict: ``boundary`` (loop order), ``arc_length``, ``boundary_detail`` (b, 3;
+        None with ``"rotation"``), ``editor`` (for re-solves), ``iterations`` (``"rotation"``), ``folded_triangles`` (normal against the rest one, the
         boundary's rotation discounted), ``max_displacement`` / ``boundary_displacement`` (largest
         move of any / a boundary vertex over the rest bbox diagonal), ``amplification`` (their
         ratio, None for an unmoved boundary).
@@ -91,9 +98,17 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
     True
     """
     # the options before the mesh and the displacement callable
-    boundary_detail = check_choice(boundary_detail, "boundary_detail", ("deformed", "rest"),
-                              "; use 'deformed' or 'rest'.")
-    _check_relations(relations)
+    method = check_choice(method, "method", ("rotation", "paper"), "; use 'rotation' or 'paper'.")
+    if boundary_detail is not None:
+        boundary_detail = check_choice(boundary_detail, "boundary_detail", ("deformed", "rest"),
+                                       "; use 'deformed' or 'rest'.")
+    if relations is not None:
+        _check_relations(relations)
+    for name, value in (("boundary_detail", boundary_detail), ("relations", relations)):
+        if method == "rotation" and value is not None:
+            raise ConstraintError(f"{name} applies to method='paper' only", parameter=name, value=value,
+                                  hint=f"pass method='paper' with {name}, or leave {name} out")
+    boundary_detail, relations = boundary_detail or "deformed", relations or "one-ring"
     check_rcond(rcond)
     resolve_backend(backend)
     check_bool(return_info, "return_info")
@@ -117,13 +132,25 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
     # before any algebra: beyond 1e75 the provisional surface's areas overflow
     _check_magnitude(Q, "the displaced boundary (its positions plus the displacement)", ConstraintError,
                      "use a smaller displacement")
-    editor = CurvatureEditor(V, F, loop, loop, relations=relations, rcond=rcond, backend=backend)
     s_, R, t = _similarity(P, Q)                # R also turns the rest normals for the fold count
-    if boundary_detail == "rest":
-        Db = editor.detail[loop]
-    else:                                       # editor.laplacian: of the rest shape
-        Db = _deformed_boundary_detail(V, F, editor.laplacian, loop, P, Q, s_, R, t, backend)
-    X = editor.solve(positions=Q, details=Db)
+    Db, iterations = None, None
+    if method == "rotation":
+        if not np.ptp(Q, axis=0).max() > 1e-12 * np.ptp(P, axis=0).max() or s_ * bbox_diagonal(V) < MIN_DIAGONAL:
+            raise ConstraintError(f"the displacement moves all {loop.size} boundary vertices onto one point",
+                                  parameter="displacement", count=loop.size,
+                                  hint="use a displacement that keeps the loop open")
+        # the patch moved by the boundary's best-fitting similarity first: a similarity of the
+        # whole boundary is then the rest state of the rotation-aware energy
+        editor = RotationAwareEditor(s_ * V @ R.T + t, F, loop, backend=backend)
+        X = editor.solve(Q)
+        iterations = editor.iterations
+    else:
+        editor = CurvatureEditor(V, F, loop, loop, relations=relations, rcond=rcond, backend=backend)
+        if boundary_detail == "rest":
+            Db = editor.detail[loop]
+        else:                                   # editor.laplacian: of the rest shape
+            Db = _deformed_boundary_detail(V, F, editor.laplacian, loop, P, Q, s_, R, t, backend)
+        X = editor.solve(positions=Q, details=Db)
     folded = folded_triangles(V, F, X, R)          # a patch turned as a whole counts none
     diag, moved = bbox_diagonal(V), np.linalg.norm(X - V, axis=1)
     on_loop = moved[loop].max()
@@ -131,10 +158,11 @@ def edit_boundary(V, F, displacement, *, boundary_detail="deformed", relations="
                "boundary_displacement": float(on_loop / diag),
                "amplification": float(moved.max() / on_loop) if on_loop > 1e-12 * diag else None}
     if folded.size:
-        _warn_folded(figures, folded, F.shape[0], boundary_detail, relations)
+        _warn_folded(figures, folded, F.shape[0], method, boundary_detail, relations)
     if not return_info:
         return X
-    return X, {"boundary": loop, "arc_length": s, "boundary_detail": Db, "editor": editor, **figures}
+    return X, {"boundary": loop, "arc_length": s, "boundary_detail": Db, "editor": editor,
+               "iterations": iterations, **figures}
 
 
 def _deformed_boundary_detail(V, F, L, loop, P, Q, s_, R, t, backend):
@@ -155,14 +183,18 @@ def _deformed_boundary_detail(V, F, L, loop, P, Q, s_, R, t, backend):
     return laplacian_product(_cotan_laplacian_unchecked(Vp, F), Vp)[loop]
 
 
-def _warn_folded(figures, folded, m, boundary_detail, relations):
+def _warn_folded(figures, folded, m, method, boundary_detail, relations):
     """A `FoldedTrianglesWarning` with the figures and what to try."""
     ratio, moved, on_loop = (figures[k] for k in ("amplification", "max_displacement", "boundary_displacement"))
     how_far = (f"vertices moved up to {ratio:.1f} times as far as the boundary ({100 * moved:.3g} % against "
                f"{100 * on_loop:.3g} % of the bbox diagonal)" if ratio is not None else
                f"vertices moved up to {100 * moved:.3g} % of the bbox diagonal, the boundary not at all")
     other = "one+two-ring" if relations == "one-ring" else "one-ring"
-    if boundary_detail == "deformed":
+    settings = f"boundary_detail={boundary_detail!r}, relations={relations!r}"
+    if method == "rotation":
+        cause, tries, settings = "", "a smaller displacement or method='paper' with boundary_detail='rest'", \
+            "method='rotation'"
+    elif boundary_detail == "deformed":
         cause = "; the curvature stage amplified the boundary's detail change (see docs/guide/editing.md)"
         tries = (f"relations={other!r}, a smaller displacement or boundary_detail='rest' (the inside keeps "
                  "its rest detail and follows the boundary)")
@@ -170,8 +202,7 @@ def _warn_folded(figures, folded, m, boundary_detail, relations):
         cause, tries = "", f"a smaller displacement or relations={other!r}"
     warnings.warn(
         f"edit_boundary: {counted(folded.size, 'triangle')} of {m} folded over (normal against the rest "
-        f"shape's; first: {first_indices(folded)}) with boundary_detail={boundary_detail!r}, "
-        f"relations={relations!r}: "
+        f"shape's; first: {first_indices(folded)}) with {settings}: "
         f"{how_far}{cause}. Try {tries}.", FoldedTrianglesWarning, stacklevel=3)
 
 

@@ -119,7 +119,8 @@ def checked_arrays(V, F, *, check_manifold=True, check_unreferenced=True):
     return _check_mesh(V, F, check_manifold, check_unreferenced)[:2]
 
 
-def _check_mesh(V, F, check_manifold, check_unreferenced, cotangents=False):
+def _check_mesh(V, F, check_manifold, check_unreferenced, cotangents=False, zero_area=True):
+    """``(V, F, cot)`` after every check; ``zero_area=False`` lets zero-area triangles pass."""
     V = as_vertices(V)
     F = as_faces(F, V.shape[0])
     diag = bbox_diagonal(V)
@@ -139,7 +140,7 @@ def _check_mesh(V, F, check_manifold, check_unreferenced, cotangents=False):
         else:
             dbl = face_double_areas(V, F)
     zero = np.flatnonzero(dbl <= 2.0 * ZERO_AREA_RELATIVE * diag ** 2)
-    if zero.size:
+    if zero.size and zero_area:
         raise MeshError(f"{counted(zero.size, 'triangle', verb='have')} zero area (first: {first_indices(zero)}; "
                         f"areas up to {ZERO_AREA_RELATIVE:g} of the bbox diagonal squared count); "
                         f"{ZERO_AREA_ADVICE.replace('them', them(zero.size), 1)}, "

@@ -6,7 +6,8 @@ import scipy.sparse as sp
 from .checks import as_count, as_index_set, as_values, check_choice
 from .geometry import bbox_centre
 from .topology import check_every_component_fixed
-from .cotan_laplacian import _symmetric_from_upper, checked_cotan_triangle
+from .cotan_laplacian import _symmetric_from_upper
+from .robust_laplacian import checked_laplacian_triangle
 from .errors import ConstraintError, CurvdetailError
 from .sparse_solver import SolverError, _upper_triangle, factorize, resolve_backend
 
@@ -18,7 +19,7 @@ class Reconstructor:
 
     Minimizes the paper's ``E_Q = sum_i |(L X)_i - D_i|^2`` over the free positions ``X_f``, the
     fixed positions ``X_c`` kept exactly; ``L`` is the cotangent Laplacian of ``V_ref`` (positive
-    semi-definite, see `cotan_laplacian`). ``rows="all"`` sums over every vertex (the
+    semi-definite, see `cotan_laplacian`), or its mollified version where ``laplacian`` says so. ``rows="all"`` sums over every vertex (the
     paper): normal equations ``(L_:f^T L_:f) X_f = L_:f^T (D - L_:c X_c)``, each solve followed by
     corrected semi-normal refinement (`refine_least_squares`), which keeps the error at
     ~1e-14 of the solution. ``rows="free"`` sums over the free vertices only: the square system
@@ -42,6 +43,11 @@ class Reconstructor:
     refinement_steps : int, optional
         Least refinement steps of ``rows="all"`` solves (default: the class attribute, 1), at
         most ``MAX_LEAST_REFINEMENT_STEPS``; 0 gives the plain normal-equation solution.
+    laplacian : {"auto", "cotan", "robust"}
+        "cotan" the plain cotangent Laplacian (refuses zero-area triangles), "robust" the
+        mollified one (`robust_laplacian`), "auto" the plain one unless ``V_ref`` has zero-area
+        triangles (`choose_laplacian`). Rebuild from the detail of the same Laplacian
+        (`checked_laplacian`).
 
     Attributes
     ----------
@@ -53,16 +59,19 @@ class Reconstructor:
         The solver backend in use.
     refinement_steps : int
         Least refinement steps of ``rows="all"`` solves.
+    laplacian, laplacian_reason : str
+        The Laplacian used ("cotan" or "robust") and why.
 
     Raises
     ------
     MeshError
-        If the mesh is malformed (see `check_mesh`).
+        If the mesh is malformed (see `check_mesh`), or has zero-area triangles with
+        ``laplacian="cotan"`` (``parameter`` "laplacian", ``first``: the first triangles).
     ConstraintError
         If there is no fixed vertex, ``fixed`` is out of range, repeated or a mask of the wrong
         length, or a connected piece has no fixed vertex.
     ValueError
-        If ``rows`` is unknown.
+        If ``rows`` or ``laplacian`` is unknown.
     SolverError
         If ``backend`` is unknown or not installed.
 
@@ -81,7 +90,7 @@ class Reconstructor:
     #: back-substitution); 0 gives the plain normal-equation solution
     refinement_steps = 1
 
-    def __init__(self, V_ref, F, fixed, *, rows="all", backend="auto", refinement_steps=None):
+    def __init__(self, V_ref, F, fixed, *, rows="all", backend="auto", refinement_steps=None, laplacian="auto"):
         rows = check_choice(rows, "rows", ROW_MODES, " is not a row mode; use 'all' (the paper's E_Q) or 'free'.")
         if refinement_steps is not None:
             try:
@@ -94,15 +103,16 @@ class Reconstructor:
                 raise CurvdetailError(f"{exc} (1, the default, gives solver precision; 0 skips the "
                                       "refinement).", parameter="refinement_steps", value=refinement_steps) from None
         self.rows = rows
-        system = self._build(V_ref, F, fixed, backend)
+        system = self._build(V_ref, F, fixed, backend, laplacian)
         self._factor = factorize(system, symmetric=True, backend=backend, upper=self._upper) \
             if self.free.size else None
         self.backend = self._factor.backend if self._factor is not None else "none"
 
-    def _build(self, V_ref, F, fixed, backend):
+    def _build(self, V_ref, F, fixed, backend, laplacian):
         """Every check, then the system to factor; ``self._upper`` says whether it is given as its
         upper triangle."""
-        V_ref, F, U, diagonal = checked_cotan_triangle(V_ref, F)
+        V_ref, F, U, diagonal, info = checked_laplacian_triangle(V_ref, F, laplacian)
+        self.laplacian, self.laplacian_reason = info["laplacian"], info["laplacian_reason"]
         n = V_ref.shape[0]
         self.n = n
         self.fixed = as_index_set(fixed, n, "fixed")
@@ -298,7 +308,8 @@ class _FreeSystemLayout:
         return upper, L_fc
 
 
-def reconstruct(V_ref, F, detail, fixed, fixed_positions, *, rows="all", backend="auto"):
+def reconstruct(V_ref, F, detail, fixed, fixed_positions, *, rows="all", backend="auto", laplacian="auto",
+                return_info=False):
     """Rebuild positions from curvature detail with some vertices fixed (one-off solve).
 
     Builds a `Reconstructor` and calls `Reconstructor.solve` once; keep a
@@ -321,20 +332,27 @@ def reconstruct(V_ref, F, detail, fixed, fixed_positions, *, rows="all", backend
         Residual rows in the energy (see `Reconstructor`).
     backend : str
         Sparse solver backend.
+    laplacian : {"auto", "cotan", "robust"}
+        The Laplacian of ``V_ref`` (see `Reconstructor`; "auto": the plain one unless ``V_ref`` has
+        zero-area triangles).
+    return_info : bool
+        Also return ``info``.
 
     Returns
     -------
     X : (n, 3) float array
         With ``X[fixed] == fixed_positions`` exactly.
+    info : dict
+        With ``return_info``: ``{"laplacian": "cotan" or "robust", "laplacian_reason": why}``.
 
     Raises
     ------
     MeshError
-        If the mesh is malformed.
+        If the mesh is malformed, or has zero-area triangles with ``laplacian="cotan"``.
     ConstraintError
         If ``fixed`` is refused, a shape is wrong, or a connected piece has no fixed vertex.
     ValueError
-        If ``rows`` is unknown.
+        If ``rows`` or ``laplacian`` is unknown.
     SolverError
         If ``backend`` is unknown or not installed, or the refinement stalls.
 
@@ -348,4 +366,6 @@ def reconstruct(V_ref, F, detail, fixed, fixed_positions, *, rows="all", backend
     >>> bool(abs(X - V).max() < 1e-12)
     True
     """
-    return Reconstructor(V_ref, F, fixed, rows=rows, backend=backend).solve(detail, fixed_positions)
+    rec = Reconstructor(V_ref, F, fixed, rows=rows, backend=backend, laplacian=laplacian)
+    X = rec.solve(detail, fixed_positions)
+    return (X, {"laplacian": rec.laplacian, "laplacian_reason": rec.laplacian_reason}) if return_info else X

@@ -6,7 +6,9 @@
 
 ``"auto"`` (also the environment variable ``CURVDETAIL_SOLVER``, which a named backend
 overrides) takes SuperLU below ``SMALL_SYSTEM_NNZ`` stored entries and otherwise the first
-installed of PARDISO, CHOLMOD (symmetric systems only) and SuperLU (docs/results/solver_ab.json).
+installed of PARDISO, CHOLMOD (symmetric systems only) and SuperLU. SuperLU runs on one thread:
+below that size MKL's threads do not pay, and on a busy machine they cost up to 10x
+(docs/results/small_solves.md).
 """
 
 import os
@@ -21,8 +23,8 @@ from .errors import CurvdetailError
 
 BACKENDS = ("pardiso", "cholmod", "splu")
 
-#: Below this many stored entries ``"auto"`` takes SuperLU (the shortest start-up).
-SMALL_SYSTEM_NNZ = 50_000
+#: Below this many stored entries (a ~28k-vertex Laplacian) ``"auto"`` takes SuperLU.
+SMALL_SYSTEM_NNZ = 200_000
 
 #: What ``"auto"`` picks, in a line (for parameter descriptions and help texts).
 AUTO_RULE = (f"auto = SuperLU below {SMALL_SYSTEM_NNZ:,} stored entries, else the first installed of "

@@ -3,11 +3,17 @@
 import numpy as np
 
 from ..curvature.topology import boundary_vertices, check_oriented
-from ..curvature.curvature_detail import curvature_detail
+from ..curvature.cotan_laplacian import laplacian_product
 from ..curvature.mixed_voronoi_area import mixed_voronoi_area
+from ..curvature.robust_laplacian import LAPLACIANS, checked_laplacian, robust_laplacian
+from .parameters import Parameter
 from .detail_attributes import AREA, DETAIL, NORMAL, store_detail  # noqa: F401  (names re-exported)
 from .meshset import layer_id, mesh_arrays, set_vertex_quality, vertex_normals
 from .registry import PAPER, filter
+
+LAPLACIAN_DESCRIPTION = ("the mesh's Laplacian: 'cotan' (refuses zero-area triangles), 'robust' (mollified "
+                         "intrinsic cotan) or 'auto' (cotan unless the mesh has zero-area triangles); the "
+                         "returned 'laplacian' says which ran")
 
 
 def signed_mean_curvature(V, F, K):
@@ -34,18 +40,19 @@ def signed_mean_curvature(V, F, K):
         the boundary's geodesic curvature in K and are left out of the figures, which are None
         where every vertex lies on the boundary). H's sign needs
         consistently oriented triangles: others are refused (meshing_re_orient_faces_coherently
-        orients them). {PAPER},
+        orients them). Zero-area triangles (scans) take the mollified Laplacian (laplacian 'auto' or
+        'robust'; A is then its lumped mass); the returned 'laplacian' says which ran. {PAPER},
         section "Curvature detail representation".
     """,
-    parameters=[],
+    parameters=[Parameter("laplacian", "str", "auto", LAPLACIAN_DESCRIPTION, choices=LAPLACIANS)],
 )
-def compute_curvature_detail(ms):
+def compute_curvature_detail(ms, *, laplacian):
     mid = layer_id(ms)
-    V, F = mesh_arrays(ms, mid)
-    D = curvature_detail(V, F)
+    V, F, L, info = checked_laplacian(*mesh_arrays(ms, mid), laplacian)
+    D = laplacian_product(L, V)         # = curvature_detail(V, F) bit for bit with the plain L
     # H's sign comes from the vertex normals: with reversed triangles it was +-H at random
     check_oriented(F, "the current mesh")
-    A = mixed_voronoi_area(V, F)
+    A = mixed_voronoi_area(V, F) if info["laplacian"] == "cotan" else robust_laplacian(V, F)[1].diagonal()
     K = D / A[:, None]                  # = mean_curvature_normal(V, F)[0], bit for bit; L built once
     H = signed_mean_curvature(V, F, K)
     store_detail(ms, mid, F, D, K, A)
@@ -65,4 +72,5 @@ def compute_curvature_detail(ms):
         "surface_area": float(A.sum()),
         "interior_vertices": int(interior.sum()),
         "boundary_vertices": int(boundary.size),
+        **info,
     }

@@ -265,9 +265,6 @@ def print_filter_parameter_list(name):
         rows : str = 'all'
         fix_boundary : bool = True
     ...
-    >>> print_filter_parameter_list("compute_curvature_detail")          # doctest: +NORMALIZE_WHITESPACE
-    compute_curvature_detail filter - list of parameter names:
-        None.
     """
     spec = get_filter(name)
     print(f"{spec.name} filter - list of parameter names:")

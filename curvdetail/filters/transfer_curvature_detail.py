@@ -3,7 +3,8 @@
 import numpy as np
 
 from ..curvature import curvature_detail, mixed_voronoi_area
-from .compute_curvature_detail import signed_mean_curvature
+from ..curvature.robust_laplacian import LAPLACIANS, source_detail
+from .compute_curvature_detail import LAPLACIAN_DESCRIPTION, signed_mean_curvature
 from .detail_attributes import DETAIL, load_detail, store_detail
 from .errors import FilterError, FilterParameterError
 from .meshset import layer_id, mesh_arrays, set_vertex_quality, vertex_attribute
@@ -23,23 +24,20 @@ def planar_map(location, parameterization, default="harmonic"):
     return None
 
 
-def check_retriangulation(Vs, loops_s, Vt, loops_t, source, target):
-    """FilterError (``parameter`` 'targetmesh', ``value`` the largest distance as a fraction of
-    the source's diagonal, ``first`` target vertices) unless the target's boundary vertices lie
-    on the source's boundary within ``RETRIANGULATION_TOLERANCE``, as ``remesh_experiment``
-    asks of a given target: another surface gives a result that measures nothing."""
-    from ..curvature.geometry import bbox_diagonal
-    from ..remesh import RETRIANGULATION_TOLERANCE, RemeshError, check_target_boundary
+def check_retriangulation(Vs, Fs, Vt, Ft, source, target):
+    """`curvdetail.remesh.check_retriangulation` (boundary within ``RETRIANGULATION_TOLERANCE``,
+    every vertex within ``SURFACE_TOLERANCE`` of the source) in the filter's words: FilterError
+    with ``parameter`` 'targetmesh' and the check's ``value``, ``count`` and ``first`` (target
+    vertices)."""
+    from ..remesh import RemeshError
+    from ..remesh import check_retriangulation as check
 
-    given = np.concatenate(loops_t) if loops_t else np.zeros(0, dtype=np.int64)
     try:
-        check_target_boundary([Vs[loop] for loop in loops_s], Vt[given], bbox_diagonal(Vs),
-                              f"pass a retriangulation of layer {source} as the target (e.g. from "
-                              "generate_curvature_remeshing)", tolerance=RETRIANGULATION_TOLERANCE)
+        check(Vs, Fs, Vt, Ft, advice=f"pass a retriangulation of layer {source} as the target (e.g. from "
+                                     "generate_curvature_remeshing)")
     except RemeshError as exc:
-        first = None if exc.first is None else given[exc.first].tolist()
         raise FilterError(f"layer {target}: {exc.problem}", parameter="targetmesh", value=exc.value,
-                          hint=exc.hint, count=exc.count, first=first) from None
+                          hint=exc.hint, count=exc.count, first=exc.first) from None
 
 
 @filter(
@@ -47,8 +45,9 @@ def check_retriangulation(Vs, loops_s, Vt, loops_t, source, target):
     category="Curvature detail",
     description=f"""
         Carry the curvature detail of the source layer (a manifold surface; a disk-topology
-        patch for location 'uv') over to the target layer (a retriangulation of it: its boundary
-        vertices within 0.1 % of the diagonal of the source's boundary, else refused), the transfer
+        patch for location 'uv') over to the target layer (a retriangulation of it: as many
+        boundary loops, its boundary vertices within 0.1 % of the diagonal of the source's
+        boundary and every vertex within 3 % of the source's surface, else refused), the transfer
         step of the paper's remeshing experiment. The detail carried is the source's stored 'curvature_detail' where it holds
         one (from compute_curvature_detail, kept while its vertices were moved; refused if the
         source was retriangulated since, as apply_curvature_reconstruction refuses it), else the
@@ -60,7 +59,10 @@ def check_retriangulation(Vs, loops_s, Vt, loops_t, source, target):
         a shared planar parameterization with the boundary on the unit circle by arc length
         ('uv'). Stores the target's 'curvature_detail', 'curvature_normal' (D / A) and
         'curvature_area' attributes, ready for apply_curvature_reconstruction, and sets its vertex
-        quality to the transferred signed mean curvature. {PAPER}, section "Remeshing", Fig. 3.
+        quality to the transferred signed mean curvature. A source with zero-area triangles (scans)
+        gives its detail by the mollified Laplacian (laplacian 'auto' or 'robust'; its caps are
+        flipped away for locating points); the returned 'laplacian' says which ran (None for
+        stored detail). {PAPER}, section "Remeshing", Fig. 3.
     """,
     parameters=[
         Parameter("sourcemesh", "mesh", 0,
@@ -77,9 +79,11 @@ def check_retriangulation(Vs, loops_s, Vt, loops_t, source, target):
         Parameter("parameterization", "str", "harmonic",
                   "planar map for location='uv' (only): own cotangent 'harmonic' map, pymeshlab's "
                   "'meshlab_harmonic' or 'lscm'", choices=("harmonic", "meshlab_harmonic", "lscm")),
+        Parameter("laplacian", "str", "auto", "where the detail is computed: the source's " + LAPLACIAN_DESCRIPTION,
+                  choices=LAPLACIANS),
     ],
 )
-def transfer_curvature_detail(ms, *, sourcemesh, targetmesh, method, location, parameterization):
+def transfer_curvature_detail(ms, *, sourcemesh, targetmesh, method, location, parameterization, laplacian):
     from ..remesh import check_surface, parameterize, transfer_curvature
     from ..remesh.transfer import squashed_in_plane
 
@@ -91,28 +95,31 @@ def transfer_curvature_detail(ms, *, sourcemesh, targetmesh, method, location, p
                           hint="load or generate the retriangulation as another layer (e.g. layer 1)")
     Vs, Fs = mesh_arrays(ms, source)
     Vt, Ft = mesh_arrays(ms, target)
-    _, _, loops_s = check_surface(Vs, Fs, f"the source (layer {source})")   # 'uv': parameterize asks for disks
-    _, _, loops_t = check_surface(Vt, Ft, f"the target (layer {target})")
-    check_retriangulation(Vs, loops_s, Vt, loops_t, source, target)
+    # zero-area caps (scans): the robust detail, and the caps flipped away for locating points
+    Fl, Dr, used = source_detail(Vs, Fs, laplacian)
+    Vs, Fl, _ = check_surface(Vs, Fl, f"the source (layer {source})")   # 'uv': parameterize asks for disks
+    Vt, Ft, _ = check_surface(Vt, Ft, f"the target (layer {target})")
+    check_retriangulation(Vs, Fl, Vt, Ft, source, target)
     # stored detail outlives moved vertices (the editing use); a broken stamp is refused in load_detail
     stored = vertex_attribute(ms, source, DETAIL, "point") is not None
-    Ds = load_detail(ms, source, Fs) if stored else curvature_detail(Vs, Fs)
-    figures = {"method": method, "location": location, "detail_source": "stored" if stored else "computed"}
+    Ds = load_detail(ms, source, Fs) if stored else curvature_detail(Vs, Fs) if Dr is None else Dr
+    figures = {"method": method, "location": location, "detail_source": "stored" if stored else "computed",
+               **(dict.fromkeys(used, None) if stored else used)}
     uv = None
     if location == "uv":
-        UVs, UVt, info = parameterize(Vs, Fs, Vt, Ft, method=parameterization)
+        UVs, UVt, info = parameterize(Vs, Fl, Vt, Ft, method=parameterization)
         # a collapsed triangle named in the filter's words (the transfer's own refusal names uv[1]
         # (UVt) and parameterize(...), which a filter user never sees)
         other = "parameterization='harmonic' or " if parameterization != "harmonic" else ""
-        for which, layer, UV, T in (("source", source, UVs, Fs), ("target", target, UVt, Ft)):
+        for which, layer, UV, T in (("source", source, UVs, Fl), ("target", target, UVt, Ft)):
             squashed_in_plane(UV, T, f"the {parameterization} parameterization of the {which} (layer {layer})",
                               f"Use {other}location='closest' (no planar map).", FilterError)
         uv = (UVs, UVt)
         figures.update(parameterization=parameterization, flipped_source=info["flipped_source"],
                        flipped_target=info["flipped_target"],
                        boundary_mismatch=info["boundary_mismatch"])
-    Dt = transfer_curvature(Vs, Fs, Vt, Ft, method=method, location=location, uv=uv,
-                            detail=Ds if stored else None)
+    Dt = transfer_curvature(Vs, Fl, Vt, Ft, method=method, location=location, uv=uv,
+                            detail=Ds if stored or Dr is not None else None)
     At = mixed_voronoi_area(Vt, Ft)
     Kt = Dt / At[:, None]
     store_detail(ms, target, Ft, Dt, Kt, At)

@@ -5,7 +5,8 @@ Depends on `curvdetail.curvature` (operators and solvers), pymeshlab (isotropic 
 Hausdorff distance), libigl (closest points) and fast-simplification (decimation).
 """
 
-from ._disk import RETRIANGULATION_TOLERANCE, NotADiskError, RemeshError, check_disk, check_surface, check_target_boundary
+from ._disk import (RETRIANGULATION_TOLERANCE, SURFACE_TOLERANCE, NotADiskError, RemeshError, check_disk,
+                    check_retriangulation, check_surface, check_target_boundary)
 from .closest_point import closest_points
 from .evaluate import hausdorff, vertex_distance
 from .experiment import WorseThanZeroDetailWarning, remesh_experiment
@@ -16,7 +17,7 @@ from .transfer import edge_curvature_measure, transfer_curvature
 
 __all__ = [
     "LongRunWarning", "NotADiskError", "RemeshError", "WorseThanZeroDetailWarning", "check_disk", "check_surface",
-    "RETRIANGULATION_TOLERANCE", "check_target_boundary", "closest_points",
+    "RETRIANGULATION_TOLERANCE", "SURFACE_TOLERANCE", "check_retriangulation", "check_target_boundary", "closest_points",
     "edge_curvature_measure", "flipped_triangles", "harmonic_map", "hausdorff", "interpolate", "locate",
     "parameterize", "remesh_experiment", "retriangulate", "spread", "transfer_curvature", "vertex_distance",
 ]

@@ -13,6 +13,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from ..curvature.checks import as_faces, check_mesh
+from ..curvature.geometry import bbox_diagonal
 from ..curvature.topology import boundary_edges, check_oriented, non_manifold_edges, vertex_components
 from ..curvature.boundary_editing import loop_of_boundary_edges
 from ..curvature.errors import CurvdetailError, MeshError, counted, first_indices
@@ -349,3 +350,84 @@ def check_target_boundary(P, X, d, advice, tolerance=TARGET_BOUNDARY_TOLERANCE):
             f"coordinate; allowed {tolerance:g}): the target must be a retriangulation of "
             "the source with its boundary vertices on the source's boundary", hint=advice,
             value=float(dist.max()), count=int(off.size), first=off[:3].tolist())
+
+
+#: A target vertex further than this (x the source's bbox diagonal) from the source's surface is
+#: refused as not a retriangulation of it: isotropic remeshing reprojects its vertices onto the
+#: surface (1e-16 measured), a decimation to its coarsest (10 % edges, ~100 vertices: spot,
+#: bunny, the nose) lies up to 1.5 % off; terrainA_1k with its heights mirrored lies up to 7 % off.
+SURFACE_TOLERANCE = 0.03
+
+
+def check_retriangulation(Vs, Fs, Vt, Ft, *, boundary_tolerance=RETRIANGULATION_TOLERANCE,
+                          surface_tolerance=SURFACE_TOLERANCE, advice=None):
+    """RemeshError unless the target ``(Vt, Ft)`` is a retriangulation of the source ``(Vs, Fs)``.
+
+    The check `remesh_experiment` makes of a given target and `transfer_curvature` of
+    every target: another surface would be given detail that is not its own, and rebuilt far off
+    (terrainA_1k onto another terrain patch: 16.6 % of the diagonal) without a word. In order:
+
+    1. as many boundary loops (a closed source, a closed target);
+    2. every target boundary vertex on the source's boundary (`check_target_boundary`,
+       within ``boundary_tolerance``);
+    3. every target vertex within ``surface_tolerance`` x the source's bbox diagonal of the source
+       surface (exact closest point, `closest_points`), plus 1e-6 of the largest coordinate
+       (float32 files far from the origin).
+
+    Parameters
+    ----------
+    Vs, Fs : (n_s, 3) float, (m_s, 3) int arrays
+        The source, checked (e.g. by `check_surface`).
+    Vt, Ft : (n_t, 3) float, (m_t, 3) int arrays
+        The target, checked.
+    boundary_tolerance : float
+        As in `check_target_boundary` (default ``RETRIANGULATION_TOLERANCE``).
+    surface_tolerance : float
+        Fraction of the source's bbox diagonal (default ``SURFACE_TOLERANCE``, 3 %).
+    advice : str or None
+        The hint (what to pass instead).
+
+    Raises
+    ------
+    RemeshError
+        ``count``: the target vertices off (or the target's boundary loops, where their number
+        differs), ``first``: the first of them (target vertex indices), ``value``: the largest
+        distance, as a fraction of the diagonal (or the target's loop count).
+    MeshError
+        A boundary that is not a set of simple loops (misoriented triangles).
+
+    Examples
+    --------
+    >>> from curvdetail.curvature.testing import icosphere
+    >>> V, F = icosphere(subdivisions=2)
+    >>> check_retriangulation(V, F, V, F)                       # a mesh is its own retriangulation
+    >>> check_retriangulation(V, F, 1.2 * V, F)
+    Traceback (most recent call last):
+    ...
+    curvdetail.remesh._disk.RemeshError: 162 of 162 target vertices lie off the source's surface ...
+    """
+    from .closest_point import closest_points
+
+    advice = advice or "pass a retriangulation of the source (e.g. from curvdetail.remesh.retriangulate)"
+    d = bbox_diagonal(Vs)
+    loops_s = boundary_loops(Fs, Vs.shape[0], "the source")
+    loops_t = boundary_loops(Ft, Vt.shape[0], "the target")
+    if len(loops_s) != len(loops_t):
+        raise RemeshError(f"the target has {counted(len(loops_t), 'boundary loop')} and the source "
+                          f"{len(loops_s)}: the target must be a retriangulation of the source", hint=advice,
+                          value=len(loops_t), count=len(loops_t), first=[int(loop[0]) for loop in loops_t[:3]])
+    if loops_t:
+        given = np.concatenate(loops_t)
+        try:
+            check_target_boundary([Vs[loop] for loop in loops_s], Vt[given], d, advice, tolerance=boundary_tolerance)
+        except RemeshError as exc:          # rows of the boundary vertices, named as target vertices
+            exc.first = given[exc.first].tolist()
+            raise
+    dist = np.sqrt(closest_points(Vt, Vs, Fs)[0]) / d
+    allowed = surface_tolerance + 1e-6 * max(float(np.abs(Vs).max()), float(np.abs(Vt).max())) / d
+    off = np.flatnonzero(dist > allowed)
+    if off.size:
+        raise RemeshError(f"{off.size} of {Vt.shape[0]} target vertices lie off the source's surface (up to "
+                          f"{100 * dist.max():.3g} % of its bbox diagonal; allowed {100 * surface_tolerance:g} %, "
+                          f"first: {first_indices(off)}): the target must be a retriangulation of the source",
+                          hint=advice, value=float(dist.max()), count=int(off.size), first=off[:3].tolist())

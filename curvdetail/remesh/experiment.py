@@ -10,12 +10,12 @@ from ..curvature.errors import CurvdetailError, MeshError, warn
 from ..curvature.checks import as_count, check_bool, check_choice
 from ..curvature.geometry import bbox_diagonal
 from ..curvature.anchors import anchor_vertices
-from ..curvature.robust_laplacian import degenerate_triangles, flip_caps, robust_laplacian
+from ..curvature.robust_laplacian import LAPLACIANS, source_detail
 from ..curvature.topology import boundary_vertices
 from ..curvature.reconstruct import ROW_MODES, Reconstructor
 from ..curvature.sparse_solver import resolve_backend
 from ._disk import TARGET_BOUNDARY_TOLERANCE, RemeshError  # noqa: F401 (their home before)
-from ._disk import check_disk, check_surface, check_target_boundary
+from ._disk import check_disk, check_retriangulation, check_surface
 from .evaluate import Surface
 from .parameterize import METHODS as PARAMETERIZATIONS
 from .parameterize import parameterize
@@ -53,10 +53,6 @@ RMS, MAX = "hausdorff_rms_percent_of_diagonal", "hausdorff_max_percent_of_diagon
 
 #: Measurements of the evaluate stage, reported one by one as ``progress("evaluate", done, total)``.
 EVALUATION_STEPS = 5
-
-#: The source's Laplacian (its detail D = L V): "auto" uses "cotan" unless the plain checks
-#: refuse the source's zero-area triangles, then "robust" (`_source`).
-LAPLACIANS = ("auto", "cotan", "robust")
 
 STAGES = ("retriangulate", "parameterize", "transfer", "reconstruct", "evaluate")
 
@@ -222,8 +218,10 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="c
     CurvdetailError
         ``target_edge`` not a positive length (even with a ``target``)
     RemeshError
-        Absurd target edge (with the numbers), a failed retriangulation, or a ``target`` with
-        boundary vertices off the source's boundary polyline (by more than
+        Absurd target edge (with the numbers), a failed retriangulation, or a ``target`` that is
+        not a retriangulation of the source (`check_retriangulation`: other boundary loops,
+        vertices more than ``SURFACE_TOLERANCE`` off its surface, or boundary vertices off the
+        source's boundary polyline by more than
         ``TARGET_BOUNDARY_TOLERANCE`` = 1e-6 of the larger of the bbox diagonal and the largest
         coordinate)
     ValueError
@@ -311,29 +309,11 @@ def _check_choice(name, value, choices):
 def _source(V, F, laplacian):
     """The checked source ``(V, F, loops)`` for the geometric stages, its detail (None: the plain
     cotan one, which the transfer computes itself) and the report's ``laplacian`` and
-    ``laplacian_reason``. "auto" falls back to "robust" only where `check_surface` refuses
-    zero-area triangles; the robust path flips the zero-area caps away (a needle, two vertices at
-    one point, is still refused, by the same checks, naming it)."""
-    if laplacian != "robust":
-        try:
-            return (*check_surface(V, F, "the source"), None,
-                    {"laplacian": "cotan", "laplacian_reason": f"laplacian={laplacian!r}: the plain "
-                     "cotangent Laplacian (the source has no zero-area triangle)"})
-        except MeshError:
-            if laplacian == "cotan" or not degenerate_triangles(V, F).size:
-                raise
-    zero = degenerate_triangles(V, F)
-    flipped = flip_caps(V, F)
-    V, F_geometric, loops = check_surface(V, flipped, "the source (its zero-area caps flipped)")
-    L, _, delta = robust_laplacian(V, F)
-    why = ("asked for (laplacian='robust')" if laplacian == "robust" else
-           "laplacian='auto': the plain cotangent Laplacian refuses them")
-    return V, F_geometric, loops, L @ V, {
-        "laplacian": "robust",
-        "laplacian_reason": f"{zero.size} zero-area source triangles (first: {zero[:3].tolist()}), {why}; "
-                            f"mollified (every edge + {delta:.3g}), and for the other stages "
-                            f"{int((flipped != np.asarray(F)).any(axis=1).sum())} triangles re-cut by "
-                            "flipping the caps' long edges (the same surface)"}
+    ``laplacian_reason``, by `source_detail` (its zero-area caps flipped away where the robust
+    Laplacian runs; a needle, two vertices at one point, is still refused, naming it)."""
+    F_located, detail, used = source_detail(V, F, laplacian)
+    what = "the source" if detail is None else "the source (its zero-area caps flipped)"
+    return (*check_surface(V, F_located, what), detail, used)
 
 
 def run_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="conservative", rows="free",
@@ -392,10 +372,9 @@ def run_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="cons
         Vt, Ft = retriangulate(V, F, method=method, target_edge=length, surface_check=surface_check)
         seconds["retriangulate"] = time.perf_counter() - t
     else:
-        Vt, Ft, loops_given = check_surface(*target, "the target")
-        given = np.concatenate(loops_given) if loops_given else np.zeros(0, dtype=np.int64)
-        check_target_boundary([V[loop] for loop in loops_s], Vt[given], d, "Pass one made by "
-                              "curvdetail.remesh.retriangulate, or target=None to make it here.")
+        Vt, Ft, _ = check_surface(*target, "the target")
+        check_retriangulation(V, F, Vt, Ft, boundary_tolerance=TARGET_BOUNDARY_TOLERANCE, advice="Pass one made "
+                              "by curvdetail.remesh.retriangulate, or target=None to make it here.")
 
     uv, param_info = None, None
     if location == "uv":

@@ -4,12 +4,13 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..curvature.checks import ZERO_AREA_RELATIVE, as_count, as_values, check_choice, checked_arrays
-from ..curvature.geometry import bbox_diagonal, face_double_areas
+from ..curvature.geometry import face_double_areas
 from ..curvature.topology import edge_keys as edge_keys
 from ..curvature.errors import CurvdetailError, MeshError, counted, first_indices
 from ..curvature.mean_curvature_normal import mean_curvature_normal
 from ..curvature.mixed_voronoi_area import mixed_voronoi_area
 from ..curvature.sparse_solver import factorize
+from ._disk import check_retriangulation
 from .closest_point import as_coordinates, check_points_and_mesh, unit_frame
 from .closest_point import _barycentric
 from .locate import _locate, interpolate, spread
@@ -139,9 +140,11 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     Raises
     ------
     MeshError
-        Malformed meshes or ``uv`` (dtypes, NaN, zero-area triangles in the plane); with
-        ``"closest"``, meshes more than ``SAME_SURFACE`` (25 %) of the source's bbox diagonal apart
-        (not two triangulations of one surface)
+        Malformed meshes or ``uv`` (dtypes, NaN, zero-area triangles in the plane)
+    RemeshError
+        (a ValueError) The target is not a retriangulation of the source (`check_retriangulation`:
+        boundary loops, boundary vertices, every vertex within ``SURFACE_TOLERANCE``, 3 % of the
+        diagonal, of the source; ``count``, ``first``: the target vertices off)
     ValueError
         Unknown method / location; ``uv`` missing, not a pair or of the wrong shape for ``"uv"``, or
         given with ``"closest"``; ``samples_per_edge`` not a whole number >= 1, too many samples, or
@@ -171,6 +174,7 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
         samples_per_edge = as_count(samples_per_edge, "samples_per_edge")
     Vs, Fs = checked_arrays(Vs, Fs)
     Vt, Ft = checked_arrays(Vt, Ft)
+    check_retriangulation(Vs, Fs, Vt, Ft)
     if detail is not None:
         detail = as_values(detail, Vs.shape[0], "detail (the source's detail)")
     if location == "uv":
@@ -189,8 +193,7 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
             K, _ = mean_curvature_normal(Vs, Fs)
         else:
             K = detail / mixed_voronoi_area(Vs, Fs)[:, None]
-        face, bary, dist = _locate(*check_points_and_mesh(tgt_dom, src_dom, Fs, names=(names[1], names[0], "Fs")))
-        _check_same_surface(dist, Vs, location)
+        face, bary, _ = _locate(*check_points_and_mesh(tgt_dom, src_dom, Fs, names=(names[1], names[0], "Fs")))
         return interpolate(K, Fs, face, bary) * mixed_voronoi_area(Vt, Ft)[:, None]
     E, c, normal = _edge_curvature_measure(Vs, Fs, normals=True)
     if detail is not None:
@@ -201,7 +204,6 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     t = (np.arange(edge.size) - start[edge] + 0.5) / q[edge]
     pts = (1 - t)[:, None] * src_dom[E[edge, 0]] + t[:, None] * src_dom[E[edge, 1]]
     face, bary, dist = _locate(*check_points_and_mesh(pts, tgt_dom, Ft, names=("edge samples", names[1], "Ft")))
-    _check_same_surface(dist, Vs, location)
     if location == "closest":
         _facing_side(pts, normal[edge], Vt, Ft, face, bary, dist)
     return spread(c[edge] / q[edge, None], Ft, face, bary, Vt.shape[0])
@@ -255,24 +257,6 @@ def _carrying(E, c, detail):
     Q = (adjacency + adjacency.T + sp.diags(degree)).tocsc()
     mu = factorize(Q).solve(residual)
     return c + 2.0 * (mu[E[:, 0]] + mu[E[:, 1]])
-
-
-#: With ``location="closest"``, a target farther than this (fraction of the source's bbox
-#: diagonal) from the source is not a retriangulation of it (measured retriangulations lie within
-#: ~1 %; a coarse decimation of a curved patch within a few %).
-SAME_SURFACE = 0.25
-
-
-def _check_same_surface(dist, Vs, location):
-    """MeshError if the closest-point distances say the meshes are not one surface."""
-    if location != "closest" or dist.size == 0:
-        return
-    worst = float(dist.max()) / bbox_diagonal(Vs)
-    if worst > SAME_SURFACE:
-        raise MeshError(f"source and target lie up to {100 * worst:.3g} % of the source's bbox diagonal "
-                        f"apart (more than {100 * SAME_SURFACE:.0f} %): location='closest' needs two "
-                        "triangulations of the same surface. Align them, or locate in a shared "
-                        "parameterization with location='uv'.", parameter="Vt", value=worst)
 
 
 def squashed_in_plane(UV, F, what, advice, error):
