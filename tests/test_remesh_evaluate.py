@@ -197,6 +197,20 @@ def test_exact_figures_are_those_of_its_own_samples(monkeypatch):
     assert r["mean"] == pytest.approx(0.5 * (ab.mean() + ba.mean()), rel=1e-12)
 
 
+def test_one_surface_measured_against_many_gives_the_one_off_figures_bit_for_bit():
+    # the experiment's way: the source checked and its tree built once, then the rebuilt, the
+    # zero-detail and the retriangulated surfaces measured against it, each as a call of its own
+    from curvdetail.remesh.evaluate import Surface
+
+    Vc, Fc, Vf, Ff = _coarse_and_fine()
+    source = Surface(Vc, Fc)
+    for lift in (0.0, 0.002, 0.3):
+        Va = Vf + [0.0, 0.0, lift]
+        d = source.vertex_distance(Va)
+        np.testing.assert_array_equal(d, vertex_distance(Va, Vc, Fc))
+        assert source.hausdorff(Va, Ff, samples=500, a_vertex_distance=d) == hausdorff(Va, Ff, Vc, Fc, samples=500)
+
+
 def test_brute_force_reference_is_right():
     # the tests' own reference, on points whose distances are known: above, beside, below a
     # corner, on the square
