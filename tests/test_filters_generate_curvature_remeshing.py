@@ -290,14 +290,14 @@ def test_the_baseline_layers_vertices_are_searched_once(monkeypatch):
     m = ms.mesh(0).face_number()
     rows = []
 
-    def spying(search):
-        def spy(P, Vs, Fs, *args, **kwargs):
-            if Fs.shape[0] == m:                           # against the source
-                rows.append(P.shape[0])
-            return search(P, Vs, Fs, *args, **kwargs)
-        return spy
+    search = evaluate.SurfaceTree.distance
 
-    monkeypatch.setattr(evaluate, "_surface_distance", spying(evaluate._surface_distance))
+    def spy(tree, P):
+        if tree.F.shape[0] == m:                           # against the source
+            rows.append(P.shape[0])
+        return search(tree, P)
+
+    monkeypatch.setattr(evaluate.SurfaceTree, "distance", spy)
     report = apply(ms, "generate_curvature_remeshing", target_edge=pymeshlab.PercentageValue(3.0),
                    add_baseline=True)
     p = report["target"]["vertices"]
