@@ -148,6 +148,23 @@ def test_the_local_fit_is_the_svd_s_nearest_rotation():
                         0.5 * Q @ np.diag([1.0, 1.0, -1.0]) + 1e-3 * rng.normal(size=(3000, 3, 3))])
     U, _, Wt = np.linalg.svd(C)
     U[:, :, 2] *= np.sign(np.linalg.det(U) * np.linalg.det(Wt))[:, None]
-    R = _closest_rotations(C)
+    R = _closest_rotations(np.ascontiguousarray(C.transpose(1, 2, 0))).transpose(2, 0, 1)   # matrix index first
     assert np.abs(R - U @ Wt).max() < 1e-9
     assert np.abs(np.linalg.det(R) - 1).max() < 1e-12
+
+
+def test_the_kept_anderson_differences_give_the_least_squares_step():
+    # Walker & Ni's step g - dG gamma, gamma = argmin |f - dF gamma| over the last `memory`
+    # differences, solved directly on the tall system; the kept Gram matrix gives it to rounding
+    from curvdetail.curvature.rotation_editor import _Anderson
+
+    rng = np.random.default_rng(3)
+    accel, samples = _Anderson(4), []
+    for _ in range(9):
+        g, f = rng.normal(size=200), rng.normal(size=200)
+        accel.add(g, f)
+        samples = (samples + [(g, f)])[-5:]
+        if len(samples) > 1:
+            G, Fr = np.array([s[0] for s in samples]), np.array([s[1] for s in samples])
+            gamma = np.linalg.lstsq(np.diff(Fr, axis=0).T, f, rcond=None)[0]
+            assert np.abs(accel.step() - (g - gamma @ np.diff(G, axis=0))).max() < 1e-12

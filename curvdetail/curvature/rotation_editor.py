@@ -36,12 +36,12 @@ class RotationAwareEditor:
       (v_i - v_j)``; where the neighbourhood turns as one, ``B_i = s R D_i``.
 
     Steps are Anderson-accelerated (`anderson_memory`); an accelerated step is kept only
-    where it lowers ``E``, so ``E`` never increases from one iteration to the next
-    (``energies``). The rotations start at the best-fit rotation of the handles (rest to given
-    positions), blended towards the identity at the fixed part by a harmonic weight, so a rigid
-    motion of every handle with ``roi=None`` is reproduced in the first iteration. The
-    iterations stop when the plain step would move no vertex more than ``tol`` times the bbox
-    diagonal, or after ``max_iterations``. The constructor does all factoring; an iteration of
+    where it lowers ``E`` (else the plain step is taken, and the next step is plain too), so
+    ``E`` never increases from one iteration to the next (``energies``). The rotations start
+    at the best-fit rotation of the handles (rest to given positions), blended towards the
+    identity at the fixed part by a harmonic weight, so a rigid motion of every handle with
+    ``roi=None`` is reproduced in the first iteration. The iterations stop when the plain step
+    would move no vertex more than ``tol`` times the bbox diagonal, or after ``max_iterations``. The constructor does all factoring; an iteration of
     `solve` is one back-substitution plus the batched local fits.
 
     Parameters
@@ -144,22 +144,32 @@ class RotationAwareEditor:
         k = in_s[rows]                                     # CSR order: sorted by row
         self._s, self._fp, self._pc = s_idx, fp, pc
         self.detail = laplacian_product(L, V)              # sum_j w_ij (v_i - v_j)
-        # per vertex i of S, sparse rows over its neighbours j: w_ij and w_ij (v_i - v_j)[c]
-        ei, ej, we = rows[k], cols[k], w[k]
+        ei, ej, we = rows[k], cols[k], w[k]                # the edges from S
         rest_e = V[ei] - V[ej]
         at_rows = at_s[ei]
-        self._W = sp.csr_matrix((we, (at_rows, ej)), shape=(s_idx.size, n))
-        self._We = [sp.csr_matrix((we * rest_e[:, c], (at_rows, ej)), shape=(s_idx.size, n)) for c in range(3)]
-        self._wsum = np.asarray(self._W.sum(axis=1)).ravel()
-        self._rest_sq = np.bincount(at_rows, weights=we * np.einsum("ij,ij->i", rest_e, rest_e),
-                                    minlength=s_idx.size)
-        # the global step's rows: free i, columns j in S (every neighbour of a free vertex is)
+        # the covariances are one product with X: row c s + i holds D_i[c] at column i and
+        # -w_ij (v_i - v_j)[c] at j, so that it gives sum_j w_ij (v_i - v_j)[c] (x_i - x_j)
+        ns = s_idx.size
+        c_rows = np.concatenate([at_rows, np.arange(ns)])
+        c_vals = np.concatenate([-we[:, None] * rest_e, self.detail[s_idx]])
+        self._cov_rows = sp.csr_matrix((c_vals.T.ravel(), (np.concatenate([c_rows + c * ns for c in range(3)]),
+                                                           np.tile(np.concatenate([ej, s_idx]), 3))), shape=(3 * ns, n))
+        # the edges i < j of E, weighted w_ij times how many of i, j are in S
+        times = np.where(rows < cols, in_s[rows].astype(float) + in_s[cols], 0.0)
+        half = times > 0
+        self._edges = (rows[half], cols[half], w[half] * times[half])
+        self._rest_sq = np.bincount(at_rows, weights=we * np.einsum("ij,ij->i", rest_e, rest_e), minlength=ns)
+        # the global step's turned details: B = T R for R (3, 3, s) as rows c s + j: R_j[:, c]; row
+        # f of T holds w_fj (v_f - v_j)[c] / 2 at column c s + j and D_f[c] / 2 at c s + f
         kf = free[ei]
         at_f = np.full(n, -1, dtype=np.int64)
         at_f[fp] = np.arange(fp.size)
-        self._Wf = [sp.csr_matrix((we[kf] * rest_e[kf, c], (at_f[ei[kf]], at_s[ej[kf]])), shape=(fp.size, s_idx.size))
-                    for c in range(3)]
-        self._fp_s = at_s[fp]
+        t_rows = np.concatenate([at_f[ei[kf]], np.arange(fp.size)])
+        t_cols = np.concatenate([at_s[ej[kf]], at_s[fp]])
+        t_vals = np.concatenate([we[kf, None] * rest_e[kf], self.detail[fp]])
+        self._turn = sp.csr_matrix((0.5 * t_vals.T.ravel(),
+                                    (np.tile(t_rows, 3), np.concatenate([t_cols + c * ns for c in range(3)]))),
+                                   shape=(fp.size, 3 * ns))
         L_free = L[fp]
         self._L_pc = L_free[:, pc].tocsr()
         outside = ~in_roi
@@ -206,27 +216,30 @@ class RotationAwareEditor:
             X[self._fp] = as_values(initial, self.n, "initial")[self._fp] - centre
             R, energy = self._local(X)
         else:
-            R = _blended_rotations(_best_rotation(self.V[self._pc], Xk), self._blend)
+            R = _blended_rotations(_best_rotation(self.V[self._pc], Xk), self._blend).transpose(1, 2, 0)
             energy = None
         self.energies = [] if energy is None else [energy]
         self.iterations, self.converged = 0, self._embed is None
         const = -(self._L_pc @ X[self._pc]) - (self._L_out_V - self._L_out_sum[:, None] * centre)
-        fp, history = self._fp, []
+        fp, accel, plain = self._fp, _Anderson(self.anderson_memory), False
         while self._embed is not None and self.iterations < self.max_iterations:
             x = X[fp]
             g = self._embed.solve(self._turned_details(R) + const)
             self.iterations += 1
             change = np.abs(g - x).max() / self.diagonal      # the plain step's move: the residual
             step = g
-            if energy is not None and self.anderson_memory:
-                history = (history + [(g.ravel(), (g - x).ravel())])[-(self.anderson_memory + 1):]
-                step = _anderson(history).reshape(g.shape) if len(history) > 1 else g
+            if energy is not None and self.anderson_memory:   # (g, g - x): a sample of the map x -> g
+                accel.add(g.ravel(), (g - x).ravel())
+                if not plain and accel.dF:
+                    step = accel.step().reshape(g.shape)
             X[fp] = step
             R_step, E_step = self._local(X)
-            if step is not g and not E_step <= energy:       # the plain step never increases E
+            # the plain step never increases E; after it, the next step is plain too (an
+            # accelerated step right after a rejected one is mostly rejected again)
+            plain = step is not g and not E_step <= energy
+            if plain:
                 X[fp] = g
                 R_step, E_step = self._local(X)
-                history = history[-1:]
             R, energy = R_step, E_step
             self.energies.append(energy)
             if change < self.tol:
@@ -240,70 +253,100 @@ class RotationAwareEditor:
         return X
 
     def _local(self, X):
-        """Rotations (scaled with ``scaling``) of every vertex of S fitted to X, and E(X, R).
-        ``X`` about a centre near the mesh (the sums below cancel large coordinates)."""
-        Xs = X[self._s]
-        # cov_i = sum_j w_ij (x_i - x_j) (v_i - v_j)^T, column c by column c
-        cov = np.stack([Xs * self.detail[self._s, c, None] - self._We[c] @ X for c in range(3)], axis=2)
+        """Rotations (scaled with ``scaling``), shape (3, 3, s), of every vertex of S fitted to X,
+        and E(X, R). ``X`` about a centre near the mesh (the sums below cancel large coordinates)."""
+        ns = self._s.size
+        # cov[a, c, i] = sum_j w_ij (x_i - x_j)[a] (v_i - v_j)[c], C order (every entry a contiguous row)
+        cov = np.ascontiguousarray((self._cov_rows @ X).reshape(3, ns, 3).transpose(2, 0, 1))
         R = _closest_rotations(cov)
-        fit = np.einsum("kij,kij->k", R, cov)                # trace(R^T cov)
-        # sum_j w_ij |x_i - x_j|^2
-        def_sq = (self._wsum * np.einsum("ij,ij->i", Xs, Xs) - 2 * np.einsum("ij,ij->i", Xs, self._W @ X)
-                  + self._W @ np.einsum("ij,ij->i", X, X))
+        fit = np.einsum("ijk,ijk->k", R, cov)                # trace(R_i^T cov_i)
+        i, j, w = self._edges
+        d = np.take(X, i, axis=0) - np.take(X, j, axis=0)
+        def_sq = np.einsum("ij,ij,i->", d, d, w)             # sum_i sum_j w_ij |x_i - x_j|^2
         if self.scaling:
             s = np.maximum(fit, 0.0) / np.maximum(self._rest_sq, np.finfo(float).tiny)
-            R = R * s[:, None, None]
-            energy = def_sq - 2 * s * fit + s * s * self._rest_sq
+            R *= s
+            energy = def_sq - np.sum(2 * s * fit - s * s * self._rest_sq)
         else:
-            energy = def_sq - 2 * fit + self._rest_sq
-        return R, float(energy.sum())
+            energy = def_sq - np.sum(2 * fit - self._rest_sq)
+        return R, float(energy)
 
     def _turned_details(self, R):
-        """``B_f = sum_j w_ij (R_i + R_j) / 2 (v_i - v_j)`` over the free rows (R scaled):
-        ``(R_f D_f + sum_j R_j w_ij (v_i - v_j)) / 2``."""
-        own = np.einsum("kab,kb->ka", R[self._fp_s], self.detail[self._fp])
-        other = sum(self._Wf[c] @ np.ascontiguousarray(R[:, :, c]) for c in range(3))
-        return 0.5 * (own + other)
+        """``B_f = sum_j w_fj (R_f + R_j) / 2 (v_f - v_j) = (R_f D_f + sum_j R_j w_fj (v_f - v_j)) / 2``
+        over the free rows, for R (3, 3, s) (scaled with ``scaling``)."""
+        return self._turn @ R.transpose(1, 2, 0).reshape(-1, 3)
 
 
-def _anderson(history):
-    """Anderson-accelerated next iterate from ``(g_k, f_k = g_k - x_k)`` of the last steps:
-    ``g - dG gamma`` with ``gamma`` minimizing ``|f - dF gamma|`` (Walker & Ni 2011)."""
-    G = np.stack([g for g, _ in history], axis=1)
-    Fr = np.stack([f for _, f in history], axis=1)
-    dG, dF = np.diff(G, axis=1), np.diff(Fr, axis=1)
-    gamma = np.linalg.lstsq(dF, Fr[:, -1], rcond=None)[0]
-    return G[:, -1] - dG @ gamma
+class _Anderson:
+    """Anderson acceleration (Walker & Ni 2011) from the samples ``(g_k, f_k = g_k - x_k)`` of
+    the last ``memory + 1`` steps: `step` is ``g - dG gamma`` with ``gamma`` minimizing
+    ``|f - dF gamma|``, from the normal equations of its few unknowns (a poor step is refused by
+    the energy test). The differences and their Gram matrix are kept, one new row a sample."""
+
+    def __init__(self, memory):
+        self.memory, self.last, self.dG, self.dF, self.gram = memory, None, [], [], np.zeros((0, 0))
+
+    def add(self, g, f):
+        if self.last is not None:
+            self.dG = (self.dG + [g - self.last[0]])[-self.memory:]
+            self.dF = (self.dF + [f - self.last[1]])[-self.memory:]
+            row = np.array([np.einsum("i,i->", self.dF[-1], d) for d in self.dF])
+            k = row.size
+            gram = np.empty((k, k))
+            gram[:-1, :-1] = self.gram[1:, 1:] if self.gram.shape[0] == k else self.gram
+            gram[-1], gram[:, -1] = row, row
+            self.gram = gram
+        self.last = (g, f)
+
+    def step(self):
+        g, f = self.last
+        gamma = np.linalg.lstsq(self.gram, np.array([np.einsum("i,i->", d, f) for d in self.dF]), rcond=None)[0]
+        out = g.copy()
+        for c, d in zip(gamma, self.dG):
+            out -= c * d
+        return out
 
 
-def _closest_rotations(C, steps=8):
-    """The rotations ``R_k`` maximizing ``trace(R_k^T C_k)`` for (k, 3, 3) ``C``: the SVD
-    solution ``U diag(1, 1, d) W^T``, ``d = det(U) det(W)``.
+def _closest_rotations(C, tol=1e-7, max_steps=20):
+    """The rotations ``R_k`` maximizing ``trace(R_k^T C_k)``, for ``C`` of shape (3, 3, k)
+    (matrix index first, so that every entry is a contiguous row); the SVD solution
+    ``U diag(1, 1, d) W^T``, ``d = det(U) det(W)``. Returns shape (3, 3, k).
 
     ``C + cof(C)`` (``C`` scaled to unit Frobenius norm) is ``U diag(s1 + d s2 s3, s2 + d s1 s3,
     s3 + d s1 s2) W^T``: where its first two entries are positive and the third has the sign of
-    ``d`` (always for ``d = 1``, rank 2 included), its orthogonal polar factor is the answer,
-    found by ``steps`` scaled Newton steps ``X <- (g X + X^-T / g) / 2``. The rest (a factor
-    that is no rotation to 1e-12) goes through `_closest_rotations_eigh`."""
+    ``d`` (always for ``d = 1``, rank 2 included), its determinant is positive and its orthogonal
+    polar factor is the answer, found by scaled Newton steps ``X <- (g X + X^-T / g) / 2`` until
+    no entry moves more than ``tol`` (the error is then about ``tol^2``). The rest (a factor that
+    is no rotation) goes through `_closest_rotations_eigh`."""
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        X = C / np.sqrt(np.einsum("kij,kij->k", C, C))[:, None, None]
-        X = X + _cofactor(X)
-        for _ in range(steps):
-            inv_t = _cofactor(X)
-            inv_t /= np.einsum("ki,ki->k", X[..., 0], inv_t[..., 0])[:, None, None]       # X^-T
-            g = (np.einsum("kij,kij->k", inv_t, inv_t) / np.einsum("kij,kij->k", X, X)) ** 0.25
-            X = 0.5 * (g[:, None, None] * X + inv_t / g[:, None, None])
-        error = np.abs(np.swapaxes(X, 1, 2) @ X - np.eye(3)).max(axis=(1, 2))
-        bad = ~((error < 1e-12) & (np.einsum("ki,ki->k", X[..., 0], np.cross(X[..., 1], X[..., 2])) > 0))
+        X = C / np.sqrt(np.einsum("ijk,ijk->k", C, C))
+        X += _cofactor(X)
+        for _ in range(max_steps):
+            cof = _cofactor(X)                               # det(X) X^-T
+            det = np.einsum("ik,ik->k", X[:, 0], cof[:, 0])
+            g = np.sqrt(np.sqrt(np.einsum("ijk,ijk->k", cof, cof) / np.einsum("ijk,ijk->k", X, X)) / np.abs(det))
+            step = 0.5 * (g * X + cof / (g * det))
+            change = np.abs(step - X)
+            X = step
+            if np.fmax.reduce(change, axis=None) < tol:     # NaN (a singular X) ignored, caught by det
+                break
+        bad = ~(det > 0)
+        if not np.fmax.reduce(change, axis=None) < tol:
+            bad |= ~(change.reshape(9, -1).max(axis=0) < tol)
     if bad.any():
-        X[bad] = _closest_rotations_eigh(C[bad])
+        X[:, :, bad] = _closest_rotations_eigh(C[:, :, bad].transpose(2, 0, 1)).transpose(1, 2, 0)
     return X
 
 
 def _cofactor(A):
-    """Cofactor matrices ``det(A) A^-T`` of (k, 3, 3) ``A``: columns ``a1 x a2, a2 x a0, a0 x a1``."""
-    a0, a1, a2 = A[..., 0], A[..., 1], A[..., 2]
-    return np.stack([np.cross(a1, a2), np.cross(a2, a0), np.cross(a0, a1)], axis=2)
+    """Cofactor matrices ``det(A) A^-T`` of (3, 3, k) ``A``."""
+    out = np.empty_like(A)
+    for i in range(3):
+        i1, i2 = (i + 1) % 3, (i + 2) % 3
+        for j in range(3):
+            j1, j2 = (j + 1) % 3, (j + 2) % 3
+            np.subtract(A[i1, j1] * A[i2, j2], A[i1, j2] * A[i2, j1], out=out[i, j])
+    return out
 
 
 def _closest_rotations_eigh(C):
@@ -326,7 +369,7 @@ def _blended_rotations(R, t):
     if angle < 1e-12 or np.linalg.norm(axis) < 1e-12 * max(angle, 1.0):
         if angle < 1e-12:
             return np.broadcast_to(np.eye(3), (t.size, 3, 3))
-        w, v = np.linalg.eigh(R + R.T)                    # a half turn: the axis is R's eigenvector 1
+        _, v = np.linalg.eigh(R + R.T)                    # a half turn: the axis is R's eigenvector 1
         axis = v[:, -1]
     axis = axis / np.linalg.norm(axis)
     K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])

@@ -1,11 +1,17 @@
 """Locate points in a triangle mesh: the triangle of the closest point and its barycentric coordinates."""
 
+import igl
 import numpy as np
 import scipy.sparse as sp
 
 from ..curvature.checks import as_count
 from ..curvature.errors import CurvdetailError, MeshError, first_indices
-from .closest_point import check_points_and_mesh, closest_in_frame, unit_frame
+from .closest_point import (
+    _barycentric,
+    check_points_and_mesh,
+    closest_in_frame,
+    unit_frame,
+)
 
 #: Barycentric coordinates taken by interpolate / spread: entries in [-tol, 1 + tol], rows summing
 #: to 1 within tol. locate() clips and normalizes its coordinates, so they are off by rounding only.
@@ -66,6 +72,59 @@ def _locate(P, V, F):
     P, V, scale = unit_frame(P, V)
     sqrD, face, _, bary = closest_in_frame(P, V, F)
     return face, bary, np.sqrt(sqrD) * scale
+
+
+#: How far `own_side` steps a sample toward its own triangles: this times the target's mean edge
+#: length, at most half the way.
+SIDE_STEP = 0.1
+
+
+def own_side(P, inner, V, F, face, bary, dist):
+    """Keep samples of a source edge on the side its triangles lie on, in place.
+
+    A sample whose closest triangle (``face``) shares no vertex with the one closest to the sample
+    stepped toward ``inner`` is located again on the triangles around that one's corners alone
+    (``face``, ``bary`` and ``dist`` rewritten). Where two sheets of the source touch (cow.off: two
+    vertices at one point on an unwelded seam) a sample on the touching edge is at distance 0 from
+    both sheets, and only the side its triangles lie on tells them apart; elsewhere the two
+    locations agree (a target equal to the source: always).
+
+    Parameters
+    ----------
+    P : (k, 3) float array
+        Samples on source edges.
+    inner : (k, 3) float array
+        For each, a point on the side of its edge's triangles (the mean of their corners
+        opposite the edge).
+    V, F : (n, 3) float and (m, 3) int arrays
+        The target mesh, checked.
+    face, bary, dist : (k,), (k, 3) and (k,) arrays
+        The samples' locations as `locate` returns them; rewritten where they change.
+
+    Returns
+    -------
+    int
+        How many samples moved.
+    """
+    if P.shape[0] == 0:
+        return 0
+    step = SIDE_STEP * np.linalg.norm(V[F[:, [1, 2, 0]]] - V[F], axis=2).mean()
+    d = inner - P
+    length = np.linalg.norm(d, axis=1, keepdims=True)
+    Q = P + d * np.minimum(step / np.maximum(length, np.finfo(float).tiny), 0.5)
+    f_q = _locate(Q, V, F)[0]
+    off = np.flatnonzero(~(F[face][:, :, None] == F[f_q][:, None, :]).any(axis=(1, 2)))
+    if off.size == 0:
+        return 0
+    around = sp.csr_matrix((np.ones(F.size), (F.ravel(), np.repeat(np.arange(F.shape[0]), 3))),
+                           shape=(V.shape[0], F.shape[0]))      # vertex -> its triangles
+    for i in off:                                               # few: where two sheets touch
+        candidates = np.unique(around[F[f_q[i]]].indices)
+        sq, at, C = igl.point_mesh_squared_distance(P[i:i + 1], V, F[candidates])
+        face[i] = candidates[at[0]]
+        bary[i] = _barycentric(C, V[F[face[i:i + 1]]])[0]
+        dist[i] = np.sqrt(sq[0])
+    return int(off.size)
 
 
 def _located(F, face, bary, what):

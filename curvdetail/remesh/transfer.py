@@ -13,7 +13,7 @@ from ..curvature.sparse_solver import factorize
 from ._disk import check_retriangulation
 from .closest_point import as_coordinates, check_points_and_mesh, unit_frame
 from .closest_point import _barycentric
-from .locate import _locate, interpolate, spread
+from .locate import _locate, interpolate, own_side, spread
 
 METHODS = ("conservative", "pointwise")
 LOCATIONS = ("closest", "uv")
@@ -65,7 +65,8 @@ def edge_curvature_measure(V, F):
 
 
 def _edge_curvature_measure(V, F, normals=False):
-    """``(E, c)``, and with ``normals`` also each edge's normal: the sum of its triangles' unit normals."""
+    """``(E, c)``, and with ``normals`` also each edge's normal (the sum of its triangles' unit normals)
+    and a point on the side of its triangles (the mean of the corners they hold opposite it)."""
     a, b, c = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
     n = np.cross(b - a, c - a)
     n /= np.linalg.norm(n, axis=1, keepdims=True)
@@ -81,8 +82,10 @@ def _edge_curvature_measure(V, F, normals=False):
     meas = np.column_stack([np.bincount(inverse, weights=g[:, j], minlength=keys.size) for j in range(3)])
     if not normals:
         return E, meas
-    n3 = np.repeat(n, 3, axis=0)
-    return E, meas, np.column_stack([np.bincount(inverse, weights=n3[:, j], minlength=keys.size) for j in range(3)])
+    n3, opposite = np.repeat(n, 3, axis=0), V[F.ravel()]          # half-edge k of a face faces its corner k
+    count = np.bincount(inverse, minlength=keys.size)[:, None]
+    return E, meas, *(np.column_stack([np.bincount(inverse, weights=X[:, j], minlength=keys.size) for j in range(3)])
+                      for X in (n3, opposite / count[inverse]))
 
 
 def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="closest", uv=None,
@@ -111,7 +114,8 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     Location: ``"closest"`` = the closest point on the other surface in space (the meshes are
     two triangulations of one surface; a conservative sample whose closest target triangle
     faces away from its source edge, the other sheet where two lie close, is put on the nearest
-    one that faces its way); ``"uv"`` = point location in a shared planar domain
+    one that faces its way, and one on a seam where two sheets touch stays on the side its own
+    triangles lie on, see `own_side`); ``"uv"`` = point location in a shared planar domain
     given as ``uv=(UVs, UVt)`` (see `parameterize`).
 
     Parameters
@@ -195,7 +199,7 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
             K = detail / mixed_voronoi_area(Vs, Fs)[:, None]
         face, bary, _ = _locate(*check_points_and_mesh(tgt_dom, src_dom, Fs, names=(names[1], names[0], "Fs")))
         return interpolate(K, Fs, face, bary) * mixed_voronoi_area(Vt, Ft)[:, None]
-    E, c, normal = _edge_curvature_measure(Vs, Fs, normals=True)
+    E, c, normal, inner = _edge_curvature_measure(Vs, Fs, normals=True)
     if detail is not None:
         c = _carrying(E, c, detail)
     q = _samples_per_edge(Vs, E, Vt, Ft, samples_per_edge)
@@ -205,6 +209,7 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     pts = (1 - t)[:, None] * src_dom[E[edge, 0]] + t[:, None] * src_dom[E[edge, 1]]
     face, bary, dist = _locate(*check_points_and_mesh(pts, tgt_dom, Ft, names=("edge samples", names[1], "Ft")))
     if location == "closest":
+        own_side(pts, inner[edge], Vt, Ft, face, bary, dist)
         _facing_side(pts, normal[edge], Vt, Ft, face, bary, dist)
     return spread(c[edge] / q[edge, None], Ft, face, bary, Vt.shape[0])
 
