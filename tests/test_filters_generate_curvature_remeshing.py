@@ -302,7 +302,10 @@ def test_the_baseline_layers_vertices_are_searched_once(monkeypatch):
                    add_baseline=True)
     p = report["target"]["vertices"]
     assert report["target"]["faces"] != m
-    assert sum(rows) == 3 * p + BASELINE_SAMPLES, rows
+    # the three vertex sets once each; face samples of the rebuilt and the retriangulated
+    # surfaces (the exact engine's default count) and the baseline's
+    n = int(np.clip(evaluate.SAMPLES_PER_FACE * report["target"]["faces"], evaluate.MIN_SAMPLES, evaluate.MAX_SAMPLES))
+    assert rows.count(p) == 3 and sorted(r for r in rows if r != p) == sorted([n, n, BASELINE_SAMPLES]), rows
 
 
 def test_report_names_the_source_file_by_its_absolute_path(tmp_path, monkeypatch):
