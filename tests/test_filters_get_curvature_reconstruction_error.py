@@ -180,14 +180,14 @@ def test_the_sampled_layers_vertices_are_searched_once(monkeypatch):
     ms = _flat_layer_beside_a_wavy_one()
     rows = []
 
-    def spying(search):
-        def spy(P, Vs, Fs, *args, **kwargs):
-            if Fs.shape[0] == ms.mesh(0).face_number():      # against the target
-                rows.append(P.shape[0])
-            return search(P, Vs, Fs, *args, **kwargs)
-        return spy
+    search = evaluate.SurfaceTree.distance
 
-    monkeypatch.setattr(evaluate, "_surface_distance", spying(evaluate._surface_distance))
+    def spy(tree, P):
+        if tree.F.shape[0] == ms.mesh(0).face_number():      # against the target
+            rows.append(P.shape[0])
+        return search(tree, P)
+
+    monkeypatch.setattr(evaluate.SurfaceTree, "distance", spy)
     apply(ms, "get_curvature_reconstruction_error", samplenum=2000)
     assert rows == [625]
 

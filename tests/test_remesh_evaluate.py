@@ -183,16 +183,32 @@ def test_exact_figures_are_those_of_its_own_samples(monkeypatch):
     monkeypatch.setattr(evaluate, "_area_samples", recording)
     Vc, Fc, Vf, Ff = _coarse_and_fine()
     r = hausdorff(Vf, Ff, Vc, Fc, samples=300, seed=0)
-    # the samples were drawn in hausdorff's frame, where the two meshes together have unit size
-    both = np.vstack([Vf, Vc])
-    _, _, scale = unit_frame(both[:0], both)
-    centre = 0.5 * (both.max(axis=0) + both.min(axis=0))
-    ab, ba = (triangle_brute_force(P * scale + centre, V, F) for P, (V, F) in zip(drawn, ((Vc, Fc), (Vf, Ff))))
+    # each mesh's samples were drawn in its own unit frame (its closest-point tree's)
+    def placed(P, V):
+        _, _, scale = unit_frame(V[:0], V)
+        return P * scale + 0.5 * (V.max(axis=0) + V.min(axis=0))
+
+    ab = triangle_brute_force(placed(drawn[0], Vf), Vc, Fc)
+    ba = triangle_brute_force(placed(drawn[1], Vc), Vf, Ff)
     assert r["samples"] == ab.size + ba.size == 600
     assert r["a_to_b_max"] == pytest.approx(max(ab.max(), triangle_brute_force(Vf, Vc, Fc).max()), rel=1e-12)
     assert r["b_to_a_max"] == pytest.approx(max(ba.max(), triangle_brute_force(Vc, Vf, Ff).max()), rel=1e-12)
     assert r["rms"] == pytest.approx(np.sqrt(0.5 * ((ab ** 2).mean() + (ba ** 2).mean())), rel=1e-12)
     assert r["mean"] == pytest.approx(0.5 * (ab.mean() + ba.mean()), rel=1e-12)
+
+
+def test_one_surface_measured_against_many_gives_the_one_off_figures_bit_for_bit():
+    # the experiment's way: the source checked and its tree built once, then the rebuilt, the
+    # zero-detail and the retriangulated surfaces measured against it, each as a call of its own
+    from curvdetail.remesh.evaluate import Surface
+
+    Vc, Fc, Vf, Ff = _coarse_and_fine()
+    source = Surface(Vc, Fc)
+    for lift in (0.0, 0.002, 0.3):
+        Va = Vf + [0.0, 0.0, lift]
+        d = source.vertex_distance(Va)
+        np.testing.assert_array_equal(d, vertex_distance(Va, Vc, Fc))
+        assert source.hausdorff(Va, Ff, samples=500, a_vertex_distance=d) == hausdorff(Va, Ff, Vc, Fc, samples=500)
 
 
 def test_brute_force_reference_is_right():
@@ -235,24 +251,24 @@ def test_given_vertex_distances_are_not_searched_again(monkeypatch, engine):
     import curvdetail.remesh.evaluate as evaluate
 
     rows = []
-    search = evaluate._surface_distance
+    search = evaluate.SurfaceTree.distance
 
-    def spy(P, V, F):
+    def spy(tree, P):
         rows.append(P.shape[0])
-        return search(P, V, F)
+        return search(tree, P)
 
     Va, Fa = grid(9, 9)                                  # 81 vertices
     Vb, Fb = grid(12, 12)                                # 144 vertices
     Vb[:, 2] = 0.05 * np.sin(5 * Vb[:, 0])
     d = vertex_distance(Va, Vb, Fb)
-    monkeypatch.setattr(evaluate, "_surface_distance", spy)
+    monkeypatch.setattr(evaluate.SurfaceTree, "distance", spy)
     hausdorff(Va, Fa, Vb, Fb, engine=engine, samples=500, a_vertex_distance=d)
     given, rows[:] = list(rows), []
     hausdorff(Va, Fa, Vb, Fb, engine=engine, samples=500)
     if engine == "meshlab":
         assert given == [144] and rows == [81, 144]
-    else:
-        assert given == [500, 500 + 144] and rows == [500 + 81, 500 + 144]
+    else:                                                # a's samples, b's samples, b's vertices
+        assert given == [500, 500, 144] and rows == [81, 500, 500, 144]
 
 
 # ---- refusals: the type and the facts a user acts on ----

@@ -387,52 +387,57 @@ def test_what_to_try_follows_the_options_that_failed(options, cli, says):
 
 def test_each_vertex_set_is_searched_once(height_field, monkeypatch):
     # the rebuilt, zero-detail and retriangulated vertices are searched against the source once
-    # each (vertex_distance, whose distances hausdorff then takes), besides the baseline's own
-    # face samples (the exact engine; pymeshlab's engine samples inside pymeshlab)
+    # each (vertex_distance, whose distances hausdorff then takes), besides the face samples
     import curvdetail.remesh.evaluate as evaluate
     from curvdetail.remesh.experiment import BASELINE_SAMPLES, run_experiment
 
     V, F = height_field
     rows = []
 
-    def spying(search):
-        def spy(P, Vs, Fs, *args, **kwargs):
-            if Fs.shape[0] == F.shape[0]:              # against the source
-                rows.append(P.shape[0])
-            return search(P, Vs, Fs, *args, **kwargs)
-        return spy
+    search = evaluate.SurfaceTree.distance
 
-    monkeypatch.setattr(evaluate, "_surface_distance", spying(evaluate._surface_distance))
+    def spy(tree, P):
+        if tree.F.shape[0] == F.shape[0]:              # against the source
+            rows.append(P.shape[0])
+        return search(tree, P)
+
+    monkeypatch.setattr(evaluate.SurfaceTree, "distance", spy)
     r = run_experiment(V, F, target_edge="5%")
     p = r["X"].shape[0]
     assert r["Ft"].shape[0] != F.shape[0]                # the spy tells the surfaces apart
-    assert sum(rows) == 3 * p + BASELINE_SAMPLES, rows
+    # the three vertex sets once each; face samples of the rebuilt and the retriangulated
+    # surfaces (the exact engine's default count) and the baseline's
+    n = int(np.clip(evaluate.SAMPLES_PER_FACE * r["Ft"].shape[0], evaluate.MIN_SAMPLES, evaluate.MAX_SAMPLES))
+    assert rows.count(p) == 3 and sorted(r for r in rows if r != p) == sorted([n, n, BASELINE_SAMPLES]), rows
 
 
 def test_report_figures_are_those_hausdorff_measures_itself(height_field, monkeypatch):
     # the vertex distances handed to hausdorff change none of its figures (to the last bit):
-    # each call is repeated without them, with the exact engine forced (seeded, so that a
-    # figure repeats exactly; pymeshlab's samples change from call to call)
-    import curvdetail.remesh.experiment as experiment
+    # each call is repeated without them (the exact engine is seeded: a figure repeats exactly)
+    import curvdetail.remesh.evaluate as evaluate
+    from curvdetail.remesh.experiment import run_experiment
 
     V, F = height_field
     d = np.linalg.norm(np.ptp(V, axis=0))
     calls = []
 
-    def spy(P, Ft, Vs, Fs, *, samples=None, engine="meshlab", a_vertex_distance=None):
+    original = evaluate.Surface.hausdorff
+
+    def spy(source, P, Ft, *, samples=None, engine="meshlab", a_vertex_distance=None):
         n = samples or 20000
-        given = hausdorff(P, Ft, Vs, Fs, samples=n, engine="exact", a_vertex_distance=a_vertex_distance)
-        calls.append((a_vertex_distance, given, hausdorff(P, Ft, Vs, Fs, samples=n, engine="exact")))
+        given = original(source, P, Ft, samples=n, engine="exact", a_vertex_distance=a_vertex_distance)
+        calls.append((P, a_vertex_distance, given, original(source, P, Ft, samples=n, engine="exact")))
         return given
 
-    monkeypatch.setattr(experiment, "hausdorff", spy)
-    r = experiment.run_experiment(V, F, target_edge="5%")
+    monkeypatch.setattr(evaluate.Surface, "hausdorff", spy)
+    r = run_experiment(V, F, target_edge="5%")
     assert len(calls) == 3
-    for (dist, given, measured), key in zip(calls, ("error", "baseline_zero_detail", "floor_retriangulated")):
-        assert dist is not None and given == measured
+    for key, P, dist in (("error", r["X"], r["distance"]), ("baseline_zero_detail", r["Z"], r["zero_distance"]),
+                         ("floor_retriangulated", r["Vt"], None)):     # the floor's measured in hausdorff
+        (given, measured), = [(g, m) for Q, a, g, m in calls if Q is P and a is dist]
+        assert given == measured
         assert r["report"][key] == {**r["report"][key], "hausdorff_max_percent_of_diagonal": 100 * given["max"] / d,
                                     "hausdorff_rms_percent_of_diagonal": 100 * given["rms"] / d}
-    assert calls[0][0] is r["distance"] and calls[1][0] is r["zero_distance"]
 
 
 def test_rebuilt_vertex_distances_are_exact_beside_a_wavy_source(monkeypatch):

@@ -70,6 +70,52 @@ def closest_in_frame(P, V, F, bary=True):
     return sqrD, face, C, _barycentric(C, V[F[face]]) if bary else None
 
 
+class SurfaceTree:
+    """libigl's AABB tree of a checked triangle mesh, built once for many distance queries.
+
+    The tree holds the mesh in its unit frame (bounding box centred at the origin, diagonal 1),
+    so queries do not depend on the mesh's scale or position; a planar mesh is held in z = 0
+    (libigl's 2D tree corrupts memory).
+
+    Parameters
+    ----------
+    V : (n, d) float array
+        Vertex positions, d = 2 or 3, as `check_points_and_mesh` returns them.
+    F : (m, 3) int64 array
+        Triangles.
+
+    Examples
+    --------
+    >>> V = np.array([[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]]); F = np.array([[0, 1, 2]])
+    >>> SurfaceTree(V, F).distance(np.array([[0.25, 0.25, 2.0], [2.0, 0.0, 0.0]])).round(12).tolist()
+    [2.0, 1.0]
+    """
+
+    def __init__(self, V, F):
+        self.centre = 0.5 * (V.max(axis=0) + V.min(axis=0))
+        self.scale = diagonal(V)
+        self.U = _in_space((V - self.centre) / self.scale)
+        self.F = F
+        self._tree = igl.AABB()
+        self._tree.init(self.U, F)
+
+    def squared_distance_in_frame(self, P):
+        """Squared distances of the points ``P`` (k, d), given in the tree's unit frame."""
+        if P.shape[0] == 0:
+            return np.empty(0)
+        return self._tree.squared_distance(self.U, self.F, _in_space(P))[0]
+
+    def distance(self, P):
+        """Exact distance (k,) of each point of ``P`` (k, d), in the mesh's coordinates."""
+        return self.scale * np.sqrt(self.squared_distance_in_frame((P - self.centre) / self.scale))
+
+
+def _in_space(X):
+    """``X`` as a C-contiguous (k, 3) float64 array (z = 0 appended to planar points)."""
+    X = X if X.shape[1] == 3 else np.column_stack([X, np.zeros(X.shape[0])])
+    return np.ascontiguousarray(X, dtype=np.float64)
+
+
 def _barycentric(X, T):
     """Barycentric coordinates of points ``X`` (k, d) in triangles ``T`` (k, 3, d), clipped to
     [0, 1] and normalized (``X`` lies on its triangle, up to rounding)."""
@@ -91,9 +137,7 @@ def check_points_and_mesh(points, V, F, names=("points", "V", "F")):
     the caller calls them, for the messages and ``e.parameter``."""
     P = as_coordinates(points, names[0], allow_empty=True)
     V = as_coordinates(V, names[1])
-    if P.shape[1] != V.shape[1]:
-        raise MeshError(f"{names[0]} {P.shape} and {names[1]} {V.shape} must both be (k, 2) or both (k, 3).",
-                        parameter=names[0], value=P.shape)
+    _check_dimension(P, V, names)
     F = np.ascontiguousarray(as_faces(F, V.shape[0], names[2]), dtype=np.int64)
     if np.ptp(V, axis=0).max() == 0:
         raise MeshError(f"{names[1]}: all {V.shape[0]} vertices are at one point (zero extent)",
@@ -105,6 +149,28 @@ def check_points_and_mesh(points, V, F, names=("points", "V", "F")):
         raise MeshError(f"{names[2]}: {zero.size} triangles have zero area (first: {first_indices(zero)}; "
                         f"areas up to {ZERO_AREA_RELATIVE:g} of the bbox diagonal squared count)",
                         parameter=names[2], count=zero.size, first=zero[:5].tolist(), hint=ZERO_AREA_ADVICE)
+    _check_reach(P, V, names)
+    return P, V, F
+
+
+def check_points(points, V, names=("points", "V")):
+    """The query ``points`` as `check_points_and_mesh` checks them, against a mesh vertex array
+    ``V`` that passed it: a C-contiguous float64 (k, d) array, or MeshError."""
+    P = as_coordinates(points, names[0], allow_empty=True)
+    _check_dimension(P, V, names)
+    _check_reach(P, V, names)
+    return P
+
+
+def _check_dimension(P, V, names):
+    if P.shape[1] != V.shape[1]:
+        raise MeshError(f"{names[0]} {P.shape} and {names[1]} {V.shape} must both be (k, 2) or both (k, 3).",
+                        parameter=names[0], value=P.shape)
+
+
+def _check_reach(P, V, names):
+    """MeshError where a point of ``P`` lies further than ``MAX_RELATIVE_DISTANCE`` bbox diagonals
+    of ``V`` from it."""
     far = box_gap(P, V) / diagonal(V)
     if far.size and far.max() > MAX_RELATIVE_DISTANCE:
         bad = np.flatnonzero(far > MAX_RELATIVE_DISTANCE)
@@ -112,7 +178,6 @@ def check_points_and_mesh(points, V, F, names=("points", "V", "F")):
                         f"diagonals of {names[1]} from it (first: {first_indices(bad)}; up to {far.max():.3g})",
                         parameter=names[0], count=bad.size, first=bad[:5].tolist(),
                         hint="the closest-point arithmetic overflows there: pass points near the mesh.")
-    return P, V, F
 
 
 def as_coordinates(X, name, allow_empty=False):

@@ -5,14 +5,17 @@ import numpy as np
 from ..curvature.checks import as_count, as_faces, check_choice, check_referenced, checked_arrays
 from ..curvature.geometry import bbox_diagonal, face_double_areas
 from ..curvature.errors import CurvdetailError, MeshError, first_indices
-from .closest_point import check_points_and_mesh, closest_in_frame, unit_frame
+from .closest_point import SurfaceTree, as_coordinates, check_points, check_points_and_mesh, unit_frame
 
 #: Largest ``samples`` (per direction), well below pymeshlab's 32-bit int: 10M is minutes and
 #: ~2 GB of samples; 1,000,000 already gives ~1e-3 relative accuracy.
 MAX_SAMPLE_COUNT = 10_000_000
 
 #: Face samples per direction: ``SAMPLES_PER_FACE`` times the sampled mesh's triangle count,
-#: clamped to [MIN_SAMPLES, MAX_SAMPLES].
+#: clamped to [MIN_SAMPLES, MAX_SAMPLES]. A one-sided RMS over n samples has the relative standard
+#: error cv / (2 sqrt(n)), cv the coefficient of variation of the squared distances: 1.9 to 2.3
+#: for the 100k-vertex scan's rebuild and floor (docs/results/scan_100k.md), so 0.3 % at 100,000
+#: samples and 0.1 % at 1,000,000 (the two-sided RMS: about 0.7 times that).
 SAMPLES_PER_FACE, MIN_SAMPLES, MAX_SAMPLES = 10, 100_000, 1_000_000
 
 #: Meshes whose bounding boxes are more than this many diagonals (of the smaller) apart are
@@ -34,13 +37,13 @@ def hausdorff(Va, Fa, Vb, Fb, *, samples=None, engine="exact", seed=0, a_vertex_
       means of the face samples.
 
     Engines: ``"exact"`` samples from numpy's ``default_rng(seed)``, the same in any process,
-    each measured exactly (libigl's AABB tree, `closest_points`).
+    each measured exactly (libigl's AABB tree, `SurfaceTree`).
     ``"meshlab"``: pymeshlab's ``get_hausdorff_distance`` (Monte Carlo samples, closest points
     in single precision), for figures comparable with MeshLab's; its random state carries over
     within a process, so repeated calls give other samples. Meshes more than ``FAR_APART``
     diagonals apart are measured with ``"exact"`` (pymeshlab's search does not return there).
-    The vertices are measured exactly by both, in a frame where the two meshes together have
-    unit size.
+    The vertices are measured exactly by both (`SurfaceTree`). `Surface` measures several meshes
+    against one surface, checking it and building its tree once.
 
     Parameters
     ----------
@@ -54,8 +57,8 @@ def hausdorff(Va, Fa, Vb, Fb, *, samples=None, engine="exact", seed=0, a_vertex_
         Random seed (>= 0) of the ``"exact"`` engine's samples (None: fresh entropy).
     a_vertex_distance : (n_a,) float array or None
         The distances of a's vertices to b, measured already with
-        ``vertex_distance(Va, Vb, Fb)`` (the same frame: the figures come out bit for bit those
-        of a call without it); None measures them here.
+        ``vertex_distance(Va, Vb, Fb)`` (the figures come out bit for bit those of a call
+        without it); None measures them here.
 
     Returns
     -------
@@ -78,33 +81,92 @@ def hausdorff(Va, Fa, Vb, Fb, *, samples=None, engine="exact", seed=0, a_vertex_
     >>> round(hausdorff(V, F, W, F)["rms"], 6)
     0.01
     """
-    # in a frame where the two together have unit size (as pymeshlab sees them too): areas of
-    # huge or tiny meshes neither over- nor underflow
-    Va, Vb, _ = check_points_and_mesh(Va, Vb, Fb, names=("Va", "Vb", "Fb"))
-    if Va.shape[1] != 3:
-        raise MeshError(f"Va has shape {Va.shape}; hausdorff measures surfaces in space, (n, 3).",
-                        parameter="Va", value=Va.shape)
-    Fa = as_faces(Fa, Va.shape[0], "Fa")              # named as the caller names it
-    both = np.vstack([Va, Vb])
-    _, both, scale = unit_frame(both[:0], both)
-    Va, Fa = checked_arrays(both[:Va.shape[0]], Fa)
-    Vb, Fb = checked_arrays(both[Va.shape[0]:], Fb)
-    engine = check_choice(engine, "engine", ("exact", "meshlab"), "; use 'exact' or 'meshlab'.")
-    samples = _check_samples(samples)
-    seed = None if seed is None else as_count(seed, "seed", minimum=0)
-    given = _check_vertex_distance(a_vertex_distance, Va.shape[0])
-    engine = "exact" if engine == "exact" or _apart(Va, Vb) else "meshlab"
-    measure = given is None
-    figures = _hausdorff_exact(Va, Fa, Vb, Fb, samples, seed, measure) if engine == "exact" else \
-        _hausdorff_meshlab(Va, Fa, Vb, Fb, samples, measure)
-    figures = _scaled(figures, scale)
-    if given is not None:
-        # after scaling: the given distances are absolute (scale * d in this frame, see
-        # vertex_distance), and rounding a product is monotonic, so the maxima come out as
-        # those of a call that measured the vertices here
-        figures["a_to_b_max"] = float(max(figures["a_to_b_max"], given.max()))
-        figures["max"] = float(max(figures["a_to_b_max"], figures["b_to_a_max"]))
-    return dict(figures, engine=engine)
+    return Surface(Vb, Fb, names=("Vb", "Fb")).hausdorff(Va, Fa, samples=samples, engine=engine, seed=seed,
+                                                         a_vertex_distance=a_vertex_distance)
+
+
+class Surface:
+    """A triangle mesh that points and other meshes are measured against, checked once and
+    searched through one closest-point tree (`SurfaceTree`) for every measurement.
+
+    An experiment measures its rebuilt, zero-detail and retriangulated surfaces against one
+    source: ``source = Surface(V, F)``, then ``source.vertex_distance(X)`` and
+    ``source.hausdorff(X, Ft)`` for each. ``Surface(Vb, Fb).hausdorff(Va, Fa, ...)`` is
+    `hausdorff` ``(Va, Fa, Vb, Fb, ...)`` and ``Surface(Vs, Fs).vertex_distance(P)`` is
+    `vertex_distance` ``(P, Vs, Fs)``, bit for bit.
+
+    Parameters
+    ----------
+    V : (n, 3) float array
+        Vertex positions ((n, 2): a planar surface, for `vertex_distance` only).
+    F : (m, 3) int array
+        Triangles; every vertex used by one.
+    names : pair of str
+        ``V`` and ``F`` as the caller calls them, for the messages and ``e.parameter``.
+
+    Raises
+    ------
+    MeshError
+        Malformed surface, as `vertex_distance` refuses it.
+
+    Examples
+    --------
+    >>> from curvdetail.curvature.testing import grid
+    >>> V, F = grid(5, 5); source = Surface(V, F)
+    >>> [round(source.hausdorff(V + [0, 0, lift], F)["rms"], 6) for lift in (0.01, 0.02)]
+    [0.01, 0.02]
+    """
+
+    def __init__(self, V, F, names=("Vs", "Fs")):
+        V = as_coordinates(V, names[0])
+        _, self.V, self.F = check_points_and_mesh(np.empty((0, V.shape[1])), V, F, names=("points", *names))
+        # as hausdorff refuses them: they measure nothing, but stretch the bounding box that the
+        # frame, the zero-area test and the far-point limit are taken relative to
+        check_referenced(self.V.shape[0], self.F, names[0])
+        self.names = names
+        self.tree = SurfaceTree(self.V, self.F)
+        self._checked = False
+
+    def vertex_distance(self, P, name="V"):
+        """`vertex_distance` of the points ``P`` (k, d) to this surface: (k,) exact distances."""
+        return self.tree.distance(check_points(P, self.V, (name, *self.names)))
+
+    def hausdorff(self, Va, Fa, *, samples=None, engine="exact", seed=0, a_vertex_distance=None):
+        """`hausdorff` of the mesh ``(Va, Fa)`` against this surface (b): the same parameters
+        and figures."""
+        Va = check_points(Va, self.V, ("Va", *self.names))
+        if Va.shape[1] != 3:
+            raise MeshError(f"Va has shape {Va.shape}; hausdorff measures surfaces in space, (n, 3).",
+                            parameter="Va", value=Va.shape)
+        Fa = as_faces(Fa, Va.shape[0], "Fa")              # named as the caller names it
+        Va, Fa = _checked_in_frame(Va, Fa)
+        if not self._checked:
+            _checked_in_frame(self.V, self.F)
+            self._checked = True
+        engine = check_choice(engine, "engine", ("exact", "meshlab"), "; use 'exact' or 'meshlab'.")
+        samples = _check_samples(samples)
+        seed = None if seed is None else as_count(seed, "seed", minimum=0)
+        given = _check_vertex_distance(a_vertex_distance, Va.shape[0])
+        engine = "exact" if engine == "exact" or _apart(Va, self.V) else "meshlab"
+        a = SurfaceTree(Va, np.ascontiguousarray(Fa, dtype=np.int64))
+        ab = self.tree.distance(Va) if given is None else given          # a's vertices, exactly
+        if engine == "exact":
+            figures = _hausdorff_exact(a, self.tree, samples, seed)
+        else:
+            figures = _hausdorff_meshlab(Va, Fa, self.V, self.F, samples)
+        # the maxima also over every vertex, measured exactly: face samples miss them, and a
+        # maximum sits at a vertex more often than not
+        figures["a_to_b_max"] = float(max(figures["a_to_b_max"], ab.max()))
+        figures["b_to_a_max"] = float(max(figures["b_to_a_max"], a.distance(self.V).max()))
+        figures["max"] = max(figures["a_to_b_max"], figures["b_to_a_max"])
+        return dict(figures, engine=engine)
+
+
+def _checked_in_frame(V, F):
+    """`checked_arrays` of the mesh in its unit frame (areas relative to its own size: huge and
+    tiny meshes neither over- nor underflow); ``(V, F)`` as given."""
+    _, U, _ = unit_frame(V[:0], V)
+    return V, checked_arrays(U, F)[1]
 
 
 def _check_vertex_distance(d, n):
@@ -153,47 +215,55 @@ def _apart(Va, Vb):
     return bool(gap > FAR_APART * min(bbox_diagonal(Va), bbox_diagonal(Vb)))
 
 
-def _scaled(figures, scale):
-    return {k: v if k == "samples" else v * scale for k, v in figures.items()}
-
-
 def _sample_count(samples, F):
     return int(samples) if samples else int(np.clip(SAMPLES_PER_FACE * F.shape[0], MIN_SAMPLES, MAX_SAMPLES))
 
 
-def _hausdorff_meshlab(Va, Fa, Vb, Fb, samples, measure_a=True):
+def _hausdorff_meshlab(Va, Fa, Vb, Fb, samples):
+    """pymeshlab's face-sample figures (no vertices) in the meshes' units, measured in a frame where
+    the two together have unit size (as its single precision measures best)."""
     import pymeshlab
 
+    both = np.vstack([Va, Vb])
+    _, both, scale = unit_frame(both[:0], both)
     ms = pymeshlab.MeshSet()
-    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=Va, face_matrix=Fa.astype(np.int32)))
-    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=Vb, face_matrix=Fb.astype(np.int32)))
-    diag = bbox_diagonal(np.vstack([Va, Vb]))
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=both[:Va.shape[0]], face_matrix=Fa.astype(np.int32)))
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=both[Va.shape[0]:], face_matrix=Fb.astype(np.int32)))
     out = []
     for sampled, target, F in ((0, 1, Fa), (1, 0, Fb)):
         # Every parameter explicitly: pymeshlab keeps values from earlier calls in one process.
         r = ms.get_hausdorff_distance(sampledmesh=sampled, targetmesh=target, savesample=False,
                                       samplevert=False, sampleedge=False, samplefauxedge=False,
                                       sampleface=True, samplenum=_sample_count(samples, F),
-                                      maxdist=pymeshlab.PureValue(2.0 * diag))
+                                      maxdist=pymeshlab.PureValue(2.0))
         out.append(r)
-    n1, n2 = out[0]["n_samples"], out[1]["n_samples"]
     rms = np.sqrt(0.5 * (out[0]["RMS"] ** 2 + out[1]["RMS"] ** 2))
-    mean = 0.5 * (out[0]["mean"] + out[1]["mean"])
-    # the maxima also over every vertex, measured exactly: face samples miss them, and a
-    # maximum sits at a vertex more often than not (a's: by the caller, if it measured them)
-    ab = max(out[0]["max"], _surface_distance(Va, Vb, Fb).max()) if measure_a else out[0]["max"]
-    ba = max(out[1]["max"], _surface_distance(Vb, Va, Fa).max())
-    return {"max": float(max(ab, ba)), "rms": float(rms), "mean": float(mean),
-            "a_to_b_max": float(ab), "b_to_a_max": float(ba), "samples": int(n1 + n2)}
+    return {"rms": float(scale * rms), "mean": float(scale * 0.5 * (out[0]["mean"] + out[1]["mean"])),
+            "a_to_b_max": float(scale * out[0]["max"]), "b_to_a_max": float(scale * out[1]["max"]),
+            "samples": int(out[0]["n_samples"] + out[1]["n_samples"])}
+
+
+def _hausdorff_exact(a, b, samples, seed):
+    """Face-sample figures (no vertices) of the meshes of the `SurfaceTree` s ``a`` and ``b``, each
+    sample measured exactly, in the meshes' units."""
+    rng = np.random.default_rng(seed)
+    d = []
+    for sampled, target in ((a, b), (b, a)):
+        P, _ = _area_samples(sampled.U, sampled.F, _sample_count(samples, sampled.F), rng)
+        d.append(target.distance(P * sampled.scale + sampled.centre) / b.scale)   # of order 1: no overflow
+    d1, d2 = d
+    return {"rms": float(b.scale * np.sqrt(0.5 * ((d1 ** 2).mean() + (d2 ** 2).mean()))),
+            "mean": float(b.scale * 0.5 * (d1.mean() + d2.mean())), "a_to_b_max": float(b.scale * d1.max()),
+            "b_to_a_max": float(b.scale * d2.max()), "samples": int(d1.size + d2.size)}
 
 
 def vertex_distance(V, Vs, Fs):
     """Exact distance from each point of ``V`` to the surface ``(Vs, Fs)`` (e.g. the per-vertex
     error of a rebuilt mesh against its source).
 
-    Measured in `hausdorff`'s frame (the points and the surface together of unit size), so
-    ``vertex_distance(Va, Vb, Fb)`` is bit for bit what ``hausdorff(Va, Fa, Vb, Fb)`` measures
-    for a's vertices and can be passed to it as ``a_vertex_distance``.
+    Bit for bit what ``hausdorff(Va, Fa, Vs, Fs)`` measures for the vertices ``Va = V``, so it
+    can be passed to it as ``a_vertex_distance``. To measure many point sets against one
+    surface, ``Surface(Vs, Fs).vertex_distance(V)`` builds its tree once.
 
     Parameters
     ----------
@@ -223,18 +293,7 @@ def vertex_distance(V, Vs, Fs):
     >>> vertex_distance(P, Vs, Fs).round(12).tolist()     # above, on, and beside the square
     [2.0, 0.0, 1.0]
     """
-    P, Vs, Fs = check_points_and_mesh(V, Vs, Fs, names=("V", "Vs", "Fs"))
-    # as hausdorff (check_mesh) refuses them: they measure nothing, but stretch the bounding box
-    # that the frame, the zero-area test and the far-point limit are taken relative to
-    check_referenced(Vs.shape[0], Fs, "Vs")
-    both = np.vstack([P, Vs])
-    _, both, scale = unit_frame(both[:0], both)
-    return scale * _surface_distance(both[:P.shape[0]], both[P.shape[0]:], Fs)
-
-
-def _surface_distance(P, V, F):
-    """Exact distance from each point of ``P`` (k, d) to the surface ``(V, F)``, in the frame given."""
-    return np.sqrt(closest_in_frame(P, V, F, bary=False)[0])
+    return Surface(Vs, Fs).vertex_distance(V)
 
 
 def _area_samples(V, F, n, rng):
@@ -245,18 +304,3 @@ def _area_samples(V, F, n, rng):
     s = np.sqrt(r1)
     bary = np.column_stack([1 - s, s * (1 - r2), s * r2])
     return (bary[:, :, None] * V[F[face]]).sum(1), face
-
-
-def _hausdorff_exact(Va, Fa, Vb, Fb, samples, seed, measure_a=True):
-    rng = np.random.default_rng(seed)
-    out = []
-    for (V1, F1), (V2, F2), vertices in (((Va, Fa), (Vb, Fb), measure_a), ((Vb, Fb), (Va, Fa), True)):
-        n = _sample_count(samples, F1)
-        P, _ = _area_samples(V1, F1, n, rng)
-        d = _surface_distance(np.vstack([P, V1]) if vertices else P, V2, F2)
-        out.append((d[:n], d[n:].max() if vertices else -np.inf))
-    (d1, v1), (d2, v2) = out
-    rms = np.sqrt(0.5 * ((d1 ** 2).mean() + (d2 ** 2).mean()))
-    ab, ba = max(d1.max(), v1), max(d2.max(), v2)
-    return {"max": float(max(ab, ba)), "rms": float(rms), "mean": float(0.5 * (d1.mean() + d2.mean())),
-            "a_to_b_max": float(ab), "b_to_a_max": float(ba), "samples": int(d1.size + d2.size)}

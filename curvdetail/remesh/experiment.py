@@ -15,7 +15,7 @@ from ..curvature.reconstruct import ROW_MODES, Reconstructor
 from ..curvature.sparse_solver import resolve_backend
 from ._disk import TARGET_BOUNDARY_TOLERANCE, RemeshError  # noqa: F401 (their home before)
 from ._disk import check_disk, check_retriangulation, check_surface
-from .evaluate import hausdorff, vertex_distance
+from .evaluate import Surface
 from .parameterize import METHODS as PARAMETERIZATIONS
 from .parameterize import parameterize
 from .retriangulate import METHODS as RETRIANGULATIONS
@@ -25,15 +25,10 @@ from .transfer import METHODS as TRANSFERS
 from .transfer import squashed_in_plane, transfer_curvature
 from .units import as_bbox_length, length_figures
 
-#: Face samples per direction for the zero-detail baseline. It lies ~10 % of the bbox diagonal
-#: from the source, where pymeshlab's grid search is slow (minutes); it is measured with
-#: ``hausdorff(engine="exact")`` and 20,000 samples, which agree with pymeshlab's 100,000-sample
-#: figures to ~1 % (mannequin_nose, mannequin_disk_1k, camelhead).
+#: Face samples per direction for the zero-detail baseline (it lies ~10 % of the bbox diagonal
+#: from the source, where every search is slow); they agree with 100,000 samples to ~1 %
+#: (mannequin_nose, mannequin_disk_1k, camelhead).
 BASELINE_SAMPLES = 20000
-
-#: A rebuilt surface with a vertex further than this (x bbox diagonal) from the source is measured
-#: with the exact engine as well (see `hausdorff`).
-FAR_SURFACE = 0.02
 
 #: RMS distances (in the report's unit, % of the source's bbox diagonal; the figures below are
 #: fractions of it) below which a figure is rounding, not
@@ -146,11 +141,8 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="c
     backend : str
         Sparse solver backend
     evaluate : bool
-        Measure distances (the costly part on big meshes). The error and the floor are measured with
-        pymeshlab's engine (see `hausdorff`): a fresh process repeats their figures exactly, a
-        second call in the same process draws other face samples (the bundled example's RMS: up to
-        1.1e-6 of the diagonal, 0.8 %, apart over three calls; the maxima, at vertices, stay the
-        same)
+        Measure distances (the costly part on big meshes), with `hausdorff`'s exact engine and its
+        seeded samples: every call repeats the figures exactly
     source_path : str or None
         Recorded in the report
     progress : callable or None
@@ -428,37 +420,37 @@ def run_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="cons
     out = {"X": X, "Ft": Ft, "Vt": Vt, "Z": Z, "Dt": Dt, "distance": None, "zero_distance": None}
     if evaluate:
         t = stage("evaluate")
+        source = Surface(V, F)              # checked, and its closest-point tree built, once
         # each vertex set searched once, exactly: these distances are the per-vertex figures
-        # (quality, vertex_max) and hausdorff takes them for its maxima, in its own frame, so
-        # its figures are those it would measure itself
-        out["distance"] = vertex_distance(X, V, F)
+        # (quality, vertex_max) and hausdorff takes them for its maxima
+        out["distance"] = source.vertex_distance(X)
         measured(1)
-        out["zero_distance"] = None if Z is None else vertex_distance(Z, V, F)
-        measured(2)
-        # pymeshlab's grid search slows down with the cube of the distance: surfaces that are
-        # far apart (a failed rebuild, the zero-detail baseline) use the exact engine.
-        far = out["distance"].max() > FAR_SURFACE * d
         engines = {}
-        for key, P, dist, n, engine in (
-                ("error", X, out["distance"], None, "exact" if far else "meshlab"),
-                ("baseline_zero_detail", Z, out["zero_distance"], BASELINE_SAMPLES, "exact"),
-                ("floor_retriangulated", Vt, vertex_distance(Vt, V, F), None, "meshlab")):
+
+        def measure(key, P, dist, n):
             try:
                 if P is None:
                     raise MeshError("the target has a closed piece, which with zero detail collapses onto its "
                                     "anchors: there is no zero-detail surface to compare with")
-                h = hausdorff(P, Ft, V, F, samples=n, engine=engine, a_vertex_distance=dist)
+                h = source.hausdorff(P, Ft, samples=n, engine="exact", a_vertex_distance=dist)
             except MeshError as exc:
                 if Z is not None and key != "baseline_zero_detail":
                     raise
                 # a harmonic surface spanning several small loops degenerates (zero-area triangles)
-                report[key] = None
-                engines[key] = exc.problem if P is None else ("the zero-detail surface is degenerate (zero-area "
-                                                              "triangles): there is no baseline to compare with")
-            else:
-                report[key] = {MAX: 100 * h["max"] / d, RMS: 100 * h["rms"] / d}
-                engines[key] = h["engine"]
-            measured(2 + len(engines))
+                return None, exc.problem if P is None else ("the zero-detail surface is degenerate (zero-area "
+                                                            "triangles): there is no baseline to compare with")
+            return {MAX: 100 * h["max"] / d, RMS: 100 * h["rms"] / d}, h["engine"]
+
+        done = {"error": measure("error", X, out["distance"], None)}
+        measured(2)
+        done["floor_retriangulated"] = measure("floor_retriangulated", Vt, None, None)
+        measured(3)
+        out["zero_distance"] = None if Z is None else source.vertex_distance(Z)
+        measured(4)
+        done["baseline_zero_detail"] = measure("baseline_zero_detail", Z, out["zero_distance"], BASELINE_SAMPLES)
+        measured(EVALUATION_STEPS)
+        for key in ("error", "baseline_zero_detail", "floor_retriangulated"):
+            report[key], engines[key] = done[key]
         report["error"]["engine"] = engines["error"]            # the engine that ran (hausdorff may switch)
         report["error"]["vertex_max_percent_of_diagonal"] = float(100 * out["distance"].max() / d)
         report.update(_ratios(report, engines))
