@@ -53,7 +53,7 @@ def edit_boundary(V, F, displacement, *, method="rotation", boundary_detail=None
     relations : {"one-ring", "one+two-ring"} or None
         ``"paper"`` only (None: ``"one-ring"``): curvature-stage relations of `CurvatureEditor`.
     rcond : float
-        Threshold of `curvature_coefficients`.
+        Threshold of `curvature_coefficients` (``"paper"`` only; unused by ``"rotation"``).
     backend : str
         Sparse solver backend.
     return_info : bool
@@ -81,7 +81,8 @@ def edit_boundary(V, F, displacement, *, method="rotation", boundary_detail=None
         If the mesh is malformed or has not exactly one boundary loop.
     ConstraintError
         If the displacements (given or returned) have the wrong shape or dtype, are not finite or
-        too large, or collapse the loop (``"deformed"``).
+        too large, or collapse the loop (``"deformed"``, or to one point with ``"rotation"``); if
+        ``boundary_detail`` or ``relations`` is given with ``method="rotation"``.
     ValueError
         If the displacement callable does not take ``(s, P)``, or an option is not one of its values.
     SolverError

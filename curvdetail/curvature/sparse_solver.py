@@ -7,8 +7,8 @@
 ``"auto"`` (also the environment variable ``CURVDETAIL_SOLVER``, which a named backend
 overrides) takes SuperLU below ``SMALL_SYSTEM_NNZ`` stored entries and otherwise the first
 installed of PARDISO, CHOLMOD (symmetric systems only) and SuperLU. SuperLU runs on one thread:
-below that size MKL's threads do not pay, and on a busy machine they cost up to 10x
-(docs/results/small_solves.md).
+below that size MKL's threads do not pay, and on a busy machine they make a re-solve many times
+slower (docs/results/small_solves.md).
 """
 
 import os

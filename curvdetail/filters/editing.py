@@ -115,10 +115,11 @@ def _matrix(text):
         the region of interest - the selected vertices, the handles and, with region_radius,
         every vertex that close to a handle - is rebuilt from its curvature details. With
         method 'rotation' (the default) each rest detail turns with its neighbourhood (local
-        rotations fitted to the one-rings, alternated with the embedding until the vertices move
-        less than 1e-4 of the diagonal). With method 'paper' the handles' curvature normals are
-        transformed by the transform's linear part and scaled by detail_scale, and the region is
-        rebuilt in two stages: the details of the other region vertices from the rotation- and
+        rotations fitted to the one-rings, alternated with the embedding until no vertex has moved
+        more than 1e-4 of the diagonal over the last 10 iterations). With method 'paper' the
+        handles' curvature normals are transformed by the transform's linear part and scaled by
+        detail_scale, and the region is rebuilt in two stages: the details of the other region
+        vertices from the rotation- and
         scale-invariant curvature coefficients (min |(I - C) D|^2), then the positions from the
         details (E_Q). Vertices outside the region do not move. Vertices move in place; the vertex quality is set to
         the distance each vertex moved. Returns the largest move, how far the curvature stage

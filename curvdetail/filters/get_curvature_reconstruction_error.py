@@ -17,10 +17,10 @@ from .registry import PAPER, filter
         between the sampled layer (by default the current one, e.g. the retriangulation rebuilt
         from transferred curvature detail) and the target layer (by default layer 0, the source as
         loaded), with pymeshlab's get_hausdorff_distance sampling the faces in both directions
-        and every vertex measured exactly, for the maxima (curvdetail.remesh.hausdorff, the same
-        figures as the remeshing report; layers more than
-        one bounding-box diagonal apart are measured with its exact engine instead, and the
-        figures say which engine ran). Returns the
+        and every vertex measured exactly, for the maxima (curvdetail.remesh.hausdorff, engine
+        'meshlab'; the remeshing report uses its seeded 'exact' engine, so the sampled figures
+        differ a little; layers more than one bounding-box diagonal apart are measured with the
+        'exact' engine instead, and the figures say which engine ran). Returns the
         maximum and RMS distances in % of the target's bounding-box diagonal and in model units
         (the unit in each key) (the
         evaluation of the paper's remeshing experiment, Fig. 3), and the one-sided figures. With

@@ -79,8 +79,8 @@ def check_retriangulation(Vs, Fs, Vt, Ft, source, target):
         Parameter("parameterization", "str", "harmonic",
                   "planar map for location='uv' (only): own cotangent 'harmonic' map, pymeshlab's "
                   "'meshlab_harmonic' or 'lscm'", choices=("harmonic", "meshlab_harmonic", "lscm")),
-        Parameter("laplacian", "str", "auto", "where the detail is computed: the source's " + LAPLACIAN_DESCRIPTION,
-                  choices=LAPLACIANS),
+        Parameter("laplacian", "str", "auto", "where the detail is computed, the source's Laplacian: "
+                  + LAPLACIAN_DESCRIPTION.removeprefix("the mesh's Laplacian: "), choices=LAPLACIANS),
     ],
 )
 def transfer_curvature_detail(ms, *, sourcemesh, targetmesh, method, location, parameterization, laplacian):

@@ -150,27 +150,26 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="c
         run) as ``progress("evaluate", done, total)`` after each of its ``EVALUATION_STEPS``
         measurements
     target : tuple (Vt, Ft) or None
-        A ready retriangulation to use instead of making one (a disk whose boundary vertices lie on
-        the source's boundary polyline); ``method`` / ``target_edge`` are then unused (but still
-        checked), the report's ``options.method`` is ``"given"`` and its
+        A ready retriangulation to use instead of making one (`check_retriangulation`: as many
+        boundary loops, its boundary vertices on the source's boundary polyline, every vertex
+        within ``SURFACE_TOLERANCE`` of the source's surface); ``method`` / ``target_edge`` are
+        then unused (but still checked), the report's ``options.method`` is ``"given"`` and its
         ``options.target_edge_model_units`` and ``target_edge_percent_of_diagonal`` None, and
         ``seconds.retriangulate`` is 0
     surface_check : bool
         Isotropic retriangulation: check the distance an edge collapse or flip moves the surface
         (pymeshlab's ``checksurfdist``; see `retriangulate`). ``False`` is faster on large
-        patches (terrainA_100k at 100k targets 26.1 s -> 19.9 s) and may change the retriangulation;
-        recorded in ``options.surface_check`` (None for a given ``target`` or ``"decimate"``)
+        targets and may change the retriangulation; recorded in ``options.surface_check`` (None
+        for a given ``target`` or ``"decimate"``)
     anchors : int
         Fixed vertices on each closed piece of the target (farthest-point sampled from its flattest
         vertex)
     laplacian : {"auto", "cotan", "robust"}
         The source's detail ``D = L V``: "cotan" the plain cotangent Laplacian (refuses zero-area
-        triangles); "robust" the mollified one
-        (`robust_laplacian`), and the geometric stages
-        see the source with its zero-area caps flipped away
-        (`flip_caps`: the same surface); "auto" "cotan"
-        unless the plain checks refuse the source's zero-area triangles. The rebuild on the target
-        uses the plain one always
+        triangles); "robust" the mollified one (`robust_laplacian`), and the geometric stages see
+        the source with its zero-area caps flipped away (`flip_caps`: the same surface); "auto"
+        "cotan" unless the plain checks refuse the source's zero-area triangles. The rebuild on
+        the target uses the plain one always
 
     Returns
     -------
@@ -187,10 +186,9 @@ def remesh_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="c
         piece there is no zero-detail surface (it collapses onto the anchors):
         ``baseline_zero_detail`` and the improvement are None, with the reason in ``ratio_notes``.
         Each ratio is None where one of its two RMS values is rounding, not a measurement (below
-        ``ROUNDING_RMS``: 1e-5 % of the diagonal as pymeshlab's single-precision engine measures,
-        1e-10 % as the exact engine does; e.g. every surface of a flat patch, or a target equal to
-        the source), with the reason under ``ratio_notes`` (``{ratio name: reason}``, present only
-        then), ``parameterization`` (flip counts, for ``location="uv"``) and
+        ``ROUNDING_RMS["exact"]``, 1e-10 % of the diagonal; e.g. every surface of a flat patch, or
+        a target equal to the source), with the reason under ``ratio_notes`` (``{ratio name:
+        reason}``, present only then), ``parameterization`` (flip counts, for ``location="uv"``) and
         ``seconds.{retriangulate, parameterize, transfer, reconstruct, evaluate, total}``,
         ``laplacian`` ("cotan" or "robust": the one used for the source's detail) and
         ``laplacian_reason`` (why, with the zero-area triangles counted and the caps flipped). With
