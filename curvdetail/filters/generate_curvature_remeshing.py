@@ -3,6 +3,7 @@
 import os
 
 from ..curvature.geometry import bbox_diagonal
+from ..curvature.robust_laplacian import LAPLACIANS
 from .apply_curvature_reconstruction import BACKEND_DESCRIPTION, BACKENDS
 from .detail_attributes import DETAIL, stamp
 from .files import loaded_from
@@ -66,7 +67,7 @@ from .transfer_curvature_detail import planar_map
                   "the source's Laplacian for its detail: 'cotan' (refuses zero-area triangles), 'robust' "
                   "(mollified intrinsic cotan, zero-area caps flipped) or 'auto' (cotan unless the source "
                   "has zero-area triangles); the report says which was used and why",
-                  choices=("auto", "cotan", "robust")),
+                  choices=LAPLACIANS),
         Parameter("evaluate", "bool", True,
                   "measure the distances to the source (half or more of the time on big meshes with "
                   "decimation, up to half with isotropic remeshing); false leaves the rebuilt and "
