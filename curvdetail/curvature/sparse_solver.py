@@ -23,8 +23,10 @@ from .errors import CurvdetailError
 
 BACKENDS = ("pardiso", "cholmod", "splu")
 
-#: Below this many stored entries (a ~28k-vertex Laplacian) ``"auto"`` takes SuperLU.
-SMALL_SYSTEM_NNZ = 200_000
+#: Below this many stored entries (a ~15k-vertex Laplacian) ``"auto"`` takes SuperLU: one thread,
+#: as fast as PARDISO there on an idle machine and many times faster beside busy processes
+#: (docs/results/small_solves.md); from a 20k-vertex Laplacian PARDISO's threads pay.
+SMALL_SYSTEM_NNZ = 100_000
 
 #: What ``"auto"`` picks, in a line (for parameter descriptions and help texts).
 AUTO_RULE = (f"auto = SuperLU below {SMALL_SYSTEM_NNZ:,} stored entries, else the first installed of "
