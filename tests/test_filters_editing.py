@@ -67,12 +67,13 @@ def test_the_default_rotation_aware_edit_turns_the_region_without_warning():
     assert figures["rank_deficient_vertices"] is None and figures["detail_amplification"] is None
 
 
-@pytest.mark.parametrize("params", [dict(detail_scale=0.5), dict(move_handles=False)])
+@pytest.mark.parametrize("params", [dict(detail_scale=0.5), dict(move_handles=False), dict(handle_detail="free"),
+                                    dict(relations="one+two-ring"), dict(relations="one+two-ring", detail_scale=2.0)])
 def test_paper_only_parameters_are_refused_with_the_rotation_aware_method(params):
     ms, V, d, handles = _meshset_with_roi()
     with pytest.raises(FilterParameterError, match="method='paper'") as e:      # the value that takes them
         apply(ms, "apply_curvature_editing", handles=handles, **params)
-    assert e.value.parameter == "method"
+    assert e.value.parameter == "method" and sorted(e.value.value) == sorted(params)
     assert np.array_equal(ms.current_mesh().vertex_matrix(), V)
 
 

@@ -172,9 +172,14 @@ def apply_curvature_editing(ms, *, handles, region_radius, transform, method, de
     V, F = mesh_arrays(ms, mid)
     h = _indices(handles, V.shape[0])
     T = _matrix(transform)
-    if method == "rotation" and (detail_scale != 1.0 or not move_handles):
-        raise FilterParameterError("method='rotation' moves the handles and keeps their details' size; "
-                                   "detail_scale and move_handles=false need method='paper'.", parameter="method")
+    paper_only = [name for name, value, default in (("detail_scale", detail_scale, 1.0),
+                                                    ("move_handles", move_handles, True),
+                                                    ("handle_detail", handle_detail, "transform"),
+                                                    ("relations", relations, "one-ring")) if value != default]
+    if method == "rotation" and paper_only:
+        raise FilterParameterError(f"{', '.join(paper_only)} apply to method='paper' only; method='rotation' "
+                                   "moves the handles and turns every detail with its neighbourhood.",
+                                   parameter="method", value=paper_only)
     if not move_handles and handle_detail == "free":
         raise FilterParameterError("move_handles=false with handle_detail='free' leaves the handles "
                                    "unconstrained; set one of them.", parameter="handle_detail")
