@@ -77,6 +77,10 @@ def test_auto_falls_back_to_robust_on_a_cap_and_reports_it():
     # the rebuilt surface is as close to the source as the clean sphere's (within 10 %)
     _, clean = remesh_experiment(*bumpy_sphere(), target_edge="4%")
     assert clean["laplacian"] == "cotan"
+    # a study's table says which ran
+    from curvdetail.evaluate.cell import report_columns
+
+    assert (report_columns(report)["laplacian"], report_columns(clean)["laplacian"]) == ("robust", "cotan")
     assert report["error"][RMS] < 1.1 * clean["error"][RMS]
 
 

@@ -63,6 +63,7 @@ def report_columns(report):
            "target_edge_model_units": o.get("target_edge_model_units"),
            "target_vertices": report["target"]["vertices"], "target_faces": report["target"]["faces"],
            "target_boundary_loops": report["target"].get("boundary_loops"), "anchors": report.get("anchors"),
+           "laplacian": report.get("laplacian"),
            "backend": o.get("backend"), "experiment_s": s["total"],
            **{f"{stage}_s": s[stage] for stage in _STAGES}}
     if "error" in report:

@@ -44,6 +44,8 @@ COLUMNS = [
     ("target_faces", _I, "triangles of the target"),
     ("target_boundary_loops", _I, "boundary loops of the target"),
     ("anchors", _I, "vertices fixed on the target's closed pieces"),
+    ("laplacian", _S, 'the source\'s Laplacian that ran: "cotan", or "robust" where the source has zero-area '
+                      'triangles'),
     ("error_rms_percent_of_diagonal", _F, "two-sided Hausdorff RMS, rebuilt surface to source"),
     ("error_max_percent_of_diagonal", _F, "two-sided Hausdorff max, rebuilt surface to source"),
     ("error_vertex_max_percent_of_diagonal", _F, "largest distance of a rebuilt vertex to the source (exact)"),
