@@ -127,6 +127,14 @@ def test_a_warm_start_from_the_result_stops_at_once():
     assert ed.iterations == 1 and np.abs(X2 - X).max() < 1e-5
 
 
+def test_a_warm_start_with_every_roi_vertex_a_handle_returns_the_handles():
+    # no free vertex: nothing to fit, the handles are the result (the warm start crashed in numpy)
+    V, F = icosphere(radius=1.0, subdivisions=1)
+    ed = RotationAwareEditor(V, F, np.arange(V.shape[0]))
+    X = ed.solve(V + 1.0, initial=V)
+    assert np.array_equal(X, V + 1.0) and ed.iterations == 0
+
+
 def test_no_handle_on_the_whole_mesh_is_refused():
     V, F = icosphere(radius=1.0, subdivisions=2)
     with pytest.raises(ConstraintError) as e:

@@ -331,6 +331,8 @@ def _closest_rotations(C, tol=1e-7, max_steps=20):
     polar factor is the answer, found by scaled Newton steps ``X <- (g X + X^-T / g) / 2`` until
     no entry moves more than ``tol`` (the error is then about ``tol^2``). The rest (a factor that
     is no rotation) goes through `_closest_rotations_eigh`."""
+    if C.shape[2] == 0:                                  # no vertex to fit (every roi vertex a handle)
+        return C.copy()
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         X = C / np.sqrt(np.einsum("ijk,ijk->k", C, C))
         X += _cofactor(X)
