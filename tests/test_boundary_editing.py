@@ -466,3 +466,16 @@ def test_a_small_smooth_edit_neither_folds_nor_warns(load_mesh):
     V, F = load_mesh("terrainA_1k.obj")
     _, info = edit_boundary(V, F, sine_displacement(0.5, periods=2, axis=2), return_info=True)
     assert info["folded_triangles"] == 0
+
+
+def test_the_rotation_aware_editor_returned_for_re_solves_rests_on_the_moved_patch():
+    # its rest is the patch moved by the boundary's similarity (here a halving about the centre):
+    # a re-solve at that boundary gives the halved patch, at the edit's boundary the edit itself
+    V, F = grid(9, 9)
+    V[:, 2] = 0.2 * np.sin(3 * V[:, 0])
+    c = V.mean(axis=0)
+    X, info = edit_boundary(V, F, lambda s, P: -0.5 * (P - c), return_info=True)
+    b, ed = info["boundary"], info["editor"]
+    halved = c + 0.5 * (V - c)
+    assert np.abs(ed.solve(halved[b]) - halved).max() < 1e-6
+    assert np.abs(ed.solve(X[b]) - X).max() < 1e-6

@@ -58,8 +58,10 @@ def edit_boundary(V, F, displacement, *, method="rotation", boundary_detail=None
         Sparse solver backend.
     return_info : bool
         Also return a dict: ``boundary`` (loop order), ``arc_length``, ``boundary_detail`` (b, 3;
-        None with ``"rotation"``), ``editor`` (for re-solves), ``iterations`` (``"rotation"``), ``folded_triangles`` (normal against the rest one, the
-        boundary's rotation discounted), ``max_displacement`` / ``boundary_displacement`` (largest
+        None with ``"rotation"``), ``editor`` (for re-solves; with ``"rotation"`` a
+        `RotationAwareEditor` whose rest is the patch moved by this displacement's best-fitting
+        similarity, so its re-solves edit that shape, not ``V``), ``iterations`` (``"rotation"``),
+        ``folded_triangles`` (normal against the rest one, the boundary's rotation discounted), ``max_displacement`` / ``boundary_displacement`` (largest
         move of any / a boundary vertex over the rest bbox diagonal), ``amplification`` (their
         ratio, None for an unmoved boundary).
 
