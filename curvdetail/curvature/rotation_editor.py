@@ -330,22 +330,27 @@ def _closest_rotations(C, tol=1e-7, max_steps=20):
     ``d`` (always for ``d = 1``, rank 2 included), its determinant is positive and its orthogonal
     polar factor is the answer, found by scaled Newton steps ``X <- (g X + X^-T / g) / 2`` until
     no entry moves more than ``tol`` (the error is then about ``tol^2``). The rest (a factor that
-    is no rotation) goes through `_closest_rotations_eigh`."""
+    is no rotation, or a start whose determinant is rounding: rank 1) goes through
+    `_closest_rotations_eigh`."""
     if C.shape[2] == 0:                                  # no vertex to fit (every roi vertex a handle)
         return C.copy()
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         X = C / np.sqrt(np.einsum("ijk,ijk->k", C, C))
         X += _cofactor(X)
-        for _ in range(max_steps):
+        for step_number in range(max_steps):
             cof = _cofactor(X)                               # det(X) X^-T
             det = np.einsum("ik,ik->k", X[:, 0], cof[:, 0])
+            if step_number == 0:
+                # det(C + cof(C)) below 1e-15 (rank 1, a one-ring on a line: rounding, up to
+                # 1e-17) makes the Newton steps' X^-T rounding: the eigen path takes it
+                start = det
             g = np.sqrt(np.sqrt(np.einsum("ijk,ijk->k", cof, cof) / np.einsum("ijk,ijk->k", X, X)) / np.abs(det))
             step = 0.5 * (g * X + cof / (g * det))
             change = np.abs(step - X)
             X = step
             if np.fmax.reduce(change, axis=None) < tol:     # NaN (a singular X) ignored, caught by det
                 break
-        bad = ~(det > 0)
+        bad = ~((det > 0) & (start > 1e-15))
         if not np.fmax.reduce(change, axis=None) < tol:
             bad |= ~(change.reshape(9, -1).max(axis=0) < tol)
     if bad.any():
@@ -372,6 +377,9 @@ def _closest_rotations_eigh(C):
     u1 /= np.maximum(np.linalg.norm(u1, axis=1), np.finfo(float).tiny)[:, None]
     u2 = np.einsum("kij,kj->ki", C, w2)
     u2 -= np.einsum("ki,ki->k", u1, u2)[:, None] * u1
+    flat = ~(np.linalg.norm(u2, axis=1) > 1e-12 * np.linalg.norm(C, axis=(1, 2)))
+    if flat.any():                      # rank 1: C w2 is rounding; any unit vector normal to u1 does
+        u2[flat] = np.cross(u1[flat], np.eye(3)[np.argmin(np.abs(u1[flat]), axis=1)])
     u2 /= np.maximum(np.linalg.norm(u2, axis=1), np.finfo(float).tiny)[:, None]
     return (np.einsum("ki,kj->kij", u1, w1) + np.einsum("ki,kj->kij", u2, w2)
             + np.einsum("ki,kj->kij", np.cross(u1, u2), np.cross(w1, w2)))
