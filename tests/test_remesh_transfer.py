@@ -408,3 +408,26 @@ def test_a_malformed_detail_is_refused_by_name(load_mesh):
         transfer_curvature(V, F, V, F, method="pointwise", detail=D)
     assert e.value.parameter.startswith("detail") and (e.value.count, e.value.first) == (1, [5])
 
+
+
+def test_samples_on_one_sheet_stay_at_their_closest_points_where_the_target_is_uneven():
+    # a target about 10 times finer near x = 0 than on average (uneven sampling, as scans have):
+    # own_side's step toward a sample's own triangles crossed many target triangles there, and
+    # moved 112 samples up to 10 times farther from the surface (the detail moved by 36 % of its max)
+    from curvdetail.remesh.locate import locate, own_side
+    from curvdetail.remesh.transfer import _edge_curvature_measure
+
+    def lift(V):
+        V[:, 2] = 0.05 * np.sin(3 * V[:, 0]) * np.cos(2 * V[:, 1])
+        return V
+
+    Vs, Fs = grid(8, 8)
+    Vt, Ft = grid(60, 60)
+    Vt[:, 0] **= 3
+    Vs, Vt = lift(Vs), lift(Vt)
+    E, _, _, inner = _edge_curvature_measure(Vs, Fs, normals=True)
+    P = Vs[E].mean(axis=1)
+    face, bary, dist = locate(P, Vt, Ft)
+    closest = face.copy()
+    assert own_side(P, inner, Vt, Ft, face, bary, dist) == 0
+    assert np.array_equal(face, closest)

@@ -74,8 +74,8 @@ def _locate(P, V, F):
     return face, bary, np.sqrt(sqrD) * scale
 
 
-#: How far `own_side` steps a sample toward its own triangles: this times the target's mean edge
-#: length, at most half the way.
+#: How far `own_side` steps a sample toward its own triangles: this times the least altitude of its
+#: closest target triangle, at most half the way.
 SIDE_STEP = 0.1
 
 
@@ -108,7 +108,12 @@ def own_side(P, inner, V, F, face, bary, dist):
     """
     if P.shape[0] == 0:
         return 0
-    step = SIDE_STEP * np.linalg.norm(V[F[:, [1, 2, 0]]] - V[F], axis=2).mean()
+    # the local size: a step of the target's mean edge crossed many triangles where the target is
+    # finer or thinner than on average, and moved the sample off its closest point on its own sheet
+    T = V[F[face]]
+    double_area = np.linalg.norm(np.cross(T[:, 1] - T[:, 0], T[:, 2] - T[:, 0]), axis=1)
+    longest = np.linalg.norm(T[:, [1, 2, 0]] - T, axis=2).max(axis=1)
+    step = SIDE_STEP * (double_area / longest)[:, None]
     d = inner - P
     length = np.linalg.norm(d, axis=1, keepdims=True)
     Q = P + d * np.minimum(step / np.maximum(length, np.finfo(float).tiny), 0.5)
