@@ -110,10 +110,9 @@ def own_side(P, inner, V, F, face, bary, dist):
         return 0
     # the local size: a step of the target's mean edge crossed many triangles where the target is
     # finer or thinner than on average, and moved the sample off its closest point on its own sheet
-    T = V[F[face]]
+    T = V[F]
     double_area = np.linalg.norm(np.cross(T[:, 1] - T[:, 0], T[:, 2] - T[:, 0]), axis=1)
-    longest = np.linalg.norm(T[:, [1, 2, 0]] - T, axis=2).max(axis=1)
-    step = SIDE_STEP * (double_area / longest)[:, None]
+    step = SIDE_STEP * (double_area / np.linalg.norm(T[:, [1, 2, 0]] - T, axis=2).max(axis=1))[face, None]
     d = inner - P
     length = np.linalg.norm(d, axis=1, keepdims=True)
     Q = P + d * np.minimum(step / np.maximum(length, np.finfo(float).tiny), 0.5)
