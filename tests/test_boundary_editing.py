@@ -479,3 +479,12 @@ def test_the_rotation_aware_editor_returned_for_re_solves_rests_on_the_moved_pat
     halved = c + 0.5 * (V - c)
     assert np.abs(ed.solve(halved[b]) - halved).max() < 1e-6
     assert np.abs(ed.solve(X[b]) - X).max() < 1e-6
+
+
+@pytest.mark.parametrize("option", [dict(boundary_detail="rest"), dict(relations="one+two-ring"), dict(rcond=1e-3)])
+def test_the_paper_s_options_are_refused_with_the_rotation_aware_default(option):
+    V, F = grid(6, 6)
+    with pytest.raises(ConstraintError) as e:
+        edit_boundary(V, F, lambda s, P: pytest.fail("the displacement ran"), **option)
+    assert e.value.parameter == next(iter(option))
+    edit_boundary(V, F, sine_displacement(0.1, axis=2), method="paper", **option)      # taken there

@@ -53,7 +53,7 @@ def edit_boundary(V, F, displacement, *, method="rotation", boundary_detail=None
     relations : {"one-ring", "one+two-ring"} or None
         ``"paper"`` only (None: ``"one-ring"``): curvature-stage relations of `CurvatureEditor`.
     rcond : float
-        Threshold of `curvature_coefficients` (``"paper"`` only; unused by ``"rotation"``).
+        Threshold of `curvature_coefficients` (``"paper"`` only).
     backend : str
         Sparse solver backend.
     return_info : bool
@@ -84,7 +84,7 @@ def edit_boundary(V, F, displacement, *, method="rotation", boundary_detail=None
     ConstraintError
         If the displacements (given or returned) have the wrong shape or dtype, are not finite or
         too large, or collapse the loop (``"deformed"``, or to one point with ``"rotation"``); if
-        ``boundary_detail`` or ``relations`` is given with ``method="rotation"``.
+        ``boundary_detail``, ``relations`` or another ``rcond`` is given with ``method="rotation"``.
     ValueError
         If the displacement callable does not take ``(s, P)``, or an option is not one of its values.
     SolverError
@@ -107,12 +107,13 @@ def edit_boundary(V, F, displacement, *, method="rotation", boundary_detail=None
                                        "; use 'deformed' or 'rest'.")
     if relations is not None:
         _check_relations(relations)
-    for name, value in (("boundary_detail", boundary_detail), ("relations", relations)):
+    check_rcond(rcond)
+    for name, value in (("boundary_detail", boundary_detail), ("relations", relations),
+                        ("rcond", None if rcond == DEFAULT_RCOND else rcond)):
         if method == "rotation" and value is not None:
             raise ConstraintError(f"{name} applies to method='paper' only", parameter=name, value=value,
                                   hint=f"pass method='paper' with {name}, or leave {name} out")
     boundary_detail, relations = boundary_detail or "deformed", relations or "one-ring"
-    check_rcond(rcond)
     resolve_backend(backend)
     check_bool(return_info, "return_info")
     V = as_vertices(V)
