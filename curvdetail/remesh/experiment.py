@@ -253,19 +253,21 @@ def _check_planar_map(UV, F, which, parameterization):
                       f'Use {other}location "closest" (the default, no planar map).', RemeshError)
 
 
-def _ratios(report, engines):
-    """``improvement_over_zero_detail`` and ``ratio_to_floor`` of a measured ``report``, each
-    None where one of its RMS figures is below the ``ROUNDING_RMS`` of the engine that measured
-    it (``engines``: figure key -> engine), and ``ratio_notes`` saying why, where one is None."""
+def _ratios(report, unmeasured):
+    """``improvement_over_zero_detail`` and ``ratio_to_floor`` of a ``report`` measured with the
+    exact engine, each None where one of its RMS figures is below that engine's ``ROUNDING_RMS``
+    or was not measured (``unmeasured``: figure key -> why), and ``ratio_notes`` saying why,
+    where one is None."""
+    floor = ROUNDING_RMS["exact"]
+
     def rounding(key, what, then):
-        if report[key] is None:                     # not measured: engines[key] says why
-            return engines[key]
+        if report[key] is None:
+            return unmeasured[key]
         rms = report[key][RMS]
-        floor = ROUNDING_RMS[engines[key]]
         if rms >= floor:
             return None
         return (f"{what} lies on the source to rounding (RMS {rms:.3g} % of the bbox diagonal, below the "
-                f"{floor:g} % its {engines[key]} engine resolves): {then}")
+                f"{floor:g} % the exact engine resolves): {then}")
 
     out, notes = {}, {}
     rebuilt = "the rebuilt surface"
@@ -423,9 +425,9 @@ def run_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="cons
         # (quality, vertex_max) and hausdorff takes them for its maxima
         out["distance"] = source.vertex_distance(X)
         measured(1)
-        engines = {}
 
         def measure(key, P, dist, n):
+            """The figures of P's surface against the source, or None and why (a baseline only)."""
             try:
                 if P is None:
                     raise MeshError("the target has a closed piece, which with zero detail collapses onto its "
@@ -437,7 +439,7 @@ def run_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="cons
                 # a harmonic surface spanning several small loops degenerates (zero-area triangles)
                 return None, exc.problem if P is None else ("the zero-detail surface is degenerate (zero-area "
                                                             "triangles): there is no baseline to compare with")
-            return {MAX: 100 * h["max"] / d, RMS: 100 * h["rms"] / d}, h["engine"]
+            return {MAX: 100 * h["max"] / d, RMS: 100 * h["rms"] / d}, None
 
         done = {"error": measure("error", X, out["distance"], None)}
         measured(2)
@@ -448,10 +450,10 @@ def run_experiment(V, F, *, method="isotropic", target_edge="1%", transfer="cons
         done["baseline_zero_detail"] = measure("baseline_zero_detail", Z, out["zero_distance"], BASELINE_SAMPLES)
         measured(EVALUATION_STEPS)
         for key in ("error", "baseline_zero_detail", "floor_retriangulated"):
-            report[key], engines[key] = done[key]
-        report["error"]["engine"] = engines["error"]            # the engine that ran (hausdorff may switch)
+            report[key] = done[key][0]
+        report["error"]["engine"] = "exact"
         report["error"]["vertex_max_percent_of_diagonal"] = float(100 * out["distance"].max() / d)
-        report.update(_ratios(report, engines))
+        report.update(_ratios(report, {key: why for key, (_, why) in done.items()}))
         seconds["evaluate"] = time.perf_counter() - t
         worse = worse_than_zero_detail(report)
         if worse is not None:
