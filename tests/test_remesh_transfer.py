@@ -142,6 +142,12 @@ def test_options_that_would_be_ignored_are_refused():
     with pytest.raises(CurvdetailError) as e:
         transfer_curvature(V, F, V, F, method="pointwise", samples_per_edge=3)
     assert e.value.parameter == "samples_per_edge"
+    with pytest.raises(CurvdetailError) as e:
+        transfer_curvature(V, F, V, F, method="pointwise", metric="source")
+    assert e.value.parameter == "metric"
+    with pytest.raises(CurvdetailError) as e:
+        transfer_curvature(V, F, V, F, metric="intrinsic")
+    assert (e.value.parameter, e.value.value) == ("metric", "intrinsic")
 
 
 def test_malformed_uv_is_named_as_uv():

@@ -7,6 +7,7 @@ from ..curvature.checks import ZERO_AREA_RELATIVE, as_count, as_values, check_ch
 from ..curvature.geometry import face_double_areas
 from ..curvature.topology import edge_keys as edge_keys
 from ..curvature.errors import CurvdetailError, MeshError, counted, first_indices
+from ..curvature.cotan_laplacian import cotan_laplacian
 from ..curvature.mean_curvature_normal import mean_curvature_normal
 from ..curvature.mixed_voronoi_area import mixed_voronoi_area
 from ..curvature.sparse_solver import factorize
@@ -14,8 +15,10 @@ from ._disk import check_retriangulation
 from .closest_point import as_coordinates, check_points_and_mesh, unit_frame
 from .closest_point import _barycentric
 from .locate import _locate, interpolate, own_side, spread
+from .metric import rebuilt_in_metric, source_metric_laplacian
 
 METHODS = ("conservative", "pointwise")
+METRICS = ("source", "target")
 LOCATIONS = ("closest", "uv")
 
 #: Most edge samples the conservative transfer takes: locating them holds ~0.5 kB each, so
@@ -89,7 +92,7 @@ def _edge_curvature_measure(V, F, normals=False):
 
 
 def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="closest", uv=None,
-                       samples_per_edge=None, detail=None):
+                       samples_per_edge=None, detail=None, metric=None):
     """Curvature detail ``D`` for the target mesh, carried over from the source mesh.
 
     The detail carried is ``detail`` where given (e.g. stored before the source's vertices were
@@ -103,11 +106,20 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     ``method="conservative"``: the extensive detail is moved as a measure. The source's detail
     lives on its edges (`edge_curvature_measure`, with ``D_i = 1/2 sum c_e`` exactly); each
     edge's measure is split evenly over sample points along the edge, every sample is located in
-    a target triangle and split over its three corners by barycentric weights. Totals are kept
-    exactly over any union of target stars, in particular ``sum_t D_t = sum_s D_s`` (to rounding),
-    and a target equal to the source gets its own detail back exactly. A given ``detail`` is put
-    on the edges as the measure closest (least squares) to the geometry's whose halves give it
-    exactly: ``c'_e = c_e + 2 (mu_i + mu_j)`` with ``Q mu = detail - D(Vs, Fs)``, ``Q`` the
+    a target triangle and split over its three corners by barycentric weights: the integral over
+    the source of ``P_s grad(phi_i)`` for each target hat function ``phi_i`` lifted onto it
+    (``P_s`` the source's tangent projector), the source's own bilinear form. With
+    ``metric="source"`` (the default) that measure is then read in the one metric it was taken
+    in: ``X`` solves ``K X = measure`` (`source_metric_laplacian`: the target's Laplacian in the
+    source's metric; the target's boundary kept, one vertex of each closed piece) and the
+    returned detail is ``measure + (L_t - K) X``: ``L_t X`` at every free vertex, so rebuilding
+    the target with its boundary fixed gives ``X``, near the retriangulated surface's own error,
+    and the total is kept (``sum_t D_t = sum_s D_s`` to rounding). ``metric="target"`` returns
+    the measure as carried, whose totals are kept over any union of target stars too; rebuilt
+    with the target's Laplacian, thin parts stretch by the inscribed target's perimeter deficit
+    (cow.off's tail: 2 %). A target equal to the source gets its own detail back either way (to
+    rounding). A given ``detail`` is put on the edges as the measure closest (least squares) to
+    the geometry's whose halves give it exactly: ``c'_e = c_e + 2 (mu_i + mu_j)`` with ``Q mu = detail - D(Vs, Fs)``, ``Q`` the
     signless Laplacian of the edge graph (degree + adjacency; positive definite on a mesh of
     triangles, well conditioned, so the correction stays near the vertices it belongs to).
 
@@ -135,6 +147,9 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     detail : (n_s, 3) float array or None
         The source's detail to carry (pointwise: ``K`` = ``detail`` / the source's mixed Voronoi
         area); ``None`` = the detail of ``Vs, Fs``
+    metric : {"source", "target"} or None
+        Conservative only: read the carried measure in the source's metric (``"source"``, the
+        default for ``None``) or take it as carried (``"target"``)
 
     Returns
     -------
@@ -152,7 +167,7 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     ValueError
         Unknown method / location; ``uv`` missing, not a pair or of the wrong shape for ``"uv"``, or
         given with ``"closest"``; ``samples_per_edge`` not a whole number >= 1, too many samples, or
-        given with ``"pointwise"``
+        given with ``"pointwise"``; ``metric`` unknown or given with ``"pointwise"``
     ConstraintError
         (a ValueError) ``detail`` not a finite (n_s, 3) array
 
@@ -176,6 +191,12 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
             raise CurvdetailError("samples_per_edge is used by method='conservative' only; drop it for 'pointwise'.",
                                   parameter="samples_per_edge")
         samples_per_edge = as_count(samples_per_edge, "samples_per_edge")
+    if metric is not None:
+        if method != "conservative":
+            raise CurvdetailError("metric is used by method='conservative' only; drop it for 'pointwise'.",
+                                  parameter="metric")
+        metric = check_choice(metric, "metric", METRICS, "; use 'source' (the rebuild consistent with the "
+                              "source's metric) or 'target' (the measure as carried).")
     Vs, Fs = checked_arrays(Vs, Fs)
     Vt, Ft = checked_arrays(Vt, Ft)
     check_retriangulation(Vs, Fs, Vt, Ft)
@@ -211,7 +232,12 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     if location == "closest":
         own_side(pts, inner[edge], Vt, Ft, face, bary, dist)
         _facing_side(pts, normal[edge], Vt, Ft, face, bary, dist)
-    return spread(c[edge] / q[edge, None], Ft, face, bary, Vt.shape[0])
+    D = spread(c[edge] / q[edge, None], Ft, face, bary, Vt.shape[0])
+    if metric == "target":
+        return D
+    K = source_metric_laplacian(Vs, Fs, Vt, Ft, *((src_dom, tgt_dom) if location == "uv" else (None, None)))
+    # = L_t X at every free vertex; the metric's difference added to the measure keeps its total
+    return D + (cotan_laplacian(Vt, Ft) - K) @ rebuilt_in_metric(K, D, Vt, Ft)
 
 
 #: Most samples `_facing_side` relocates one by one; more (a target wound against the

@@ -1,0 +1,103 @@
+"""The target's cotangent Laplacian measured in the source surface's metric (the transfer's rebuild)."""
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..curvature.sparse_solver import factorize
+from ..curvature.topology import boundary_vertices, vertex_components
+from .closest_point import check_points_and_mesh
+from .locate import _locate, own_side
+
+#: Most quadrature points `source_metric_laplacian` takes (k^2 per target triangle, k from 3 down
+#: to 1 where the target has more triangles than this allows): ~0.5 kB each while located.
+MAX_METRIC_SAMPLES = 4_000_000
+
+#: A quadrature point whose source triangle turns more than 60 degrees from its target triangle
+#: (cos below this: the other sheet, or a fold) counts with the target's own metric.
+FACING = 0.5
+
+
+def source_metric_laplacian(Vs, Fs, Vt, Ft, src_dom=None, tgt_dom=None):
+    """Stiffness matrix of the target's hat functions lifted onto the source surface.
+
+    ``K_ij = sum_T A_T grad(phi_i)^T M_T grad(phi_j)``, with ``M_T`` the mean over quadrature
+    points of triangle ``T`` of ``P_s / c``: ``P_s = I - n_s n_s^T`` the tangent projector of the
+    source triangle over the point, ``c = n_s . n_T``. This is the Dirichlet energy of the lifted
+    functions on the source (its area element is ``dA_T / c``, its gradient ``P_s grad(phi)``).
+    The conservative transfer's load is ``integral over the source of P_s grad(phi_i)``: the
+    same bilinear form applied to the source's coordinates, so the rebuild ``K X = D`` is a
+    Galerkin method consistent in one metric. Rebuilt with the target's own Laplacian (``M_T =
+    P_T``) instead, thin parts stretch: an inscribed tube is shorter round than the source's,
+    and the carried detail, the source's conormal flux, outweighs the target's by that deficit.
+
+    A target equal to the source gives its cotangent Laplacian (to rounding).
+
+    Parameters
+    ----------
+    Vs, Fs, Vt, Ft : checked arrays
+        Source and target meshes (the target free of zero-area triangles).
+    src_dom, tgt_dom : (n_s, d), (n_t, d) float arrays or None
+        Where to locate: a shared planar map (d = 2), or None for the 3D closest point (then a
+        point on a seam stays on the side of its own triangle, `own_side`).
+
+    Returns
+    -------
+    K : (n_t, n_t) scipy.sparse.csr_matrix
+        Symmetric, rows summing to zero, positive semi-definite.
+    """
+    T = Vt[Ft]
+    cross = np.cross(T[:, 1] - T[:, 0], T[:, 2] - T[:, 0])
+    double_area = np.linalg.norm(cross, axis=1)
+    n = cross / double_area[:, None]
+    # grad(phi_k) = n x (opposite edge) / (2A), corner k of each triangle
+    G = np.cross(n[:, None, :], T[:, [2, 0, 1]] - T[:, [1, 2, 0]]) / double_area[:, None, None]
+    h_t = np.linalg.norm(T[:, [1, 2, 0]] - T, axis=2).mean()
+    h_s = np.linalg.norm(Vs[Fs[:, [1, 2, 0]]] - Vs[Fs], axis=2).mean()
+    # 9 points per triangle, 16 where the source is finer; fewer beyond MAX_METRIC_SAMPLES
+    k = max(1, int(min(max(3, np.ceil(2 * h_t / h_s)), 4, np.sqrt(MAX_METRIC_SAMPLES / Ft.shape[0]))))
+    B = _subdivision_centroids(k)
+    tri = np.repeat(np.arange(Ft.shape[0]), B.shape[0])
+    P = np.einsum("qk,tkd->tqd", B, T).reshape(-1, 3)
+    if tgt_dom is None:
+        face, bary, dist = _locate(*check_points_and_mesh(P, Vs, Fs, names=("target samples", "Vs", "Fs")))
+        own_side(P, T.mean(axis=1)[tri], Vs, Fs, face, bary, dist)
+    else:
+        Q = np.einsum("qk,tkd->tqd", B, tgt_dom[Ft]).reshape(-1, tgt_dom.shape[1])
+        face = _locate(*check_points_and_mesh(Q, src_dom, Fs, names=("target samples", "uv[0] (UVs)", "Fs")))[0]
+    ns = np.cross(Vs[Fs[:, 1]] - Vs[Fs[:, 0]], Vs[Fs[:, 2]] - Vs[Fs[:, 0]])[face]
+    ns /= np.linalg.norm(ns, axis=1, keepdims=True)
+    c = np.einsum("ij,ij->i", ns, n[tri])
+    away = c < FACING
+    ns[away], c[away] = n[tri][away], 1.0
+    M = ((np.eye(3) - ns[:, :, None] * ns[:, None, :]) / c[:, None, None]).reshape(-1, B.shape[0], 3, 3).mean(axis=1)
+    local = 0.5 * double_area[:, None, None] * np.einsum("tid,tde,tje->tij", G, M, G)
+    rows, cols = np.repeat(Ft, 3, axis=1), np.tile(Ft, (1, 3))
+    N = Vt.shape[0]
+    return sp.csr_matrix((local.ravel(), (rows.ravel(), cols.ravel())), shape=(N, N))
+
+
+def _subdivision_centroids(k):
+    """Barycentric coordinates (k^2, 3) of the centroids of a triangle cut into k^2 equal ones."""
+    i, j = np.meshgrid(np.arange(k), np.arange(k), indexing="ij")
+    up = np.column_stack([(i + 1 / 3).ravel(), (j + 1 / 3).ravel()])[(i + j).ravel() < k]
+    down = np.column_stack([(i + 2 / 3).ravel(), (j + 2 / 3).ravel()])[(i + j).ravel() < k - 1]
+    uv = np.vstack([up, down]) / k
+    return np.column_stack([1 - uv.sum(axis=1), uv])
+
+
+def rebuilt_in_metric(K, D, Vt, Ft):
+    """Positions ``X`` with ``(K X)_i = D_i`` at every free vertex; kept where they are: the
+    target's boundary and one vertex of each closed piece (any: ``K`` annihilates translations,
+    so the rest is the same up to that piece's translation)."""
+    n = Vt.shape[0]
+    fixed = np.zeros(n, dtype=bool)
+    fixed[boundary_vertices(Ft)] = True
+    piece, count = vertex_components(Ft, n)
+    first = np.unique(piece, return_index=True)[1]          # a vertex of each piece
+    fixed[first[~np.isin(np.arange(count), piece[fixed])]] = True
+    free = ~fixed
+    X = Vt.copy()
+    K = K.tocsr()
+    rhs = D[free] - K[free][:, fixed] @ Vt[fixed]
+    X[free] = factorize(K[free][:, free].tocsc()).solve(rhs)
+    return X
