@@ -34,3 +34,27 @@ def test_detail_on_an_unwelded_seam_stays_on_its_own_sheet(tilt):
 def test_a_seamed_mesh_onto_itself_gets_its_own_detail_back():
     Vs, Fs, _ = seam(0.5)
     np.testing.assert_allclose(transfer_curvature(Vs, Fs, Vs, Fs), curvature_detail(Vs, Fs), atol=1e-12)
+
+
+def slit(n):
+    """A bumped square with a slit along y = 1/2 from its centre to the edge x = 1: the slit's
+    vertices are duplicated for the triangles above it, except its tip at the centre, which both
+    sides share (cow.off's horn tips touch along such a seam from a vertex their fans share)."""
+    V, F = grid(n, n)
+    V[:, 2] = 0.2 * np.sin(np.pi * V[:, 0]) * np.sin(np.pi * V[:, 1])
+    on_slit = np.flatnonzero(np.isclose(V[:, 1], 0.5) & (V[:, 0] > 0.5 + 1e-9))
+    copy = np.arange(len(V))
+    copy[on_slit] = len(V) + np.arange(on_slit.size)
+    above = V[F].mean(axis=1)[:, 1] > 0.5
+    F = F.copy()
+    F[above] = copy[F[above]]
+    return np.vstack([V, V[on_slit]]), F
+
+
+@pytest.mark.parametrize("n", [9, 13])
+def test_a_slit_mesh_onto_itself_gets_its_own_detail_back(n):
+    # a sample on the slit is at distance 0 from both sides; near its tip the stepped sample's
+    # triangle shares the tip with the other side's, which once passed it as the same side
+    V, F = slit(n)
+    D = curvature_detail(V, F)
+    np.testing.assert_allclose(transfer_curvature(V, F, V, F, metric="target"), D, atol=1e-12 * np.abs(D).max())

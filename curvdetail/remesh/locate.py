@@ -82,12 +82,13 @@ SIDE_STEP = 0.1
 def own_side(P, inner, V, F, face, bary, dist):
     """Keep samples of a source edge on the side its triangles lie on, in place.
 
-    A sample whose closest triangle (``face``) shares no vertex with the one closest to the sample
-    stepped toward ``inner`` is located again on the triangles around that one's corners alone
-    (``face``, ``bary`` and ``dist`` rewritten). Where two sheets of the source touch (cow.off: two
-    vertices at one point on an unwelded seam) a sample on the touching edge is at distance 0 from
-    both sheets, and only the side its triangles lie on tells them apart; elsewhere the two
-    locations agree (a target equal to the source: always).
+    A sample whose closest triangle (``face``) is neither the one closest to the sample stepped
+    toward ``inner`` nor across an edge from it is located again on that one and the three across
+    its edges (``face``, ``bary`` and ``dist`` rewritten). Where two sheets of the source touch
+    (cow.off: two horn tips at one point, touching along a seam from a vertex they share) a
+    sample on the touching edge is at distance 0 from both sheets, and only the side its
+    triangles lie on tells them apart; elsewhere the two locations agree, or differ by less than
+    the step near a vertex (a target equal to the source: always agree).
 
     Parameters
     ----------
@@ -117,18 +118,24 @@ def own_side(P, inner, V, F, face, bary, dist):
     length = np.linalg.norm(d, axis=1, keepdims=True)
     Q = P + d * np.minimum(step / np.maximum(length, np.finfo(float).tiny), 0.5)
     f_q = _locate(Q, V, F)[0]
-    off = np.flatnonzero(~(F[face][:, :, None] == F[f_q][:, None, :]).any(axis=(1, 2)))
+    # the same triangle or one across an edge: one sharing a vertex alone may lie on another sheet
+    # where two meet at that vertex (cow.off's two horn tips: two fans of one vertex)
+    across = (F[face][:, :, None] == F[f_q][:, None, :]).sum(axis=(1, 2)) >= 2
+    off = np.flatnonzero(~across)
     if off.size == 0:
         return 0
     around = sp.csr_matrix((np.ones(F.size), (F.ravel(), np.repeat(np.arange(F.shape[0]), 3))),
                            shape=(V.shape[0], F.shape[0]))      # vertex -> its triangles
-    for i in off:                                               # few: where two sheets touch
-        candidates = np.unique(around[F[f_q[i]]].indices)
+    moved = 0
+    for i in off:                                               # few: near vertices, where sheets touch
+        triangles, corners = np.unique(around[F[f_q[i]]].indices, return_counts=True)
+        candidates = triangles[corners >= 2]                    # f_q and the three across its edges
         sq, at, C = igl.point_mesh_squared_distance(P[i:i + 1], V, F[candidates])
+        moved += int(candidates[at[0]] != face[i])
         face[i] = candidates[at[0]]
         bary[i] = _barycentric(C, V[F[face[i:i + 1]]])[0]
         dist[i] = np.sqrt(sq[0])
-    return int(off.size)
+    return moved
 
 
 def _located(F, face, bary, what):
