@@ -3,6 +3,7 @@
 import numpy as np
 import scipy.sparse as sp
 
+from ..curvature.checks import checked_arrays
 from ..curvature.sparse_solver import factorize
 from ..curvature.topology import boundary_vertices, vertex_components
 from .closest_point import check_points_and_mesh
@@ -17,7 +18,7 @@ MAX_METRIC_SAMPLES = 4_000_000
 FACING = 0.5
 
 
-def source_metric_laplacian(Vs, Fs, Vt, Ft, src_dom=None, tgt_dom=None):
+def source_metric_laplacian(Vs, Fs, Vt, Ft):
     """Stiffness matrix of the target's hat functions lifted onto the source surface.
 
     ``K_ij = sum_T A_T grad(phi_i)^T M_T grad(phi_j)``, with ``M_T`` the mean over quadrature
@@ -30,21 +31,45 @@ def source_metric_laplacian(Vs, Fs, Vt, Ft, src_dom=None, tgt_dom=None):
     P_T``) instead, thin parts stretch: an inscribed tube is shorter round than the source's,
     and the carried detail, the source's conormal flux, outweighs the target's by that deficit.
 
-    A target equal to the source gives its cotangent Laplacian (to rounding).
+    A target equal to the source gives its cotangent Laplacian (to rounding); a target triangle
+    whose source triangle turns more than 60 degrees from it (another sheet, a fold) counts with
+    its own metric there.
 
     Parameters
     ----------
-    Vs, Fs, Vt, Ft : checked arrays
-        Source and target meshes (the target free of zero-area triangles).
-    src_dom, tgt_dom : (n_s, d), (n_t, d) float arrays or None
-        Where to locate: a shared planar map (d = 2), or None for the 3D closest point (then a
-        point on a seam stays on the side of its own triangle, `own_side`).
+    Vs, Fs : (n_s, 3) float, (m_s, 3) int arrays
+        Source mesh
+    Vt, Ft : (n_t, 3) float, (m_t, 3) int arrays
+        Target mesh, a retriangulation of the source (points located by 3D closest point, a
+        point on a seam kept on its own triangle's side, `own_side`)
 
     Returns
     -------
     K : (n_t, n_t) scipy.sparse.csr_matrix
         Symmetric, rows summing to zero, positive semi-definite.
+
+    Raises
+    ------
+    MeshError
+        Malformed meshes (as `check_mesh` names them), a zero-area triangle included
+
+    Examples
+    --------
+    >>> from curvdetail.curvature.testing import grid
+    >>> from curvdetail.curvature import cotan_laplacian
+    >>> Vt, F = grid(5, 5); Vs = Vt.copy(); Vs[:, 2] = 0.5 * Vs[:, 0]    # a flat target under a slope
+    >>> K = source_metric_laplacian(Vs, F, Vt, F)
+    >>> bool(abs(K - cotan_laplacian(Vs, F)).max() < 1e-12)              # the slope's own Laplacian
+    True
     """
+    Vs, Fs = checked_arrays(Vs, Fs, check_manifold=False, check_unreferenced=False)
+    Vt, Ft = checked_arrays(Vt, Ft, check_manifold=False, check_unreferenced=False)
+    return _source_metric_laplacian(Vs, Fs, Vt, Ft)
+
+
+def _source_metric_laplacian(Vs, Fs, Vt, Ft, src_dom=None, tgt_dom=None):
+    """`source_metric_laplacian` on checked arrays; ``src_dom, tgt_dom``: a shared planar map
+    (n_s, 2), (n_t, 2) to locate in, or None for the 3D closest point."""
     T = Vt[Ft]
     cross = np.cross(T[:, 1] - T[:, 0], T[:, 2] - T[:, 0])
     double_area = np.linalg.norm(cross, axis=1)

@@ -15,7 +15,7 @@ from ._disk import check_retriangulation
 from .closest_point import as_coordinates, check_points_and_mesh, unit_frame
 from .closest_point import _barycentric
 from .locate import _locate, interpolate, own_side, spread
-from .metric import rebuilt_in_metric, source_metric_laplacian
+from .metric import _source_metric_laplacian, rebuilt_in_metric
 
 METHODS = ("conservative", "pointwise")
 METRICS = ("source", "target")
@@ -235,7 +235,7 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     D = spread(c[edge] / q[edge, None], Ft, face, bary, Vt.shape[0])
     if metric == "target":
         return D
-    K = source_metric_laplacian(Vs, Fs, Vt, Ft, *((src_dom, tgt_dom) if location == "uv" else (None, None)))
+    K = _source_metric_laplacian(Vs, Fs, Vt, Ft, *((src_dom, tgt_dom) if location == "uv" else (None, None)))
     # = L_t X at every free vertex; the metric's difference added to the measure keeps its total
     return D + (cotan_laplacian(Vt, Ft) - K) @ rebuilt_in_metric(K, D, Vt, Ft)
 
