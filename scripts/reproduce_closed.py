@@ -38,80 +38,31 @@ TARGET_RATIO = 1.5
 
 #: Below the table: where the misses come from (measured with this code).
 NOTES = """
-## Where the misses come from
+## Where the figures come from
 
-The reconstruction is exact given the target's own detail (rebuilt from `L Vt`, cow, mannequin_ear,
-elephant_trunk and camelhead return `Vt` to 1e-14 of the diagonal): the error is all in the
-transferred detail.
+The reconstruction is exact given the target's own detail (rebuilt from `L Vt`, every model
+returns `Vt` to 1e-14 of the diagonal): the error is all in the transferred detail.
 
-- **cow.off** at both edges: the max sits at the tail's tip, and the rebuilt tail is stretched
-  along its axis (at 1 % the displacement grows linearly from 0 at the root to 0.66 % at the tip,
-  about 2 % strain; at 0.5 % the tip's vertices are 0.30 % off). The tail is about 2 % of the
-  diagonal across, some six target edges round at 1 %; the transferred detail's sum over the tail
-  beyond a cut exceeds the target's own by 1-4 %, and a long thin appendage is the softest
-  direction of the rebuild, so the mismatch adds up along it (the detail error of the tail and the
-  rear, x < -0.43, alone moves the tip 0.78 %, that of the rest 0.03 %). Not a location error:
-  relocating every tail sample found on the body's triangles (or the reverse) onto its own part
-  moves none.
-- **cow.off, 0.5 %, fixed**: the source has two vertices at one point (621 and 2761, an unwelded seam
-  vertex where two cone tips touch) and the target keeps the pair. A sample on the seam lies at
-  distance 0 from both sheets, whose facing normals agree (cos 0.72-0.98), so half of each tip's
-  detail went to the other tip and the rebuilt tips opened by 0.7 % (max 0.71-0.73 %).
-  A sample is now kept on the side its own triangles lie on (`remesh.locate.own_side`): max 0.30-0.32 %,
-  RMS 2.42x -> 2.13x the floor; no other model's figures move. (These figures, and the ones of the
-  second look below, were measured with pymeshlab's sampled Hausdorff; the table is measured with
-  the exact engine's seeded samples, which repeat from run to run.)
-- **Disk patches at 0.5 %** (mannequin_ear, elephant_trunk, camelhead; the max is within target
-  everywhere): the rebuild's error is a smooth deformation (95 % of it survives 20 one-ring
-  averaging steps), does not change with 4x the edge samples, and is a slightly flattened surface:
-  scaling the transferred detail by 1.001 lowers mannequin_ear's ratio from 1.44x to 1.32x at 1 %
-  and from 1.85x to 1.69x at 0.5 %. A systematic discretization error, not a location error.
-
-Second look (load about 2 on the 2-core machine; figures are vertex-to-source distances or
-pymeshlab Hausdorff ratios to the floor, on one saved retriangulation per model):
-
-- **The tail's excess is the cut-corner perimeter deficit.** The detail summed over a region is
-  the conormal flux through the region's cut, which on a tube is its perimeter along the axis. The
-  target's vertices lie on the source's facets and its edges cut across the source's folds, so its
-  tube is inscribed and shorter round: at 1 % the perimeters of plane cuts y < 0, -0.05, -0.1, -0.12
-  are 2.6, 0.8, 0.8 and 0.6 % longer on the source than on the target. The transferred sum beyond
-  those cuts is 0.6, 1.1, 1.1 and 0.4 % larger than the target's own. The source and target areas
-  of the tail (face-sampled, x < -0.45, y < 0) differ by 1.3 %. The ~2 % strain matches. It is not
-  the coarse k-gon of the first guess: at 1 % the target is finer round the tail than the source
-  (38 against 30 segments at y = -0.1). The cause is confirmed: scaling the transferred detail of
-  the tail's vertices alone (x < -0.43, y < 0) by 0.99 lowers cow 1 % from 0.038 % RMS and 0.645 %
-  max to 0.026 % and 0.24 % (floor 0.022 % and about 0.27 %). At 0.5 % the best factor is 0.995,
-  which lowers 0.017 % and 0.295 % to 0.014 % and 0.164 % (floor 0.008 %, so RMS stays about 1.7x
-  and the rest of that miss is not the tail).
-- **No per-vertex form of that correction works.** Some variants transfer the source's area
-  measure with the same machinery and multiply the detail by (own barycentric area) / (transferred
-  area), so they transfer K = detail / area and multiply by the target's area. All of them make
-  things worse. With area on the edge samples, the ratio is noisy (1st to 99th percentile
-  0.39-18), and after 1-8 one-ring smoothings it still gives 13-24x RMS at cow 1 %. With 1.4 M
-  face samples the ratio is accurate (median 0.9975, tail 0.987) but gives 7x (0.25-0.28 %). The
-  ratio divided by its global mean still gives 6x, or 0.034 % RMS and 0.57 % max after 100
-  smoothings. A spatially varying factor with a gradient puts a net force of about (grad r) |D| on
-  the free vertices, and the rebuild is far more sensitive to that than to the 1 % flux error. A
-  global factor rescales the whole model about its anchor. Only a constant factor over a whole
-  appendage helps, and choosing appendages is not a transfer. On mannequin_ear at 0.5 % the same
-  ratio moves RMS from 0.008 % to 0.011-0.015 %.
-- **Disks at 0.5 %: the options do not help.** On mannequin_ear, rows="all" gives the same RMS
-  ratio (1.84x, max 0.93x). location="uv" gives 22x RMS and 6.9x max, and 27x with rows="all".
-  The pointwise K A_t transfer gives 45x and 12.6x (cow 1 %: 143x and 73x). Sharpening the
-  transferred detail by a one-ring unsharp mask, D + a (D - W D), is 16x worse already at a = 0.25.
-  Most of the residual displacement is tangential (0.0117 % against 0.0076 % normal). Its normal
-  part does not follow the target's own normal detail (correlation -0.06), so it is not a
-  curvature-proportional flattening. The conservative transfer gives the rebuild the Galerkin load
-  of the source surface on the target's hat functions, so the rebuild is the Ritz projection of
-  the source on the target, while the floor is the interpolant. Both are second order, and a
-  ratio of 1.5-2x between them is plausibly the method's own limit at this refinement (not proven
-  here). Nothing was made the default.
-
-Tried for the tail, not adopted: a stricter normal test (cos > 0.5: 25x RMS at 1 %), 2 or 3
-anchors (no change), samples moved 0.1-0.25 target edges inward along their normal (RMS worse),
-the detail rescaled by the target/source area ratio (worse everywhere), the pointwise transfer
-(60-136x). The floor's max measured on pymeshlab's samples moved between runs (cow at 0.5 %:
-0.10-0.19 % over six runs); the exact engine's seeded samples give one figure.
+- **The rebuild reads the carried detail in the source's metric** (`transfer_curvature`,
+  `source_metric_laplacian`). The conservative transfer measures the source's detail against the
+  target's hat functions lifted onto the source, which is the source's own bilinear form; rebuilt
+  with the target's Laplacian instead, the target being inscribed (its tube shorter round than the
+  source's), the detail's flux outweighs the target's by the perimeter deficit. That stretched
+  cow.off's tail by 2 % (1 %: RMS 1.69x, max 2.13x the floor at the tail's tip) and flattened
+  fine targets (0.5 %: mannequin_ear 1.83x, elephant_trunk 1.66x, camelhead 1.81x RMS). Solving
+  with the target's Laplacian in the source's metric brings them to the rows above; the measure
+  as carried is still `transfer_curvature(..., metric="target")`.
+- **cow.off** has two horn tips at one point (source vertices 621 and 2761) touching along a
+  seam from a vertex both fans share (620); the target keeps the pair. A sample on the seam is at
+  distance 0 from both horns and only its own triangles' side tells them apart
+  (`remesh.locate.own_side`); accepting a triangle that shares only the vertex 620 as the same
+  side sent half of each tip's detail to the other tip (1 %: max 0.48 %, now 0.25 %).
+- **cow.off at 0.5 %, max 1.71x (over)**: the max sits on the same seam, on horn A's crest
+  (source triangle 736, between 620 and the tip), which the retriangulation cuts: target vertices
+  placed 0.003 below the crest. Sampled densely (400 points per source triangle) the floor's
+  own max there is 0.23 % (the table's seeded samples find 0.157 % elsewhere) and the rebuild's
+  0.35 %: the rebuild, a Galerkin (Ritz) projection of the source where the floor is an
+  interpolant, cuts the crest deeper. Its RMS (1.26x) is within target.
 """
 
 

@@ -11,7 +11,7 @@ from .locate import _locate, own_side
 
 #: Most quadrature points `source_metric_laplacian` takes (k^2 per target triangle, k from 3 down
 #: to 1 where the target has more triangles than this allows): ~0.5 kB each while located.
-MAX_METRIC_SAMPLES = 4_000_000
+MAX_METRIC_SAMPLES = 3_000_000
 
 #: A quadrature point whose source triangle turns more than 60 degrees from its target triangle
 #: (cos below this: the other sheet, or a fold) counts with the target's own metric.
@@ -94,7 +94,10 @@ def _source_metric_laplacian(Vs, Fs, Vt, Ft, src_dom=None, tgt_dom=None):
     c = np.einsum("ij,ij->i", ns, n[tri])
     away = c < FACING
     ns[away], c[away] = n[tri][away], 1.0
-    M = ((np.eye(3) - ns[:, :, None] * ns[:, None, :]) / c[:, None, None]).reshape(-1, B.shape[0], 3, 3).mean(axis=1)
+    # M_T = mean of (I - n_s n_s^T) / c over the triangle's points, without a (points, 3, 3) array
+    w = (1.0 / c).reshape(-1, B.shape[0]) / B.shape[0]
+    ns = ns.reshape(-1, B.shape[0], 3)
+    M = w.sum(axis=1)[:, None, None] * np.eye(3) - np.einsum("tq,tqd,tqe->tde", w, ns, ns)
     local = 0.5 * double_area[:, None, None] * np.einsum("tid,tde,tje->tij", G, M, G)
     rows, cols = np.repeat(Ft, 3, axis=1), np.tile(Ft, (1, 3))
     N = Vt.shape[0]
