@@ -124,18 +124,40 @@ def own_side(P, inner, V, F, face, bary, dist):
     off = np.flatnonzero(~across)
     if off.size == 0:
         return 0
-    around = sp.csr_matrix((np.ones(F.size), (F.ravel(), np.repeat(np.arange(F.shape[0]), 3))),
-                           shape=(V.shape[0], F.shape[0]))      # vertex -> its triangles
-    moved = 0
-    for i in off:                                               # few: near vertices, where sheets touch
-        triangles, corners = np.unique(around[F[f_q[i]]].indices, return_counts=True)
-        candidates = triangles[corners >= 2]                    # f_q and the three across its edges
-        sq, at, C = igl.point_mesh_squared_distance(P[i:i + 1], V, F[candidates])
-        moved += int(candidates[at[0]] != face[i])
-        face[i] = candidates[at[0]]
-        bary[i] = _barycentric(C, V[F[face[i:i + 1]]])[0]
-        dist[i] = np.sqrt(sq[0])
+    # f_q and the (up to) three triangles across its edges, nearest to the sample
+    candidates = np.column_stack([f_q[off], igl.triangle_triangle_adjacency(F)[0][f_q[off]]])
+    sq = np.full(candidates.shape, np.inf)
+    near = np.empty(candidates.shape + (V.shape[1],))
+    for j in range(4):
+        ok = candidates[:, j] >= 0
+        sq[ok, j], near[ok, j] = _closest_on_triangles(P[off[ok]], V[F[candidates[ok, j]]])
+    pick = np.argmin(sq, axis=1)
+    rows = np.arange(off.size)
+    new = candidates[rows, pick]
+    moved = int((new != face[off]).sum())
+    face[off], dist[off] = new, np.sqrt(sq[rows, pick])
+    bary[off] = _barycentric(near[rows, pick], V[F[new]])
     return moved
+
+
+def _closest_on_triangles(P, T):
+    """Squared distance (k,) and closest point (k, 3) of each point ``P`` (k, 3) on its own
+    triangle ``T`` (k, 3, 3): the projection where it falls inside, else the nearest edge point."""
+    a, b, c = T[:, 0], T[:, 1], T[:, 2]
+    n = np.cross(b - a, c - a)
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    X = P - np.einsum("ij,ij->i", P - a, n)[:, None] * n
+    inside = np.ones(P.shape[0], dtype=bool)
+    for u, v, w in ((a, b, c), (b, c, a), (c, a, b)):      # X on w's side of each edge
+        inside &= np.einsum("ij,ij->i", np.cross(v - u, X - u), n) >= 0
+    best, sq = X, np.where(inside, np.einsum("ij,ij->i", P - X, P - X), np.inf)
+    for u, v in ((a, b), (b, c), (c, a)):
+        t = np.clip(np.einsum("ij,ij->i", P - u, v - u) / np.einsum("ij,ij->i", v - u, v - u), 0.0, 1.0)
+        Q = u + t[:, None] * (v - u)
+        d = np.einsum("ij,ij->i", P - Q, P - Q)
+        closer = d < sq
+        best, sq = np.where(closer[:, None], Q, best), np.where(closer, d, sq)
+    return sq, best
 
 
 def _located(F, face, bary, what):

@@ -7,7 +7,7 @@ from ..curvature.checks import checked_arrays
 from ..curvature.sparse_solver import factorize
 from ..curvature.topology import boundary_vertices, vertex_components
 from .closest_point import check_points_and_mesh
-from .locate import _locate, own_side
+from .locate import _locate
 
 #: Most quadrature points `source_metric_laplacian` takes (k^2 per target triangle, k from 3 down
 #: to 1 where the target has more triangles than this allows): ~0.5 kB each while located.
@@ -40,8 +40,8 @@ def source_metric_laplacian(Vs, Fs, Vt, Ft):
     Vs, Fs : (n_s, 3) float, (m_s, 3) int arrays
         Source mesh
     Vt, Ft : (n_t, 3) float, (m_t, 3) int arrays
-        Target mesh, a retriangulation of the source (points located by 3D closest point, a
-        point on a seam kept on its own triangle's side, `own_side`)
+        Target mesh, a retriangulation of the source (its points located on the source by 3D
+        closest point)
 
     Returns
     -------
@@ -84,8 +84,7 @@ def _source_metric_laplacian(Vs, Fs, Vt, Ft, src_dom=None, tgt_dom=None):
     tri = np.repeat(np.arange(Ft.shape[0]), B.shape[0])
     P = np.einsum("qk,tkd->tqd", B, T).reshape(-1, 3)
     if tgt_dom is None:
-        face, bary, dist = _locate(*check_points_and_mesh(P, Vs, Fs, names=("target samples", "Vs", "Fs")))
-        own_side(P, T.mean(axis=1)[tri], Vs, Fs, face, bary, dist)
+        face = _locate(*check_points_and_mesh(P, Vs, Fs, names=("target samples", "Vs", "Fs")))[0]
     else:
         Q = np.einsum("qk,tkd->tqd", B, tgt_dom[Ft]).reshape(-1, tgt_dom.shape[1])
         face = _locate(*check_points_and_mesh(Q, src_dom, Fs, names=("target samples", "uv[0] (UVs)", "Fs")))[0]
