@@ -259,3 +259,25 @@ def test_interpolate_and_spread_refuse_faces_that_are_not_located_ones(flat_disk
     with pytest.raises(MeshError) as e:
         spread(np.ones(4), F, face, bary, V.shape[0])
     assert (e.value.parameter, e.value.value) == ("values", 4)
+
+
+def test_closest_points_on_paired_triangles_match_libigl():
+    # own_side's relocation: each point against its own triangle (inside, beyond an edge, beyond
+    # a corner), checked against libigl's exact closest point on that one triangle
+    import igl
+
+    from curvdetail.remesh.locate import _closest_on_triangles
+
+    V, F = TRIANGLE
+    for point, closest, distance, _ in HAND:
+        sq, C = _closest_on_triangles(np.array([point]), V[F])
+        assert np.sqrt(sq[0]) == pytest.approx(distance, abs=1e-12)
+        np.testing.assert_allclose(C[0], closest, atol=1e-12)
+    rng = np.random.default_rng(3)
+    T = rng.normal(size=(300, 3, 3))
+    P = T.mean(axis=1) + 2.0 * rng.normal(size=(300, 3))
+    sq, C = _closest_on_triangles(P, T)
+    for i in range(0, 300, 7):
+        ref_sq, _, ref_C = igl.point_mesh_squared_distance(P[i:i + 1], T[i], np.array([[0, 1, 2]]))
+        assert sq[i] == pytest.approx(ref_sq[0], rel=1e-10, abs=1e-12)
+        np.testing.assert_allclose(C[i], ref_C[0], atol=1e-10)
