@@ -119,9 +119,10 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     with the target's Laplacian, thin parts stretch by the inscribed target's perimeter deficit
     (cow.off's tail: 2 %). A target equal to the source gets its own detail back either way (to
     rounding). A given ``detail`` is put on the edges as the measure closest (least squares) to
-    the geometry's whose halves give it exactly: ``c'_e = c_e + 2 (mu_i + mu_j)`` with ``Q mu = detail - D(Vs, Fs)``, ``Q`` the
-    signless Laplacian of the edge graph (degree + adjacency; positive definite on a mesh of
-    triangles, well conditioned, so the correction stays near the vertices it belongs to).
+    the geometry's whose halves give it exactly: ``c'_e = c_e + 2 (mu_i + mu_j)`` with
+    ``Q mu = detail - D(Vs, Fs)``, ``Q`` the signless Laplacian of the edge graph (degree +
+    adjacency; positive definite on a mesh of triangles, well conditioned, so the correction stays
+    near the vertices it belongs to).
 
     Location: ``"closest"`` = the closest point on the other surface in space (the meshes are
     two triangulations of one surface; a conservative sample whose closest target triangle
