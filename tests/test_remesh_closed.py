@@ -129,7 +129,7 @@ def test_two_spheres_touching_at_a_vertex_stay_two_pieces(apart, monkeypatch):
 def test_detail_stays_on_its_own_sheet_where_two_lie_close(relocate, monkeypatch):
     # two spheres 0.001 apart; the target's first one is 2 % smaller, so near the gap the source's
     # first sphere is closer to the target's second. Known answer: a closed piece's detail sums
-    # to zero, and the conservative transfer keeps each piece's total where its samples land
+    # to zero, and the measure carried on the edges keeps each piece's total where its samples land
     import importlib
 
     from curvdetail.curvature.testing import icosphere
@@ -143,9 +143,12 @@ def test_detail_stays_on_its_own_sheet_where_two_lie_close(relocate, monkeypatch
     if not relocate:
         monkeypatch.setattr(importlib.import_module("curvdetail.remesh.transfer"), "_facing_side",
                             lambda *args: None)
-    Dt = transfer_curvature(Vs, Fs, Vt, Fs)
+    Dt = transfer_curvature(Vs, Fs, Vt, Fs, metric="target")
     first = np.abs(Dt[:n].sum(axis=0)).max() / np.abs(Dt).sum()
     assert (first < 1e-12) == relocate           # moved to the other sphere without the check
+    # in the source's metric each piece's detail is integrated on its own triangles: zero
+    Dt = transfer_curvature(Vs, Fs, Vt, Fs)
+    assert np.abs(Dt[:n].sum(axis=0)).max() < 1e-12 * np.abs(Dt).sum()
 
 
 def test_a_closed_surface_with_a_reversed_triangle_is_refused():

@@ -127,7 +127,7 @@ def test_samples_per_edge_must_be_a_sane_whole_number(value):
     # 0 and -1 were clamped to 1, 2.5 truncated, "5" and True accepted, 10**30 an OverflowError
     V, F = grid(5, 5)
     with pytest.raises(CurvdetailError) as e:
-        transfer_curvature(V, F, V, F, samples_per_edge=value)
+        transfer_curvature(V, F, V, F, samples_per_edge=value, metric="target")
     assert e.value.parameter == "samples_per_edge"
     if value == 10 ** 30:                               # 56 edges: 5.6e31 samples, beyond the limit
         assert e.value.value == 56 * 10 ** 30
@@ -141,6 +141,9 @@ def test_options_that_would_be_ignored_are_refused():
     assert e.value.parameter == "uv"
     with pytest.raises(CurvdetailError) as e:
         transfer_curvature(V, F, V, F, method="pointwise", samples_per_edge=3)
+    assert e.value.parameter == "samples_per_edge"
+    with pytest.raises(CurvdetailError) as e:            # the source's own detail is not on the edges
+        transfer_curvature(V, F, V, F, samples_per_edge=3)
     assert e.value.parameter == "samples_per_edge"
     with pytest.raises(CurvdetailError) as e:
         transfer_curvature(V, F, V, F, method="pointwise", metric="source")

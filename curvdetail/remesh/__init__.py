@@ -11,7 +11,7 @@ from .closest_point import closest_points
 from .evaluate import hausdorff, vertex_distance
 from .experiment import WorseThanZeroDetailWarning, remesh_experiment
 from .locate import interpolate, locate, spread
-from .metric import source_metric_laplacian
+from .metric import source_metric
 from .parameterize import flipped_triangles, harmonic_map, parameterize
 from .retriangulate import LongRunWarning, retriangulate
 from .transfer import edge_curvature_measure, transfer_curvature
@@ -20,6 +20,6 @@ __all__ = [
     "LongRunWarning", "NotADiskError", "RemeshError", "WorseThanZeroDetailWarning", "check_disk", "check_surface",
     "RETRIANGULATION_TOLERANCE", "SURFACE_TOLERANCE", "check_retriangulation", "check_target_boundary", "closest_points",
     "edge_curvature_measure", "flipped_triangles", "harmonic_map", "hausdorff", "interpolate", "locate",
-    "parameterize", "remesh_experiment", "retriangulate", "source_metric_laplacian", "spread", "transfer_curvature",
+    "parameterize", "remesh_experiment", "retriangulate", "source_metric", "spread", "transfer_curvature",
     "vertex_distance",
 ]

@@ -1,4 +1,4 @@
-"""The target's cotangent Laplacian measured in the source surface's metric (the transfer's rebuild)."""
+"""The target's Laplacian and the source's detail, both on the target's hat functions lifted onto the source."""
 
 import numpy as np
 import scipy.sparse as sp
@@ -9,44 +9,50 @@ from ..curvature.topology import boundary_vertices, vertex_components
 from .closest_point import check_points_and_mesh
 from .locate import _locate
 
-#: Most quadrature points `source_metric_laplacian` takes (k^2 per target triangle, k from 3 down
-#: to 1 where the target has more triangles than this allows): ~0.5 kB each while located.
-MAX_METRIC_SAMPLES = 3_000_000
+#: Most quadrature points `source_metric` takes (k^2 per target triangle, k from 4 down to 1 where
+#: the target has more triangles than this allows): ~0.5 kB each while located.
+MAX_METRIC_SAMPLES = 4_000_000
 
 #: A quadrature point whose source triangle turns more than 60 degrees from its target triangle
 #: (cos below this: the other sheet, or a fold) counts with the target's own metric.
 FACING = 0.5
 
 
-def source_metric_laplacian(Vs, Fs, Vt, Ft):
-    """Stiffness matrix of the target's hat functions lifted onto the source surface.
+def source_metric(Vs, Fs, Vt, Ft):
+    """The target's Laplacian in the source's metric, and the source's detail on the target.
 
-    ``K_ij = sum_T A_T grad(phi_i)^T M_T grad(phi_j)``, with ``M_T`` the mean over quadrature
-    points of triangle ``T`` of ``P_s / c``: ``P_s = I - n_s n_s^T`` the tangent projector of the
-    source triangle over the point, ``c = n_s . n_T``. This is the Dirichlet energy of the lifted
-    functions on the source (its area element is ``dA_T / c``, its gradient ``P_s grad(phi)``).
-    The conservative transfer's load is ``integral over the source of P_s grad(phi_i)``: the
-    same bilinear form applied to the source's coordinates, so the rebuild ``K X = D`` is a
-    Galerkin method consistent in one metric. Rebuilt with the target's own Laplacian (``M_T =
-    P_T``) instead, thin parts stretch: an inscribed tube is shorter round than the source's,
-    and the carried detail, the source's conormal flux, outweighs the target's by that deficit.
+    The target's hat functions ``phi_i`` are lifted onto the source by the closest point of each
+    target point on the source. On the source their Dirichlet energy is
+    ``K_ij = sum_T A_T grad(phi_i)^T M_T grad(phi_j)`` and the source's detail (the weak mean
+    curvature normal, ``D = L V`` on the source's own hat functions) is
+    ``D_i = integral over the source of grad(phi_i) . grad(x) = sum_T A_T M_T grad(phi_i)``, with
+    ``M_T`` the mean over quadrature points of target triangle ``T`` of ``P_s / c``: ``P_s = I -
+    n_s n_s^T`` the tangent projector of the source triangle at the point's closest point,
+    ``c = n_s . n_T`` (the source's area element is ``dA_T / c``, a lifted gradient ``P_s
+    grad(phi)``). Both come from the same points, so ``K X = D`` is one Galerkin method: the rebuilt
+    ``X`` is the source's best approximation in the target's space. Rebuilt with the target's own
+    Laplacian (``M_T = P_T``) instead, or with the detail integrated along another map, thin parts
+    stretch (the inscribed target's tubes are shorter round) and folds are cut.
 
-    A target equal to the source gives its cotangent Laplacian (to rounding); a target triangle
-    whose source triangle turns more than 60 degrees from it (another sheet, a fold) counts with
-    its own metric there.
+    A target equal to the source gives its cotangent Laplacian and its detail (to rounding); a
+    quadrature point whose source triangle turns more than 60 degrees from its target triangle
+    (another sheet, a fold) counts with the target's own metric there. Points: 16 per target
+    triangle, 25 where the source is finer than the target, fewer beyond
+    ``MAX_METRIC_SAMPLES``.
 
     Parameters
     ----------
     Vs, Fs : (n_s, 3) float, (m_s, 3) int arrays
         Source mesh
     Vt, Ft : (n_t, 3) float, (m_t, 3) int arrays
-        Target mesh, a retriangulation of the source (its points located on the source by 3D
-        closest point)
+        Target mesh, a retriangulation of the source
 
     Returns
     -------
     K : (n_t, n_t) scipy.sparse.csr_matrix
         Symmetric, rows summing to zero, positive semi-definite.
+    D : (n_t, 3) float array
+        The source's detail on the target's lifted hat functions; sums to zero.
 
     Raises
     ------
@@ -56,20 +62,20 @@ def source_metric_laplacian(Vs, Fs, Vt, Ft):
     Examples
     --------
     >>> from curvdetail.curvature.testing import grid
-    >>> from curvdetail.curvature import cotan_laplacian
+    >>> from curvdetail.curvature import cotan_laplacian, curvature_detail
     >>> Vt, F = grid(5, 5); Vs = Vt.copy(); Vs[:, 2] = 0.5 * Vs[:, 0]    # a flat target under a slope
-    >>> K = source_metric_laplacian(Vs, F, Vt, F)
-    >>> bool(abs(K - cotan_laplacian(Vs, F)).max() < 1e-12)              # the slope's own Laplacian
-    True
+    >>> K, D = source_metric(Vs, F, Vt, F)          # the lifted hat functions are the source's own
+    >>> bool(abs(K - cotan_laplacian(Vs, F)).max() < 1e-12), bool(abs(D - curvature_detail(Vs, F)).max() < 1e-12)
+    (True, True)
     """
     Vs, Fs = checked_arrays(Vs, Fs, check_manifold=False, check_unreferenced=False)
     Vt, Ft = checked_arrays(Vt, Ft, check_manifold=False, check_unreferenced=False)
-    return _source_metric_laplacian(Vs, Fs, Vt, Ft)
+    return _source_metric(Vs, Fs, Vt, Ft)
 
 
-def _source_metric_laplacian(Vs, Fs, Vt, Ft, src_dom=None, tgt_dom=None):
-    """`source_metric_laplacian` on checked arrays; ``src_dom, tgt_dom``: a shared planar map
-    (n_s, 2), (n_t, 2) to locate in, or None for the 3D closest point."""
+def _source_metric(Vs, Fs, Vt, Ft, src_dom=None, tgt_dom=None):
+    """`source_metric` on checked arrays; ``src_dom, tgt_dom``: a shared planar map (n_s, 2),
+    (n_t, 2) to locate in, or None for the 3D closest point."""
     T = Vt[Ft]
     cross = np.cross(T[:, 1] - T[:, 0], T[:, 2] - T[:, 0])
     double_area = np.linalg.norm(cross, axis=1)
@@ -78,12 +84,11 @@ def _source_metric_laplacian(Vs, Fs, Vt, Ft, src_dom=None, tgt_dom=None):
     G = np.cross(n[:, None, :], T[:, [2, 0, 1]] - T[:, [1, 2, 0]]) / double_area[:, None, None]
     h_t = np.linalg.norm(T[:, [1, 2, 0]] - T, axis=2).mean()
     h_s = np.linalg.norm(Vs[Fs[:, [1, 2, 0]]] - Vs[Fs], axis=2).mean()
-    # 9 points per triangle, 16 where the source is finer; fewer beyond MAX_METRIC_SAMPLES
-    k = max(1, int(min(max(3, np.ceil(2 * h_t / h_s)), 4, np.sqrt(MAX_METRIC_SAMPLES / Ft.shape[0]))))
+    k = max(1, int(min(max(4, np.ceil(2 * h_t / h_s)), 5, np.sqrt(MAX_METRIC_SAMPLES / Ft.shape[0]))))
     B = _subdivision_centroids(k)
     tri = np.repeat(np.arange(Ft.shape[0]), B.shape[0])
-    P = np.einsum("qk,tkd->tqd", B, T).reshape(-1, 3)
     if tgt_dom is None:
+        P = np.einsum("qk,tkd->tqd", B, T).reshape(-1, 3)
         face = _locate(*check_points_and_mesh(P, Vs, Fs, names=("target samples", "Vs", "Fs")))[0]
     else:
         Q = np.einsum("qk,tkd->tqd", B, tgt_dom[Ft]).reshape(-1, tgt_dom.shape[1])
@@ -93,14 +98,17 @@ def _source_metric_laplacian(Vs, Fs, Vt, Ft, src_dom=None, tgt_dom=None):
     c = np.einsum("ij,ij->i", ns, n[tri])
     away = c < FACING
     ns[away], c[away] = n[tri][away], 1.0
-    # M_T = mean of (I - n_s n_s^T) / c over the triangle's points, without a (points, 3, 3) array
-    w = (1.0 / c).reshape(-1, B.shape[0]) / B.shape[0]
+    # A_T M_T, M_T the mean of (I - n_s n_s^T) / c over the triangle's points (no (points, 3, 3) array)
+    w = (0.5 * double_area[:, None] / B.shape[0]) / c.reshape(-1, B.shape[0])
     ns = ns.reshape(-1, B.shape[0], 3)
-    M = w.sum(axis=1)[:, None, None] * np.eye(3) - np.einsum("tq,tqd,tqe->tde", w, ns, ns)
-    local = 0.5 * double_area[:, None, None] * np.einsum("tid,tde,tje->tij", G, M, G)
+    AM = w.sum(axis=1)[:, None, None] * np.eye(3) - np.einsum("tq,tqd,tqe->tde", w, ns, ns)
+    MG = np.einsum("tde,tje->tjd", AM, G)                           # A_T M_T grad(phi_j), (m, 3, 3)
+    local = np.einsum("tid,tjd->tij", G, MG)
     rows, cols = np.repeat(Ft, 3, axis=1), np.tile(Ft, (1, 3))
     N = Vt.shape[0]
-    return sp.csr_matrix((local.ravel(), (rows.ravel(), cols.ravel())), shape=(N, N))
+    K = sp.csr_matrix((local.ravel(), (rows.ravel(), cols.ravel())), shape=(N, N))
+    D = np.column_stack([np.bincount(Ft.ravel(), weights=MG[:, :, d].ravel(), minlength=N) for d in range(3)])
+    return K, D
 
 
 def _subdivision_centroids(k):

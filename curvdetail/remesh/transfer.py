@@ -15,7 +15,7 @@ from ._disk import check_retriangulation
 from .closest_point import as_coordinates, check_points_and_mesh, unit_frame
 from .closest_point import _barycentric
 from .locate import _locate, interpolate, own_side, spread
-from .metric import _source_metric_laplacian, rebuilt_in_metric
+from .metric import _source_metric, rebuilt_in_metric
 
 METHODS = ("conservative", "pointwise")
 METRICS = ("source", "target")
@@ -103,26 +103,28 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     interpolated (barycentric) at each target vertex's location and multiplied by the target's own
     mixed Voronoi area: ``D_t = K(x_t) A_t``.
 
-    ``method="conservative"``: the extensive detail is moved as a measure. The source's detail
-    lives on its edges (`edge_curvature_measure`, with ``D_i = 1/2 sum c_e`` exactly); each
-    edge's measure is split evenly over sample points along the edge, every sample is located in
-    a target triangle and split over its three corners by barycentric weights: the integral over
-    the source of ``P_s grad(phi_i)`` for each target hat function ``phi_i`` lifted onto it
-    (``P_s`` the source's tangent projector), the source's own bilinear form. With
-    ``metric="source"`` (the default) that measure is then read in the one metric it was taken
-    in: ``X`` solves ``K X = measure`` (`source_metric_laplacian`: the target's Laplacian in the
-    source's metric; the target's boundary kept, one vertex of each closed piece) and the
-    returned detail is ``measure + (L_t - K) X``: ``L_t X`` at every free vertex, so rebuilding
-    the target with its boundary fixed gives ``X``, near the retriangulated surface's own error,
-    and the total is kept (``sum_t D_t = sum_s D_s`` to rounding). ``metric="target"`` returns
-    the measure as carried, whose totals are kept over any union of target stars too; rebuilt
-    with the target's Laplacian, thin parts stretch by the inscribed target's perimeter deficit
-    (cow.off's tail: 2 %). A target equal to the source gets its own detail back either way (to
-    rounding). A given ``detail`` is put on the edges as the measure closest (least squares) to
-    the geometry's whose halves give it exactly: ``c'_e = c_e + 2 (mu_i + mu_j)`` with
-    ``Q mu = detail - D(Vs, Fs)``, ``Q`` the signless Laplacian of the edge graph (degree +
-    adjacency; positive definite on a mesh of triangles, well conditioned, so the correction stays
-    near the vertices it belongs to).
+    ``method="conservative"`` (the default): the source's detail as a measure, read in one
+    metric. The source's detail is the weak mean curvature normal ``integral of grad(phi) .
+    grad(x)`` over the source; on the target's hat functions ``phi_i`` lifted onto the source it is
+    ``D_i``, and their energy on the source is ``K`` (`source_metric`: both by quadrature on the
+    target's triangles, from the closest points on the source). ``X`` solves ``K X = D`` (the
+    target's boundary kept, one vertex of each closed piece) and the returned detail is
+    ``D + (L_t - K) X``: ``L_t X`` at every free vertex, so rebuilding the target with its boundary
+    fixed gives ``X``, the source's best approximation in the target's space, and the total is
+    kept (``sum_t D_t = sum_s D_s`` to rounding). A given ``detail`` adds what it differs by from the
+    geometry's, carried on the source's edges (below). ``metric="target"`` returns instead the
+    measure carried on the edges: the source's detail lives on its edges (`edge_curvature_measure`,
+    with ``D_i = 1/2 sum c_e`` exactly), each edge's measure is split evenly over sample points
+    along it, every sample is located in a target triangle and split over its three corners by
+    barycentric weights; totals are kept over any union of target stars, but rebuilt with the
+    target's Laplacian, thin parts stretch by the inscribed target's perimeter deficit (cow.off's
+    tail: 2 %), and the samples' map (source to target) is not the quadrature's (target to
+    source), which cuts folds (cow.off's horns). A target equal to the source gets its own detail
+    back either way (to rounding). A given ``detail`` is put on the edges as the measure closest
+    (least squares) to the geometry's whose halves give it exactly: ``c'_e = c_e + 2 (mu_i +
+    mu_j)`` with ``Q mu = detail - D(Vs, Fs)``, ``Q`` the signless Laplacian of the edge graph
+    (degree + adjacency; positive definite on a mesh of triangles, well conditioned, so the
+    correction stays near the vertices it belongs to).
 
     Location: ``"closest"`` = the closest point on the other surface in space (the meshes are
     two triangulations of one surface; a conservative sample whose closest target triangle
@@ -142,15 +144,15 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     uv : tuple (UVs (n_s, 2), UVt (n_t, 2)) or None
         Required for ``location="uv"``, refused with ``"closest"`` (it would not be used)
     samples_per_edge : int or None
-        Conservative only: samples per source edge, a whole number >= 1 (the total over all edges at
-        most 20,000,000, ~10 GB); ``None`` = enough that samples are at most half the target's mean
-        edge length apart
+        Where detail is carried on the edges (``metric="target"``, or a given ``detail``): samples
+        per source edge, a whole number >= 1 (the total over all edges at most 20,000,000, ~10 GB);
+        ``None`` = enough that samples are at most half the target's mean edge length apart
     detail : (n_s, 3) float array or None
         The source's detail to carry (pointwise: ``K`` = ``detail`` / the source's mixed Voronoi
         area); ``None`` = the detail of ``Vs, Fs``
     metric : {"source", "target"} or None
-        Conservative only: read the carried measure in the source's metric (``"source"``, the
-        default for ``None``) or take it as carried (``"target"``)
+        Conservative only: the detail and the rebuild in the source's metric (``"source"``, the
+        default for ``None``), or the measure carried on the edges (``"target"``)
 
     Returns
     -------
@@ -168,7 +170,8 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     ValueError
         Unknown method / location; ``uv`` missing, not a pair or of the wrong shape for ``"uv"``, or
         given with ``"closest"``; ``samples_per_edge`` not a whole number >= 1, too many samples, or
-        given with ``"pointwise"``; ``metric`` unknown or given with ``"pointwise"``
+        given with ``"pointwise"`` or where nothing is carried on the edges; ``metric`` unknown or
+        given with ``"pointwise"``
     ConstraintError
         (a ValueError) ``detail`` not a finite (n_s, 3) array
 
@@ -203,6 +206,10 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     check_retriangulation(Vs, Fs, Vt, Ft)
     if detail is not None:
         detail = as_values(detail, Vs.shape[0], "detail (the source's detail)")
+    elif samples_per_edge is not None and metric != "target":
+        raise CurvdetailError("samples_per_edge is used where detail is carried on the edges: with metric='target' "
+                              "or a given detail; drop it here (the source's own detail is integrated over the "
+                              "target's triangles).", parameter="samples_per_edge")
     if location == "uv":
         src_dom, tgt_dom = _check_uv(uv, Vs.shape[0], Vt.shape[0])
         names = ("uv[0] (UVs)", "uv[1] (UVt)")
@@ -221,9 +228,22 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
             K = detail / mixed_voronoi_area(Vs, Fs)[:, None]
         face, bary, _ = _locate(*check_points_and_mesh(tgt_dom, src_dom, Fs, names=(names[1], names[0], "Fs")))
         return interpolate(K, Fs, face, bary) * mixed_voronoi_area(Vt, Ft)[:, None]
+    if metric == "target":
+        return _on_edges(Vs, Fs, Vt, Ft, src_dom, tgt_dom, names, location, samples_per_edge, detail, whole=True)
+    K, D = _source_metric(Vs, Fs, Vt, Ft, *((src_dom, tgt_dom) if location == "uv" else (None, None)))
+    if detail is not None:              # what the given detail differs by, carried on the edges
+        D = D + _on_edges(Vs, Fs, Vt, Ft, src_dom, tgt_dom, names, location, samples_per_edge, detail, whole=False)
+    # = L_t X at every free vertex; the metric's difference added to D keeps its total
+    return D + (cotan_laplacian(Vt, Ft) - K) @ rebuilt_in_metric(K, D, Vt, Ft)
+
+
+def _on_edges(Vs, Fs, Vt, Ft, src_dom, tgt_dom, names, location, samples_per_edge, detail, whole):
+    """The source's detail carried to the target as a measure on the source's edges (``whole``:
+    the geometry's measure, made to fit ``detail`` where given), or only the part of the fitted
+    measure by which ``detail`` differs from the geometry's (``whole=False``)."""
     E, c, normal, inner = _edge_curvature_measure(Vs, Fs, normals=True)
     if detail is not None:
-        c = _carrying(E, c, detail)
+        c = c + _carrying(E, c, detail) if whole else _carrying(E, c, detail)
     q = _samples_per_edge(Vs, E, Vt, Ft, samples_per_edge)
     edge = np.repeat(np.arange(E.shape[0]), q)
     start = np.concatenate([[0], np.cumsum(q)[:-1]])
@@ -233,12 +253,7 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
     if location == "closest":
         own_side(pts, inner[edge], Vt, Ft, face, bary, dist)
         _facing_side(pts, normal[edge], Vt, Ft, face, bary, dist)
-    D = spread(c[edge] / q[edge, None], Ft, face, bary, Vt.shape[0])
-    if metric == "target":
-        return D
-    K = _source_metric_laplacian(Vs, Fs, Vt, Ft, *((src_dom, tgt_dom) if location == "uv" else (None, None)))
-    # = L_t X at every free vertex; the metric's difference added to the measure keeps its total
-    return D + (cotan_laplacian(Vt, Ft) - K) @ rebuilt_in_metric(K, D, Vt, Ft)
+    return spread(c[edge] / q[edge, None], Ft, face, bary, Vt.shape[0])
 
 
 #: Most samples `_facing_side` relocates one by one; more (a target wound against the
@@ -275,8 +290,8 @@ def _facing_side(P, normal, Vt, Ft, face, bary, dist):
 
 
 def _carrying(E, c, detail):
-    """Edge measure (k, 3) closest to ``c`` whose halves sum to ``detail`` (n, 3) at the vertices
-    of the edges ``E`` (k, 2): ``c + 2 (mu_i + mu_j)`` with ``Q mu = detail - halves of c``."""
+    """The least change (k, 3) of the edge measure ``c`` whose halves then sum to ``detail`` (n, 3)
+    at the vertices of the edges ``E`` (k, 2): ``2 (mu_i + mu_j)`` with ``Q mu = detail - halves of c``."""
     n = detail.shape[0]
     residual = detail.copy()
     for end in (0, 1):
@@ -288,7 +303,7 @@ def _carrying(E, c, detail):
     # x^T Q x = sum over edges (x_i + x_j)^2: zero only on a 2-colourable graph, never with triangles
     Q = (adjacency + adjacency.T + sp.diags(degree)).tocsc()
     mu = factorize(Q).solve(residual)
-    return c + 2.0 * (mu[E[:, 0]] + mu[E[:, 1]])
+    return 2.0 * (mu[E[:, 0]] + mu[E[:, 1]])
 
 
 def squashed_in_plane(UV, F, what, advice, error):
