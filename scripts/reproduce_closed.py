@@ -43,29 +43,27 @@ NOTES = """
 The reconstruction is exact given the target's own detail (rebuilt from `L Vt`, every model
 returns `Vt` to 1e-14 of the diagonal): the error is all in the transferred detail.
 
-- **The rebuild reads the carried detail in the source's metric** (`transfer_curvature`,
-  `source_metric_laplacian`). The conservative transfer measures the source's detail against the
-  target's hat functions lifted onto the source, which is the source's own bilinear form; rebuilt
-  with the target's Laplacian instead, the target being inscribed (its tube shorter round than the
-  source's), the detail's flux outweighs the target's by the perimeter deficit. That stretched
-  cow.off's tail by 2 % (1 %: RMS 1.69x, max 2.13x the floor at the tail's tip) and flattened
-  fine targets (0.5 %: mannequin_ear 1.83x, elephant_trunk 1.66x, camelhead 1.81x RMS). Solving
-  with the target's Laplacian in the source's metric brings them to the rows above; the measure
-  as carried is still `transfer_curvature(..., metric="target")`.
-- **cow.off** has two horn tips at one point (source vertices 621 and 2761) touching along a
-  seam from a vertex both fans share (620); the target keeps the pair. A sample on the seam is at
-  distance 0 from both horns and only its own triangles' side tells them apart
-  (`remesh.locate.own_side`); accepting a triangle that shares only the vertex 620 as the same
-  side sent half of each tip's detail to the other tip (1 %: max 0.48 %, 1.53x the floor's).
-- **cow.off at 0.5 %, max (over)**: the max sits on the same seam, on horn A's crest
-  (source triangle 736, between 620 and the tip), which the retriangulation cuts: target vertices
-  placed 0.003 below the crest. Sampled densely (400 points per source triangle) the floor's
-  own max there is 0.23 % (the table's seeded samples find 0.157 % elsewhere) and the rebuild's
-  0.35 %: the rebuild, a Galerkin (Ritz) projection of the source where the floor is an
-  interpolant, cuts the crest deeper. Its RMS is within target; it moves with the anchor (one
-  vertex pinned to its target position fixes the translation, and the flattest vertex is picked
-  among many nearly flat ones: rounding-level changes of the detail have moved it between 1.26x
-  and 1.35x).
+- **The transfer is one Galerkin method** (`transfer_curvature`, `source_metric`): the source's
+  detail on the target's hat functions lifted onto the source (its weak mean curvature normal),
+  rebuilt with the target's Laplacian in the source's metric, both integrated at the same 16
+  points of each target triangle. Each half of that removed a miss of an earlier transfer, which
+  carried the detail as a measure along the source's edges (`metric="target"`):
+  - rebuilt with the target's own Laplacian, that measure stretched thin parts, the target being
+    inscribed (its tubes shorter round than the source's): cow.off's tail by 2 % (1 %: RMS 1.69x,
+    max 2.13x the floor) and fine targets flattened (0.5 %: mannequin_ear 1.83x, elephant_trunk
+    1.66x, camelhead 1.81x RMS);
+  - rebuilt in the source's metric but integrated along the edges' own map (source to target,
+    where the metric's points go target to source), it cut a fin-like crest: cow.off's horn tips
+    touch along a seam from a vertex both horns share, and at 0.5 % the max sat on horn A's crest
+    there (1.69x; RMS 1.33x).
+- **cow.off's seam** also needs each edge sample kept on its own horn where the detail is carried
+  on the edges (a given detail, or `metric="target"`): a sample on the seam is at distance 0 from
+  both horns, and a triangle sharing only the seam's vertex with the stepped sample's is not taken
+  as the same side (`remesh.locate.own_side`).
+- **Anchors**: a closed piece's one anchor (its flattest vertex, pinned to its target position)
+  fixes the translation; it is picked among many nearly flat vertices, so small changes of the
+  detail can move it and the piece with it (the cow at 0.5 % read 1.26-1.35x RMS across
+  rounding-level changes of an earlier transfer).
 """
 
 
