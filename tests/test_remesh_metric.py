@@ -84,3 +84,15 @@ def test_rebuilding_from_the_transferred_detail_gives_the_metric_solution(load_m
     X = rebuilt_in_metric(*source_metric(V, F, Vt, Ft), Vt, Ft)
     D = transfer_curvature(V, F, Vt, Ft)
     assert np.abs(reconstruct(Vt, Ft, D, b, Vt[b], rows="free") - X).max() < 1e-9 * np.ptp(V, axis=0).max()
+
+
+def test_either_winding_gives_the_same_metric_and_detail(load_mesh):
+    # a target wound the other way once counted every point as facing away, and got back its own
+    # Laplacian and detail (now equal up to a few ties of the closest point: a point on a source
+    # edge may see either of its triangles)
+    V, F = load_mesh("mannequin_ear.obj")
+    Vt, Ft = retriangulate(V, F, target_edge="3%")
+    K, D = source_metric(V, F, Vt, Ft)
+    K2, D2 = source_metric(V, F, Vt, Ft[:, ::-1])
+    assert _relative(K2, K) < 1e-2 and _relative(D2, D) < 1e-2
+    assert _relative(D, cotan_laplacian(Vt, Ft) @ Vt) > 0.1                 # not the target's own

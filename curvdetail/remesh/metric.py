@@ -9,36 +9,40 @@ from ..curvature.topology import boundary_vertices, vertex_components
 from .closest_point import check_points_and_mesh
 from .locate import _locate
 
-#: Most quadrature points `source_metric` takes (k^2 per target triangle, k from 4 down to 1 where
-#: the target has more triangles than this allows): ~0.5 kB each while located.
+#: Quadrature points `source_metric` aims at most for: k^2 per target triangle, k = 4 or 5 or fewer
+#: where the target has more triangles than this allows (at least one each): ~0.5 kB each while
+#: located.
 MAX_METRIC_SAMPLES = 4_000_000
 
 #: A quadrature point whose source triangle turns more than 60 degrees from its target triangle
-#: (cos below this: the other sheet, or a fold) counts with the target's own metric.
+#: (cos below this: a fold, or another sheet facing away) counts with the target's own metric. A
+#: target piece wound against the source has its cosines turned first.
 FACING = 0.5
 
 
 def source_metric(Vs, Fs, Vt, Ft):
     """The target's Laplacian in the source's metric, and the source's detail on the target.
 
-    The target's hat functions ``phi_i`` are lifted onto the source by the closest point of each
-    target point on the source. On the source their Dirichlet energy is
+    Over each target triangle ``T`` the source is taken as a height field along ``T``'s normal, and
+    the target's hat functions ``phi_i`` are lifted onto it along that normal; which source triangle
+    lies over a quadrature point of ``T`` is found by the point's closest point on the source. On
+    the source the lifted functions' Dirichlet energy is
     ``K_ij = sum_T A_T grad(phi_i)^T M_T grad(phi_j)`` and the source's detail (the weak mean
     curvature normal, ``D = L V`` on the source's own hat functions) is
     ``D_i = integral over the source of grad(phi_i) . grad(x) = sum_T A_T M_T grad(phi_i)``, with
-    ``M_T`` the mean over quadrature points of target triangle ``T`` of ``P_s / c``: ``P_s = I -
-    n_s n_s^T`` the tangent projector of the source triangle at the point's closest point,
-    ``c = n_s . n_T`` (the source's area element is ``dA_T / c``, a lifted gradient ``P_s
-    grad(phi)``). Both come from the same points, so ``K X = D`` is one Galerkin method: the rebuilt
-    ``X`` is the source's best approximation in the target's space. Rebuilt with the target's own
-    Laplacian (``M_T = P_T``) instead, or with the detail integrated along another map, thin parts
-    stretch (the inscribed target's tubes are shorter round) and folds are cut.
+    ``M_T`` the mean over the quadrature points of ``P_s / c``: ``P_s = I - n_s n_s^T`` the
+    tangent projector of the source triangle over the point, ``c = n_s . n_T`` (the height field's
+    area element is ``dA_T / c``, a lifted gradient ``P_s grad(phi)``). Both come from the same
+    points, so ``K X = D`` is one Galerkin method: the rebuilt ``X`` is the height fields' best
+    approximation in the target's space. Rebuilt with the target's own Laplacian (``M_T = P_T``)
+    instead, thin parts stretch (the inscribed target's tubes are shorter round); with the detail
+    located another way than the points (source edges onto the target), folds are cut.
 
-    A target equal to the source gives its cotangent Laplacian and its detail (to rounding); a
+    A target piece wound against the source gives the same ``K`` and ``D`` as wound with it. A
+    target equal to the source gives its cotangent Laplacian and its detail (to rounding); a
     quadrature point whose source triangle turns more than 60 degrees from its target triangle
-    (another sheet, a fold) counts with the target's own metric there. Points: 16 per target
-    triangle, 25 where the source is finer than the target, fewer beyond
-    ``MAX_METRIC_SAMPLES``.
+    (a fold, another sheet facing away) counts with the target's own metric there. Points: 16 per target triangle, 25 where the source's mean edge is
+    under half the target's, fewer (at least one) beyond ``MAX_METRIC_SAMPLES``.
 
     Parameters
     ----------
@@ -96,6 +100,9 @@ def _source_metric(Vs, Fs, Vt, Ft, src_dom=None, tgt_dom=None):
     ns = np.cross(Vs[Fs[:, 1]] - Vs[Fs[:, 0]], Vs[Fs[:, 2]] - Vs[Fs[:, 0]])[face]
     ns /= np.linalg.norm(ns, axis=1, keepdims=True)
     c = np.einsum("ij,ij->i", ns, n[tri])
+    # a target piece wound against the source: its points' cosines turned, then read as the rest
+    piece = vertex_components(Ft, Vt.shape[0])[0][Ft[:, 0]][tri]
+    c *= np.where(np.bincount(piece, weights=c) < 0, -1.0, 1.0)[piece]
     away = c < FACING
     ns[away], c[away] = n[tri][away], 1.0
     # A_T M_T, M_T the mean of (I - n_s n_s^T) / c over the triangle's points (no (points, 3, 3) array)

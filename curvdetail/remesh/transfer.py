@@ -105,26 +105,27 @@ def transfer_curvature(Vs, Fs, Vt, Ft, *, method="conservative", location="close
 
     ``method="conservative"`` (the default): the source's detail as a measure, read in one
     metric. The source's detail is the weak mean curvature normal ``integral of grad(phi) .
-    grad(x)`` over the source; on the target's hat functions ``phi_i`` lifted onto the source it is
-    ``D_i``, and their energy on the source is ``K`` (`source_metric`: both by quadrature on the
-    target's triangles, from the closest points on the source). ``X`` solves ``K X = D`` (the
-    target's boundary kept, one vertex of each closed piece) and the returned detail is
-    ``D + (L_t - K) X``: ``L_t X`` at every free vertex, so rebuilding the target with its boundary
-    fixed gives ``X``, the source's best approximation in the target's space, and the total is
-    kept (``sum_t D_t = sum_s D_s`` to rounding). A given ``detail`` adds what it differs by from the
+    grad(x)`` over the source; on the target's hat functions ``phi_i`` lifted onto the source (a
+    height field over each target triangle) it is ``D_i``, and their energy on the source is ``K``
+    (`source_metric`: both by quadrature on the target's triangles, each point's source triangle
+    found by closest point). ``X`` solves ``K X = D`` (the target's boundary kept, one vertex of
+    each closed piece) and the returned detail is ``D + (L_t - K) X``: ``L_t X`` at every free
+    vertex, so rebuilding the target with its boundary fixed gives ``X``, and the total is kept
+    (``sum_t D_t = sum_s D_s`` to rounding). A given ``detail`` adds what it differs by from the
     geometry's, carried on the source's edges (below). ``metric="target"`` returns instead the
-    measure carried on the edges: the source's detail lives on its edges (`edge_curvature_measure`,
-    with ``D_i = 1/2 sum c_e`` exactly), each edge's measure is split evenly over sample points
-    along it, every sample is located in a target triangle and split over its three corners by
-    barycentric weights; totals are kept over any union of target stars, but rebuilt with the
-    target's Laplacian, thin parts stretch by the inscribed target's perimeter deficit (cow.off's
-    tail: 2 %), and the samples' map (source to target) is not the quadrature's (target to
-    source), which cuts folds (cow.off's horns). A target equal to the source gets its own detail
-    back either way (to rounding). A given ``detail`` is put on the edges as the measure closest
-    (least squares) to the geometry's whose halves give it exactly: ``c'_e = c_e + 2 (mu_i +
-    mu_j)`` with ``Q mu = detail - D(Vs, Fs)``, ``Q`` the signless Laplacian of the edge graph
-    (degree + adjacency; positive definite on a mesh of triangles, well conditioned, so the
-    correction stays near the vertices it belongs to).
+    measure carried on the edges: the source's detail lives on its edges
+    (`edge_curvature_measure`, with ``D_i = 1/2 sum c_e`` exactly), each edge's measure is split
+    evenly over sample points along it, every sample is located in a target triangle and split
+    over its three corners by barycentric weights; totals are kept over any union of target
+    stars, but rebuilt with the target's Laplacian, thin parts stretch by the inscribed target's
+    perimeter deficit (cow.off's tail: 2 %), and read in the source's metric, the samples (source
+    edges located on the target) and the quadrature points (the target's located on the source)
+    disagree on folds, which the rebuild then cuts (cow.off's horns). A target equal to the source
+    gets its own detail back either way (to rounding). A given ``detail`` is put on the edges as
+    the measure closest (least squares) to the geometry's whose halves give it exactly:
+    ``c'_e = c_e + 2 (mu_i + mu_j)`` with ``Q mu = detail - D(Vs, Fs)``, ``Q`` the signless
+    Laplacian of the edge graph (degree + adjacency; positive definite on a mesh of triangles,
+    well conditioned, so the correction stays near the vertices it belongs to).
 
     Location: ``"closest"`` = the closest point on the other surface in space (the meshes are
     two triangulations of one surface; a conservative sample whose closest target triangle
