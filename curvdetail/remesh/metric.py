@@ -3,9 +3,10 @@
 import numpy as np
 import scipy.sparse as sp
 
+from ..curvature.anchors import anchor_vertices
 from ..curvature.checks import checked_arrays
 from ..curvature.sparse_solver import factorize
-from ..curvature.topology import boundary_vertices, vertex_components
+from ..curvature.topology import vertex_components
 from .closest_point import check_points_and_mesh
 from .locate import _locate
 
@@ -129,14 +130,10 @@ def _subdivision_centroids(k):
 
 def rebuilt_in_metric(K, D, Vt, Ft):
     """Positions ``X`` with ``(K X)_i = D_i`` at every free vertex; kept where they are: the
-    target's boundary and one vertex of each closed piece (any: ``K`` annihilates translations,
-    so the rest is the same up to that piece's translation)."""
-    n = Vt.shape[0]
-    fixed = np.zeros(n, dtype=bool)
-    fixed[boundary_vertices(Ft)] = True
-    piece, count = vertex_components(Ft, n)
-    first = np.unique(piece, return_index=True)[1]          # a vertex of each piece
-    fixed[first[~np.isin(np.arange(count), piece[fixed])]] = True
+    target's boundary and one vertex of each closed piece (`anchor_vertices`; any would do: ``K``
+    annihilates translations, so the rest is the same up to that piece's translation)."""
+    fixed = np.zeros(Vt.shape[0], dtype=bool)
+    fixed[anchor_vertices(Vt, Ft, detail=D)] = True
     free = ~fixed
     X = Vt.copy()
     K = K.tocsr()
